@@ -1,0 +1,214 @@
+"""Build the paper's first-order model (Eqs. 8–9) from thermoelastic matrices::
+
+        [I  0   0  ]        [ 0      I      0    ]
+    A = [0  M   0  ],   B = [−K^uu  −C^uu  −K^uθ ],   X = [u, v, θ]
+        [0  0  C^θθ]        [ 0     −C^θu  −K^θθ ]
+
+Contact ``i`` has a normal row ``n_i`` on the displacement dofs (``u_n = n_i · u``, towards
+the casing) and a temperature dof receiving the frictional heat ``α_i λ_i``. Loads are
+``f^u s(t)`` and ``f^θ s(t)`` terms. With ``thermal="auto"`` the temperature dofs are kept
+only when something thermal is asked for (coupling, heat input or a heat load); otherwise
+they are dropped and ``info["dropped"]`` says why.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.sparse as sp
+
+from .model import Contact, EnergyForms, FirstOrderModel, Layout, LoadTerm
+from .thermoelastic import ThermoelasticMatrices
+
+__all__ = ["ContactSpec", "Load", "first_order_model"]
+
+
+@dataclass
+class ContactSpec:
+    """Contacts on the free dofs of a :class:`ThermoelasticMatrices`.
+
+    Parameters
+    ----------
+    normals : (n_c, n_u) array or sparse: row i gives the normal displacement of contact i,
+        positive towards the casing (closing the gap).
+    heat_dofs : (n_c,) free temperature dof receiving the frictional heat of contact i, or a
+        (n_c, n_θ) array distributing it.
+    gap : initial gap(s) (m), array or callable ``t -> (n_c,)``.
+    restitution : Newton's coefficient e in [0, 1].
+    heat_coefficient : α (m/s) in ``f_tip = α λ``; scalar, (n_c,) or callable of t.
+    """
+
+    normals: object
+    gap: object
+    heat_dofs: object = None
+    restitution: float = 0.0
+    heat_coefficient: object = 0.0
+    names: list | None = None
+
+
+@dataclass
+class Load:
+    """A load ``vector × signal(t)`` on the displacement (``field="u"``) or temperature dofs."""
+
+    vector: np.ndarray
+    signal: object
+    field: str = "u"
+    name: str = "load"
+
+
+def _rows(a, n_cols):
+    a = sp.csr_matrix(a) if sp.issparse(a) else sp.csr_matrix(np.atleast_2d(a))
+    if a.shape[1] != n_cols:
+        raise ValueError(f"contact normals must have {n_cols} columns, got {a.shape[1]}")
+    return a
+
+
+def first_order_model(
+    mats: ThermoelasticMatrices,
+    *,
+    contact: ContactSpec | None = None,
+    loads=(),
+    observe: dict | None = None,
+    thermal: str | bool = "auto",
+    x0=None,
+) -> FirstOrderModel:
+    """Assemble ``A``, ``B`` of Eq. (9) and the contact, load and energy data.
+
+    ``observe`` maps a signal name to ``(field, rows)`` with ``field`` in {"u", "v", "theta"}
+    and ``rows`` a (k, n_field) array/sparse matrix or an index array of free dofs.
+    """
+    nu, nt = mats.n_u, mats.n_t
+    heat_loads = [ld for ld in loads if ld.field == "theta"]
+    has_coupling = mats.Kut.count_nonzero() > 0 or mats.Ctu.count_nonzero() > 0
+    has_heat = contact is not None and (
+        callable(contact.heat_coefficient) or np.any(np.asarray(contact.heat_coefficient) > 0)
+    )
+    dropped = []
+    if thermal == "auto":
+        keep = bool(has_coupling or has_heat or heat_loads)
+        if not keep:
+            dropped.append("temperature dofs: no thermal coupling, heat input or heat load")
+    else:
+        keep = bool(thermal)
+        if not keep and (has_coupling or has_heat or heat_loads):
+            dropped.append("temperature dofs dropped on request: coupling and heat ignored")
+    if not keep:
+        nt = 0
+    L = Layout(nu, nu, nt)
+    I_u = sp.identity(nu, format="csr")
+    Z = lambda r, c: sp.csr_matrix((r, c))  # noqa: E731
+    A = sp.block_diag([I_u, mats.M] + ([mats.Ctt] if nt else []), format="csc")
+    if nt:
+        B = sp.bmat(
+            [
+                [Z(nu, nu), I_u, Z(nu, nt)],
+                [-mats.K, -mats.C, -mats.Kut],
+                [Z(nt, nu), -mats.Ctu, -mats.Ktt],
+            ],
+            format="csc",
+        )
+    else:
+        B = sp.bmat([[Z(nu, nu), I_u], [-mats.K, -mats.C]], format="csc")
+    n = L.n
+
+    def embed(block: str, vec) -> np.ndarray:
+        out = np.zeros(n)
+        out[getattr(L, block)] = np.asarray(vec, dtype=float).ravel()
+        return out
+
+    terms = []
+    for ld in loads:
+        if ld.field == "u":
+            vec = embed("v", ld.vector)
+            terms.append(LoadTerm(vec, ld.signal, power=vec.copy(), heat=0.0, name=ld.name))
+        elif ld.field == "theta":
+            if nt:
+                vec = embed("t", ld.vector)
+                total = float(np.sum(ld.vector))
+                terms.append(LoadTerm(vec, ld.signal, power=np.zeros(n), heat=total, name=ld.name))
+        else:
+            raise ValueError(f"load field must be 'u' or 'theta', got {ld.field!r}")
+
+    con = None
+    if contact is not None:
+        N = _rows(contact.normals, nu)
+        nc = N.shape[0]
+        G = np.zeros((n, nc))
+        G[L.u] = -N.T.toarray()
+        Gv = np.zeros((n, nc))
+        Gv[L.v] = -N.T.toarray()
+        Ht = np.zeros((n, nc))
+        if nt and contact.heat_dofs is not None:
+            hd = np.asarray(contact.heat_dofs)
+            if hd.ndim == 1:
+                Ht[L.t.start + hd.astype(int), np.arange(nc)] = 1.0
+            else:
+                Ht[L.t] = hd.T
+        con = Contact(
+            G=G,
+            Gv=Gv,
+            Hm=Gv.copy(),
+            Ht=Ht,
+            gap0=contact.gap,
+            restitution=contact.restitution,
+            heat_coefficient=contact.heat_coefficient if nt else 0.0,
+            names=list(contact.names or []),
+        )
+
+    observations = {}
+    for name, (fld, rows) in (observe or {}).items():
+        block = {"u": "u", "v": "v", "theta": "t"}[fld]
+        size = getattr(L, {"u": "n_u", "v": "n_v", "t": "n_t"}[block])
+        if size == 0:
+            continue
+        r = np.asarray(rows) if not sp.issparse(rows) else rows
+        if not sp.issparse(r) and r.ndim == 1:
+            r = sp.csr_matrix((np.ones(r.size), (np.arange(r.size), r)), shape=(r.size, size))
+        r = sp.csr_matrix(r)
+        blk = getattr(L, block)
+        full = sp.hstack(
+            [Z(r.shape[0], blk.start), r, Z(r.shape[0], n - blk.stop)], format="csr"
+        )
+        observations[name] = full
+
+    Zn = lambda: sp.csr_matrix((n, n))  # noqa: E731
+    Qk = sp.block_diag([Z(nu, nu), mats.M] + ([Z(nt, nt)] if nt else []), format="csr")
+    Qe = sp.block_diag([mats.K, Z(nu, nu)] + ([Z(nt, nt)] if nt else []), format="csr")
+    Pd = sp.block_diag([Z(nu, nu), -mats.C] + ([Z(nt, nt)] if nt else []), format="csr")
+    Pth = Zn()
+    heat_content = np.zeros(n)
+    heat_outflow = np.zeros(n)
+    if nt:
+        Pth = sp.bmat(
+            [[Z(nu, nu), Z(nu, nu), Z(nu, nt)], [Z(nu, nu), Z(nu, nu), -mats.Kut], [None, None, Z(nt, nt)]],
+            format="csr",
+        )
+        ones = np.ones(nt)
+        heat_content[L.t] = mats.Ctt.T @ ones
+        heat_outflow[L.v] = mats.Ctu.T @ ones
+        heat_outflow[L.t] = mats.Ktt.T @ ones
+    energy = EnergyForms(Qk, Qe, Pth, Pd, heat_content, heat_outflow)
+
+    Pu = mats.prolongation_u()
+    blocks = [Pu, Pu] + ([mats.prolongation_t()] if nt else [])
+    to_full = sp.block_diag(blocks, format="csr")
+    info = {
+        "n_u": nu,
+        "n_theta": nt,
+        "thermal": bool(nt),
+        "coupling": mats.info.get("coupling"),
+        "dropped": dropped,
+    }
+    return FirstOrderModel(
+        A=A,
+        B=B,
+        layout=L,
+        loads=terms,
+        contact=con,
+        observations=observations,
+        energy=energy,
+        to_full=to_full,
+        x0=x0,
+        info=info,
+    )

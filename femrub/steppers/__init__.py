@@ -1,0 +1,31 @@
+"""Time steppers for first-order models with unilateral contact."""
+
+from .base import NumericalInstability, State, Stepper, check_step
+from .carpenter import Carpenter
+from .theta_method import ACTIVATION_RULES, ThetaMethod
+
+SCHEMES = {"theta": ThetaMethod, "carpenter": Carpenter}
+
+
+def make_stepper(scheme: str, model, h, **options) -> Stepper:
+    """Stepper by name: ``"theta"`` (paper Sec. 3) or ``"carpenter"``."""
+    try:
+        cls = SCHEMES[scheme]
+    except KeyError:
+        raise ValueError(
+            f"unknown scheme {scheme!r}; use one of {', '.join(SCHEMES)}"
+        ) from None
+    return cls(model, h, **options)
+
+
+__all__ = [
+    "ACTIVATION_RULES",
+    "Carpenter",
+    "NumericalInstability",
+    "SCHEMES",
+    "State",
+    "Stepper",
+    "ThetaMethod",
+    "check_step",
+    "make_stepper",
+]

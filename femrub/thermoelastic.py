@@ -1,0 +1,198 @@
+"""Assembly of the coupled thermoelastic matrices of the paper's Eq. (2), for any mesh.
+
+:func:`assemble_thermoelastic` takes a displacement basis (vector element) and a temperature
+basis (scalar element) on the same mesh and returns :class:`ThermoelasticMatrices`::
+
+    M ü + C^uu u̇ + K^uu u + K^uθ θ = f^u + f_contact          (2a)
+    C^θθ θ̇ + C^θu u̇ + K^θθ θ     = f^θ + f_tip                (2b)
+
+with Dirichlet dofs (clamped root, root held at ambient temperature) removed. The 1D bar of
+the paper and a 3D blade go through this same function; only the bases differ.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+import scipy.sparse as sp
+from skfem import Basis
+
+from . import forms
+from .lumping import lump
+from .material import Material, check_finite_positive
+
+__all__ = ["ThermoelasticMatrices", "assemble_thermoelastic", "COUPLINGS"]
+
+COUPLINGS = ("none", "physical", "paper")
+
+
+@dataclass
+class ThermoelasticMatrices:
+    """Matrices of Eq. (2) on the free dofs, plus what is needed to map back to the mesh.
+
+    ``free_u`` / ``free_t`` index the free dofs in the bases' full numbering; ``n_u_all`` /
+    ``n_t_all`` are the full sizes. ``Kut`` is ``K^uθ`` (n_u × n_θ), ``Ctu`` is ``C^θu``
+    (n_θ × n_u).
+    """
+
+    M: sp.csr_matrix
+    C: sp.csr_matrix
+    K: sp.csr_matrix
+    Kut: sp.csr_matrix
+    Ctu: sp.csr_matrix
+    Ctt: sp.csr_matrix
+    Ktt: sp.csr_matrix
+    free_u: np.ndarray
+    free_t: np.ndarray
+    n_u_all: int
+    n_t_all: int
+    basis_u: Basis | None = None
+    basis_t: Basis | None = None
+    info: dict = field(default_factory=dict)
+
+    @property
+    def n_u(self) -> int:
+        return self.M.shape[0]
+
+    @property
+    def n_t(self) -> int:
+        return self.Ctt.shape[0]
+
+    def u_index(self, full_dofs) -> np.ndarray:
+        """Positions in the free numbering of displacement dofs given in full numbering."""
+        return _positions(self.free_u, self.n_u_all, full_dofs, "displacement")
+
+    def t_index(self, full_dofs) -> np.ndarray:
+        """Positions in the free numbering of temperature dofs given in full numbering."""
+        return _positions(self.free_t, self.n_t_all, full_dofs, "temperature")
+
+    def prolongation_u(self) -> sp.csr_matrix:
+        """Sparse map from free displacement dofs to all dofs (zeros on Dirichlet dofs)."""
+        return _prolongation(self.free_u, self.n_u_all)
+
+    def prolongation_t(self) -> sp.csr_matrix:
+        """Sparse map from free temperature dofs to all dofs."""
+        return _prolongation(self.free_t, self.n_t_all)
+
+
+def _positions(free: np.ndarray, n_all: int, full_dofs, what: str) -> np.ndarray:
+    lookup = np.full(n_all, -1)
+    lookup[free] = np.arange(free.size)
+    pos = lookup[np.atleast_1d(np.asarray(full_dofs, dtype=int))]
+    if np.any(pos < 0):
+        raise ValueError(f"a {what} dof asked for is fixed by a Dirichlet condition")
+    return pos
+
+
+def _prolongation(free: np.ndarray, n_all: int) -> sp.csr_matrix:
+    ones = np.ones(free.size)
+    return sp.csr_matrix((ones, (free, np.arange(free.size))), shape=(n_all, free.size))
+
+
+def _free(n: int, fixed) -> np.ndarray:
+    mask = np.ones(n, dtype=bool)
+    if fixed is not None:
+        mask[np.asarray(fixed, dtype=int)] = False
+    return np.flatnonzero(mask)
+
+
+def assemble_thermoelastic(
+    basis_u: Basis,
+    basis_t: Basis,
+    material: Material,
+    *,
+    area: float = 1.0,
+    lumping: str = "row-sum",
+    heat_lumping: str | None = None,
+    coupling: str = "physical",
+    beta: float | None = None,
+    strain_heating: bool = False,
+    rayleigh: tuple[float, float] = (0.0, 0.0),
+    fixed_u=None,
+    fixed_t=None,
+) -> ThermoelasticMatrices:
+    """Assemble M, C^uu, K^uu, K^uθ, C^θu, C^θθ, K^θθ (paper Eq. 2) and apply Dirichlet dofs.
+
+    Parameters
+    ----------
+    basis_u, basis_t
+        Displacement basis (``ElementVector`` of a Lagrange element) and temperature basis
+        (scalar Lagrange element) on the same mesh.
+    material
+        :class:`~femrub.material.Material`.
+    area
+        Cross-section (m²) for a 1D bar; 1 for 2D/3D solids.
+    lumping
+        Mass lumping: ``"consistent"``, ``"row-sum"`` (P1) or ``"hrz"`` (P2, required to keep
+        masses positive); ``heat_lumping`` defaults to ``lumping`` (scalar field).
+    coupling
+        ``"none"`` (K^uθ = 0), ``"physical"`` (K^uθ = −∫ b θ div v, b = (dλ + 2μ) α_th) or
+        ``"paper"`` (K^uθ = β K^uu, the paper's Sec. 4.1 model, which needs u and θ on the
+        same scalar dofs).
+    beta
+        Paper coupling coefficient β (m/K); required with ``coupling="paper"``.
+    strain_heating
+        Include C^θu = −T0 (K^uθ)^T (thermoelastic heating); the paper omits it.
+    rayleigh
+        ``(a, b)`` Rayleigh damping ``C^uu = a M + b K^uu``.
+    fixed_u, fixed_t
+        Dirichlet dofs (full numbering of each basis), held at zero.
+    """
+    if coupling not in COUPLINGS:
+        raise ValueError(f"unknown coupling {coupling!r}; use one of {', '.join(COUPLINGS)}")
+    area = check_finite_positive("area", area)
+    dim = basis_u.mesh.dim()
+    lam, mu = forms.lame_parameters(material.young, material.poisson, dim)
+    n_comp = basis_u.elem.dim if hasattr(basis_u.elem, "dim") else 1
+
+    M = lump(forms.mass.assemble(basis_u, rho=material.rho, area=area), lumping, n_comp)
+    K = forms.stiffness.assemble(basis_u, lam=lam, mu=mu, area=area)
+    Ctt = forms.heat_capacity.assemble(basis_t, rho_c=material.rho_c, area=area)
+    Ctt = lump(Ctt, heat_lumping or lumping, 1)
+    Ktt = forms.conductivity.assemble(basis_t, k=material.conductivity, area=area)
+
+    b = (dim * lam + 2.0 * mu) * material.expansion
+    if coupling == "physical":
+        Kut = forms.thermal_stress.assemble(basis_t, basis_u, b=b, area=area)
+    elif coupling == "paper":
+        if beta is None or not np.isfinite(beta):
+            raise ValueError("coupling='paper' needs a finite beta (m/K), e.g. beta=-4.5e-7")
+        if K.shape[0] != Ktt.shape[0]:
+            raise ValueError("coupling='paper' needs u and θ on the same dofs; use 'physical'")
+        Kut = beta * K
+    else:
+        Kut = sp.csr_matrix((basis_u.N, basis_t.N))
+    if strain_heating:
+        if coupling == "paper":
+            Ctu = -material.reference_temperature * Kut.T
+        else:
+            Ctu = forms.strain_heating.assemble(
+                basis_u, basis_t, T0=material.reference_temperature, b=b, area=area
+            )
+    else:
+        Ctu = sp.csr_matrix((basis_t.N, basis_u.N))
+    a_r, b_r = (float(x) for x in rayleigh)
+    C = a_r * M + b_r * K
+
+    fu, ft = _free(basis_u.N, fixed_u), _free(basis_t.N, fixed_t)
+
+    def sub(A, rows, cols):
+        return sp.csr_matrix(A)[rows][:, cols].tocsr()
+
+    return ThermoelasticMatrices(
+        M=sub(M, fu, fu),
+        C=sub(sp.csr_matrix(C), fu, fu),
+        K=sub(K, fu, fu),
+        Kut=sub(Kut, fu, ft),
+        Ctu=sub(Ctu, ft, fu),
+        Ctt=sub(Ctt, ft, ft),
+        Ktt=sub(Ktt, ft, ft),
+        free_u=fu,
+        free_t=ft,
+        n_u_all=basis_u.N,
+        n_t_all=basis_t.N,
+        basis_u=basis_u,
+        basis_t=basis_t,
+        info={"dim": dim, "lumping": lumping, "coupling": coupling, "area": area, "beta": beta},
+    )
