@@ -65,7 +65,9 @@ class BarCase:
             if not math.isfinite(v):
                 raise ValueError(f"{name} must be finite, got {v!r}")
         if self.alpha < 0:
-            raise ValueError(f"alpha must be >= 0 (frictional heat is never negative), got {self.alpha}")
+            raise ValueError(
+                f"alpha must be >= 0 (frictional heat is never negative), got {self.alpha}"
+            )
         if not (isinstance(self.n_elements, int) and self.n_elements >= 1):
             raise ValueError(f"n_elements must be a positive integer, got {self.n_elements!r}")
         if not (0.0 <= float(self.restitution) <= 1.0):
@@ -154,7 +156,9 @@ def bar_model(case: BarCase = PAPER, **changes) -> FirstOrderModel:
     }
     x0 = None
     n_t = mats.n_t
-    model = first_order_model(mats, contact=contact, loads=loads, observe=observe, thermal=case.thermal)
+    model = first_order_model(
+        mats, contact=contact, loads=loads, observe=observe, thermal=case.thermal
+    )
     if case.initial_velocity:
         x0 = np.zeros(model.n_dofs)
         x0[model.layout.v] = case.initial_velocity

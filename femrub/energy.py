@@ -18,88 +18,104 @@ from __future__ import annotations
 
 import numpy as np
 
-from .model import FirstOrderModel
+from .linalg import compact
+from .model import EnergyForms, FirstOrderModel
 from .results import ENERGY_KEYS
 
 __all__ = ["EnergyMeter"]
 
+_WORKS = ("external_work", "thermal_work", "damping_work", "contact_work")
+_HEATS = ("friction_heat", "heat_load", "heat_outflow")
+
 
 class EnergyMeter:
-    """Accumulates the energy balance step by step (see module docstring)."""
+    """Accumulates the energy balance over blocks of steps (see module docstring).
+
+    ``update(i0, X, impulse, t, h, alpha)`` takes the states ``X[0..m]`` at times ``t[0..m]``
+    (``X[0]`` already recorded as row ``i0``) and the impulses of the ``m`` steps, and fills
+    rows ``i0 + 1 .. i0 + m`` with vectorised increments.
+    """
 
     def __init__(self, model: FirstOrderModel, capacity: int):
         self.model = model
-        self.forms = model.energy
-        self.data = {k: np.zeros(capacity) for k in ENERGY_KEYS}
-        self._acc = dict.fromkeys(ENERGY_KEYS, 0.0)
-        self._powers = [term.power for term in model.loads]
+        f = model.energy
+        self.forms = EnergyForms(
+            *(compact(q) for q in (f.Qk, f.Qe, f.Pth, f.Pd)), f.heat_content, f.heat_outflow
+        )
+        self._signals = [term.signal for term in model.loads]
+        self._powers = (
+            np.column_stack([term.power for term in model.loads]) if model.loads else None
+        )
         self._heats = np.array([term.heat for term in model.loads])
+        c = model.contact
+        self._GvT = None if c is None else np.ascontiguousarray(c.Gv.T)
+        self.data = {k: np.zeros(capacity) for k in ENERGY_KEYS}
         self._E0 = self._Q0 = 0.0
         self.scale = 0.0
         self.heat_scale = 0.0
 
-    def _mech(self, X):
-        f = self.forms
-        return 0.5 * X @ (f.Qk @ X), 0.5 * X @ (f.Qe @ X)
+    @staticmethod
+    def _quad(Q, X):
+        """Row-wise ``x_iᵀ Q x_i`` for the rows ``x_i`` of ``X``."""
+        QX = X @ Q.T if isinstance(Q, np.ndarray) else (Q @ X.T).T  # X @ Q.T: fast BLAS path
+        return np.einsum("ij,ij->i", X, np.asarray(QX))
 
     def start(self, X0: np.ndarray) -> None:
-        kin, ela = self._mech(X0)
-        self._E0 = kin + ela
-        self._Q0 = float(self.forms.heat_content @ X0)
-        self._acc.update(kinetic=kin, elastic=ela, heat_content=self._Q0)
-        self.scale = abs(self._E0)
-        self.heat_scale = abs(self._Q0)
-        self.record(0)
+        f, d = self.forms, self.data
+        X = X0[None, :]
+        d["kinetic"][0] = 0.5 * self._quad(f.Qk, X)[0]
+        d["elastic"][0] = 0.5 * self._quad(f.Qe, X)[0]
+        d["heat_content"][0] = float(f.heat_content @ X0)
+        self._E0 = d["kinetic"][0] + d["elastic"][0]
+        self._Q0 = d["heat_content"][0]
+        self.scale, self.heat_scale = abs(self._E0), abs(self._Q0)
 
-    def record(self, i: int) -> None:
-        for k, v in self._acc.items():
-            self.data[k][i] = v
+    def update(self, i0, X, impulse, t, h, alpha) -> None:
+        """Fill rows ``i0 + 1 .. i0 + m`` from a block of states (see class docstring)."""
+        f, d = self.forms, self.data
+        m = X.shape[0] - 1
+        rows = slice(i0 + 1, i0 + 1 + m)
+        Xm = 0.5 * (X[1:] + X[:-1])
+        inc = {}
+        if self._powers is not None:
+            S = np.array([[float(sig(tt)) for sig in self._signals] for tt in t])
+            Sbar = 0.5 * (S[1:] + S[:-1])
+            inc["external_work"] = h * np.einsum("ij,ij->i", Sbar, Xm @ self._powers)
+            inc["heat_load"] = h * (Sbar @ self._heats)
+        inc["thermal_work"] = h * self._quad(f.Pth, Xm)
+        inc["damping_work"] = h * self._quad(f.Pd, Xm)
+        if self._GvT is not None:
+            dwc = np.einsum("ij,ij->i", impulse, Xm @ self._GvT.T)
+            inc["contact_work"] = dwc
+            inc["impact_dissipation"] = -dwc
+            inc["friction_heat"] = np.einsum("ij,ij->i", alpha, impulse)
+        inc["heat_outflow"] = h * (Xm @ f.heat_outflow)
+        for k, v in inc.items():
+            d[k][rows] = d[k][i0] + np.cumsum(v)
+        d["kinetic"][rows] = 0.5 * self._quad(f.Qk, X[1:])
+        d["elastic"][rows] = 0.5 * self._quad(f.Qe, X[1:])
+        d["heat_content"][rows] = X[1:] @ f.heat_content
+        works = sum(d[k][rows] for k in _WORKS)
+        d["energy_error"][rows] = d["kinetic"][rows] + d["elastic"][rows] - self._E0 - works
+        heats = d["friction_heat"][rows] + d["heat_load"][rows] - d["heat_outflow"][rows]
+        d["heat_error"][rows] = d["heat_content"][rows] - self._Q0 - heats
+        mech = np.max([np.abs(d[k][rows]) for k in _WORKS], axis=0)
+        heat = np.max([np.abs(d[k][rows]) for k in _HEATS], axis=0)
+        self._scale_rows = np.maximum.accumulate(np.maximum(mech, self.scale))
+        self._heat_rows = np.maximum.accumulate(np.maximum(heat, self.heat_scale))
+        self.scale, self.heat_scale = self._scale_rows[-1], self._heat_rows[-1]
 
-    def update(self, i, Xk, Xk1, impulse, tk, tk1, h, alpha, gap_velocity_mid) -> None:
-        """Add the increments of step ``i − 1 → i`` and store row ``i``."""
-        f, a = self.forms, self._acc
-        Xm = 0.5 * (Xk + Xk1)
-        if self._powers:
-            s = np.array([0.5 * (t.signal(tk) + t.signal(tk1)) for t in self.model.loads])
-            a["external_work"] += h * float(sum(si * (p @ Xm) for si, p in zip(s, self._powers)))
-            a["heat_load"] += h * float(s @ self._heats)
-        a["thermal_work"] += h * float(Xm @ (f.Pth @ Xm))
-        a["damping_work"] += h * float(Xm @ (f.Pd @ Xm))
-        if impulse.size:
-            dwc = float(impulse @ gap_velocity_mid)
-            a["contact_work"] += dwc
-            a["impact_dissipation"] -= dwc
-            a["friction_heat"] += float(alpha @ impulse)
-        a["heat_outflow"] += h * float(f.heat_outflow @ Xm)
-        kin, ela = self._mech(Xk1)
-        a["kinetic"], a["elastic"] = kin, ela
-        a["heat_content"] = float(f.heat_content @ Xk1)
-        works = a["external_work"] + a["thermal_work"] + a["damping_work"] + a["contact_work"]
-        a["energy_error"] = kin + ela - self._E0 - works
-        heats = a["friction_heat"] + a["heat_load"] - a["heat_outflow"]
-        a["heat_error"] = a["heat_content"] - self._Q0 - heats
-        self.scale = max(
-            self.scale,
-            abs(a["external_work"]),
-            abs(a["thermal_work"]),
-            abs(a["damping_work"]),
-            abs(a["contact_work"]),
-        )
-        self.heat_scale = max(
-            self.heat_scale, abs(a["friction_heat"]), abs(a["heat_load"]), abs(a["heat_outflow"])
-        )
-        self.record(i)
-
-    def blown_up(self, factor: float = 1e3) -> bool:
-        """True when a balance residual dwarfs the energy put in or taken out (numerics).
+    def blown_up(self, rows: slice, factor: float = 1e3) -> int | None:
+        """First row in ``rows`` where a balance residual dwarfs the energy put in or taken out.
 
         A physical runaway is fed by the thermal work and keeps the balance closed; a
         numerical instability creates energy from nothing and opens it.
         """
-        a = self._acc
-        mech = abs(a["energy_error"]) > factor * max(self.scale, 1e-30)
-        heat = abs(a["heat_error"]) > factor * max(self.heat_scale, 1e-30)
-        return bool(mech or heat)
+        d = self.data
+        bad = (np.abs(d["energy_error"][rows]) > factor * np.maximum(self._scale_rows, 1e-30)) | (
+            np.abs(d["heat_error"][rows]) > factor * np.maximum(self._heat_rows, 1e-30)
+        )
+        return rows.start + int(np.argmax(bad)) if bad.any() else None
 
     def arrays(self, n: int) -> dict[str, np.ndarray]:
         return {k: v[:n].copy() for k, v in self.data.items()}

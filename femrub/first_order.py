@@ -167,9 +167,7 @@ def first_order_model(
             r = sp.csr_matrix((np.ones(r.size), (np.arange(r.size), r)), shape=(r.size, size))
         r = sp.csr_matrix(r)
         blk = getattr(L, block)
-        full = sp.hstack(
-            [Z(r.shape[0], blk.start), r, Z(r.shape[0], n - blk.stop)], format="csr"
-        )
+        full = sp.hstack([Z(r.shape[0], blk.start), r, Z(r.shape[0], n - blk.stop)], format="csr")
         observations[name] = full
 
     Zn = lambda: sp.csr_matrix((n, n))  # noqa: E731
@@ -181,7 +179,11 @@ def first_order_model(
     heat_outflow = np.zeros(n)
     if nt:
         Pth = sp.bmat(
-            [[Z(nu, nu), Z(nu, nu), Z(nu, nt)], [Z(nu, nu), Z(nu, nu), -mats.Kut], [None, None, Z(nt, nt)]],
+            [
+                [Z(nu, nu), Z(nu, nu), Z(nu, nt)],
+                [Z(nu, nu), Z(nu, nu), -mats.Kut],
+                [None, None, Z(nt, nt)],
+            ],
             format="csr",
         )
         ones = np.ones(nt)

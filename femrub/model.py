@@ -100,7 +100,8 @@ class Contact:
 
     def __post_init__(self):
         self.G, self.Gv, self.Hm, self.Ht = (
-            np.atleast_2d(np.asarray(a, dtype=float).T).T for a in (self.G, self.Gv, self.Hm, self.Ht)
+            np.atleast_2d(np.asarray(a, dtype=float).T).T
+            for a in (self.G, self.Gv, self.Hm, self.Ht)
         )
         e = float(self.restitution)
         if not (0.0 <= e <= 1.0):

@@ -12,9 +12,7 @@ def make_stepper(scheme: str, model, h, **options) -> Stepper:
     try:
         cls = SCHEMES[scheme]
     except KeyError:
-        raise ValueError(
-            f"unknown scheme {scheme!r}; use one of {', '.join(SCHEMES)}"
-        ) from None
+        raise ValueError(f"unknown scheme {scheme!r}; use one of {', '.join(SCHEMES)}") from None
     return cls(model, h, **options)
 
 

@@ -12,12 +12,16 @@ from __future__ import annotations
 
 import math
 import time
+from contextlib import nullcontext
 from dataclasses import dataclass
 
 import numpy as np
+import scipy.sparse as sp
+from threadpoolctl import threadpool_limits
 from tqdm.auto import tqdm
 
 from ..energy import EnergyMeter
+from ..linalg import compact
 from ..model import FirstOrderModel
 from ..results import Results
 
@@ -96,12 +100,15 @@ class Stepper:
         gap, gdot = self._contact_state(self.t, self.X)
         return State(self.k, self.t, self.X, self.impulse, gap, gdot)
 
-    def step(self) -> State:
-        """Advance one step of size ``h`` and return the new :class:`State`."""
+    def _advance(self) -> None:
         X, impulse = self._step()
         self.k += 1
         self.t = self.t0 + self.k * self.h
         self.X, self.impulse = X, impulse
+
+    def step(self) -> State:
+        """Advance one step of size ``h`` and return the new :class:`State`."""
+        self._advance()
         return self.state
 
     def iterate(self, t_end: float):
@@ -140,77 +147,115 @@ class Stepper:
         check_step(self.h, t_end)
         model, h = self.model, self.h
         n = int(round((t_end - self.t) / h))
+        N, nc, c = model.n_dofs, model.n_contacts, model.contact
         names = list(model.observations)
-        O = [model.observations[k] for k in names]
-        sizes = [o.shape[0] for o in O]
+        sizes = [model.observations[k].shape[0] for k in names]
+        O = compact(sp.vstack([model.observations[k] for k in names])) if names else None
         obs = np.zeros((n + 1, sum(sizes)))
-        nc = model.n_contacts
-        gap, imp = np.zeros((n + 1, nc)), np.zeros((n + 1, nc))
-        t = np.zeros(n + 1)
+        gap, imp, t = np.zeros((n + 1, nc)), np.zeros((n + 1, nc)), np.zeros(n + 1)
+        alpha = np.zeros((n + 1, nc))
         meter = EnergyMeter(model, n + 1) if (energy and model.energy is not None) else None
+        lim_idx = _limit_index(limits or {}, names, sizes)
         states, stimes = [], []
-        limits = dict(limits or {})
-        lim_idx = _limit_index(limits, names, sizes)
         status, message = "ok", ""
         h_lim = self.stability_limit()
         if h > h_lim:
             status = "unstable"
             message = f"h = {h:.3g} s exceeds the stability limit {h_lim:.3g} s of {self.name}"
+        chunk = int(max(1, min(512, 2_000_000 // max(N, 1))))
+        buf = np.empty((chunk + 1, N))
+        GT = None if c is None else np.ascontiguousarray(c.G.T)
 
-        def record(i, st):
-            t[i] = st.t
-            obs[i] = np.concatenate([np.asarray(o @ st.X).ravel() for o in O]) if O else []
+        def flush(i0, m):
+            """Post-process rows i0+1..i0+m from the buffer; return the last valid row."""
+            rows = slice(i0 + 1, i0 + 1 + m)
+            X = buf[: m + 1]
+            ok = np.all(np.isfinite(X[1:]), axis=1)
+            last = i0 + m if ok.all() else i0 + int(np.argmin(ok))
+            if last < i0 + m:
+                m, rows, X = last - i0, slice(i0 + 1, last + 1), X[: last - i0 + 1]
+            if O is not None:
+                obs[rows] = X[1:] @ O.T if isinstance(O, np.ndarray) else (O @ X[1:].T).T
             if nc:
-                gap[i], imp[i] = st.gap, st.impulse
-            if store_every and i % store_every == 0:
-                states.append(st.X.copy())
-                stimes.append(st.t)
+                g0 = np.array([c.gap_at(tt) for tt in t[rows]])
+                gap[rows] = g0 + X[1:] @ GT.T
+                alpha[rows] = np.array([c.alpha_at(tt) for tt in t[rows]])
+            if meter is not None and m:
+                with np.errstate(all="ignore"):
+                    meter.update(i0, X, imp[rows], t[i0 : rows.stop], h, alpha[rows])
+                bad = meter.blown_up(rows)
+                if bad is not None:
+                    raise _Stop(
+                        "unstable", f"energy created from nothing at t = {t[bad]:.6g} s", bad
+                    )
+            if last < rows.stop - 1 or not ok.all():
+                raise _Stop("unstable", f"non-finite state at t = {t[last + 1]:.6g} s", last)
+            hit = _limit_hit(limits or {}, lim_idx, obs[rows], imp[rows] / h)
+            if hit is not None:
+                j, what = hit
+                raise _Stop(
+                    "diverged-physically", f"{what} at t = {t[i0 + 1 + j]:.6g} s", i0 + 1 + j
+                )
+            if store_every:
+                for r in range(rows.start, rows.stop):
+                    if r % store_every == 0:
+                        states.append(buf[r - i0].copy())
+                        stimes.append(t[r])
+            return rows.stop - 1
 
         start = time.process_time()
-        i = 0
+        # small models: one BLAS thread (threads only add overhead on tiny mat-vecs)
+        blas = threadpool_limits(limits=1, user_api="blas") if N < 2000 else nullcontext()
+        blas.__enter__()
         bar = tqdm(total=n, disable=not progress, unit="step", desc=label or self.name, leave=False)
+        i_end = 0
         try:
-            st = self.state
-            record(0, st)
+            t[0], buf[0] = self.t, self.X
+            if nc:
+                gap[0], imp[0] = self.state.gap, self.impulse
+                alpha[0] = c.alpha_at(self.t)
+            if O is not None:
+                obs[0] = O @ self.X
             if meter is not None:
-                meter.start(st.X)
+                meter.start(self.X)
+            if store_every:
+                states.append(self.X.copy())
+                stimes.append(self.t)
+            i0, j = 0, 0
             for i in range(1, n + 1):
-                Xk, tk = self.X, self.t
-                st = self.step()
-                if not np.all(np.isfinite(st.X)):
-                    raise NumericalInstability(f"non-finite state at t = {st.t:.6g} s")
-                record(i, st)
-                if meter is not None:
-                    c = model.contact
-                    gm = c.Gv.T @ (0.5 * (Xk + st.X)) if nc else np.zeros(0)
-                    alpha = c.alpha_at(st.t) if nc else np.zeros(0)
-                    meter.update(i, Xk, st.X, st.impulse, tk, st.t, h, alpha, gm)
-                    if meter.blown_up():
-                        raise NumericalInstability(
-                            f"energy created from nothing at t = {st.t:.6g} s (blow-up)"
-                        )
+                try:
+                    self._advance()
+                except (FloatingPointError, ArithmeticError) as exc:
+                    i_end = flush(i0, j)
+                    raise _Stop("unstable", f"{type(exc).__name__}: {exc}", i_end) from None
+                j += 1
+                buf[j], t[i] = self.X, self.t
+                if nc:
+                    imp[i] = self.impulse
                 if on_state is not None:
-                    on_state(st)
-                hit = _limit_hit(limits, lim_idx, obs[i], imp[i] / h)
-                if hit:
-                    status, message = "diverged-physically", hit + f" at t = {st.t:.6g} s"
-                    break
-                if i % 256 == 0:
-                    bar.update(256)
-            i_end = i
-        except NumericalInstability as exc:
-            status, message, i_end = "unstable", f"{self.name}: {exc}", i - 1
+                    on_state(self.state)
+                if j == chunk or i == n:
+                    i_end = flush(i0, j)
+                    bar.update(j)
+                    buf[0] = buf[j]
+                    i0, j = i, 0
+        except _Stop as stop:
+            status, i_end = stop.status, stop.row
+            message = f"{self.name}: {stop.message}" if stop.status == "unstable" else stop.message
         except KeyboardInterrupt:
-            status, message, i_end = "interrupted", "interrupted by the user", i - 1
+            status, message = "interrupted", "interrupted by the user; results kept up to here"
+            i_end = flush(i0, j - 1) if j > 1 else i0
         except Exception as exc:  # keep what was computed
-            status, message, i_end = "failed", f"{type(exc).__name__}: {exc}", i - 1
+            status, message = "failed", f"{type(exc).__name__}: {exc}"
         finally:
             bar.close()
-        m = max(i_end, 0) + 1
+            blas.__exit__(None, None, None)
+        m = i_end + 1
         signals, col = {}, 0
         for name, size in zip(names, sizes):
             signals[name] = obs[:m, col : col + size].copy()
             col += size
+        keep = [k for k, tt in enumerate(stimes) if tt <= t[i_end] + 0.5 * h]
         return Results(
             scheme=self.name,
             h=h,
@@ -223,10 +268,16 @@ class Stepper:
             message=message,
             steps=m - 1,
             cpu_seconds=time.process_time() - start,
-            states=np.array(states) if states else None,
-            state_times=np.array(stimes) if stimes else None,
+            states=np.array([states[k] for k in keep]) if keep else None,
+            state_times=np.array([stimes[k] for k in keep]) if keep else None,
             info={"label": label, "stability_limit": h_lim, "n_dofs": model.n_dofs},
         )
+
+
+class _Stop(Exception):
+    def __init__(self, status, message, row):
+        super().__init__(message)
+        self.status, self.message, self.row = status, message, int(row)
 
 
 def _limit_index(limits, names, sizes):
@@ -240,9 +291,13 @@ def _limit_index(limits, names, sizes):
     return idx
 
 
-def _limit_hit(limits, idx, row, force):
+def _limit_hit(limits, idx, rows, force):
+    """First ``(row, message)`` where a stop limit is exceeded in a block, or ``None``."""
+    first = None
     for key, bound in limits.items():
-        vals = force if key == "contact_force" else row[idx[key]]
-        if vals.size and np.max(np.abs(vals)) > bound:
-            return f"{key} exceeded {bound:g}"
-    return ""
+        vals = force if key == "contact_force" else rows[:, idx[key]]
+        if vals.size:
+            over = np.any(np.abs(vals) > bound, axis=1)
+            if over.any() and (first is None or np.argmax(over) < first[0]):
+                first = (int(np.argmax(over)), f"{key} exceeded {bound:g}")
+    return first

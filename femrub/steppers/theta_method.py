@@ -14,8 +14,12 @@ impact law in velocity form (Eqs. 21–23), an LCP::
 
 which for one contact is the paper's prox formula (Eq. 25b). Active contacts:
 
-* ``"paper"``: the gap at ``t_{k+1}`` is closed (``g_{k+1} <= 0``), iterated to a fixed point
-  with the impulse (the paper's semi-smooth Newton loop, Sec. 3);
+* ``"paper"``: the gap at ``t_{k+1}`` is closed (``g_{k+1} <= 0``, paper Eq. 25b), iterated
+  to a fixed point with the impulse (the role of the paper's semi-smooth Newton loop); a
+  contact already closed at ``t_k`` stays active (it opens through ``P = 0``). At the step
+  where the tip crosses the casing the fixed point may not exist (closing it makes the gap
+  open, leaving it open makes it close): the free step is taken, so the tip penetrates by
+  at most ``h |ġ|`` and is then held there while ``λ > 0``, as the paper describes (Sec. 4.3);
 * ``"predicted"``: Moreau–Jean (Siconos) rule ``g_k + γ h ġ_k <= 0``.
 
 The heat input ``α P`` enters the same step as the impulse. Penetration is not prevented at
@@ -25,8 +29,8 @@ the position level; it stays below ``h |ġ|`` (paper Sec. 4.3).
 from __future__ import annotations
 
 import numpy as np
-import scipy.sparse.linalg as spla
 
+from ..linalg import Factorised, compact
 from .base import Stepper
 from .contact_solve import solve_impulses
 
@@ -62,30 +66,45 @@ class ThetaMethod(Stepper):
     def _setup(self):
         m, h, g = self.model, self.h, self.gamma
         D = (m.A - (h * g) * m.B).tocsc()
-        try:
-            self._lu = spla.splu(D)
-        except RuntimeError as exc:
-            raise ValueError(f"the iteration matrix D = A - h γ B is singular ({exc})") from None
-        self._hB = (h * m.B).tocsr()
-        self._Fk = m.load(self.t)
+        self._lu = Factorised(D, what="iteration matrix D = A - h γ B")
+        hB = (h * m.B).tocsc()
+        if self._lu.dense:  # amplification matrix: X_p = T X_k + Y s̄
+            self._T = np.eye(m.n_dofs) + self._lu.solve(hB.toarray())
+        else:
+            self._hB = compact(hB)
+        self._signals = [term.signal for term in m.loads]
+        F = (
+            np.column_stack([term.vector for term in m.loads])
+            if m.loads
+            else np.zeros((m.n_dofs, 0))
+        )
+        self._hF = h * F
+        self._Y = self._lu.solve(self._hF) if (self._lu.dense and F.shape[1]) else None
+        self._sk = self._signal_values(self.t)
         c = m.contact
         if c is not None:
-            self._Zm = self._solve_many(c.Hm)
-            self._Zt = self._solve_many(c.Ht)
+            self._Zm = self._lu.solve(c.Hm)
+            self._Zt = self._lu.solve(c.Ht)
             self._Wm, self._Wt = c.Gv.T @ self._Zm, c.Gv.T @ self._Zt
+            self._GvT, self._GT = np.ascontiguousarray(c.Gv.T), np.ascontiguousarray(c.G.T)
         self._warm = None
 
-    def _solve_many(self, H):
-        return np.column_stack([self._lu.solve(np.ascontiguousarray(col)) for col in H.T])
+    def _signal_values(self, t):
+        return np.array([float(sig(t)) for sig in self._signals])
 
     def _step(self):
         m, h, g = self.model, self.h, self.gamma
         t1 = self.t + h
-        F1 = m.load(t1)
         Xk = self.X
-        rhs = self._hB @ Xk + h * (g * F1 + (1.0 - g) * self._Fk)
-        Xp = Xk + self._lu.solve(rhs)
-        self._Fk = F1
+        s1 = self._signal_values(t1)
+        sbar = g * s1 + (1.0 - g) * self._sk
+        self._sk = s1
+        if self._lu.dense:
+            Xp = self._T @ Xk
+            if self._Y is not None:
+                Xp += self._Y @ sbar
+        else:
+            Xp = Xk + self._lu.solve(self._hB @ Xk + self._hF @ sbar)
         c = m.contact
         if c is None:
             return Xp, np.zeros(0)
@@ -93,25 +112,31 @@ class ThetaMethod(Stepper):
         Z = self._Zm + self._Zt * alpha
         W = self._Wm + self._Wt * alpha
         e = c.restitution
-        gdot_k = c.Gv.T @ Xk
-        gdot_p = c.Gv.T @ Xp
+        gdot_k = self._GvT @ Xk
+        gdot_p = self._GvT @ Xp
         q = (gdot_p + e * gdot_k) / (1.0 + e)
         Wn = W / (1.0 + e)
         if self.activation == "predicted":
-            gap_k = c.gap_at(self.t) + c.G.T @ Xk
+            gap_k = c.gap_at(self.t) + self._GT @ Xk
             active = gap_k + g * h * gdot_k <= 0.0
             P = solve_impulses(Wn, q, active, self._warm)
         else:
-            gap0 = c.gap_at(t1)
-            gap_p = gap0 + c.G.T @ Xp
-            GZ = c.G.T @ Z
-            active = gap_p <= 0.0
-            P = np.zeros(c.n)
-            for _ in range(2 * c.n + 2):
+            gap_k = c.gap_at(self.t) + self._GT @ Xk
+            gap_p = c.gap_at(t1) + self._GT @ Xp
+            GZ = self._GT @ Z
+            closed = gap_k <= 0.0
+            active = closed | (gap_p <= 0.0)
+            seen = []
+            while True:
                 P = solve_impulses(Wn, q, active, self._warm)
-                new = (gap_p + GZ @ P <= 0.0) | (P > 0.0)
+                new = closed | (gap_p + GZ @ P <= 0.0)
                 if np.array_equal(new, active):
                     break
+                if any(np.array_equal(new, a) for a in seen):  # no consistent set: free step
+                    active = new & active
+                    P = solve_impulses(Wn, q, active, self._warm)
+                    break
+                seen.append(active)
                 active = new
         self._warm = P > 0.0
         return Xp + Z @ P, P

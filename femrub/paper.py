@@ -1,0 +1,267 @@
+"""Reproduction of the paper's figures (Thorin et al., GT2018-75959) on the 1D bar.
+
+``reproduce(out_dir)`` runs every case once (runs shared between figures are cached), writes
+one PNG and one CSV per figure, each run's history (CSV), and ``summary.json`` with a row
+per (figure, run). The frictional heat coefficient of Figs. 2 and 4–7 is not printed in the
+paper; :data:`ALPHA_DEFAULT` documents the choice. The paper's runaway (α = 7 m/s, Fig. 3)
+is stopped by the physical criterion :data:`LIMITS` and reported as
+``"diverged-physically"``.
+"""
+
+from __future__ import annotations
+
+import csv
+import json
+import math
+import platform
+import time
+from collections.abc import Callable
+from dataclasses import asdict, dataclass
+from pathlib import Path
+
+import numpy as np
+
+from . import __version__
+from .bar import PAPER, bar_model
+from .plotting import savefig, tip_panels
+from .steppers import make_stepper
+
+__all__ = ["Run", "FIGURES", "ALPHA_DEFAULT", "LIMITS", "MODELS", "run_case", "reproduce"]
+
+#: α (m/s) of the figures whose α the paper does not print (Figs. 2, 4, 5, 6, 7).
+ALPHA_DEFAULT = 3.0
+#: Physical stop criterion: tip temperature rise (K) beyond which titanium would melt.
+LIMITS = {"tip_temperature": 1500.0}
+T_END = 0.4
+
+
+@dataclass(frozen=True)
+class Run:
+    """One simulation of the paper case."""
+
+    label: str
+    scheme: str = "theta"
+    h: float = 1e-4
+    alpha: float = ALPHA_DEFAULT
+    coupled: bool = True
+    model: str = "full"
+    activation: str = "paper"
+
+    def key(self) -> tuple:
+        return (self.scheme, self.h, self.alpha, self.coupled, self.model, self.activation)
+
+
+def _full(alpha: float, coupled: bool):
+    return bar_model(PAPER, alpha=alpha, coupling="paper" if coupled else "none")
+
+
+#: Model builders by name: ``f(alpha, coupled) -> FirstOrderModel``; reductions add theirs.
+MODELS: dict[str, Callable] = {"full": _full}
+
+_S = {
+    "solid": {"lw": 1.2},
+    "dashed": {"ls": "--", "lw": 1.2},
+    "dotted": {"ls": ":", "lw": 1.5},
+    "dashdot": {"ls": "-.", "lw": 1.2},
+}
+
+FIGURES: dict[str, dict] = {
+    "fig2": {
+        "title": f"Fig. 2: thermal coupling, coupled vs uncoupled (α = {ALPHA_DEFAULT} m/s)",
+        "runs": [(Run("coupled"), _S["solid"]), (Run("uncoupled", coupled=False), _S["dashed"])],
+    },
+    "fig3": {
+        "title": "Fig. 3: influence of α in the heat flux α λ",
+        "runs": [
+            (Run("α = 1 m/s", alpha=1.0), _S["solid"]),
+            (Run("α = 3 m/s", alpha=3.0), _S["solid"]),
+            (Run("α = 7 m/s", alpha=7.0), _S["solid"]),
+        ],
+    },
+    "fig5": {
+        "title": "Fig. 5: Carpenter's scheme vs the θ-method",
+        "runs": [
+            (Run("Carpenter, h = 1e-5 s", scheme="carpenter", h=1e-5), _S["dashed"]),
+            (Run("θ-method, h = 1e-5 s", h=1e-5), _S["solid"]),
+            (Run("θ-method, h = 1e-6 s", h=1e-6), _S["dotted"]),
+        ],
+    },
+    "fig6": {
+        "title": "Fig. 6: close-up of the first contact phase",
+        "tlim": (3.5e-3, 6.5e-3),
+        "time_unit": "ms",
+        "panels": ("tip_displacement", "contact_force"),
+        "runs": [
+            (Run("Carpenter, h = 1e-5 s", scheme="carpenter", h=1e-5), _S["dashed"]),
+            (Run("θ-method, h = 1e-5 s", h=1e-5), _S["solid"]),
+            (Run("θ-method, h = 1e-6 s", h=1e-6), _S["dotted"]),
+            (Run("θ-method, h = 1e-4 s", h=1e-4), _S["dashdot"]),
+        ],
+    },
+    "fig7": {
+        "title": "Fig. 7: influence of the time step (θ-method)",
+        "runs": [
+            (Run("h = 1e-5 s", h=1e-5), _S["solid"]),
+            (Run("h = 1e-4 s", h=1e-4), _S["dotted"]),
+            (Run("h = 5e-4 s", h=5e-4), _S["dashed"]),
+        ],
+    },
+    "stability": {
+        "title": "Carpenter above its stability limit",
+        "runs": [(Run("Carpenter, h = 3e-5 s", scheme="carpenter", h=3e-5), _S["solid"])],
+        "plot": False,
+    },
+}
+
+
+def run_case(run: Run, t_end: float = T_END, *, progress: bool = False):
+    """Build the model of ``run`` and integrate it to ``t_end``; return ``(results, model)``."""
+    if run.model not in MODELS:
+        raise ValueError(f"unknown model {run.model!r}; available: {', '.join(MODELS)}")
+    model = MODELS[run.model](run.alpha, run.coupled)
+    opts = {"activation": run.activation} if run.scheme == "theta" else {}
+    stepper = make_stepper(run.scheme, model, run.h, **opts)
+    t0 = time.perf_counter()
+    res = stepper.run(t_end, progress=progress, limits=LIMITS, label=run.label)
+    res.info["wall_seconds"] = time.perf_counter() - t0
+    return res, model
+
+
+def contact_phases(res, merge: float) -> list[tuple[float, float]]:
+    """Contact phases, merging contacts separated by less than ``merge`` seconds.
+
+    Within one load cycle the tip may impact, lift off for a few steps and impact again
+    (paper Fig. 6 shows two impulses); such bursts count as one contact phase.
+    """
+    phases = res.contact_phases()
+    out: list[list[float]] = []
+    for a, b in phases:
+        if out and a - out[-1][1] <= merge:
+            out[-1][1] = b
+        else:
+            out.append([a, b])
+    return [(a, b) for a, b in out]
+
+
+def summarise(figure: str, run: Run, res, model) -> dict:
+    """The ``summary.json`` row of one run."""
+    period = 2.0 * math.pi / PAPER.force_frequency
+    temp = res.signals.get("tip_temperature")
+    gap = res.gap[:, 0] if res.gap.size else np.zeros(1)
+    fct = res.first_contact_time()
+    return {
+        "figure": figure,
+        "label": run.label,
+        "scheme": run.scheme,
+        "activation": run.activation if run.scheme == "theta" else None,
+        "model": run.model,
+        "h": run.h,
+        "alpha": run.alpha,
+        "coupled": run.coupled,
+        "n_dofs": model.n_dofs,
+        "t_end": float(res.t[-1]),
+        "first_contact_time": fct,
+        "contact_phases": len(contact_phases(res, merge=0.25 * period)),
+        "impacts": len(res.contact_phases()),
+        "max_contact_force": float(res.force.max()) if res.force.size else 0.0,
+        "tip_temperature_end": float(temp[-1, 0]) if temp is not None else 0.0,
+        "max_penetration": float(max(0.0, -gap.min())),
+        "energy_error": res.energy_error(),
+        "impact_dissipation": float(res.energy["impact_dissipation"][-1]) if res.energy else None,
+        "steps": res.steps,
+        "cpu_seconds": res.cpu_seconds,
+        "wall_seconds": res.info.get("wall_seconds"),
+        "cpu_per_step_us": 1e6 * res.cpu_seconds / max(res.steps, 1),
+        "stability_limit": res.info.get("stability_limit"),
+        "status": res.status,
+        "message": res.message,
+    }
+
+
+def _figure_csv(path: Path, runs) -> None:
+    """One CSV per figure: time and the three signals of every run (rows = union of times)."""
+    cols, names = [], []
+    for label, res, _ in runs:
+        temp = res.signals.get("tip_temperature")
+        for name, arr in (
+            ("t", res.t),
+            ("tip_displacement", res.signal("tip_displacement")),
+            ("tip_temperature", temp[:, 0] if temp is not None else np.zeros_like(res.t)),
+            ("contact_force", res.force.sum(axis=1)),
+        ):
+            cols.append(arr)
+            names.append(f"{label} | {name}")
+    n = max(len(c) for c in cols)
+    with path.open("w", newline="") as fh:
+        w = csv.writer(fh)
+        w.writerow(names)
+        for i in range(n):
+            w.writerow([f"{c[i]:.9g}" if i < len(c) else "" for c in cols])
+
+
+def reproduce(
+    out_dir,
+    *,
+    figures=None,
+    t_end: float = T_END,
+    progress: bool = True,
+    log: Callable[[str], None] = print,
+) -> list[dict]:
+    """Run the paper's cases, write PNGs, CSVs and ``summary.json`` into ``out_dir``.
+
+    The summary is rewritten after every run, so an interrupted reproduction keeps the rows
+    of the runs it finished.
+    """
+    out = Path(out_dir)
+    (out / "runs").mkdir(parents=True, exist_ok=True)
+    names = list(figures or FIGURES)
+    unknown = [f for f in names if f not in FIGURES]
+    if unknown:
+        raise ValueError(f"unknown figure(s) {unknown}; available: {', '.join(FIGURES)}")
+    cache: dict[tuple, tuple] = {}
+    rows: list[dict] = []
+    started = time.perf_counter()
+    for fig in names:
+        spec = FIGURES[fig]
+        drawn = []
+        for run, style in spec["runs"]:
+            if run.key() not in cache:
+                res, model = run_case(run, t_end, progress=progress)
+                cache[run.key()] = (res, model)
+                stem = "_".join(str(k) for k in run.key()).replace(" ", "")
+                res.save_csv(out / "runs" / f"{stem}.csv")
+                log(
+                    f"  {fig}: {run.label:<24} {res.status:<20} {res.steps:>7} steps "
+                    f"{res.cpu_seconds:6.2f} s cpu"
+                )
+            res, model = cache[run.key()]
+            rows.append(summarise(fig, run, res, model))
+            drawn.append((run.label, res, style))
+            _write_summary(out, rows, started)
+        if spec.get("plot", True):
+            f = tip_panels(
+                drawn,
+                title=spec["title"],
+                panels=spec.get("panels", ("tip_displacement", "tip_temperature", "contact_force")),
+                tlim=spec.get("tlim"),
+                time_unit=spec.get("time_unit", "s"),
+                gap=PAPER.gap,
+            )
+            savefig(f, out / f"{fig}.png")
+            _figure_csv(out / f"{fig}.csv", drawn)
+    return rows
+
+
+def _write_summary(out: Path, rows, started) -> None:
+    doc = {
+        "femrub_version": __version__,
+        "python": platform.python_version(),
+        "case": asdict(PAPER),
+        "alpha_default": ALPHA_DEFAULT,
+        "limits": LIMITS,
+        "wall_seconds": time.perf_counter() - started,
+        "runs": rows,
+    }
+    tmp = out / "summary.json.tmp"
+    tmp.write_text(json.dumps(doc, indent=2, default=float))
+    tmp.replace(out / "summary.json")
