@@ -77,7 +77,7 @@ def thermal_stress(theta, v, w):
 
 @BilinearForm
 def heat_capacity(theta, eta, w):
-    """Heat capacity ``C^θθ = ∫ ρ c A θ η dx`` (Eq. 2b); parameters ``rho_c`` (J/(m³K)), ``area``."""
+    """Heat capacity ``C^θθ = ∫ ρ c A θ η dx`` (Eq. 2b); parameters ``rho_c``, ``area``."""
     return w.rho_c * w.area * theta * eta
 
 

@@ -1,0 +1,24 @@
+"""Elastic bar impacting a rigid obstacle vs the exact solution (Doyen, Ern, Piperno 2011)."""
+
+import pytest
+
+import bar_impact as ex
+
+
+@pytest.mark.parametrize("row", ex.rows, ids=lambda r: f"{r['scheme']}-{r['n_elements']}")
+def test_impact_matches_exact_solution(row):
+    exact = ex.exact
+    tol = 0.03 if row["n_elements"] == 50 else 0.012
+    assert row["contact_start"] == pytest.approx(exact.contact_start, abs=2 * row["h"])
+    assert row["contact_duration"] == pytest.approx(exact.contact_duration, rel=tol)
+    assert row["impulse"] == pytest.approx(exact.impulse, rel=tol)
+    assert row["mean_force"] == pytest.approx(exact.contact_force, rel=tol)
+    assert row["rebound_velocity"] == pytest.approx(exact.rebound_velocity, rel=tol)
+
+
+def test_impact_converges_with_mesh():
+    err = {}
+    for r in ex.rows:
+        if r["scheme"] == "theta":
+            err[r["n_elements"]] = abs(r["rebound_velocity"] / ex.exact.rebound_velocity - 1)
+    assert err[200] < 0.5 * err[50]
