@@ -230,6 +230,7 @@ def reproduce(
                 cache[run.key()] = (res, model)
                 stem = "_".join(str(k) for k in run.key()).replace(" ", "")
                 res.save_csv(out / "runs" / f"{stem}.csv")
+                res.save_npz(out / "runs" / f"{stem}.npz")
                 log(
                     f"  {fig}: {run.label:<24} {res.status:<20} {res.steps:>7} steps "
                     f"{res.cpu_seconds:6.2f} s cpu"

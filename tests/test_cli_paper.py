@@ -1,0 +1,78 @@
+"""`femrub paper` end to end: figures, CSVs, summary.json with the paper's findings."""
+
+import json
+
+import numpy as np
+import pytest
+
+from femrub.cli import main
+from femrub.results import Results
+
+REQUIRED = {
+    "figure", "label", "scheme", "h", "alpha", "coupled", "first_contact_time", "contact_phases",
+    "max_contact_force", "tip_temperature_end", "max_penetration", "energy_error", "steps",
+    "cpu_seconds", "status", "n_dofs",
+}  # fmt: skip
+
+
+@pytest.fixture(scope="module")
+def paper_out(tmp_path_factory):
+    out = tmp_path_factory.mktemp("paper")
+    assert main(["paper", "--out", str(out), "--quiet"]) == 0
+    return out
+
+
+@pytest.fixture(scope="module")
+def summary(paper_out):
+    return json.loads((paper_out / "summary.json").read_text())["runs"]
+
+
+def _row(summary, figure, label):
+    return next(r for r in summary if r["figure"] == figure and r["label"] == label)
+
+
+def test_files_written(paper_out, summary):
+    for fig in ("fig2", "fig3", "fig5", "fig6", "fig7"):
+        png = paper_out / f"{fig}.png"
+        assert png.stat().st_size > 20_000 and png.read_bytes()[:4] == b"\x89PNG"
+        header = (paper_out / f"{fig}.csv").read_text().splitlines()[0]
+        assert "tip_displacement" in header and "tip_temperature" in header
+    for row in summary:
+        assert REQUIRED <= set(row), REQUIRED - set(row)
+    npz = sorted((paper_out / "runs").glob("*.npz"))
+    assert npz
+    res = Results.load_npz(npz[0])
+    assert res.t.size == res.signal("tip_displacement").size
+
+
+def test_paper_findings(summary):
+    ok = [r for r in summary if r["status"] == "ok"]
+    fine = _row(summary, "fig5", "θ-method, h = 1e-6 s")["first_contact_time"]
+    assert 4e-3 < fine < 5e-3  # paper Sec. 4.3: just after 4 ms
+    assert all(abs(r["first_contact_time"] - fine) <= 1.5 * r["h"] for r in ok)
+    assert all(r["energy_error"] < 1e-6 for r in ok if r["scheme"] == "theta")
+    # Fig. 3: α = 7 runs away (physically), α = 1 and 3 do not
+    assert _row(summary, "fig3", "α = 7 m/s")["status"] == "diverged-physically"
+    t1 = _row(summary, "fig3", "α = 1 m/s")["tip_temperature_end"]
+    t3 = _row(summary, "fig3", "α = 3 m/s")["tip_temperature_end"]
+    assert 0 < t1 < t3 < 1500
+    # Fig. 2: the coupling raises temperature and force
+    c, u = _row(summary, "fig2", "coupled"), _row(summary, "fig2", "uncoupled")
+    assert c["tip_temperature_end"] > 3 * u["tip_temperature_end"]
+    # Figs. 5/6: Carpenter at 1e-5 s agrees with the θ-method; unstable at 3e-5 s
+    ca = _row(summary, "fig5", "Carpenter, h = 1e-5 s")
+    th = _row(summary, "fig5", "θ-method, h = 1e-5 s")
+    assert ca["status"] == "ok"
+    assert ca["tip_temperature_end"] == pytest.approx(th["tip_temperature_end"], rel=0.03)
+    st = _row(summary, "stability", "Carpenter, h = 3e-5 s")
+    assert st["status"] == "unstable" and st["stability_limit"] < 3e-5
+    # Fig. 7: the penetration of the θ-method grows with h and stays below a micrometre or two
+    pen = [_row(summary, "fig7", f"h = {h} s")["max_penetration"] for h in ("1e-5", "1e-4", "5e-4")]
+    assert pen[0] < pen[1] < pen[2] < 3e-6
+    assert np.isfinite([r["cpu_seconds"] for r in summary]).all()
+
+
+def test_bad_cli_input(capsys):
+    assert main(["paper", "--figures", "fig99", "--out", "/tmp/femrub-none"]) == 2
+    err = capsys.readouterr().err
+    assert "unknown figure" in err and err.count("\n") == 1
