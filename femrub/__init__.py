@@ -8,7 +8,7 @@ from .first_order import ContactSpec, Load, first_order_model
 from .material import Material
 from .model import Contact, EnergyForms, FirstOrderModel, Layout, LoadTerm
 from .results import Results
-from .steppers import Carpenter, ThetaMethod, make_stepper
+from .steppers import Carpenter, Penalty, ThetaMethod, make_stepper
 from .thermoelastic import ThermoelasticMatrices, assemble_thermoelastic
 
 __version__ = "0.1.0"
@@ -25,6 +25,7 @@ __all__ = [
     "Load",
     "LoadTerm",
     "Material",
+    "Penalty",
     "Results",
     "ThermoelasticMatrices",
     "ThetaMethod",

@@ -1,8 +1,7 @@
 """Elastic bar impacting a rigid obstacle vs the exact solution (Doyen, Ern, Piperno 2011)."""
 
-import pytest
-
 import bar_impact as ex
+import pytest
 
 
 @pytest.mark.parametrize("row", ex.rows, ids=lambda r: f"{r['scheme']}-{r['n_elements']}")

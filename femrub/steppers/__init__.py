@@ -2,13 +2,14 @@
 
 from .base import NumericalInstability, State, Stepper, check_step
 from .carpenter import Carpenter
+from .penalty import Penalty
 from .theta_method import ACTIVATION_RULES, ThetaMethod
 
-SCHEMES = {"theta": ThetaMethod, "carpenter": Carpenter}
+SCHEMES = {"theta": ThetaMethod, "carpenter": Carpenter, "penalty": Penalty}
 
 
 def make_stepper(scheme: str, model, h, **options) -> Stepper:
-    """Stepper by name: ``"theta"`` (paper Sec. 3) or ``"carpenter"``."""
+    """Stepper by name: ``"theta"`` (paper Sec. 3), ``"carpenter"`` or ``"penalty"``."""
     try:
         cls = SCHEMES[scheme]
     except KeyError:
@@ -20,6 +21,7 @@ __all__ = [
     "ACTIVATION_RULES",
     "Carpenter",
     "NumericalInstability",
+    "Penalty",
     "SCHEMES",
     "State",
     "Stepper",
