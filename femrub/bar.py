@@ -41,6 +41,7 @@ class BarCase:
     conductivity: float = 3.35
     expansion: float = 8.6e-6
     n_elements: int = 20
+    grading: float = 1.0
     coupling: str = "paper"
     beta: float = -4.5e-7
     strain_heating: bool = False
@@ -68,6 +69,8 @@ class BarCase:
             raise ValueError(
                 f"alpha must be >= 0 (frictional heat is never negative), got {self.alpha}"
             )
+        if not (math.isfinite(float(self.grading)) and float(self.grading) >= 1.0):
+            raise ValueError(f"grading must be >= 1 (1: uniform mesh), got {self.grading!r}")
         if not (isinstance(self.n_elements, int) and self.n_elements >= 1):
             raise ValueError(f"n_elements must be a positive integer, got {self.n_elements!r}")
         if not (0.0 <= float(self.restitution) <= 1.0):
@@ -101,8 +104,13 @@ PAPER = BarCase()
 
 
 def bar_matrices(case: BarCase = PAPER) -> tuple[ThermoelasticMatrices, int]:
-    """Assemble the bar's matrices with scikit-fem; return them and the tip's free dof."""
-    mesh = fem.MeshLine(np.linspace(0.0, case.length, case.n_elements + 1))
+    """Assemble the bar's matrices with scikit-fem; return them and the tip's free dof.
+
+    Nodes sit at ``x = L (1 − (1 − ξ)^p)`` with ``ξ`` uniform and ``p = case.grading``
+    (1: uniform; > 1: elements refined towards the tip).
+    """
+    xi = np.linspace(0.0, 1.0, case.n_elements + 1)
+    mesh = fem.MeshLine(case.length * (1.0 - (1.0 - xi) ** case.grading))
     basis_u = fem.Basis(mesh, fem.ElementVector(fem.ElementLineP1()))
     basis_t = fem.Basis(mesh, fem.ElementLineP1())
     x = mesh.p[0]

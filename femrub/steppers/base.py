@@ -207,6 +207,9 @@ class Stepper:
         # small models: one BLAS thread (threads only add overhead on tiny mat-vecs)
         blas = threadpool_limits(limits=1, user_api="blas") if N < 2000 else nullcontext()
         blas.__enter__()
+        # a blow-up overflows before the next check; non-finite states are caught and reported
+        fp = np.errstate(over="ignore", invalid="ignore")
+        fp.__enter__()
         bar = tqdm(total=n, disable=not progress, unit="step", desc=label or self.name, leave=False)
         i_end = 0
         try:
@@ -249,6 +252,7 @@ class Stepper:
             status, message = "failed", f"{type(exc).__name__}: {exc}"
         finally:
             bar.close()
+            fp.__exit__(None, None, None)
             blas.__exit__(None, None, None)
         m = i_end + 1
         signals, col = {}, 0
