@@ -23,7 +23,7 @@ import numpy as np
 
 from . import __version__
 from .bar import PAPER, bar_model
-from .plotting import savefig, tip_panels
+from .plotting import energy_panel, savefig, tip_panels
 from .steppers import make_stepper
 
 __all__ = ["Run", "FIGURES", "ALPHA_DEFAULT", "LIMITS", "MODELS", "run_case", "reproduce"]
@@ -250,6 +250,11 @@ def reproduce(
             )
             savefig(f, out / f"{fig}.png")
             _figure_csv(out / f"{fig}.csv", drawn)
+        if fig == "fig5":  # energy balances of the two schemes at the same step
+            for run, _ in spec["runs"][:2]:
+                res = cache[run.key()][0]
+                title = f"Energy balance: {run.label} (residual {res.energy_error():.1e})"
+                savefig(energy_panel(res, title=title), out / f"energy_{run.scheme}.png")
     return rows
 
 
