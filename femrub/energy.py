@@ -112,9 +112,12 @@ class EnergyMeter:
         numerical instability creates energy from nothing and opens it.
         """
         d = self.data
-        bad = (np.abs(d["energy_error"][rows]) > factor * np.maximum(self._scale_rows, 1e-30)) | (
-            np.abs(d["heat_error"][rows]) > factor * np.maximum(self._heat_rows, 1e-30)
+        # compared only once something has entered: round-off before that is not a blow-up
+        mech = (self._scale_rows > 0) & (
+            np.abs(d["energy_error"][rows]) > factor * self._scale_rows
         )
+        heat = (self._heat_rows > 0) & (np.abs(d["heat_error"][rows]) > factor * self._heat_rows)
+        bad = mech | heat
         return rows.start + int(np.argmax(bad)) if bad.any() else None
 
     def arrays(self, n: int) -> dict[str, np.ndarray]:

@@ -55,8 +55,17 @@ def _full(alpha: float, coupled: bool):
     return bar_model(PAPER, alpha=alpha, coupling="paper" if coupled else "none")
 
 
-#: Model builders by name: ``f(alpha, coupled) -> FirstOrderModel``; reductions add theirs.
-MODELS: dict[str, Callable] = {"full": _full}
+def _reduced(name: str) -> Callable:
+    def build(alpha: float, coupled: bool):
+        from .reduction import paper_reduced_model
+
+        return paper_reduced_model(name, alpha, coupled)
+
+    return build
+
+
+#: Model builders by name: ``f(alpha, coupled) -> FirstOrderModel``.
+MODELS: dict[str, Callable] = {"full": _full, "RM1": _reduced("RM1"), "RM2": _reduced("RM2")}
 
 _S = {
     "solid": {"lw": 1.2},
@@ -76,6 +85,14 @@ FIGURES: dict[str, dict] = {
             (Run("α = 1 m/s", alpha=1.0), _S["solid"]),
             (Run("α = 3 m/s", alpha=3.0), _S["solid"]),
             (Run("α = 7 m/s", alpha=7.0), _S["solid"]),
+        ],
+    },
+    "fig4": {
+        "title": f"Fig. 4: complete model vs reduced models (α = {ALPHA_DEFAULT} m/s)",
+        "runs": [
+            (Run("complete model"), _S["solid"]),
+            (Run("RM1 (n_uv = 3, n_θ = 12)", model="RM1"), _S["dashed"]),
+            (Run("RM2 (n_uv = 2, n_θ = 5)", model="RM2"), _S["dotted"]),
         ],
     },
     "fig5": {

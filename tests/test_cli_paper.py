@@ -32,7 +32,7 @@ def _row(summary, figure, label):
 
 
 def test_files_written(paper_out, summary):
-    for fig in ("fig2", "fig3", "fig5", "fig6", "fig7"):
+    for fig in ("fig2", "fig3", "fig4", "fig5", "fig6", "fig7"):
         png = paper_out / f"{fig}.png"
         assert png.stat().st_size > 20_000 and png.read_bytes()[:4] == b"\x89PNG"
         header = (paper_out / f"{fig}.csv").read_text().splitlines()[0]
@@ -46,7 +46,7 @@ def test_files_written(paper_out, summary):
 
 
 def test_paper_findings(summary):
-    ok = [r for r in summary if r["status"] == "ok"]
+    ok = [r for r in summary if r["status"] == "ok" and r["model"] == "full"]
     fine = _row(summary, "fig5", "θ-method, h = 1e-6 s")["first_contact_time"]
     assert 4e-3 < fine < 5e-3  # paper Sec. 4.3: just after 4 ms
     assert all(abs(r["first_contact_time"] - fine) <= 1.5 * r["h"] for r in ok)
@@ -70,6 +70,18 @@ def test_paper_findings(summary):
     pen = [_row(summary, "fig7", f"h = {h} s")["max_penetration"] for h in ("1e-5", "1e-4", "5e-4")]
     assert pen[0] < pen[1] < pen[2] < 3e-6
     assert np.isfinite([r["cpu_seconds"] for r in summary]).all()
+
+
+def test_fig4_reduced_models(summary):
+    full = _row(summary, "fig4", "complete model")
+    rm1 = _row(summary, "fig4", "RM1 (n_uv = 3, n_θ = 12)")
+    rm2 = _row(summary, "fig4", "RM2 (n_uv = 2, n_θ = 5)")
+    assert (full["n_dofs"], rm1["n_dofs"], rm2["n_dofs"]) == (60, 18, 10)
+    for rm in (rm1, rm2):
+        assert rm["status"] == "ok"
+        assert rm["tip_temperature_end"] == pytest.approx(full["tip_temperature_end"], rel=0.1)
+        assert rm["max_contact_force"] == pytest.approx(full["max_contact_force"], rel=0.25)
+        assert abs(rm["first_contact_time"] - full["first_contact_time"]) <= 5e-4
 
 
 def test_bad_cli_input(capsys):

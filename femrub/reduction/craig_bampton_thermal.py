@@ -8,8 +8,18 @@ form of Eq. (9) (1D or 3D, sparse, any number of contacts) and builds
   ``Ψ = −B_ii⁻¹ B_ib`` (Eq. 11), ``n_uv`` first-order mechanical shapes (clamped modes
   ``φ_j`` used as displacement and as velocity shapes) and ``n_θ`` thermal modes ``χ_k``
   with the coupling correction ``Φ^uθ = −K_ii⁻¹ K^uθ_ii χ`` (after Eq. 11);
-* the left basis ``R̃`` of Eq. (14): ``R̃ = R`` (Galerkin) or the adjoint Craig–Bampton basis
-  built the same way from ``Bᵀ`` (Petrov–Galerkin, see ``docs/reduction.md``);
+* the left basis ``R̃`` of Eq. (14), chosen by ``projection``:
+
+  - ``"petrov-galerkin"`` (default): the boundary equations are kept as in the full model
+    (unit left vectors on ``u_b, v_b, θ_b``: mass and heat capacity stay lumped on the
+    contact dofs) and the interior equations are projected on the left eigenvectors of the
+    clamped uncoupled problem (``M_ii φ_j`` for the kinematic rows, ``φ_j`` for the momentum
+    rows, ``χ_k`` with the adjoint correction ``C^θu_iiᵀ χ_k`` for the heat rows);
+  - ``"galerkin"``: ``R̃ = R``;
+  - ``"adjoint"``: the Craig–Bampton basis of the adjoint problem, static shapes
+    ``−B_ii⁻ᵀ B_biᵀ`` and the same left modes (two-sided moment matching at s = 0);
+
+  ``docs/reduction.md`` derives them and compares them on the paper case;
 * the reduced model ``Ā = R̃ᵀ A R``, ``B̄ = R̃ᵀ B R`` (Eqs. 14–15), a
   :class:`~femrub.model.FirstOrderModel` that every stepper runs unchanged.
 
@@ -19,8 +29,12 @@ arbitrarily q^uv", after Eq. 15)::
     X̄ = [u_b, q_u | v_b, q_v | θ_b, q_θ],   Layout(n_b + n_qu, n_b + n_qv, n_θb + n_θ)
 
 ``n_uv`` counts real first-order mechanical shapes as the paper does (``2 n_i`` for the full
-interior): mode ``j`` gives a displacement shape and a velocity shape. ``n_qu = ⌈n_uv/2⌉``
-and ``n_qv = ⌊n_uv/2⌋``: an odd ``n_uv`` adds the next mode as a displacement shape only.
+interior): mode ``φ_j`` gives a displacement shape (in ``q_u``) and a velocity shape (in
+``q_v``). ``n_qu = ⌊n_uv/2⌋`` and ``n_qv = ⌈n_uv/2⌉``: an odd ``n_uv`` adds mode
+``(n_uv + 1)/2`` as a velocity shape only. With no displacement partner that coordinate is
+inert for every projection (its momentum row sees no force), so an odd ``n_uv`` behaves as
+``n_uv − 1``; as a displacement shape only it would instead stiffen the boundary row of the
+Petrov–Galerkin model (a frozen interior displacement with no inertia).
 """
 
 from __future__ import annotations
@@ -37,7 +51,7 @@ from .modes import clamped_modes, normalise_columns
 
 __all__ = ["PROJECTIONS", "ThermoelasticCraigBampton", "craig_bampton_thermal"]
 
-PROJECTIONS = ("galerkin", "petrov-galerkin")
+PROJECTIONS = ("petrov-galerkin", "galerkin", "adjoint")
 
 
 class ThermoelasticCraigBampton:
@@ -48,7 +62,7 @@ class ThermoelasticCraigBampton:
     model : full :class:`~femrub.model.FirstOrderModel` of the form of Eq. (9).
     n_uv : number of first-order mechanical shapes (``None``: all, ``2 n_i``).
     n_theta : number of thermal modes (``None``: all interior temperature dofs).
-    projection : ``"galerkin"`` (``R̃ = R``) or ``"petrov-galerkin"`` (adjoint basis).
+    projection : ``"petrov-galerkin"``, ``"galerkin"`` or ``"adjoint"`` (module docstring).
     boundary : optional ``{"u": positions in the u-block, "theta": positions in the θ-block}``;
         default: the contact dofs (:func:`~femrub.reduction.blocks.contact_boundary`).
 
@@ -56,12 +70,14 @@ class ThermoelasticCraigBampton:
     ----------
     R, left : (N, r) right and left bases (dense), rows in the full state order.
     layout : reduced :class:`~femrub.model.Layout`.
-    omega2 : (n_qu,) clamped mechanical eigenvalues ω² (rad²/s²).
+    omega2 : (n_qv,) clamped mechanical eigenvalues ω² (rad²/s²) of the shapes kept.
     mu : (n_θ,) clamped thermal eigenvalues (1/s) of ``K^θθ χ = μ C^θθ χ``.
     timings : seconds spent in the static shapes, the modes and the bases.
     """
 
-    def __init__(self, model, n_uv=None, n_theta=None, *, projection="galerkin", boundary=None):
+    def __init__(
+        self, model, n_uv=None, n_theta=None, *, projection="petrov-galerkin", boundary=None
+    ):
         if projection not in PROJECTIONS:
             raise ValueError(f"unknown projection {projection!r}; use one of {PROJECTIONS}")
         if not isinstance(model, FirstOrderModel):
@@ -75,7 +91,7 @@ class ThermoelasticCraigBampton:
         n_uv = 2 * mi.size if n_uv is None else _count("n_uv", n_uv, 2 * mi.size)
         n_theta = ti.size if n_theta is None else _count("n_theta", n_theta, ti.size)
         self.n_uv, self.n_theta = n_uv, n_theta
-        self.n_qu, self.n_qv = (n_uv + 1) // 2, n_uv // 2
+        self.n_qu, self.n_qv = n_uv // 2, (n_uv + 1) // 2
         self.boundary = {"u": mb, "theta": tb}
         if sp.csr_matrix(blocks.M)[mb][:, mi].count_nonzero():
             warnings.warn(
@@ -93,21 +109,23 @@ class ThermoelasticCraigBampton:
         psi = solver.solve(-B_ib)  # Eq. (11)
         self.timings["static_shapes"] = time.perf_counter() - t0
         t0 = time.perf_counter()
-        self.omega2, phi = clamped_modes(solver.K, solver.M, self.n_qu, solver.solve_K)
+        self.omega2, phi = clamped_modes(solver.K, solver.M, self.n_qv, solver.solve_K)
         self.mu, chi = clamped_modes(solver.Ktt, solver.Ctt, n_theta, solver.solve_T)
         phi_ut = -solver.solve_K(solver.Kut @ chi)  # K_ii Φ^uθ = −K^uθ_ii Φ^θθ
         self.timings["modes"] = time.perf_counter() - t0
         t0 = time.perf_counter()
         self._idx = (mb, mi, tb, ti)
         self.layout = Layout(mb.size + self.n_qu, mb.size + self.n_qv, tb.size + n_theta)
-        self.R = self._assemble(psi, phi, phi[:, : self.n_qv], chi, phi_ut)
+        self.R = self._assemble(psi, phi[:, : self.n_qu], phi, chi, phi_ut)
         if projection == "galerkin":
             self.left = self.R
-        else:  # adjoint Craig–Bampton basis: the same construction with Bᵀ
-            B_bi_T = B[self._bnd][:, self._int].T.toarray()
-            psi_l = solver.solve_transposed(-B_bi_T)
-            mphi = normalise_columns(solver.M @ phi)
-            self.left = self._assemble(psi_l, mphi, phi[:, : self.n_qv], chi, solver.Ctu.T @ chi)
+        else:  # left (adjoint) modes; boundary columns: adjoint static shapes or unit vectors
+            if projection == "adjoint":
+                psi_l = solver.solve_transposed(-B[self._bnd][:, self._int].T.toarray())
+            else:  # boundary equations kept as in the full model
+                psi_l = np.zeros_like(psi)
+            mphi = normalise_columns(solver.M @ phi[:, : self.n_qu])
+            self.left = self._assemble(psi_l, mphi, phi, chi, solver.Ctu.T @ chi)
         self.timings["bases"] = time.perf_counter() - t0
         self._rom = None
 
@@ -159,7 +177,7 @@ class ThermoelasticCraigBampton:
         ]
         contact = None if m.contact is None else m.contact.project(Lt, R)
         obs = {k: np.asarray(O @ R) for k, O in m.observations.items()}
-        energy = None if m.energy is None else m.energy.project(R)
+        energy = None if m.energy is None else self._energy(Ar, Br)
         to_full = None if m.to_full is None else np.asarray(m.to_full @ R)
         self.timings["projection"] = time.perf_counter() - t0
         info = {
@@ -189,6 +207,24 @@ class ThermoelasticCraigBampton:
             info=info,
         )
         return self._rom
+
+    def _energy(self, Ar, Br):
+        """Energy forms projected on ``R``; the thermal-stress power uses ``u̇``, not ``v``.
+
+        The full model's thermal power ``vᵀ(−K^uθ θ)`` equals ``u̇ᵀ(−K^uθ θ)`` because
+        ``u̇ = v``; a reduced model only keeps ``u̇_b = v_b`` (its interior ``u̇`` is the rate of
+        ``R_u X̄``, which holds thermal-expansion shapes that ``v`` lacks), so the power of the
+        thermal stresses on the reduced displacement is ``(R_u Ā⁻¹ B̄ X̄)ᵀ(−K^uθ)(R_θ X̄)``.
+        """
+        m, R = self.fom, self.R
+        forms = m.energy.project(R)
+        L = m.layout
+        if L.n_t:
+            P = sp.csr_matrix(m.energy.Pth)
+            P_u = sp.vstack([P[L.v], P[L.u], P[L.t]], format="csr")  # v-rows moved to u-rows
+            rate = np.linalg.solve(Ar, Br)  # Ẋ̄ = Ā⁻¹ B̄ X̄ without loads and impulses
+            forms.Pth = sp.csr_matrix(rate.T @ (R.T @ np.asarray(P_u @ R)))
+        return forms
 
     def reconstruct(self, Xr: np.ndarray) -> np.ndarray:
         """Full state ``R X̄`` of a reduced state (r,) or of the rows of an (m, r) array."""

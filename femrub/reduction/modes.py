@@ -17,6 +17,7 @@ import numpy as np
 import scipy.linalg as sla
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
+from threadpoolctl import threadpool_limits
 
 __all__ = ["DENSE_MODES_BELOW", "clamped_modes", "normalise_columns"]
 
@@ -58,7 +59,8 @@ def clamped_modes(K, M, k: int, solve=None, *, tol: float = 1e-12):
     if n < DENSE_MODES_BELOW or k >= n - 1:
         Kd = K.toarray() if sp.issparse(K) else np.asarray(K)
         Md = M.toarray() if sp.issparse(M) else np.asarray(M)
-        lam, V = sla.eigh(Kd, Md, subset_by_index=[0, k - 1])
+        with threadpool_limits(limits=1, user_api="blas"):  # threads only slow small problems
+            lam, V = sla.eigh(Kd, Md, subset_by_index=[0, k - 1])
     else:
         opinv = None
         if solve is not None:

@@ -31,6 +31,7 @@ import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
+from ..linalg import Factorised
 from .base import Stepper
 from .contact_solve import solve_impulses
 
@@ -49,7 +50,7 @@ class Carpenter(Stepper):
         if (A - sp.diags(A.diagonal())).count_nonzero() == 0:
             self._diagA = A.diagonal()
         else:
-            self._lu = spla.splu(A)
+            self._lu = Factorised(A, what="matrix A")
         self._B = m.B.tocsr()
         Sv = np.zeros(L.n, dtype=bool)
         Sv[L.v] = True
