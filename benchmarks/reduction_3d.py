@@ -35,7 +35,7 @@ from femrub.first_order import ContactSpec, Load, first_order_model
 from femrub.reduction import ThermoelasticCraigBampton
 
 L, W, H = 0.1, 0.02, 0.004  # m
-SIZES = {"1e4": (20, 6, 3), "3e4": (28, 9, 4), "1e5": (50, 15, 4)}
+SIZES = {"1e4": (20, 6, 3), "3e4": (28, 9, 4), "1e5": (54, 16, 4)}
 QUICK = {"3e3": (10, 4, 2)}
 N_UV, N_THETA = 6, 12
 F0, OMEGA, GAP, ALPHA = 100.0, 5000.0, 0.8e-6, 3.0  # N, rad/s, m, m/s

@@ -12,7 +12,7 @@ reference cell.
 
 from __future__ import annotations
 
-from functools import lru_cache
+from functools import cache
 from itertools import combinations
 
 import numpy as np
@@ -45,26 +45,38 @@ def _signed_volume(x: np.ndarray, tet: tuple[int, ...]) -> float:
     return float(np.dot(np.cross(b - a, c - a), d - a)) / 6.0
 
 
-def _boundary_triangles(kind: str, bits: int) -> set[frozenset[int]]:
+def _boundary_triangles(kind: str, bits: int) -> tuple[set[frozenset[int]], set[frozenset[int]]]:
+    """Required boundary triangles and forbidden edges (the uncut diagonals)."""
     _, quads, tris = _REF[kind]
     out = {frozenset(tri) for tri in tris}
+    forbidden = set()
     for k, (a, b, c, d) in enumerate(quads):
         if (bits >> k) & 1:
             out |= {frozenset((a, b, d)), frozenset((b, c, d))}
+            forbidden.add(frozenset((a, c)))
         else:
             out |= {frozenset((a, b, c)), frozenset((a, c, d))}
-    return out
+            forbidden.add(frozenset((b, d)))
+    return out, forbidden
 
 
 def _search(x, candidates, required, open_faces, used, volume):
     """Depth-first exact cover: close every open face exactly once."""
     if not open_faces:
         return list(used) if abs(volume) < 1e-12 else None
-    face, side = next(iter(open_faces.items()))
-    for tet in candidates.get(face, ()):
-        apex = (set(tet) - face).pop()
+    options = {}
+    for face, side in open_faces.items():
         centre = np.mean([x[i] for i in face], axis=0)
-        if np.dot(x[apex] - centre, side) <= 0 or tet in used:
+        options[face] = [
+            tet
+            for tet in candidates.get(face, ())
+            if tet not in used and np.dot(x[(set(tet) - face).pop()] - centre, side) > 0
+        ]
+        if len(options[face]) < 2:
+            break
+    face = min(options, key=lambda f: len(options[f]))
+    for tet in options[face]:
+        if abs(_signed_volume(x, tet)) > volume + 1e-12:
             continue
         new_open, ok = dict(open_faces), True
         for tri in map(frozenset, combinations(tet, 3)):
@@ -94,18 +106,18 @@ def _search(x, candidates, required, open_faces, used, volume):
     return None
 
 
-@lru_cache(maxsize=None)
+@cache
 def _template(kind: str, bits: int) -> tuple[tuple[int, ...], ...] | None:
     """Positively oriented tetrahedra of reference cell ``kind`` for diagonal ``bits``."""
     coords, _, _ = _REF[kind]
     x = np.array(coords, dtype=float)
     n = len(x)
     volume = 0.5 if kind == "wedge" else (1.0 if kind == "hexahedron" else 1.0 / 6.0)
-    required = _boundary_triangles(kind, bits)
+    required, forbidden = _boundary_triangles(kind, bits)
     candidates: dict[frozenset[int], list[tuple[int, ...]]] = {}
     for tet in combinations(range(n), 4):
         vol = _signed_volume(x, tet)
-        if abs(vol) < 1e-12:
+        if abs(vol) < 1e-12 or any(frozenset(e) in forbidden for e in combinations(tet, 2)):
             continue
         tet = tet if vol > 0 else (tet[0], tet[1], tet[3], tet[2])
         for tri in map(frozenset, combinations(tet, 3)):

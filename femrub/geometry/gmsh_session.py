@@ -2,7 +2,10 @@
 
 from __future__ import annotations
 
+import ctypes
 import itertools
+import os
+import sys
 from collections.abc import Iterator
 from contextlib import contextmanager
 
@@ -13,6 +16,39 @@ from .errors import GeometryError
 __all__ = ["GmshSession", "gmsh_session"]
 
 _COUNTER = itertools.count()
+
+
+@contextmanager
+def _quiet_output(enabled: bool) -> Iterator[None]:
+    """Send file descriptors 1 and 2 to the null device.
+
+    gmsh (and its bundled libraries) print some diagnostics with printf/fprintf,
+    bypassing ``General.Terminal``; this silences them for the duration.
+    """
+    if not enabled:
+        yield
+        return
+    try:
+        sys.stdout.flush()
+        sys.stderr.flush()
+        saved = [os.dup(1), os.dup(2)]
+    except (OSError, ValueError, AttributeError):  # pragma: no cover - no usable fds
+        yield
+        return
+    devnull = os.open(os.devnull, os.O_WRONLY)
+    os.dup2(devnull, 1)
+    os.dup2(devnull, 2)
+    try:
+        yield
+    finally:
+        try:
+            ctypes.CDLL(None).fflush(None)
+        except (OSError, AttributeError):  # pragma: no cover - not a POSIX libc
+            pass
+        for fd, copy in zip((1, 2), saved, strict=True):
+            os.dup2(copy, fd)
+            os.close(copy)
+        os.close(devnull)
 
 
 class GmshSession:
@@ -92,10 +128,11 @@ def gmsh_session(verbose: bool = False, name: str = "femrub") -> Iterator[GmshSe
         gmsh.logger.start()
     gmsh.model.add(session.model_name)
     try:
-        yield session
-    except GeometryError:
-        raise
+        with _quiet_output(not verbose):
+            yield session
     except Exception as exc:
+        if type(exc) is not Exception:  # gmsh raises plain Exception; let others through
+            raise
         detail = session.last_errors() or str(exc)
         raise GeometryError(
             f"gmsh failed: {detail}; try a larger mesh size h or h_min, fewer sections,"
@@ -108,6 +145,6 @@ def gmsh_session(verbose: bool = False, name: str = "femrub") -> Iterator[GmshSe
         else:
             gmsh.model.setCurrent(session.model_name)
             gmsh.model.remove()
-            if previous:
+            if previous is not None:
                 gmsh.model.setCurrent(previous)
             session.restore_options()

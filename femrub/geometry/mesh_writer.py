@@ -108,7 +108,9 @@ def write_blade_mesh(blade: BladeMesh, path: str | Path, binary: bool = False) -
         else:
             _write_msh(blade, path, points, contact_idx, binary)
     except OSError as exc:
-        raise GeometryError(f"Cannot write {str(path)!r}: {exc.strerror or exc}.") from exc
+        raise GeometryError(
+            f"Cannot write {str(path)!r}: {exc.strerror or exc}; choose a writable path."
+        ) from exc
     return path
 
 

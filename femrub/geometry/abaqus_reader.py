@@ -1,0 +1,222 @@
+"""Read an Abaqus/CalculiX solid mesh into a :class:`BladeMesh` of linear tetrahedra."""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Sequence
+from pathlib import Path
+
+import numpy as np
+import skfem
+
+from .abaqus_parser import SOLID_TYPES, AbaqusModel, parse_abaqus
+from .blade_mesh import BladeMesh
+from .cell_split import split_into_tets
+from .errors import GeometryError
+from .tet_ops import compact_vertices, orient_positive
+from .tip_detection import detect_tip
+from .units import length_scale
+
+__all__ = ["MIDSIDE_EDGES", "read_abaqus"]
+
+#: Corner pair (0-based) of every mid-side node, per element node count (Abaqus order).
+MIDSIDE_EDGES = {
+    10: [(0, 1), (1, 2), (2, 0), (0, 3), (1, 3), (2, 3)],
+    15: [(0, 1), (1, 2), (2, 0), (3, 4), (4, 5), (5, 3), (0, 3), (1, 4), (2, 5)],
+    20: [(0, 1), (1, 2), (2, 3), (3, 0), (4, 5), (5, 6), (6, 7), (7, 4),
+         (0, 4), (1, 5), (2, 6), (3, 7)],
+}  # fmt: skip
+
+
+def _lookup(model: AbaqusModel) -> np.ndarray:
+    ids = model.node_ids
+    if np.unique(ids).size != ids.size:
+        raise GeometryError("Duplicate node numbers in *NODE data; renumber the source mesh.")
+    table = -np.ones(int(ids.max()) + 1, dtype=np.int64)
+    table[ids] = np.arange(ids.size)
+    return table
+
+
+def _columns(table: np.ndarray, ids, what: str) -> np.ndarray:
+    ids = np.asarray(list(ids), dtype=np.int64)
+    bad = (ids < 0) | (ids >= table.size)
+    cols = np.where(bad, -1, table[np.clip(ids, 0, table.size - 1)])
+    if (cols < 0).any():
+        raise GeometryError(
+            f"{what} refers to undefined node {int(ids[np.argmax(cols < 0)])}; check node numbers."
+        )
+    return cols
+
+
+def _named_set(model: AbaqusModel, name: str, role: str) -> list[int]:
+    members = model.find_set(model.nsets, name)
+    if members is None:
+        available = ", ".join(model.nsets) or "none"
+        raise GeometryError(
+            f"Node set {name!r} for {role} not found (available NSETs: {available});"
+            f" fix the {role}= argument."
+        )
+    return list(dict.fromkeys(members))
+
+
+def _midside_map(model: AbaqusModel, table: np.ndarray) -> dict[int, tuple[int, int]]:
+    """Node column of every mid-side node -> node columns of its two corners."""
+    out: dict[int, tuple[int, int]] = {}
+    for block in model.blocks:
+        n = block.nodes.shape[0]
+        if n not in MIDSIDE_EDGES:
+            continue
+        n_corner = SOLID_TYPES[n][1]
+        for k, (a, b) in enumerate(MIDSIDE_EDGES[n]):
+            mids = table[block.nodes[n_corner + k]]
+            pairs = np.stack([table[block.nodes[a]], table[block.nodes[b]]])
+            for mid, pa, pb in zip(mids.tolist(), *pairs.tolist(), strict=True):
+                out.setdefault(mid, (pa, pb))
+    return out
+
+
+def _contact_edges(model, table, old_to_new, contact_cols, vertex) -> np.ndarray:
+    """Vertex pair of the tetrahedral edge carrying each mid-side contact node, else -1."""
+    edge = -np.ones((2, vertex.size), dtype=np.int64)
+    if (vertex < 0).any():
+        mids = _midside_map(model, table)
+        for k in np.flatnonzero(vertex < 0):
+            pair = mids.get(int(contact_cols[k]))
+            if pair is not None:
+                edge[:, k] = old_to_new[list(pair)]
+    return edge
+
+
+def read_abaqus(
+    path: str | Path,
+    length_unit: str,
+    *,
+    radial_axis="z",
+    root: str | None = None,
+    tip: str | None = None,
+    contact: str | Sequence[int] | None = None,
+    elset: str | None = None,
+) -> BladeMesh:
+    """Read an Abaqus/CalculiX input deck as linear tetrahedra in metres.
+
+    Quadratic elements keep only their corner nodes; wedges and hexahedra are
+    split into tetrahedra with the global-node-number diagonal rule, which keeps
+    the tetrahedral mesh conforming. Mid-side nodes stay addressable: set
+    coordinates are kept in :attr:`BladeMesh.point_sets` and contact nodes may
+    be mid-side nodes (``info["contact_map"]`` gives, for each contact node, its
+    vertex index or the two vertices of the tetrahedral edge it sits on).
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+        Input deck (``*INCLUDE`` is followed).
+    length_unit : str
+        Length unit of the deck: ``"mm"`` (N-mm-t-s models such as Rotor 37), ``"m"``
+        or ``"cm"``. Required because decks carry no unit information.
+    radial_axis : str or array_like, optional
+        Rotation axis of the machine.
+    root : str, optional
+        NSET of the clamped nodes; default: all nodes in ``*BOUNDARY`` lines.
+    tip : str, optional
+        NSET of the tip face; default: detected from boundary facets facing
+        away from the axis (:func:`~femrub.geometry.tip_detection.detect_tip`).
+    contact : str or sequence of int, optional
+        NSET name or node numbers of the contact nodes (order kept); default: an
+        NSET named ``contact`` if present, else none.
+    elset : str, optional
+        Only use elements of this ELSET.
+
+    Returns
+    -------
+    BladeMesh
+        Node sets ``root``, ``tip``, every NSET (restricted to vertices) and
+        ``contact`` when all contact nodes are vertices.
+
+    Raises
+    ------
+    GeometryError
+        Unreadable file, unsupported element, unknown unit, missing set or node.
+    """
+    start = time.perf_counter()
+    scale = length_scale(length_unit)
+    model = parse_abaqus(path)
+    table = _lookup(model)
+    points = model.coords * scale
+    keep = None
+    if elset is not None:
+        members = model.find_set(model.elsets, elset)
+        if members is None:
+            available = ", ".join(model.elsets) or "none"
+            raise GeometryError(
+                f"Element set {elset!r} not found (available ELSETs: {available}); fix elset=."
+            )
+        keep = np.asarray(members, dtype=np.int64)
+    tets, counts = [], {}
+    for block in model.blocks:
+        nodes = block.nodes if keep is None else block.nodes[:, np.isin(block.ids, keep)]
+        kind, n_corner = SOLID_TYPES[block.nodes.shape[0]]
+        corner_ids = nodes[:n_corner]
+        cols = _columns(table, corner_ids.ravel(), f"*ELEMENT, TYPE={block.etype}").reshape(
+            corner_ids.shape
+        )
+        tets.append(split_into_tets(kind, cols, global_ids=corner_ids))
+        counts[block.etype] = counts.get(block.etype, 0) + nodes.shape[1]
+    p, t, old_to_new = compact_vertices(points, np.hstack(tets))
+    t = orient_positive(p, t)
+
+    root_ids = model.boundary if root is None else _named_set(model, root, "root")
+    if not root_ids:
+        raise GeometryError(f"No *BOUNDARY nodes in {str(path)!r} to clamp; pass root=NSET_NAME.")
+    root_ids = list(dict.fromkeys(root_ids))
+    point_sets, node_sets = {}, {}
+
+    def add_set(name: str, ids) -> None:
+        cols = _columns(table, ids, f"Node set {name!r}")
+        point_sets[name] = points[:, cols]
+        idx = old_to_new[cols]
+        node_sets[name] = np.unique(idx[idx >= 0])
+
+    for name, ids in model.nsets.items():
+        add_set(name, list(dict.fromkeys(ids)))
+    add_set("root", root_ids)
+    if tip is None:
+        node_sets["tip"] = detect_tip(p, t, radial_axis)
+    else:
+        add_set("tip", _named_set(model, tip, "tip"))
+
+    if contact is None and model.find_set(model.nsets, "contact") is not None:
+        contact = "contact"
+    if contact is None:
+        contact_ids = []
+    elif isinstance(contact, str):
+        contact_ids = _named_set(model, contact, "contact")
+    else:
+        contact_ids = [int(i) for i in contact]
+    contact_cols = _columns(table, contact_ids, "contact")
+    vertex = old_to_new[contact_cols]
+    edge = _contact_edges(model, table, old_to_new, contact_cols, vertex)
+    if (vertex >= 0).all():
+        node_sets["contact"] = vertex
+    contact_map = {
+        "node_ids": np.asarray(contact_ids, dtype=np.int64),
+        "vertex": vertex,
+        "edge": edge,
+    }
+
+    mesh = skfem.MeshTet1(np.ascontiguousarray(p), np.ascontiguousarray(t))
+    return BladeMesh(
+        mesh=mesh,
+        node_sets=node_sets,
+        contact_points=points[:, contact_cols],
+        radial_axis=radial_axis,
+        source=f"{path} ({length_unit})",
+        point_sets=point_sets,
+        vertex_ids=model.node_ids[old_to_new >= 0],
+        info={
+            "element_counts": counts,
+            "n_source_nodes": int(model.node_ids.size),
+            "files": model.files,
+            "contact_map": contact_map,
+            "read_time_s": time.perf_counter() - start,
+        },
+    )
