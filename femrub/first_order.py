@@ -37,6 +37,7 @@ class ContactSpec:
     gap : initial gap(s) (m), array or callable ``t -> (n_c,)``.
     restitution : Newton's coefficient e in [0, 1].
     heat_coefficient : α (m/s) in ``f_tip = α λ``; scalar, (n_c,) or callable of t.
+    gap_rate : ``dg/dt`` of a moving obstacle, callable ``t -> (n_c,)`` (m/s), or None.
     """
 
     normals: object
@@ -45,6 +46,7 @@ class ContactSpec:
     restitution: float = 0.0
     heat_coefficient: object = 0.0
     names: list | None = None
+    gap_rate: object = None
 
 
 @dataclass
@@ -154,6 +156,7 @@ def first_order_model(
             restitution=contact.restitution,
             heat_coefficient=contact.heat_coefficient if nt else 0.0,
             names=list(contact.names or []),
+            gap_rate=contact.gap_rate,
         )
 
     observations = {}

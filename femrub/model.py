@@ -8,7 +8,7 @@ coordinates and ``A`` may have off-diagonal blocks (``A_21``, ``A_23``, ...).
 Contact (paper Eq. 8b) is described in gap form, independent of the model's coordinates::
 
     g(t, X) = g0(t) + Gᵀ X          normal gap at each contact (m), g >= 0 means open
-    ġ       = Gvᵀ X                 normal gap velocity (m/s)
+    ġ       = ġ0(t) + Gvᵀ X         normal gap velocity (m/s); ġ0 = dg0/dt (moving casing)
     force   = Hm λ + Ht (α λ)       reaction λ >= 0 (N) and frictional heat α λ (W)
 
 The paper's tip node is the case ``G = −e_u(n)``, ``Gv = Hm = −e_v(n)``, ``Ht = e_θ(n)``:
@@ -84,6 +84,7 @@ class Contact:
     ----------
     G, Gv, Hm, Ht : (N, n_c) arrays (dense; n_c is small).
     gap0 : (n_c,) initial gaps (m) or a callable ``t -> (n_c,)`` (rotating casing profile).
+    gap_rate : ``dg0/dt``, a callable ``t -> (n_c,)`` (m/s) when ``gap0`` moves; ``None``: 0.
     restitution : Newton restitution coefficient e in [0, 1].
     heat_coefficient : α (m/s) per contact, scalar, array or callable ``t -> (n_c,)``.
     names : labels of the contacts.
@@ -97,6 +98,7 @@ class Contact:
     restitution: float = 0.0
     heat_coefficient: float | np.ndarray | Callable = 0.0
     names: list[str] = field(default_factory=list)
+    gap_rate: Callable | None = None
 
     def __post_init__(self):
         self.G, self.Gv, self.Hm, self.Ht = (
@@ -124,6 +126,10 @@ class Contact:
 
     def gap_at(self, t: float) -> np.ndarray:
         return np.asarray(self.gap0(t), dtype=float) if callable(self.gap0) else self.gap0
+
+    def rate_at(self, t: float) -> np.ndarray | float:
+        """``dg0/dt`` at ``t`` (0 for a fixed obstacle)."""
+        return 0.0 if self.gap_rate is None else np.asarray(self.gap_rate(t), dtype=float)
 
     def alpha_at(self, t: float) -> np.ndarray:
         if callable(self.heat_coefficient):

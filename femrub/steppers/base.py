@@ -93,7 +93,7 @@ class Stepper:
         c = self.model.contact
         if c is None:
             return np.zeros(0), np.zeros(0)
-        return c.gap_at(t) + c.G.T @ X, c.Gv.T @ X
+        return c.gap_at(t) + c.G.T @ X, c.rate_at(t) + c.Gv.T @ X
 
     @property
     def state(self) -> State:
@@ -221,6 +221,8 @@ class Stepper:
                 obs[0] = O @ self.X
             if meter is not None:
                 meter.start(self.X)
+            if on_state is not None:
+                on_state(self.state)
             if store_every:
                 states.append(self.X.copy())
                 stimes.append(self.t)

@@ -121,8 +121,8 @@ class ThetaMethod(Stepper):
         alpha = c.alpha_at(t1)
         Z = self._Zm + self._Zt * alpha
         W = self._Wm + self._Wt * alpha
-        gdot_k = self._GvT @ Xk
-        gdot_p = self._GvT @ Xp
+        gdot_k = c.rate_at(self.t) + self._GvT @ Xk
+        gdot_p = c.rate_at(t1) + self._GvT @ Xp
         # Newton's law for approaching contacts; midpoint law (e = 1) for separating ones
         e = np.where(gdot_k > 0.0, 1.0, c.restitution)
         q = (gdot_p + e * gdot_k) / (1.0 + e)

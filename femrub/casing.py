@@ -1,0 +1,123 @@
+"""Rigid casing profiles: the radial gap seen by a blade node as the rotor turns.
+
+A contact node at angular position ``φ`` (rad, around the machine axis) of a blade turning
+at ``Ω`` (rad/s) sees the casing at angle ``ψ = Ω t + φ``; its undeformed radial gap is the
+profile ``g(ψ)`` (m). The deformed gap is ``g(ψ) − n · u`` with ``n`` the outward radial
+direction at the node (see :mod:`femrub.solid`).
+
+* :class:`Concentric`: ``g(ψ) = c``.
+* :class:`Lobed`: ``g(ψ) = c − δ cos(k (ψ − ψ0))``, an ovalised casing with ``k`` lobes;
+  with ``δ > c`` the casing intrudes at ``k`` places per revolution.
+* :class:`TwoLobePiollet`: the two-lobe profile of Piollet, Nyssen & Batailly, J. Sound Vib.
+  460 (2019) 114878, Eqs. 3–4: ``g(ψ) = g_m (1 − 2 exp(−((mod(ψ, π)/π − 0.5)/w)²))``,
+  ``g_m = 0.356 mm``, ``w = 0.15``.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import asdict, dataclass
+
+import numpy as np
+
+from .material import check_finite_positive
+
+__all__ = ["CasingProfile", "Concentric", "Lobed", "TwoLobePiollet", "casing_profile", "PROFILES"]
+
+
+class CasingProfile:
+    """Base class: ``gap(angle)`` (m) of the undeformed blade at casing angle ``angle`` (rad)."""
+
+    kind = "profile"
+
+    def gap(self, angle):
+        raise NotImplementedError
+
+    def slope(self, angle):
+        """``dg/dψ`` (m/rad); the gap rate of a node is ``Ω slope(Ω t + φ)``."""
+        raise NotImplementedError
+
+    def min_gap(self) -> float:
+        """Smallest gap over a revolution (m); negative when the casing intrudes."""
+        return float(np.min(self.gap(np.linspace(0.0, 2.0 * math.pi, 4001))))
+
+    def as_dict(self) -> dict:
+        return {"kind": self.kind, **asdict(self)}
+
+
+@dataclass(frozen=True)
+class Concentric(CasingProfile):
+    """Round casing, constant clearance ``clearance`` (m)."""
+
+    clearance: float
+    kind = "concentric"
+
+    def __post_init__(self):
+        if not math.isfinite(self.clearance):
+            raise ValueError(f"casing clearance must be finite, got {self.clearance!r}")
+
+    def gap(self, angle):
+        return np.full_like(np.asarray(angle, dtype=float), self.clearance)
+
+    def slope(self, angle):
+        return np.zeros_like(np.asarray(angle, dtype=float))
+
+
+@dataclass(frozen=True)
+class Lobed(CasingProfile):
+    """Ovalised casing: ``clearance − depth cos(lobes (ψ − phase))`` (m)."""
+
+    clearance: float
+    depth: float
+    lobes: int = 2
+    phase: float = 0.0
+    kind = "lobed"
+
+    def __post_init__(self):
+        check_finite_positive("casing depth", self.depth, allow_zero=True)
+        if not (isinstance(self.lobes, int) and self.lobes >= 1):
+            raise ValueError(f"casing lobes must be a positive integer, got {self.lobes!r}")
+        if not math.isfinite(self.clearance):
+            raise ValueError(f"casing clearance must be finite, got {self.clearance!r}")
+
+    def gap(self, angle):
+        return self.clearance - self.depth * np.cos(self.lobes * (np.asarray(angle) - self.phase))
+
+    def slope(self, angle):
+        k = self.lobes
+        return self.depth * k * np.sin(k * (np.asarray(angle) - self.phase))
+
+
+@dataclass(frozen=True)
+class TwoLobePiollet(CasingProfile):
+    """Two-lobe casing of Piollet et al. (2019), Eqs. 3–4 (gap in m)."""
+
+    mean_gap: float = 0.356e-3
+    width: float = 0.15
+    kind = "two-lobe"
+
+    def __post_init__(self):
+        check_finite_positive("casing mean_gap", self.mean_gap)
+        check_finite_positive("casing width", self.width)
+
+    def gap(self, angle):
+        s = np.mod(np.asarray(angle, dtype=float), math.pi) / math.pi - 0.5
+        return self.mean_gap * (1.0 - 2.0 * np.exp(-((s / self.width) ** 2)))
+
+    def slope(self, angle):
+        s = np.mod(np.asarray(angle, dtype=float), math.pi) / math.pi - 0.5
+        w2 = self.width**2
+        return self.mean_gap * 4.0 * s / (w2 * math.pi) * np.exp(-(s**2) / w2)
+
+
+PROFILES = {"concentric": Concentric, "lobed": Lobed, "two-lobe": TwoLobePiollet}
+
+
+def casing_profile(kind: str, **params) -> CasingProfile:
+    """Profile by name (``"concentric"``, ``"lobed"``, ``"two-lobe"``) and parameters."""
+    if kind not in PROFILES:
+        raise ValueError(f"unknown casing profile {kind!r}; use one of {', '.join(PROFILES)}")
+    try:
+        return PROFILES[kind](**params)
+    except TypeError as exc:
+        raise ValueError(f"casing profile {kind!r}: {exc}") from None
