@@ -181,11 +181,14 @@ def solid_model(
     casing: CasingProfile | None = None,
     rotation_speed: float = 0.0,
     friction: float = 0.0,
+    heat_partition: float = 1.0,
     restitution: float = 0.0,
     order: int = 2,
     coupling: str = "physical",
     strain_heating: bool = False,
     rayleigh: tuple[float, float] = (0.0, 0.0),
+    damping_ratio: float | None = None,
+    damping_modes: tuple[int, int] = (1, 5),
     lumping: str | None = None,
     tip_force=None,
     thermal: str | bool = "auto",
@@ -198,9 +201,13 @@ def solid_model(
     material : :class:`Material` (SI).
     casing : casing profile (default: concentric, 0.1 mm clearance).
     rotation_speed : Ω (rad/s); the casing angle seen by a node is ``Ω t + φ``.
-    friction : Coulomb coefficient μ; the heat input is ``μ Ω r λ`` (W).
+    friction : Coulomb coefficient μ; the frictional power is ``μ Ω r λ`` (W).
+    heat_partition : fraction of the frictional power that enters the blade (the rest goes
+        into the casing); the heat input is ``η μ Ω r λ``.
     restitution : Newton's coefficient e.
     order : 2 (vector P2 displacement, default) or 1 (P1, locks in bending).
+    rayleigh : ``(a, b)`` of ``C = a M + b K``; or ``damping_ratio`` ζ, fitted as Rayleigh
+        damping at the clamped modes ``damping_modes`` (1-based) of the blade.
     tip_force : optional ``(force_vector_N, signal)``: a total force spread uniformly over
         the ``tip`` node set's faces, times ``signal(t)``.
 
@@ -213,6 +220,9 @@ def solid_model(
         raise ValueError(f"displacement order must be 1 or 2, got {order!r}")
     omega = float(rotation_speed)
     mu_f = check_finite_positive("friction", friction, allow_zero=True)
+    eta = check_finite_positive("heat_partition", heat_partition, allow_zero=True)
+    if eta > 1.0:
+        raise ValueError(f"heat_partition must be in [0, 1], got {heat_partition!r}")
     if not np.isfinite(omega):
         raise ValueError(f"rotation_speed must be finite (rad/s), got {rotation_speed!r}")
     casing = casing or Concentric(1e-4)
@@ -235,6 +245,14 @@ def solid_model(
         fixed_u=fixed_u,
         fixed_t=fixed_t,
     )
+    if damping_ratio:
+        from .damping import lowest_frequencies, rayleigh_coefficients
+
+        i, j = damping_modes
+        w = lowest_frequencies(mats.K, mats.M, max(i, j))
+        a, b = rayleigh_coefficients(float(damping_ratio), w[i - 1], w[j - 1])
+        mats.C = (a * mats.M + b * mats.K).tocsr()
+        rayleigh = (a, b)
     t2 = time.perf_counter()
     nc = contacts.points.shape[1]
     free_u = mats.u_index(contacts.u_dofs.ravel()).reshape(3, nc)
@@ -257,7 +275,7 @@ def solid_model(
         gap_rate=gap_rate,
         heat_dofs=heat.toarray(),
         restitution=restitution,
-        heat_coefficient=mu_f * abs(omega) * contacts.radii,
+        heat_coefficient=eta * mu_f * abs(omega) * contacts.radii,
         names=[f"contact{i}" for i in range(nc)],
     )
     loads = []
@@ -290,6 +308,8 @@ def solid_model(
         casing=casing.as_dict(),
         rotation_speed=omega,
         friction=mu_f,
+        heat_partition=eta,
+        rayleigh=tuple(float(x) for x in rayleigh),
         timings=timings,
     )
     fields.info.update(timings=timings)

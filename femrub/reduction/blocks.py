@@ -22,6 +22,7 @@ import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
+from ..linalg import sparse_lu
 from ..model import FirstOrderModel
 
 __all__ = ["ModelBlocks", "split_blocks", "contact_boundary", "InteriorSolver"]
@@ -182,7 +183,4 @@ class InteriorSolver:
 def _splu(M, what: str):
     if M.shape[0] == 0:
         return None
-    try:
-        return spla.splu(sp.csc_matrix(M), permc_spec="MMD_AT_PLUS_A")
-    except RuntimeError as exc:
-        raise ValueError(f"the {what} is singular ({exc})") from None
+    return sparse_lu(M, symmetric=True, what=what)

@@ -162,7 +162,8 @@ class Stepper:
         if h > h_lim:
             status = "unstable"
             message = f"h = {h:.3g} s exceeds the stability limit {h_lim:.3g} s of {self.name}"
-        chunk = int(max(1, min(512, 2_000_000 // max(N, 1))))
+        # states are post-processed in chunks; a callback must only see checked states
+        chunk = 1 if on_state is not None else int(max(1, min(512, 2_000_000 // max(N, 1))))
         buf = np.empty((chunk + 1, N))
         GT = None if c is None else np.ascontiguousarray(c.G.T)
 
@@ -237,13 +238,13 @@ class Stepper:
                 buf[j], t[i] = self.X, self.t
                 if nc:
                     imp[i] = self.impulse
-                if on_state is not None:
-                    on_state(self.state)
                 if j == chunk or i == n:
                     i_end = flush(i0, j)
                     bar.update(j)
                     buf[0] = buf[j]
                     i0, j = i, 0
+                if on_state is not None:
+                    on_state(self.state)
         except _Stop as stop:
             status, i_end = stop.status, stop.row
             message = f"{self.name}: {stop.message}" if stop.status == "unstable" else stop.message

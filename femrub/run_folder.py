@@ -1,0 +1,137 @@
+"""A run's results folder: history, summary, plots and (for 3D) the VTK series.
+
+:func:`run_to_folder` integrates a model with a stepper and writes, into ``out``:
+``history.csv`` and ``history.npz`` (every observed signal, gaps, contact forces and
+impulses, energy balance), ``summary.json`` (inputs, versions, timings, energy balance,
+status), ``signals.png`` and, when a :class:`~femrub.solid.FieldMap` is given, ``vtk/``
+(``.pvd`` + ``.vtu``, written as the run goes) and ``snapshot.png``. A run that is
+interrupted or fails keeps everything written so far and says so in ``summary.json``.
+A finished result is not overwritten unless ``overwrite=True``.
+"""
+
+from __future__ import annotations
+
+import json
+import platform
+import time
+from pathlib import Path
+
+import numpy as np
+
+from . import __version__
+from .plotting import savefig, tip_panels
+
+__all__ = ["run_to_folder", "ResultExists"]
+
+
+class ResultExists(FileExistsError):
+    """The output folder already holds a finished result."""
+
+
+def _jsonable(x):
+    if isinstance(x, dict):
+        return {str(k): _jsonable(v) for k, v in x.items()}
+    if isinstance(x, list | tuple):
+        return [_jsonable(v) for v in x]
+    if isinstance(x, np.ndarray):
+        return x.tolist()
+    if isinstance(x, np.generic):
+        return x.item()
+    if isinstance(x, float | int | str | bool) or x is None:
+        return x
+    return str(x)
+
+
+def _write_json(path: Path, doc: dict) -> None:
+    tmp = path.with_suffix(".json.tmp")
+    tmp.write_text(json.dumps(_jsonable(doc), indent=2))
+    tmp.replace(path)
+
+
+def run_to_folder(
+    stepper,
+    t_end: float,
+    out,
+    *,
+    fields=None,
+    vtk_stride: int = 0,
+    inputs: dict | None = None,
+    limits: dict | None = None,
+    progress: bool = False,
+    overwrite: bool = False,
+    snapshot: bool = True,
+):
+    """Run ``stepper`` to ``t_end`` and write the results folder ``out`` (module docstring).
+
+    Returns the :class:`~femrub.results.Results`.
+    """
+    out = Path(out)
+    summary_path = out / "summary.json"
+    if summary_path.exists() and not overwrite:
+        prev = json.loads(summary_path.read_text()).get("status")
+        if prev not in (None, "running"):
+            raise ResultExists(
+                f"{out} already holds a finished result (status {prev}); "
+                "use another folder or overwrite"
+            )
+    out.mkdir(parents=True, exist_ok=True)
+    model = stepper.model
+    doc = {
+        "femrub_version": __version__,
+        "python": platform.python_version(),
+        "scheme": stepper.name,
+        "h": stepper.h,
+        "t_end": t_end,
+        "n_dofs": model.n_dofs,
+        "n_contacts": model.n_contacts,
+        "model": model.info,
+        "inputs": inputs or {},
+        "status": "running",
+    }
+    _write_json(summary_path, doc)
+    series = None
+    if fields is not None and vtk_stride:
+        from .vtk_output import VTKSeries
+
+        series = VTKSeries(out / "vtk", model, fields, h=stepper.h, stride=vtk_stride)
+    t0 = time.perf_counter()
+    res = stepper.run(t_end, progress=progress, limits=limits, on_state=series)
+    wall = time.perf_counter() - t0
+    res.save_csv(out / "history.csv")
+    res.save_npz(out / "history.npz")
+    panels = [k for k in ("tip_displacement", "tip_temperature") if k in res.signals]
+    savefig(
+        tip_panels(
+            [(stepper.name, res, {})],
+            panels=(*panels, "contact_force"),
+            title=f"{stepper.name}, h = {stepper.h:g} s: {res.status}",
+        ),
+        out / "signals.png",
+    )
+    if series is not None and series.frames and snapshot:
+        from .vtk_output import snapshot_png
+
+        try:
+            snapshot_png(series.dir / series.frames[-1][1], out / "snapshot.png")
+        except Exception as exc:  # rendering is optional (no OpenGL on the machine)
+            doc["snapshot_error"] = f"{type(exc).__name__}: {exc}"
+    e = res.energy
+    doc.update(
+        status=res.status,
+        message=res.message,
+        steps=res.steps,
+        t_reached=float(res.t[-1]),
+        cpu_seconds=res.cpu_seconds,
+        wall_seconds=wall,
+        cpu_per_step_us=1e6 * res.cpu_seconds / max(res.steps, 1),
+        first_contact_time=res.first_contact_time(),
+        max_contact_force=float(res.force.max()) if res.force.size else 0.0,
+        energy_error=res.energy_error(),
+        energy={k: float(v[-1]) for k, v in e.items()} if e else {},
+        vtk=str(series.pvd_path.relative_to(out)) if series is not None else None,
+        vtk_frames=len(series.frames) if series is not None else 0,
+    )
+    for name, arr in res.signals.items():
+        doc.setdefault("signals_max_abs", {})[name] = float(np.abs(arr).max()) if arr.size else 0.0
+    _write_json(summary_path, doc)
+    return res
