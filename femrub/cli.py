@@ -1,12 +1,15 @@
-"""Command line: ``femrub paper --out DIR`` and friends.
+"""Command line: ``femrub run | check | sweep | scenes | scene show | paper | mesh``.
 
-Errors in the input are reported on one line (``femrub: error: ...``) with exit status 2;
-an interrupted run keeps what it wrote and exits with status 130.
+Errors in the input are reported on one line (``femrub: error: ...``) with exit status 2,
+never as a traceback (set ``FEMRUB_DEBUG=1`` to see one); an interrupted run keeps what it
+wrote, says where, and exits with status 130; a run that fails keeps its partial results
+and exits with status 1.
 """
 
 from __future__ import annotations
 
 import argparse
+import os
 import sys
 import time
 from pathlib import Path
@@ -32,12 +35,193 @@ def _paper(args) -> int:
     return 0
 
 
+def _changes(args) -> dict:
+    from .scenes import SceneError, parse_value
+
+    out = {}
+    for item in args.set or []:
+        if "=" not in item:
+            raise SceneError(f"--set {item!r}: use KEY=VALUE, e.g. --set scheme.h=1e-5")
+        key, value = item.split("=", 1)
+        out[key.strip()] = parse_value(value.strip())
+    return out
+
+
+def _load(args):
+    from .scenes import load_scene
+
+    return load_scene(args.scene, _changes(args))
+
+
+def _log(args):
+    return None if args.quiet else (lambda s: print(f"  {s}", flush=True))
+
+
+def _run(args) -> int:
+    from .scenes import run_scene
+
+    scene = _load(args)
+    out = Path(args.out or f"{scene.name}-out")
+    if not args.quiet:
+        print(f"femrub run: {scene.source} -> {out}/", flush=True)
+
+    def on_built(built):
+        if args.explain:
+            print(built.explain(), flush=True)
+
+    t0 = time.perf_counter()
+    res, built = run_scene(
+        scene, out, overwrite=args.overwrite, progress=not args.quiet, log=_log(args),
+        on_built=on_built,
+    )  # fmt: skip
+    where = f"{out}/ (summary.json, history.csv, history.npz)"
+    if res.status == "interrupted":
+        print(
+            f"femrub: interrupted at t = {res.t[-1]:.6g} s after {res.steps} steps; partial "
+            f"results kept in {where}; rerun the same command to start again",
+            file=sys.stderr,
+        )
+        return 130
+    if res.status == "failed":
+        print(
+            f"femrub: run failed at t = {res.t[-1]:.6g} s: {res.message}; partial results "
+            f"kept in {where}",
+            file=sys.stderr,
+        )
+        return 1
+    if not args.quiet:
+        peak = max((abs(res.signals[k]).max() for k in res.signals if "temperature" in k),
+                   default=0.0)  # fmt: skip
+        force = res.force.max() if res.force.size else 0.0
+        print(
+            f"done in {time.perf_counter() - t0:.1f} s: status {res.status}, {res.steps} "
+            f"steps, max contact force {force:.4g} N, max temperature rise {peak:.4g} K"
+        )
+        if res.status != "ok":
+            print(f"  note: {res.message}")
+        vtk = " and vtk/rub.pvd (ParaView)" if built.fields is not None and scene[
+            "outputs.vtk_stride"] else ""  # fmt: skip
+        print(f"  results in {out}/: summary.json, history.csv, signals.png{vtk}")
+    return 0
+
+
+def _check(args) -> int:
+    from .scenes import build
+
+    scene = _load(args)
+    if args.schema_only:
+        scene.check_files()
+        if not args.quiet:
+            print(f"ok: {scene.source} is a valid scene (model not built)")
+        return 0
+    built = build(scene, log=_log(args))
+    if args.explain:
+        print(built.explain())
+    if not args.quiet:
+        r = built.report
+        print(
+            f"ok: {scene.source}: {r['model']['n_dofs']} dofs, {r['model']['n_contacts']} "
+            f"contact(s), {r['scheme']['name']} h = {r['scheme']['h']:g} s, "
+            f"{r['scheme']['steps']} steps"
+        )
+    return 0
+
+
+def _scenes(args) -> int:
+    from .scenes import builtin_scenes
+
+    for name, desc in builtin_scenes().items():
+        print(f"{name:<14} {desc}")
+    return 0
+
+
+def _scene_show(args) -> int:
+    from .scenes import builtin_text
+
+    sys.stdout.write(builtin_text(args.name))
+    return 0
+
+
+def _sweep(args) -> int:
+    from .sweep import parse_param, run_sweep
+
+    scene = _load(args)
+    if not args.param:
+        raise ValueError("give at least one --param KEY=START:STOP:STEP")
+    params = [parse_param(p) for p in args.param]
+    out = Path(args.out or f"{scene.name}-sweep")
+    t0 = time.perf_counter()
+    rows = run_sweep(
+        scene, params, out, scheduler=args.scheduler, workers=args.workers,
+        overwrite=args.overwrite, progress=not args.quiet, log=None if args.quiet else print,
+    )  # fmt: skip
+    failed = [r for r in rows if r.get("status") not in ("ok", "unstable", "diverged-physically")]
+    for r in failed:
+        print(
+            f"femrub: point {r['point']} ({r['folder']}): {r.get('status')}: "
+            f"{r.get('message', '')}",
+            file=sys.stderr,
+        )
+    if not args.quiet:
+        print(
+            f"done in {time.perf_counter() - t0:.1f} s: {len(rows)} points "
+            f"({sum(r['skipped'] for r in rows)} skipped), {len(failed)} failed; "
+            f"{out / 'interaction.png'}, {out / 'interaction.csv'}"
+        )
+    return 1 if failed else 0
+
+
+def _scene_args(p: argparse.ArgumentParser, out: bool = True) -> None:
+    p.add_argument("scene", help="scene file (.toml) or built-in scene name (femrub scenes)")
+    p.add_argument(
+        "--set",
+        action="append",
+        metavar="KEY=VALUE",
+        help="change a key, e.g. --set scheme.h=1e-5 (repeatable)",
+    )
+    if out:
+        p.add_argument("-o", "--out", help="results folder (default NAME-out)")
+        p.add_argument("--overwrite", action="store_true", help="replace a finished result")
+    p.add_argument("--quiet", "-q", action="store_true", help="no progress output")
+
+
 def build_parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(
         prog="femrub", description="Nonsmooth thermomechanical blade-casing rub (SI units)."
     )
     p.add_argument("--version", action="store_true", help="print the version and exit")
     sub = p.add_subparsers(dest="command")
+    rp = sub.add_parser("run", help="run a scene into a results folder")
+    _scene_args(rp)
+    rp.add_argument(
+        "--explain",
+        action="store_true",
+        help="print what was built and why (dofs, dropped physics and contacts)",
+    )
+    rp.set_defaults(func=_run)
+    cp = sub.add_parser("check", help="validate a scene and build its model, without running")
+    _scene_args(cp, out=False)
+    cp.add_argument("--explain", action="store_true", help="print what would be built and why")
+    cp.add_argument("--schema-only", action="store_true", help="only check the file (instant)")
+    cp.set_defaults(func=_check)
+    sp = sub.add_parser("sweep", help="run a scene over a parameter grid (dask.distributed)")
+    _scene_args(sp)
+    sp.add_argument(
+        "--param",
+        action="append",
+        metavar="KEY=SPEC",
+        help="swept key: START:STOP:STEP (stop included) or A,B,C (repeatable)",
+    )
+    sp.add_argument("--workers", type=int, default=2, help="local worker processes (default 2)")
+    sp.add_argument("--scheduler", help="address of a dask scheduler (default: LocalCluster)")
+    sp.set_defaults(func=_sweep)
+    lp = sub.add_parser("scenes", help="list the built-in scenes")
+    lp.set_defaults(func=_scenes)
+    shp = sub.add_parser("scene", help="show a built-in scene")
+    ssub = shp.add_subparsers(dest="scene_command", required=True)
+    show = ssub.add_parser("show", help="print a built-in scene (copy it to edit)")
+    show.add_argument("name")
+    show.set_defaults(func=_scene_show)
     pp = sub.add_parser("paper", help="reproduce the paper's figures on the 1D bar")
     pp.add_argument("--out", "-o", default="paper-out", help="output folder (default paper-out)")
     pp.add_argument("--figures", help="comma-separated subset, e.g. fig2,fig6")
@@ -52,6 +236,11 @@ def build_parser() -> argparse.ArgumentParser:
         mp = add_mesh_parser(sub)
         mp.set_defaults(func=run_mesh)
     return p
+
+
+def _one_line(exc: BaseException) -> str:
+    text = str(exc).strip()
+    return text.splitlines()[0] if text else type(exc).__name__
 
 
 def main(argv=None) -> int:
@@ -70,10 +259,18 @@ def main(argv=None) -> int:
     except KeyboardInterrupt:
         print("femrub: interrupted; files written so far are kept", file=sys.stderr)
         return 130
-    except (ValueError, FileNotFoundError, KeyError) as exc:
-        msg = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
-        print(f"femrub: error: {msg}", file=sys.stderr)
+    except (ValueError, FileNotFoundError, FileExistsError, KeyError) as exc:
+        print(f"femrub: error: {_one_line(exc)}", file=sys.stderr)
         return 2
+    except Exception as exc:
+        if os.environ.get("FEMRUB_DEBUG"):
+            raise
+        print(
+            f"femrub: internal error: {type(exc).__name__}: {_one_line(exc)} "
+            "(set FEMRUB_DEBUG=1 for the traceback)",
+            file=sys.stderr,
+        )
+        return 1
 
 
 if __name__ == "__main__":  # pragma: no cover

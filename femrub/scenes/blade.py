@@ -1,0 +1,148 @@
+"""The blade of a 3D scene: gmsh parametric blade, sections or a mesh file, with its groups.
+
+:func:`load_blade` returns a :class:`~femrub.geometry.BladeMesh` whose ``root`` node set is
+the clamped face (``boundary.root``) and whose contact points are the scene's candidates
+(``contact.group`` or ``contact.nodes``). Missing groups, nodes or units are reported as a
+one-line :class:`~femrub.scenes.spec.SceneError` naming the scene key.
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+
+from ..geometry import GeometryError, box_blade, naca_blade, read_mesh, sections_blade
+from ..geometry.readers import detect_format
+from .spec import SceneError, fail
+
+__all__ = ["load_blade"]
+
+
+def _groups(blade) -> str:
+    return ", ".join(f"{k} ({v.size} nodes)" for k, v in sorted(blade.node_sets.items())) or "none"
+
+
+def _build(scene):
+    g = scene["geometry"]
+    kind = g["kind"]
+    size = {k: g[k] for k in ("h", "h_min") if g.get(k) is not None}
+    tips = {"n_contact": g.get("n_contact"), "contact_margin": g.get("contact_margin")}
+    if kind == "box":
+        return box_blade(
+            g["span"], g["chord"], g["thickness"], hub_radius=g["hub_radius"], **tips, **size
+        )
+    if kind == "naca":
+        return naca_blade(
+            g["code"], g["span"], g["root_chord"], g["tip_chord"], g["twist"], g["n_sections"],
+            hub_radius=g["hub_radius"], stacking=g["stacking"], n_points=g["n_points"],
+            **tips, **size,
+        )  # fmt: skip
+    if kind == "sections":
+        paths = [scene.path(f) for f in g["files"]] if g.get("files") else scene.path(g["path"])
+        return sections_blade(
+            paths, length_unit=g["length_unit"], pattern=g["pattern"], radial_axis=g["axis"],
+            interpolate=g["interpolate"], ruled=g["ruled"], **tips, **size,
+        )  # fmt: skip
+    return _read(scene)
+
+
+def _read(scene):
+    g, contact = scene["geometry"], scene["contact"]
+    path = scene.path(g["path"])
+    fmt = detect_format(path)
+    kw = {}
+    if g.get("axis") is not None:
+        kw["radial_axis"] = g["axis"]
+    root = scene["boundary"].get("root")
+    if root is not None:
+        kw["root"] = root
+    if g.get("tip") is not None:
+        kw["tip"] = None if g["tip"] == "detect" else g["tip"]
+    if fmt == "abaqus":
+        if g.get("length_unit") is None:
+            fail(
+                "geometry.length_unit",
+                None,
+                f"{path.name} is an Abaqus/CalculiX deck without "
+                "unit information; give 'mm' (N-mm-t-s models), 'cm' or 'm'",
+            )
+        if contact.get("nodes") is not None:
+            kw["contact"] = contact["nodes"]
+    try:
+        blade = read_mesh(path, g.get("length_unit"), **kw)
+        blade.info["contact_from_nodes"] = "contact" in kw
+    except GeometryError as exc:
+        _reader_error(scene, exc)
+    for key, name in (("boundary.root", root), ("geometry.tip", g.get("tip"))):
+        if name not in (None, "detect", "root", "tip") and name not in blade.node_sets:
+            fail(key, name, f"missing mesh group in {path.name}; groups: {_groups(blade)}")
+    return blade
+
+
+def _reader_error(scene, exc):
+    """Re-raise a reader's :class:`GeometryError` under the scene key at fault."""
+    g, contact = scene["geometry"], scene["contact"]
+    root = scene["boundary"].get("root")
+    msg = str(exc)
+    if "Node set 'root'" in msg or (root is not None and repr(root) in msg):
+        fail("boundary.root", root or "root", f"missing mesh group: {msg}")
+    if "Node set 'tip'" in msg or "tip face" in msg:
+        fail("geometry.tip", g.get("tip"), f"missing mesh group: {msg}")
+    if "contact" in msg and contact.get("nodes") is not None:
+        fail("contact.nodes", contact["nodes"], msg)
+    raise SceneError(f"geometry.path = {g['path']!r}: {msg}") from None
+
+
+def _contact_points(scene, blade) -> np.ndarray:
+    contact = scene["contact"]
+    nodes, group = contact.get("nodes"), contact["group"]
+    if nodes is not None:
+        if blade.info.get("contact_from_nodes"):
+            return blade.contact_points
+        ids = blade.vertex_ids
+        if ids is None:
+            fail("contact.nodes", nodes, f"{blade.source} has no node numbers; use contact.group")
+        lookup = {int(v): i for i, v in enumerate(ids)}
+        missing = [n for n in nodes if n not in lookup]
+        if missing:
+            fail("contact.nodes", nodes, f"node {missing[0]} is not a mesh vertex")
+        return blade.mesh.p[:, [lookup[n] for n in nodes]]
+    if group == "contact" and blade.contact_points.shape[1]:
+        return blade.contact_points
+    idx = blade.node_sets.get(group)
+    if idx is None or idx.size == 0:
+        fail(
+            "contact.group",
+            group,
+            f"missing mesh group: no nodes in group {group!r} of "
+            f"{blade.source}; groups: {_groups(blade)}",
+        )
+    return blade.mesh.p[:, idx]
+
+
+def load_blade(scene, log=None):
+    """Mesh or read the scene's blade; return it with the candidate contact points set.
+
+    Parameters
+    ----------
+    scene : :class:`~femrub.scenes.scene.Scene` with a 3D geometry.
+    log : optional callable for progress messages.
+
+    Returns
+    -------
+    BladeMesh
+    """
+    if log:
+        log(f"geometry: {scene['geometry']['kind']} ...")
+    try:
+        blade = _build(scene)
+    except GeometryError as exc:
+        raise SceneError(f"geometry ({scene['geometry']['kind']}): {exc}") from None
+    root = scene["boundary"].get("root")
+    if root is not None and scene["geometry"]["kind"] != "mesh" and root != "root":
+        if root not in blade.node_sets:
+            fail("boundary.root", root, f"missing mesh group; groups: {_groups(blade)}")
+        blade.node_sets["root"] = blade.node_sets[root]
+    pts = _contact_points(scene, blade)
+    return replace(blade, contact_points=pts, node_sets=dict(blade.node_sets))

@@ -1,0 +1,121 @@
+"""Text of ``femrub run SCENE --explain``: what was built and why, from a build report."""
+
+from __future__ import annotations
+
+import math
+
+__all__ = ["explain"]
+
+
+def _um(x: float) -> str:
+    if not math.isfinite(x):
+        return "inf"
+    return f"{x * 1e3:.3g} mm" if abs(x) >= 1e-3 else f"{x * 1e6:.3g} µm"
+
+
+def _dofs(d: dict) -> str:
+    parts = f"u {d['n_u']} + v {d['n_v']}" + (f" + θ {d['n_theta']}" if d["n_theta"] else "")
+    return f"{d['n_dofs']} state dofs ({parts}), {d['n_contacts']} contact(s)"
+
+
+def _contacts(c: dict, reach_key) -> list[str]:
+    n, kept, dropped = c["candidates"], c["kept"], c["dropped"]
+    if not n:
+        return ["no contact points"]
+    if reach_key == "auto":
+        rule = (
+            f"reach {_um(c['reach'])} = 2 × tip-force deflection {_um(c['deflection'])}"
+            f" + casing intrusion {_um(c['intrusion'])} (+ margin)"
+        )
+    elif reach_key == "all":
+        rule = "contact.reach = 'all'"
+    else:
+        rule = f"contact.reach = {_um(c['reach'])}"
+    lines = [f"{len(kept)} of {n} kept ({rule})"]
+    if c["min_gap_kept"]:
+        lines.append(
+            f"smallest gap over a revolution of the kept ones: "
+            f"{_um(min(c['min_gap_kept']))} .. {_um(max(c['min_gap_kept']))}"
+        )
+    if dropped:
+        shown = ", ".join(f"{d['name']} ({_um(d['min_gap'])})" for d in dropped[:6])
+        more = f" and {len(dropped) - 6} more" if len(dropped) > 6 else ""
+        lines.append(f"dropped {len(dropped)}: never within reach, smallest gap {shown}{more}")
+    return lines
+
+
+def _reduction(r: dict) -> list[str]:
+    if r["method"] == "none":
+        return ["none (reduction.method = 'none'): the full model runs"]
+    head = (
+        f"{r['method']}: n_uv = {r['n_uv']}, n_theta = {r['n_theta']} -> {r['n_reduced']}"
+        f" dofs (from {r['n_full']}; boundary {r['n_boundary_u']} u + "
+        f"{r['n_boundary_theta']} θ dofs, {r['projection']})"
+    )
+    lines = [head]
+    if r["method"] == "auto":
+        f = r.get("natural_frequencies_hz", [])
+        ok = "meets" if r.get("frequency_target_met") else "MISSES"
+        lines.append(
+            f"first {len(f)} natural frequencies within {100 * r['frequency_error']:.2g} %"
+            f" ({ok} target {100 * r['target']:.2g} %): " + ", ".join(f"{x:.4g}" for x in f) + " Hz"
+        )
+        if "thermal_error" in r:
+            ok = "meets" if r.get("thermal_target_met") else "MISSES"
+            lines.append(
+                f"contact-temperature response within {100 * r['thermal_error']:.2g} %"
+                f" ({ok} the target)"
+            )
+    if r.get("note"):
+        lines.append(r["note"])
+    return lines
+
+
+def explain(report: dict, reach_key=None) -> str:
+    """Format a build report (:func:`femrub.scenes.build.build`) as aligned text."""
+    rows = [("scene", f"{report['scene']} ({report['source']})"), ("geometry", report["geometry"])]
+    full, model = report["full"], report["model"]
+    line = _dofs(model)
+    if model["n_dofs"] != full["n_dofs"] or model["n_contacts"] != full["n_contacts"]:
+        line += f"; full model {_dofs(full)}"
+    if "fe_dofs" in full:
+        line += f"; {full['fe_dofs']} FE dofs"
+    rows.append(("model", line))
+    rows.append(("thermal", report["thermal"]))
+    for d in report["dropped"]:
+        rows.append(("dropped", d))
+    reach_key = reach_key or report.get("reach_key", "auto")
+    rows += [("contacts", x) for x in _contacts(report["contacts"], reach_key)]
+    rows += [("reduction", x) for x in _reduction(report["reduction"])]
+    s = report["scheme"]
+    opts = ", ".join(f"{k} {v}" for k, v in s.items() if k not in ("name", "h", "t_end", "steps"))
+    rows.append(
+        (
+            "scheme",
+            f"{s['name']}, h = {s['h']:g} s, t_end = {s['t_end']:g} s: "
+            f"{s['steps']} steps" + (f" ({opts})" if opts else ""),
+        )
+    )
+    rows.append(("signals", ", ".join(report["signals"]) + " (+ gaps, contact forces, energy)"))
+    if report["signals_not_observed"]:
+        rows.append(("not kept", ", ".join(report["signals_not_observed"]) + " (outputs.signals)"))
+    if report["limits"]:
+        rows.append(("limits", ", ".join(f"{k} <= {v:g}" for k, v in report["limits"].items())))
+    for note in report.get("ignored", []):
+        rows.append(("ignored", note))
+    o = report["outputs"]
+    rows.append(
+        (
+            "outputs",
+            f"VTK every {o['vtk_stride']} steps"
+            if o["vtk_stride"]
+            else "no VTK (outputs.vtk_stride = 0)",
+        )
+    )
+    if report.get("natural_frequencies_hz"):
+        rows.append(
+            ("modes", ", ".join(f"{x:.4g}" for x in report["natural_frequencies_hz"]) + " Hz")
+        )
+    t = report.get("timings", {})
+    rows.append(("timings", ", ".join(f"{k} {v:.2f} s" for k, v in t.items())))
+    return "\n".join(f"  {k:<10} {v}" for k, v in rows)

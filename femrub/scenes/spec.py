@@ -1,0 +1,179 @@
+"""Key specifications of scene files: type, unit, default, allowed values, one-line errors.
+
+A :class:`Spec` checks and normalises one value (:meth:`Spec.check`); a :class:`Variant`
+is a table whose allowed keys depend on a selector key (``geometry.kind``, ``scheme.name``,
+...). Every error is a :class:`SceneError` (a ``ValueError``) whose one-line message names
+the key, the value given and what is allowed.
+"""
+
+from __future__ import annotations
+
+import difflib
+import math
+from dataclasses import dataclass, field
+
+from .units import SI_LABEL, to_si
+
+__all__ = ["REQUIRED", "SceneError", "Spec", "Variant", "fail", "unknown_key"]
+
+REQUIRED = object()
+
+
+class SceneError(ValueError):
+    """Invalid scene: the message is one line naming the key, the value and what is allowed."""
+
+    def __init__(self, message: str) -> None:
+        super().__init__(" ".join(str(message).split()))
+
+
+def fail(key: str, value, allowed: str):
+    """Raise :class:`SceneError` ``"key = value: allowed"``."""
+    raise SceneError(f"{key} = {_show(value)}: {allowed}")
+
+
+def _show(value) -> str:
+    text = repr(value)
+    return text if len(text) <= 60 else text[:57] + "..."
+
+
+def unknown_key(key: str, allowed) -> SceneError:
+    """Error for an unknown key, with a close match when there is one."""
+    allowed = sorted(allowed)
+    name = key.rsplit(".", 1)[-1]
+    close = difflib.get_close_matches(name, allowed, n=1)
+    hint = f" (did you mean {close[0]!r}?)" if close else ""
+    return SceneError(f"unknown key {key}{hint}; allowed here: {', '.join(allowed) or 'none'}")
+
+
+@dataclass(frozen=True)
+class Spec:
+    """One scene key.
+
+    Parameters
+    ----------
+    kind : ``"float"``, ``"int"``, ``"bool"``, ``"str"``, ``"choice"``, ``"vec3"``,
+        ``"pair"`` (two floats), ``"ints"`` (list of int), ``"strs"`` (list of str).
+    default : value used when the key is absent (``REQUIRED``: must be given; ``None``:
+        left to the builder).
+    dim : unit dimension of a float (:mod:`femrub.scenes.units`).
+    lo, hi : bounds of a number; ``lo_open`` / ``hi_open`` exclude them.
+    choices : allowed strings of a ``choice``, or words accepted besides a number
+        (``reach = "auto"``) or a list (``signals = "all"``).
+    doc : one-line description (docs/scenes.md).
+    """
+
+    kind: str
+    default: object = None
+    dim: str = "none"
+    lo: float | None = None
+    hi: float | None = None
+    lo_open: bool = False
+    hi_open: bool = False
+    choices: tuple = ()
+    doc: str = ""
+
+    @property
+    def unit(self) -> str:
+        return SI_LABEL.get(self.dim, "-") if self.kind in ("float", "pair", "vec3") else "-"
+
+    def _bounds(self, key, value, x):
+        if not math.isfinite(x):
+            fail(key, value, f"must be a finite number{self._range()}")
+        if self.lo is not None and (x < self.lo or (self.lo_open and x == self.lo)):
+            fail(key, value, f"must be{self._range()}")
+        if self.hi is not None and (x > self.hi or (self.hi_open and x == self.hi)):
+            fail(key, value, f"must be{self._range()}")
+
+    def _range(self) -> str:
+        parts = []
+        if self.lo is not None:
+            parts.append(f"{'>' if self.lo_open else '>='} {self.lo:g}")
+        if self.hi is not None:
+            parts.append(f"{'<' if self.hi_open else '<='} {self.hi:g}")
+        unit = f" {self.unit}" if self.unit != "-" else ""
+        return (
+            (" " + " and ".join(parts) + unit) if parts else (f" (in {unit.strip()})" * bool(unit))
+        )
+
+    def _number(self, key, value) -> float:
+        try:
+            x = to_si(value, self.dim)
+        except ValueError as exc:
+            words = f", or one of {', '.join(map(repr, self.choices))}" if self.choices else ""
+            fail(key, value, f"{exc}{words}")
+        self._bounds(key, value, x)
+        return x
+
+    def check(self, key: str, value):
+        """Normalised value of ``key`` (SI floats, lists), or raise :class:`SceneError`."""
+        if self.choices and self.kind not in ("choice", "str") and isinstance(value, str):
+            if value in self.choices:
+                return value
+            if self.kind != "float":
+                fail(key, value, f"use one of {', '.join(map(repr, self.choices))} or a list")
+        k = self.kind
+        if k == "float":
+            return self._number(key, value)
+        if k == "int":
+            if isinstance(value, bool) or not isinstance(value, int):
+                fail(key, value, f"must be an integer{self._range()}")
+            self._bounds(key, value, value)
+            return int(value)
+        if k == "bool":
+            if not isinstance(value, bool):
+                fail(key, value, "must be true or false")
+            return value
+        if k == "str":
+            if not isinstance(value, str):
+                fail(key, value, "must be a string")
+            return value
+        if k == "choice":
+            if value not in self.choices:
+                fail(key, value, f"use one of {', '.join(map(repr, self.choices))}")
+            return value
+        if k in ("vec3", "pair"):
+            n = 3 if k == "vec3" else 2
+            if not isinstance(value, list) or len(value) != n:
+                words = f" or one of {', '.join(map(repr, self.choices))}" if self.choices else ""
+                fail(key, value, f"must be a list of {n} numbers{words}")
+            return [self._number(f"{key}[{i}]", v) for i, v in enumerate(value)]
+        if k == "ints":
+            ok = isinstance(value, list) and value
+            if not ok or any(isinstance(v, bool) or not isinstance(v, int) for v in value):
+                fail(key, value, "must be a non-empty list of integers")
+            return [int(v) for v in value]
+        if k == "strs":
+            if (
+                not isinstance(value, list)
+                or not value
+                or not all(isinstance(v, str) for v in value)
+            ):
+                words = f" or one of {', '.join(map(repr, self.choices))}" if self.choices else ""
+                fail(key, value, f"must be a non-empty list of strings{words}")
+            return list(value)
+        raise AssertionError(k)  # pragma: no cover
+
+    def describe(self) -> str:
+        """Type, unit, default and allowed values, for the documentation."""
+        if self.default is REQUIRED:
+            d = "required"
+        elif self.default is None:
+            d = "builder default"
+        else:
+            d = repr(self.default)
+        allowed = f"; {' | '.join(map(repr, self.choices))}" if self.choices else ""
+        return f"{self.kind}{allowed} [{self.unit}], default {d}"
+
+
+@dataclass(frozen=True)
+class Variant:
+    """A table whose keys depend on the value of ``selector`` (e.g. ``geometry.kind``)."""
+
+    selector: str
+    variants: dict
+    default: str
+    common: dict = field(default_factory=dict)
+    doc: str = ""
+
+    def keys_for(self, choice: str) -> dict:
+        return {**self.common, **self.variants[choice]}

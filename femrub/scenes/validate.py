@@ -1,0 +1,240 @@
+"""Validation of a scene document: per-key checks against the schema, then cross-checks.
+
+:func:`normalize` turns a parsed TOML document into the normalised scene data (every
+section present, defaults filled in, quantities as SI floats) or raises a one-line
+:class:`~femrub.scenes.spec.SceneError`. It does no heavy work and touches no file;
+:func:`check_files` checks the paths a scene references.
+"""
+
+from __future__ import annotations
+
+import copy
+import os
+from pathlib import Path
+
+from .schema import SCHEMA, TOP
+from .spec import REQUIRED, SceneError, Variant, fail, unknown_key
+
+__all__ = ["normalize", "check_files", "signals_for", "MAX_STEPS"]
+
+#: Largest number of time steps a scene may ask for (memory of the histories).
+MAX_STEPS = 20_000_000
+
+_BAR_SIGNALS = ("tip_displacement", "tip_velocity", "tip_temperature", "contact_force")
+_SOLID_SIGNALS = (
+    "tip_displacement",
+    "tip_temperature",
+    "contact_displacement",
+    "contact_temperature",
+    "contact_force",
+)
+
+
+def signals_for(kind: str) -> tuple[str, ...]:
+    """Signals a geometry kind can observe (``contact_force`` is always in the history)."""
+    return _BAR_SIGNALS if kind == "bar" else _SOLID_SIGNALS
+
+
+def normalize(doc) -> dict:
+    """Validate a parsed scene document; return the normalised data (SI, defaults filled)."""
+    if not isinstance(doc, dict):
+        raise SceneError(f"a scene must be a TOML table, got {type(doc).__name__}")
+    allowed = {**TOP, **SCHEMA}
+    for key in doc:
+        if key not in allowed:
+            raise unknown_key(str(key), allowed)
+    out = {k: spec.check(k, doc[k]) if k in doc else spec.default for k, spec in TOP.items()}
+    physics = doc.get("physics")
+    if isinstance(physics, dict) and isinstance(physics.get("thermal"), bool):
+        physics = {**physics, "thermal": "on" if physics["thermal"] else "off"}
+        doc = {**doc, "physics": physics}
+    for section, spec in SCHEMA.items():
+        out[section] = _table(section, doc.get(section, {}), spec)
+    _cross_check(out)
+    return out
+
+
+def _table(prefix: str, value, spec) -> dict:
+    if not isinstance(value, dict):
+        fail(prefix, value, "must be a table")
+    out, where = {}, ""
+    if isinstance(spec, Variant):
+        choice = value.get(spec.selector, spec.default)
+        if not isinstance(choice, str) or choice not in spec.variants:
+            fail(f"{prefix}.{spec.selector}", choice, f"use one of {', '.join(spec.variants)}")
+        keys = spec.keys_for(choice)
+        out[spec.selector] = choice
+        where = f" ({prefix}.{spec.selector} = {choice!r})"
+        allowed = [spec.selector, *keys]
+    else:
+        keys, allowed = spec, list(spec)
+    for k in value:
+        if k not in allowed:
+            err = unknown_key(f"{prefix}.{k}", allowed)
+            raise SceneError(str(err).replace("; allowed", f"{where}; allowed", 1))
+    for k, s in keys.items():
+        dotted = f"{prefix}.{k}"
+        if isinstance(s, Variant | dict):
+            out[k] = _table(dotted, value.get(k, {}), s)
+        elif k in value:
+            out[k] = s.check(dotted, value[k])
+        elif s.default is REQUIRED:
+            unit = f" in {s.unit}" if s.unit != "-" else ""
+            raise SceneError(f"{dotted} is required{where}: {s.doc}{unit}")
+        elif s.default is not None:
+            out[k] = copy.deepcopy(s.default)
+    return out
+
+
+def _cross_check(d: dict) -> None:
+    geo, contact, loads, physics = d["geometry"], d["contact"], d["loads"], d["physics"]
+    scheme, outputs, casing = d["scheme"], d["outputs"], d["contact"]["casing"]
+    kind = geo["kind"]
+    force = loads["tip_force"]
+    if kind == "bar":
+        if casing["kind"] != "concentric":
+            fail(
+                "contact.casing.kind",
+                casing["kind"],
+                "the 1D bar has a fixed gap; use 'concentric'",
+            )
+        if contact["friction"] != 0.0:
+            fail(
+                "contact.friction",
+                contact["friction"],
+                "the 1D bar has no sliding speed; "
+                "give its heat coefficient as contact.heat_coefficient (m/s)",
+            )
+        if contact["group"] != "contact" or contact.get("nodes") is not None:
+            key = "contact.nodes" if contact.get("nodes") is not None else "contact.group"
+            fail(
+                key,
+                contact.get("nodes") or contact["group"],
+                "the 1D bar's only contact is its tip; remove the key",
+            )
+        if outputs["vtk_stride"]:
+            fail(
+                "outputs.vtk_stride",
+                outputs["vtk_stride"],
+                "VTK output needs a 3D geometry (geometry.kind = 'bar' has no mesh); use 0",
+            )
+        if force.get("direction", "radial") != "radial":
+            fail(
+                "loads.tip_force.direction",
+                force["direction"],
+                "the bar's tip force is axial; use 'radial'",
+            )
+        if d["boundary"].get("root") is not None:
+            fail("boundary.root", d["boundary"]["root"], "the bar is clamped at x = 0; remove it")
+    else:
+        if contact["heat_coefficient"] != 0.0:
+            fail(
+                "contact.heat_coefficient",
+                contact["heat_coefficient"],
+                "3D contacts take their "
+                "heat coefficient from contact.friction (α = friction Ω r); remove the key",
+            )
+        if physics["coupling"] == "paper":
+            fail(
+                "physics.coupling",
+                "paper",
+                "the paper coupling (β K^uu) is the 1D bar's; use "
+                "'physical', 'none' or 'auto' in 3D",
+            )
+        if not d["boundary"]["clamped"]:
+            fail("boundary.clamped", False, "3D blades are clamped at boundary.root; use true")
+        if contact.get("nodes") is not None and kind != "mesh":
+            fail(
+                "contact.nodes",
+                contact["nodes"],
+                "node numbers need geometry.kind = 'mesh'; use contact.group",
+            )
+        if kind == "sections" and (geo.get("path") is None) == (geo.get("files") is None):
+            raise SceneError(
+                "geometry: give exactly one of geometry.path (a folder) and "
+                "geometry.files (a list of section files)"
+            )
+        if kind == "naca":
+            from ..geometry.errors import GeometryError
+            from ..geometry.naca import naca4_parameters
+
+            try:
+                naca4_parameters(geo["code"])
+            except GeometryError as exc:
+                fail("geometry.code", geo["code"], str(exc))
+        if kind in ("box", "naca") and geo.get("h_min") is not None and geo.get("h") is not None:
+            if geo["h_min"] > geo["h"]:
+                fail("geometry.h_min", geo["h_min"], f"must be <= geometry.h = {geo['h']:g} m")
+    known = signals_for(kind)
+    sig = outputs["signals"]
+    for name in [] if sig == "all" else sig:
+        if name not in known or name == "contact_force":
+            fail(
+                "outputs.signals",
+                name,
+                f"unknown signal for geometry.kind = {kind!r}; use "
+                f"'all' or some of {', '.join(k for k in known if k != 'contact_force')}",
+            )
+    for name in d["limits"]:
+        if name not in known:
+            fail(
+                f"limits.{name}",
+                d["limits"][name],
+                f"no such signal for geometry.kind = {kind!r}; limits apply to {', '.join(known)}",
+            )
+    h, t_end = scheme["h"], scheme["t_end"]
+    if t_end < h:
+        fail("scheme.t_end", t_end, f"must be >= scheme.h = {h:g} s")
+    if t_end / h > MAX_STEPS:
+        fail(
+            "scheme.h",
+            h,
+            f"gives {t_end / h:.3g} steps to t_end = {t_end:g} s; at most "
+            f"{MAX_STEPS:.0e} allowed (raise h or lower t_end)",
+        )
+    if force["law"] == "sin" and force["frequency"] == "rotation" and loads["rotation_speed"] == 0:
+        fail(
+            "loads.tip_force.frequency",
+            "rotation",
+            "with loads.rotation_speed = 0 the force "
+            "would vanish; give a frequency in rad/s or a rotation speed",
+        )
+
+
+def shared_dir() -> Path:
+    """Reference-data folder: ``$FEMRUB_SHARED_DATA`` or ``<project>/../shared/data``."""
+    from ..geometry import shared_data_dir
+
+    return shared_data_dir()
+
+
+def resolve_path(text: str, base_dir: Path) -> Path:
+    """A scene path: ``{shared}/...`` in the reference-data folder, else from ``base_dir``."""
+    if text.startswith("{shared}"):
+        return shared_dir() / text[len("{shared}") :].lstrip("/\\")
+    path = Path(os.path.expanduser(text))
+    return path if path.is_absolute() else Path(base_dir) / path
+
+
+def check_files(data: dict, base_dir: Path) -> None:
+    """Raise a one-line :class:`SceneError` when a file the scene needs is missing."""
+    geo = data["geometry"]
+    entries = []
+    if geo["kind"] == "mesh":
+        entries.append(("geometry.path", geo["path"], "file"))
+    elif geo["kind"] == "sections":
+        if geo.get("path") is not None:
+            entries.append(("geometry.path", geo["path"], "folder"))
+        for i, f in enumerate(geo.get("files") or []):
+            entries.append((f"geometry.files[{i}]", f, "file"))
+    for key, text, what in entries:
+        path = resolve_path(text, base_dir)
+        ok = path.is_file() if what == "file" else path.is_dir()
+        if not ok:
+            hint = ""
+            if text.startswith("{shared}"):
+                hint = (
+                    f"; the reference data folder {shared_dir()} is absent or incomplete "
+                    "(set FEMRUB_SHARED_DATA)"
+                )
+            fail(key, text, f"{what} {path} not found{hint}")

@@ -1,0 +1,219 @@
+"""Parameter sweeps of a scene on dask.distributed, resumable, with an interaction map.
+
+``femrub sweep SCENE --param rotation_speed=200:2000:50 -o DIR`` runs every point of the
+grid (cartesian product of the ``--param`` values) as one task that writes its own results
+folder ``DIR/runs/NNN_key=value/`` (:func:`femrub.scenes.run_scene`). Tasks run on a
+``LocalCluster`` of this machine (2 worker processes, 1 thread each, by default) or on the
+cluster behind ``--scheduler ADDRESS`` (the output folder must then be shared). A point
+whose folder holds a finished result is skipped, so rerunning the command after a failure
+or an interruption only runs what is missing. At the end ``DIR/interaction.csv`` and
+``DIR/interaction.png`` (:mod:`femrub.scenes.interaction`) summarise the sweep.
+
+Parameter values: ``start:stop:step`` (stop included), ``a,b,c`` or one value; a unit may
+follow the numbers (``1000:3000:500rpm``); plain numbers are SI.
+"""
+
+from __future__ import annotations
+
+import csv
+import itertools
+import json
+import re
+from pathlib import Path
+
+import numpy as np
+
+from .scenes import FINISHED, SceneError, folder_status, parse_value, resolve_key, run_scene
+from .scenes.scene import Scene
+
+__all__ = ["parse_param", "grid", "run_point", "point_metrics", "run_sweep"]
+
+_RANGE = re.compile(r"^\s*([^:]+):([^:]+):([^:]+?)\s*([A-Za-zµμ/^]+[A-Za-z0-9µμ/^]*)?\s*$")
+#: natural frequencies computed for the Campbell diagram
+N_MODES = 4
+
+
+def _number(text: str, what: str) -> float:
+    try:
+        return float(text)
+    except ValueError:
+        raise SceneError(f"--param {what}: {text!r} is not a number") from None
+
+
+def parse_param(text: str) -> tuple[str, list]:
+    """``"key=spec"`` -> ``(dotted key, values)`` (module docstring for ``spec``)."""
+    if "=" not in text:
+        raise SceneError(f"--param {text!r}: use KEY=START:STOP:STEP or KEY=A,B,C")
+    key, spec = (s.strip() for s in text.split("=", 1))
+    key = resolve_key(key)
+    m = _RANGE.match(spec)
+    if m:
+        a, b, step = (_number(g, text) for g in m.groups()[:3])
+        if step <= 0 or b < a or (b - a) / step > 10_000:
+            raise SceneError(f"--param {text!r}: need START <= STOP, STEP > 0, <= 10000 points")
+        n = int(np.floor((b - a) / step + 1e-9)) + 1
+        values = [float(f"{a + i * step:.12g}") for i in range(n)]
+        unit = m.group(4)
+        return key, [f"{v:g} {unit}" for v in values] if unit else values
+    return key, [parse_value(v.strip()) for v in spec.split(",") if v.strip()]
+
+
+def grid(params: list[tuple[str, list]]) -> list[dict]:
+    """Cartesian product of the parameter values, as dicts of dotted key -> value."""
+    keys = [k for k, _ in params]
+    return [dict(zip(keys, combo)) for combo in itertools.product(*(v for _, v in params))]
+
+
+def _point_name(i: int, changes: dict) -> str:
+    parts = [f"{k.rsplit('.', 1)[-1]}={v}" for k, v in changes.items()]
+    return re.sub(r"[^A-Za-z0-9_=.,+-]+", "", f"{i:03d}_" + "_".join(parts))[:120]
+
+
+def point_metrics(folder) -> dict:
+    """The interaction-map quantities of one run folder (from its ``summary.json``)."""
+    folder = Path(folder)
+    try:
+        s = json.loads((folder / "summary.json").read_text())
+    except (OSError, ValueError):
+        return {"status": "missing", "message": f"no summary.json in {folder}"}
+    peaks = s.get("signals_max_abs", {})
+    temps = [peaks[k] for k in ("tip_temperature", "contact_temperature") if k in peaks]
+    disp = [peaks[k] for k in ("tip_displacement", "contact_displacement") if k in peaks]
+    build = s.get("inputs", {}).get("build", {})
+    return {
+        "status": s.get("status"),
+        "message": s.get("message", ""),
+        "max_tip_displacement": max(disp) if disp else None,
+        "max_contact_force": s.get("max_contact_force"),
+        "max_temperature": max(temps) if temps else 0.0,
+        "first_contact_time": s.get("first_contact_time"),
+        "t_reached": s.get("t_reached"),
+        "wall_seconds": s.get("wall_seconds"),
+        "natural_frequencies_hz": build.get("natural_frequencies_hz", []),
+    }
+
+
+def run_point(scene_data: dict, source: str, base_dir: str, changes: dict, out: str) -> dict:
+    """Run one point (in a worker); never raises: failures come back as a row."""
+    try:
+        scene = Scene(scene_data, source, Path(base_dir)).with_changes(changes)
+        run_scene(scene, out, overwrite=True, modes=N_MODES)
+    except Exception as exc:  # a bad point must not stop the sweep
+        Path(out).mkdir(parents=True, exist_ok=True)
+        msg = f"{type(exc).__name__}: {exc}".splitlines()[0]
+        if folder_status(out) in (None, "running"):
+            (Path(out) / "summary.json").write_text(
+                json.dumps({"status": "failed", "message": msg})
+            )
+        return {"status": "failed", "message": msg}
+    return point_metrics(out)
+
+
+def _client(scheduler, workers):
+    from dask.distributed import Client, LocalCluster
+
+    if scheduler:
+        return Client(scheduler), None
+    cluster = LocalCluster(
+        n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=None,
+        env={"OMP_NUM_THREADS": "1", "OPENBLAS_NUM_THREADS": "1", "MKL_NUM_THREADS": "1"},
+    )  # fmt: skip
+    return Client(cluster), cluster
+
+
+def run_sweep(
+    scene: Scene, params, out, *, scheduler=None, workers=2, overwrite=False, progress=False,
+    log=None,
+) -> list[dict]:  # fmt: skip
+    """Run the sweep; return one row per point (params, metrics, folder, skipped).
+
+    Parameters
+    ----------
+    scene : base :class:`~femrub.scenes.scene.Scene`.
+    params : list of ``(dotted key, values)`` (:func:`parse_param`).
+    out : sweep folder.
+    scheduler : address of a dask scheduler; ``None``: a ``LocalCluster`` of ``workers``.
+    overwrite : rerun points that already have a finished result.
+    """
+    out = Path(out)
+    points = grid(params)
+    keys = [k for k, _ in params]
+    for p in points:  # every point must be a valid scene before any work
+        scene.with_changes(p)
+    out.mkdir(parents=True, exist_ok=True)
+    doc = {"scene": scene.data, "params": {k: v for k, v in params}, "n_points": len(points)}
+    (out / "sweep.json").write_text(json.dumps(doc, indent=2, default=str))
+    (out / "scene.toml").write_text(scene.dumps())
+    rows = []
+    for i, p in enumerate(points):
+        folder = out / "runs" / _point_name(i, p)
+        done = folder_status(folder) in FINISHED and not overwrite
+        rows.append({"point": i, "params": p, "folder": str(folder), "skipped": done})
+    todo = [r for r in rows if not r["skipped"]]
+    for r in rows:
+        if r["skipped"]:
+            r.update(point_metrics(r["folder"]))
+    if log:
+        log(
+            f"sweep: {len(points)} points, {len(rows) - len(todo)} already done, "
+            f"{len(todo)} to run -> {out}/"
+        )
+    if todo:
+        _compute(scene, todo, scheduler, workers, progress)
+    for r in rows:
+        r["x"] = _x(scene.with_changes(r["params"]), keys[0])
+    _write_csv(rows, keys, out / "interaction.csv")
+    from .scenes.interaction import plot_interaction_map
+
+    plot_interaction_map(rows, keys, scene.data, out / "interaction.png")
+    return rows
+
+
+def _compute(scene, todo, scheduler, workers, progress) -> None:
+    from dask.distributed import as_completed
+    from tqdm.auto import tqdm
+
+    client, cluster = _client(scheduler, workers)
+    try:
+        futures = {
+            client.submit(
+                run_point, scene.data, scene.source, str(scene.base_dir), r["params"],
+                r["folder"], pure=False, key=f"femrub-point-{r['point']}-{id(r)}",
+            ): r
+            for r in todo
+        }  # fmt: skip
+        bar = tqdm(total=len(futures), disable=not progress, unit="point", desc="sweep")
+        for fut in as_completed(futures):
+            r = futures[fut]
+            try:
+                r.update(fut.result())
+            except Exception as exc:  # worker lost, etc.
+                r.update(status="failed", message=f"{type(exc).__name__}: {exc}")
+            bar.update(1)
+        bar.close()
+    finally:
+        client.close()
+        if cluster is not None:
+            cluster.close()
+
+
+def _x(scene, key) -> float:
+    v = scene[key]
+    return float(v) if isinstance(v, int | float) and not isinstance(v, bool) else str(v)
+
+
+def _write_csv(rows, keys, path) -> None:
+    n_f = max((len(r.get("natural_frequencies_hz") or []) for r in rows), default=0)
+    cols = ["point", *keys, "status", "max_tip_displacement_m", "max_contact_force_N",
+            "max_temperature_K", "first_contact_time_s", "t_reached_s",
+            *[f"f{j + 1}_hz" for j in range(n_f)], "skipped", "folder", "message"]  # fmt: skip
+    with open(path, "w", newline="") as fh:
+        w = csv.writer(fh)
+        w.writerow(cols)
+        for r in rows:
+            f = list(r.get("natural_frequencies_hz") or []) + [""] * n_f
+            w.writerow([r["point"], *[r["x"] if k == keys[0] else r["params"][k] for k in keys],
+                        r.get("status"), r.get("max_tip_displacement"),
+                        r.get("max_contact_force"), r.get("max_temperature"),
+                        r.get("first_contact_time"), r.get("t_reached"), *f[:n_f],
+                        r["skipped"], r["folder"], r.get("message", "")])  # fmt: skip

@@ -1,0 +1,82 @@
+"""`femrub sweep`: a grid on a LocalCluster with 2 workers, resumed after a failure."""
+
+import csv
+import json
+
+import pytest
+
+from femrub.cli import main
+from femrub.scenes import SceneError
+from femrub.sweep import grid, parse_param
+
+TINY = """
+name = "tiny"
+[geometry]
+kind = "bar"
+n_elements = 4
+[contact]
+casing = { kind = "concentric", clearance = "15 um" }
+heat_coefficient = 3.0
+[loads]
+rotation_speed = 200.0
+tip_force = { law = "sin", amplitude = 7.0 }
+[scheme]
+h = 2e-4
+t_end = 0.02
+"""
+
+
+def test_parse_param():
+    assert parse_param("rotation_speed=200:2000:50") == (
+        "loads.rotation_speed",
+        [200.0 + 50 * i for i in range(37)],
+    )
+    key, values = parse_param("loads.rotation_speed=1000:3000:1000rpm")
+    assert values == ["1000 rpm", "2000 rpm", "3000 rpm"]
+    assert parse_param("contact.restitution=0,0.5,1") == ("contact.restitution", [0, 0.5, 1])
+    assert len(grid([("a.b", [1, 2]), ("c.d", [3, 4, 5])])) == 6
+    for bad in ("rotation_speed", "rotation_speed=3:1:1", "rotation_speed=1:2:0", "nope=1:2:1"):
+        with pytest.raises(SceneError):
+            parse_param(bad)
+
+
+def _csv(path):
+    with open(path) as fh:
+        return list(csv.DictReader(fh))
+
+
+def test_sweep_runs_and_resumes(tmp_path, capsys):
+    scene = tmp_path / "tiny.toml"
+    scene.write_text(TINY)
+    out = tmp_path / "sweep"
+    args = ["sweep", str(scene), "--param", "rotation_speed=100:300:100", "-o", str(out),
+            "--workers", "2", "-q"]  # fmt: skip
+    assert main(args) == 0
+    rows = _csv(out / "interaction.csv")
+    assert [r["loads.rotation_speed"] for r in rows] == ["100.0", "200.0", "300.0"]
+    assert all(r["status"] == "ok" and r["skipped"] == "False" for r in rows)
+    assert all(float(r["max_contact_force_N"]) > 0 and float(r["f1_hz"]) > 0 for r in rows)
+    png = out / "interaction.png"
+    assert png.read_bytes()[:4] == b"\x89PNG" and png.stat().st_size > 20_000
+    runs = sorted((out / "runs").iterdir())
+    assert len(runs) == 3 and all((r / "history.csv").is_file() for r in runs)
+    # a point that failed (here: its summary says so) is rerun, finished ones are skipped
+    stamps = {r.name: (r / "summary.json").stat().st_mtime_ns for r in runs}
+    (runs[1] / "summary.json").write_text(json.dumps({"status": "failed"}))
+    assert main(args) == 0
+    rows = _csv(out / "interaction.csv")
+    assert [r["skipped"] for r in rows] == ["True", "False", "True"]
+    assert all(r["status"] == "ok" for r in rows)
+    for r in (runs[0], runs[2]):
+        assert (r / "summary.json").stat().st_mtime_ns == stamps[r.name]
+    assert capsys.readouterr().err == ""
+
+
+def test_sweep_rejects_an_invalid_point_before_any_work(tmp_path, capsys):
+    scene = tmp_path / "tiny.toml"
+    scene.write_text(TINY)
+    args = ["sweep", str(scene), "--param", "contact.restitution=0,2", "-o",
+            str(tmp_path / "s"), "-q"]  # fmt: skip
+    assert main(args) == 2
+    assert "contact.restitution = 2: must be" in capsys.readouterr().err
+    assert not (tmp_path / "s").exists()
