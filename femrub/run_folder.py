@@ -6,7 +6,8 @@ impulses, energy balance), ``summary.json`` (inputs, versions, timings, energy b
 status), ``signals.png`` and, when a :class:`~femrub.solid.FieldMap` is given, ``vtk/``
 (``.pvd`` + ``.vtu``, written as the run goes) and ``snapshot.png``. A run that is
 interrupted or fails keeps everything written so far and says so in ``summary.json``.
-A finished result is not overwritten unless ``overwrite=True``.
+A finished result (status ok, unstable or diverged-physically) is not overwritten unless
+``overwrite=True``; an interrupted or failed one is simply run again.
 """
 
 from __future__ import annotations
@@ -60,6 +61,7 @@ def run_to_folder(
     progress: bool = False,
     overwrite: bool = False,
     snapshot: bool = True,
+    plots: bool = True,
 ):
     """Run ``stepper`` to ``t_end`` and write the results folder ``out`` (module docstring).
 
@@ -69,10 +71,10 @@ def run_to_folder(
     summary_path = out / "summary.json"
     if summary_path.exists() and not overwrite:
         prev = json.loads(summary_path.read_text()).get("status")
-        if prev not in (None, "running"):
+        if prev not in (None, "running", "interrupted", "failed"):
             raise ResultExists(
                 f"{out} already holds a finished result (status {prev}); "
-                "use another folder or overwrite"
+                "use another folder or --overwrite"
             )
     out.mkdir(parents=True, exist_ok=True)
     model = stepper.model
@@ -100,15 +102,16 @@ def run_to_folder(
     res.save_csv(out / "history.csv")
     res.save_npz(out / "history.npz")
     panels = [k for k in ("tip_displacement", "tip_temperature") if k in res.signals]
-    savefig(
-        tip_panels(
-            [(stepper.name, res, {})],
-            panels=(*panels, "contact_force"),
-            title=f"{stepper.name}, h = {stepper.h:g} s: {res.status}",
-        ),
-        out / "signals.png",
-    )
-    if series is not None and series.frames and snapshot:
+    if plots:
+        savefig(
+            tip_panels(
+                [(stepper.name, res, {})],
+                panels=(*panels, "contact_force"),
+                title=f"{stepper.name}, h = {stepper.h:g} s: {res.status}",
+            ),
+            out / "signals.png",
+        )
+    if series is not None and series.frames and snapshot and plots:
         from .vtk_output import snapshot_png
 
         try:

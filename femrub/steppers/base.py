@@ -162,8 +162,19 @@ class Stepper:
         if h > h_lim:
             status = "unstable"
             message = f"h = {h:.3g} s exceeds the stability limit {h_lim:.3g} s of {self.name}"
-        # states are post-processed in chunks; a callback must only see checked states
-        chunk = 1 if on_state is not None else int(max(1, min(512, 2_000_000 // max(N, 1))))
+        # states are post-processed in chunks; the callback gets the checked ones afterwards
+        chunk = int(max(1, min(512, 2_000_000 // max(N, 1))))
+        GvT = None if c is None else np.ascontiguousarray(c.Gv.T)
+
+        def deliver(i0, last):
+            """Call ``on_state`` for the checked rows ``i0 + 1 .. last`` of the buffer."""
+            if on_state is None:
+                return
+            for r in range(i0 + 1, last + 1):
+                X = buf[r - i0]
+                gdot = c.rate_at(t[r]) + GvT @ X if nc else np.zeros(0)
+                on_state(State(r, t[r], X, imp[r], gap[r], gdot))
+
         buf = np.empty((chunk + 1, N))
         GT = None if c is None else np.ascontiguousarray(c.G.T)
 
@@ -240,13 +251,13 @@ class Stepper:
                     imp[i] = self.impulse
                 if j == chunk or i == n:
                     i_end = flush(i0, j)
+                    deliver(i0, i_end)
                     bar.update(j)
                     buf[0] = buf[j]
                     i0, j = i, 0
-                if on_state is not None:
-                    on_state(self.state)
         except _Stop as stop:
             status, i_end = stop.status, stop.row
+            deliver(i0, min(i_end, i0 + j))
             message = f"{self.name}: {stop.message}" if stop.status == "unstable" else stop.message
         except KeyboardInterrupt:
             status, message = "interrupted", "interrupted by the user; results kept up to here"
