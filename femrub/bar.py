@@ -71,6 +71,13 @@ class BarCase:
             )
         if not (math.isfinite(float(self.grading)) and float(self.grading) >= 1.0):
             raise ValueError(f"grading must be >= 1 (1: uniform mesh), got {self.grading!r}")
+        if self.coupling == "paper" and float(self.grading) != 1.0:
+            # β K^uu expands each node by -β θ whatever its element size: on a graded mesh a
+            # hot micrometre-long tip element would push the tip tens of µm (mesh-dependent)
+            raise ValueError(
+                "coupling='paper' (K^uθ = β K^uu) needs a uniform mesh (grading = 1); "
+                "use coupling='physical' on a graded mesh"
+            )
         if not (isinstance(self.n_elements, int) and self.n_elements >= 1):
             raise ValueError(f"n_elements must be a positive integer, got {self.n_elements!r}")
         if not (0.0 <= float(self.restitution) <= 1.0):

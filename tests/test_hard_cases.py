@@ -55,16 +55,32 @@ def test_chattering_and_long_closed_contact():
         assert np.ptp(res.gap[a + 1 : b, 0]) < 1e-12
 
 
-def test_stiff_heat_equation():
-    case = dict(alpha=3.0, conductivity=3.35e3, grading=3.0, n_elements=60)
+@pytest.mark.parametrize("gamma_thermal", [0.5, 1.0])
+def test_stiff_heat_equation(gamma_thermal):
+    # micrometre-long tip elements (grading 3) and a 1000x conductivity: stiff heat modes
+    case = dict(alpha=3.0, conductivity=3.35e3, grading=3.0, n_elements=60, coupling="physical")
     model = fr.bar_model(**case)
-    res = fr.ThetaMethod(model, 1e-4).run(0.1)
-    assert res.status == "ok" and np.isfinite(res.signal("tip_temperature")).all()
-    assert abs(res.energy["heat_error"][-1]) < 1e-9 * res.energy["friction_heat"][-1]
+    runs = [
+        fr.ThetaMethod(model, h, gamma_thermal=gamma_thermal).run(
+            0.1, limits={"tip_temperature": 1500}
+        )
+        for h in (1e-4, 2.5e-5)
+    ]
+    for res in runs:
+        T = res.signal("tip_temperature")
+        assert res.status == "ok" and np.isfinite(T).all() and T.max() < 50.0
+        assert abs(res.energy["heat_error"][-1]) < 1e-9 * res.energy["friction_heat"][-1]
+    T_end = [r.signal("tip_temperature")[-1] for r in runs]
+    assert T_end[0] == pytest.approx(T_end[1], rel=0.05)  # converged in h
     carp = fr.Carpenter(model, 1e-5)
     assert carp.stability_limit() < 1e-6  # explicit heat equation: tiny stable step
     out = carp.run(0.01)
     assert out.status == "unstable" and np.isfinite(out.signal("tip_temperature")).all()
+
+
+def test_paper_coupling_refuses_graded_mesh():
+    with pytest.raises(ValueError, match="uniform mesh"):
+        fr.bar_model(grading=3.0)
 
 
 def test_many_contacts_closing_at_once():

@@ -2,8 +2,11 @@
 
 One step from ``t_k`` to ``t_{k+1} = t_k + h`` (paper Eq. 16a, impulse ``P = h λ_{k+1}``)::
 
-    D X_{k+1} = D X_k + h [B X_k + γ F_{k+1} + (1 − γ) F_k] + (Hm + Ht diag α) P
-    D = A − h γ B                                   (constant: factorised once)
+    D X_{k+1} = D X_k + h [B X_k + Γ F_{k+1} + (I − Γ) F_k] + (Hm + Ht diag α) P
+    D = A − h Γ B                                   (constant: factorised once)
+
+with ``Γ = γ I`` as in the paper, or ``γ`` on the mechanical rows and ``γ_θ`` on the heat
+rows (``gamma_thermal``).
 
 so ``X_{k+1} = X_p + Z P`` with the free prediction ``X_p`` (Eq. 17) and
 ``Z = D⁻¹ (Hm + Ht diag α)``. The gap velocity is ``ġ_{k+1} = ġ_p + W P`` with the Delassus
@@ -39,6 +42,7 @@ the position level; it stays below ``h |ġ|`` (paper Sec. 4.3).
 from __future__ import annotations
 
 import numpy as np
+import scipy.sparse as sp
 
 from ..linalg import Factorised, compact
 from .base import Stepper
@@ -57,28 +61,46 @@ class ThetaMethod(Stepper):
     model : :class:`~femrub.model.FirstOrderModel`.
     h : time step (s).
     gamma : θ-method parameter γ in [1/2, 1] (1/2: trapezoidal, no numerical dissipation).
+    gamma_thermal : γ of the heat-equation rows (default: ``gamma``). The trapezoidal rule is
+        not L-stable: on a stiff heat equation (fine elements at the tip, large
+        conductivity) its stiff thermal modes ring from step to step, and through the
+        coupling and the frictional heat this can drive a spurious runaway. 1 (backward
+        Euler on the heat rows) damps them while the mechanics stays trapezoidal.
     activation : ``"paper"`` or ``"predicted"`` (see module docstring).
     """
 
     name = "theta"
 
-    def __init__(self, model, h, *, gamma: float = 0.5, activation: str = "paper", t0=0.0):
+    def __init__(
+        self,
+        model,
+        h,
+        *,
+        gamma: float = 0.5,
+        gamma_thermal: float | None = None,
+        activation: str = "paper",
+        t0=0.0,
+    ):
         gamma = float(gamma)
-        if not (0.5 <= gamma <= 1.0):
-            raise ValueError(f"gamma must be in [0.5, 1] for a stable θ-method, got {gamma!r}")
+        gamma_t = gamma if gamma_thermal is None else float(gamma_thermal)
+        for name, val in (("gamma", gamma), ("gamma_thermal", gamma_t)):
+            if not (0.5 <= val <= 1.0):
+                raise ValueError(f"{name} must be in [0.5, 1] for a stable θ-method, got {val!r}")
         if activation not in ACTIVATION_RULES:
             raise ValueError(
                 f"unknown activation rule {activation!r}; use one of {', '.join(ACTIVATION_RULES)}"
             )
-        self.gamma, self.activation = gamma, activation
+        self.gamma, self.gamma_thermal, self.activation = gamma, gamma_t, activation
         super().__init__(model, h, t0=t0)
 
     def _setup(self):
-        m, h, g = self.model, self.h, self.gamma
-        D = (m.A - (h * g) * m.B).tocsc()
-        self._lu = Factorised(D, what="iteration matrix D = A - h γ B")
+        m, h = self.model, self.h
+        gam = np.full(m.n_dofs, self.gamma)
+        gam[m.layout.t] = self.gamma_thermal  # Γ: per-row θ-method parameter
+        D = (m.A - h * (sp.diags(gam) @ m.B)).tocsc()
+        self._lu = Factorised(D, what="iteration matrix D = A - h Γ B")
         hB = (h * m.B).tocsc()
-        if self._lu.dense:  # amplification matrix: X_p = T X_k + Y s̄
+        if self._lu.dense:  # amplification matrix: X_p = T X_k + Y1 s_{k+1} + Y0 s_k
             self._T = np.eye(m.n_dofs) + self._lu.solve(hB.toarray())
         else:
             self._hB = compact(hB)
@@ -88,33 +110,71 @@ class ThetaMethod(Stepper):
             if m.loads
             else np.zeros((m.n_dofs, 0))
         )
-        self._hF = h * F
-        self._Y = self._lu.solve(self._hF) if (self._lu.dense and F.shape[1]) else None
+        self._hF1, self._hF0 = h * gam[:, None] * F, h * (1.0 - gam)[:, None] * F
+        self._Y1 = self._Y0 = None
+        if self._lu.dense and F.shape[1]:
+            self._Y1, self._Y0 = self._lu.solve(self._hF1), self._lu.solve(self._hF0)
         self._sk = self._signal_values(self.t)
         c = m.contact
+        self._fast = False
         if c is not None:
             self._Zm = self._lu.solve(c.Hm)
             self._Zt = self._lu.solve(c.Ht)
             self._Wm, self._Wt = c.Gv.T @ self._Zm, c.Gv.T @ self._Zt
             self._GvT, self._GT = np.ascontiguousarray(c.Gv.T), np.ascontiguousarray(c.G.T)
+            # one contact, constant gap and α, fixed obstacle, dense: scalar fast path
+            if (
+                c.n == 1
+                and self._lu.dense
+                and not callable(c.gap0)
+                and not callable(c.heat_coefficient)
+                and c.gap_rate is None
+            ):
+                a = c.heat_coefficient
+                self._fast = True
+                self._z = (self._Zm + self._Zt * a)[:, 0].copy()
+                self._w = float((self._Wm + self._Wt * a)[0, 0])
+                self._gv, self._gr = self._GvT[0].copy(), self._GT[0].copy()
+                self._g0, self._e = float(c.gap0[0]), float(c.restitution)
+                if self._w <= 0.0:
+                    raise ValueError("non-positive Delassus operator at the contact")
         self._warm = None
 
     def _signal_values(self, t):
         return np.array([float(sig(t)) for sig in self._signals])
+
+    def _step_fast(self, Xk, Xp):
+        """One contact (see ``_setup``): the LCP and the activation fixed point in closed form.
+
+        For one contact the paper rule's fixed point is "active iff closed at t_k or
+        predicted closed at t_{k+1}"; the impulse is the prox of Eq. (25b).
+        """
+        gdk = self._gv @ Xk
+        gap_k = self._g0 + self._gr @ Xk
+        if self.activation == "predicted":
+            active = gap_k + self.gamma * self.h * gdk <= 0.0
+        else:
+            active = gap_k <= 0.0 or self._g0 + self._gr @ Xp <= 0.0
+        if not active:
+            return Xp, np.zeros(1)
+        e = 1.0 if gdk > 0.0 else self._e
+        P = max(0.0, -(self._gv @ Xp + e * gdk) / self._w)
+        return Xp + P * self._z, np.array([P])
 
     def _step(self):
         m, h, g = self.model, self.h, self.gamma
         t1 = self.t + h
         Xk = self.X
         s1 = self._signal_values(t1)
-        sbar = g * s1 + (1.0 - g) * self._sk
-        self._sk = s1
+        s0, self._sk = self._sk, s1
         if self._lu.dense:
             Xp = self._T @ Xk
-            if self._Y is not None:
-                Xp += self._Y @ sbar
+            if self._Y1 is not None:
+                Xp += self._Y1 @ s1 + self._Y0 @ s0
         else:
-            Xp = Xk + self._lu.solve(self._hB @ Xk + self._hF @ sbar)
+            Xp = Xk + self._lu.solve(self._hB @ Xk + self._hF1 @ s1 + self._hF0 @ s0)
+        if self._fast:
+            return self._step_fast(Xk, Xp)
         c = m.contact
         if c is None:
             return Xp, np.zeros(0)

@@ -1,0 +1,222 @@
+"""Shared helpers of the speed and accuracy benchmarks (SI units throughout).
+
+* the two test problems: the paper's bar (``paper_model``) and a free elastic bar impacting
+  a rigid obstacle (``impact_model``, exact d'Alembert solution ``impact_exact``);
+* the error measures of ``docs/performance.md`` (``Measures``, ``compare``);
+* CPU timing, peak memory, Markdown tables and JSON output.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import platform
+import resource
+import sys
+import time
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+import femrub as fr
+from femrub.analytic import bar_impact
+
+ROOT = Path(__file__).resolve().parents[1]
+DOCS = ROOT / "docs"
+OUT = DOCS / "performance"
+
+# free bar impacting a rigid obstacle (examples/bar_impact.py; Doyen, Ern & Piperno 2011)
+E, RHO, AREA, LENGTH, V0, GAP = 110e9, 4500.0, 1e-6, 0.3, 0.1, 1e-5
+WAVE_SPEED = math.sqrt(E / RHO)
+EXACT = bar_impact(LENGTH, E, RHO, AREA, V0, GAP)
+IMPACT_T_END = 1.5 * (EXACT.contact_start + EXACT.contact_duration)
+#: load period of the paper case (s): one contact phase per period
+PERIOD = 2.0 * math.pi / fr.PAPER.force_frequency
+ALPHA = 3.0
+
+
+def paper_model(alpha: float = ALPHA, coupled: bool = True, **changes) -> fr.FirstOrderModel:
+    """The paper's 20-node bar (60 dofs), coupled through ``β K^uu`` unless ``coupled=False``."""
+    return fr.bar_model(alpha=alpha, coupling="paper" if coupled else "none", **changes)
+
+
+def impact_model(n_elements: int, **changes) -> fr.FirstOrderModel:
+    """Free bar of ``n_elements`` elements moving at ``V0`` towards an obstacle ``GAP`` away."""
+    case = dict(
+        n_elements=n_elements,
+        clamped=False,
+        total_mass=None,
+        density=RHO,
+        young=E,
+        area=AREA,
+        length=LENGTH,
+        force_amplitude=0.0,
+        coupling="none",
+        alpha=0.0,
+        gap=GAP,
+        initial_velocity=V0,
+        restitution=0.0,
+    )
+    case.update(changes)
+    return fr.bar_model(**case)
+
+
+def impact_exact_displacement(t: np.ndarray) -> np.ndarray:
+    """Exact tip displacement (m): free flight, held at the obstacle for 2L/c, rebound at −v0."""
+    t1 = EXACT.contact_start
+    t2 = t1 + EXACT.contact_duration
+    return np.where(t < t1, V0 * t, np.where(t < t2, GAP, GAP - V0 * (t - t2)))
+
+
+@dataclass
+class Measures:
+    """What the error measures compare: tip displacement history, end temperature, phases."""
+
+    t: np.ndarray
+    u: np.ndarray
+    T_end: float
+    phases: np.ndarray
+    t1: float
+
+    @classmethod
+    def of(cls, res, period: float | None, t_end: float) -> Measures:
+        """Measures of a run up to ``t_end``; ``period`` splits the impulses into phases."""
+        n = int(np.searchsorted(res.t, t_end * (1 + 1e-9), side="right"))
+        t, imp = res.t[:n], res.impulse[:n].sum(axis=1)
+        T = res.signals.get("tip_temperature")
+        return cls(
+            t=t,
+            u=res.signal("tip_displacement")[:n],
+            T_end=float(T[n - 1, 0]) if T is not None else math.nan,
+            phases=phase_impulses(t, imp, period, t_end),
+            t1=first_contact(t, imp),
+        )
+
+
+def phase_impulses(t, impulse, period: float | None, t_end: float) -> np.ndarray:
+    """Impulse (N s) per contact phase: per load period, or the whole run if no period."""
+    if period is None:
+        return np.array([impulse.sum()])
+    n = max(1, math.ceil(t_end / period - 1e-9))
+    # the impulse of row k belongs to the step (t_{k-1}, t_k]
+    idx = np.clip(((t - 1e-12) // period).astype(int), 0, n - 1)
+    return np.bincount(idx, weights=impulse, minlength=n)
+
+
+def first_contact(t, impulse, rel: float = 1e-6) -> float:
+    """First time (s) whose step carries an impulse above ``rel`` × the largest one."""
+    if impulse.size == 0 or impulse.max() <= 0:
+        return math.nan
+    return float(t[np.argmax(impulse > rel * impulse.max())])
+
+
+def compare(m: Measures, ref: Measures) -> dict[str, float]:
+    """Error measures of ``m`` against ``ref`` (definitions in docs/performance.md).
+
+    ``u_L2``: time-L2 relative error of the tip displacement (piecewise-linear interpolant
+    of ``m`` on the reference grid); ``u_max``: largest error / largest reference value;
+    ``T_end``: relative error of the tip temperature at the end; ``P_phase``: largest error
+    of the impulse of a contact phase / largest reference phase impulse; ``t1``: error of
+    the first-contact time (s).
+    """
+    u = np.interp(ref.t, m.t, m.u)
+    du = u - ref.u
+    k = min(m.phases.size, ref.phases.size)
+    dP = np.abs(m.phases[:k] - ref.phases[:k])
+    if m.phases.size != ref.phases.size:
+        dP = np.r_[dP, np.abs(m.phases[k:]), np.abs(ref.phases[k:])]
+    return {
+        "u_L2": float(np.sqrt(_integral(du**2, ref.t) / _integral(ref.u**2, ref.t))),
+        "u_max": float(np.max(np.abs(du)) / np.max(np.abs(ref.u))),
+        "T_end": abs(m.T_end - ref.T_end) / abs(ref.T_end) if ref.T_end else math.nan,
+        "P_phase": float(dP.max() / np.abs(ref.phases).max()),
+        "t1": abs(m.t1 - ref.t1),
+    }
+
+
+def _integral(y, t) -> float:
+    """Trapezoidal rule."""
+    return float(0.5 * np.sum((y[1:] + y[:-1]) * np.diff(t)))
+
+
+def exact_impact_measures(n: int = 20001) -> Measures:
+    """The exact solution of the impact problem as :class:`Measures`."""
+    t = np.linspace(0.0, IMPACT_T_END, n)
+    return Measures(
+        t=t,
+        u=impact_exact_displacement(t),
+        T_end=math.nan,
+        phases=np.array([EXACT.impulse]),
+        t1=EXACT.contact_start,
+    )
+
+
+def timed(fn, *args, **kwargs):
+    """``(fn(*args, **kwargs), CPU seconds, wall seconds)``."""
+    c0, w0 = time.process_time(), time.perf_counter()
+    out = fn(*args, **kwargs)
+    return out, time.process_time() - c0, time.perf_counter() - w0
+
+
+def peak_rss_mib() -> float:
+    """Peak resident memory of this process (MiB)."""
+    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
+
+
+def machine() -> dict:
+    """Where the numbers come from: platform, Python, cores, load average."""
+    import os
+
+    return {
+        "python": platform.python_version(),
+        "platform": platform.platform(),
+        "cores": os.cpu_count(),
+        "load_average": [round(x, 2) for x in os.getloadavg()],
+        "femrub": fr.__version__,
+        "numpy": np.__version__,
+        "executable": sys.executable,
+    }
+
+
+def fmt(x, digits: int = 3) -> str:
+    """Number for a Markdown table: ``—`` for NaN/None, scientific for small or large."""
+    if x is None or (isinstance(x, float) and not math.isfinite(x)):
+        return "—"
+    if isinstance(x, (int, np.integer)) and not isinstance(x, bool):
+        return str(int(x))
+    if isinstance(x, str):
+        return x
+    x = float(x)
+    if x == 0.0:
+        return "0"
+    if 1e-2 <= abs(x) < 1e4:
+        return f"{x:.{digits}g}"
+    return f"{x:.{max(digits - 1, 1)}e}"
+
+
+def md_table(rows: list[dict], cols: list[tuple[str, str]]) -> str:
+    """Markdown table of ``rows`` with ``cols = [(key, header), ...]``."""
+    out = ["| " + " | ".join(h for _, h in cols) + " |", "|" + "---|" * len(cols)]
+    for r in rows:
+        out.append("| " + " | ".join(fmt(r.get(k)) for k, _ in cols) + " |")
+    return "\n".join(out)
+
+
+def write_json(path: Path, doc) -> Path:
+    """Write ``doc`` as indented JSON (NaN as null)."""
+
+    def clean(x):
+        if isinstance(x, dict):
+            return {k: clean(v) for k, v in x.items()}
+        if isinstance(x, (list, tuple)):
+            return [clean(v) for v in x]
+        if isinstance(x, (np.floating, float)):
+            return float(x) if math.isfinite(x) else None
+        if isinstance(x, np.integer):
+            return int(x)
+        return x
+
+    path.parent.mkdir(parents=True, exist_ok=True)
+    path.write_text(json.dumps(clean(doc), indent=1))
+    return path
