@@ -29,11 +29,9 @@ import subprocess
 import sys
 import tempfile
 import time
-from contextlib import contextmanager, nullcontext
 from pathlib import Path
 
 import numpy as np
-from threadpoolctl import threadpool_limits
 
 import femrub as fr
 
@@ -112,81 +110,17 @@ def siconos_run(N, steps, h, storage, reps) -> dict:
     return json.loads(out.stdout.strip().splitlines()[-1])
 
 
-class FastTheta(fr.ThetaMethod):
-    """Prototype of the recommended single-contact fast path (see docs/performance.md).
-
-    Same results bit for bit as :class:`femrub.ThetaMethod` on a dense model with one
-    contact, constant gap and constant α; falls back to the general step otherwise.
-    """
-
-    def _setup(self):
-        super()._setup()
-        c = self.model.contact
-        self._fast = (
-            c is not None
-            and c.n == 1
-            and self._lu.dense
-            and not callable(c.heat_coefficient)
-            and not callable(c.gap0)
-            and getattr(c, "gap_rate", None) is None
-        )
-        if self._fast:
-            a = float(c.heat_coefficient[0])
-            self._z = (self._Zm + self._Zt * a)[:, 0].copy()
-            self._w = float((self._Wm + self._Wt * a)[0, 0])
-            self._gv, self._gr = self._GvT[0].copy(), self._GT[0].copy()
-            self._g0, self._e, self._P0 = float(c.gap0[0]), float(c.restitution), np.zeros(1)
-
-    def _step(self):
-        if not self._fast:
-            return super()._step()
-        h, g, Xk = self.h, self.gamma, self.X
-        Xp = self._T @ Xk
-        if self._Y is not None:
-            s1 = self._signal_values(self.t + h)
-            Xp += self._Y @ (g * s1 + (1.0 - g) * self._sk)
-            self._sk = s1
-        gdk = self._gv @ Xk
-        if self.activation == "predicted":
-            active = self._g0 + self._gr @ Xk + g * h * gdk <= 0.0
-        else:  # one contact: the paper rule's fixed point reduces to this test
-            active = self._g0 + self._gr @ Xk <= 0.0 or self._g0 + self._gr @ Xp <= 0.0
-        if not active:
-            return Xp, self._P0
-        e = 1.0 if gdk > 0.0 else self._e
-        P = max(0.0, -(self._gv @ Xp + e * gdk) / self._w)
-        return (Xp + P * self._z if P > 0.0 else Xp), np.array([P])
-
-
-@contextmanager
-def proposed():
-    """Changes 1 and 3 of docs/performance.md: one BLAS thread, SuperLU for every size."""
-    import femrub.linalg as la
-
-    saved = getattr(la, "PARDISO_ABOVE", None)
-    if saved is not None:
-        la.PARDISO_ABOVE = math.inf
-    try:
-        with threadpool_limits(limits=1, user_api="blas"):
-            yield
-    finally:
-        if saved is not None:
-            la.PARDISO_ABOVE = saved
-
-
-VARIANTS = ("shipped", "shipped, energy on", "proposed", "proposed, energy on")
-VARIANTS += ("proposed + fast path",)
+VARIANTS = ("femrub", "femrub, energy on")
 
 
 def femrub_run(model, h, steps, variant, reps) -> tuple[float, float]:
     """Best per-step CPU (s) of ``reps`` runs, and the final tip displacement (m)."""
     best, tip = math.inf, math.nan
     for _ in range(reps):
-        ctx = proposed() if variant.startswith("proposed") else nullcontext()
-        with ctx:
-            cls = FastTheta if variant.endswith("fast path") else fr.ThetaMethod
-            stepper = cls(model, h, activation="predicted")
-            res = stepper.run(steps * h, energy=variant.endswith("energy on"))
+        stepper = fr.ThetaMethod(model, h, activation="predicted")
+        res = stepper.run(steps * h, energy=variant.endswith("energy on"))
+        if res.status != "ok" or res.steps == 0:
+            raise RuntimeError(f"femrub run {variant!r} ended {res.status}: {res.message}")
         best = min(best, res.cpu_seconds / res.steps)
         tip = float(res.signal("tip_displacement")[-1])
     return best, tip
@@ -204,7 +138,7 @@ def compare_sizes(cfg, log) -> tuple[list[dict], str | None]:
         stepper, fact, _ = C.timed(fr.ThetaMethod, model, h, activation="predicted")
         D = (model.A - 0.5 * h * model.B).tocsr()
         base = {"N": N, "state": model.n_dofs, "steps": steps, "h": h, "nnz_D": D.nnz}
-        variants = [v for v in VARIANTS if stepper._lu.dense or not v.endswith("fast path")]
+        variants = list(VARIANTS)
         tips = {}
         for v in variants:
             per, tip = femrub_run(model, h, steps, v, cfg["reps"])
@@ -219,7 +153,7 @@ def compare_sizes(cfg, log) -> tuple[list[dict], str | None]:
                 continue
             reps = cfg["reps"] if N <= 100 else 1
             s = siconos_run(N, steps, h, storage, reps)
-            dtip = abs(s["tip"] - tips["shipped"]) / abs(tips["shipped"])
+            dtip = abs(s["tip"] - tips["femrub"]) / abs(tips["femrub"])
             rows.append({**base, "code": "Siconos", "variant": storage, **s, "tip_diff": dtip})
             log(f"  N = {N}: Siconos {storage}: {1e6 * s['per_step']:.1f} µs/step")
     return rows, missing
