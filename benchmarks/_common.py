@@ -43,23 +43,11 @@ def paper_model(alpha: float = ALPHA, coupled: bool = True, **changes) -> fr.Fir
 
 def impact_model(n_elements: int, **changes) -> fr.FirstOrderModel:
     """Free bar of ``n_elements`` elements moving at ``V0`` towards an obstacle ``GAP`` away."""
-    case = dict(
-        n_elements=n_elements,
-        clamped=False,
-        total_mass=None,
-        density=RHO,
-        young=E,
-        area=AREA,
-        length=LENGTH,
-        force_amplitude=0.0,
-        coupling="none",
-        alpha=0.0,
-        gap=GAP,
-        initial_velocity=V0,
-        restitution=0.0,
+    from femrub.bar import impact_bar_model
+
+    return impact_bar_model(
+        n_elements, velocity=V0, gap=GAP, young=E, density=RHO, area=AREA, length=LENGTH, **changes
     )
-    case.update(changes)
-    return fr.bar_model(**case)
 
 
 def impact_exact_displacement(t: np.ndarray) -> np.ndarray:

@@ -10,6 +10,7 @@ import numpy as np
 
 import femrub as fr
 from femrub.analytic import bar_impact
+from femrub.bar import impact_bar_model
 
 E, RHO, AREA, LENGTH, V0, GAP = 110e9, 4500.0, 1e-6, 0.3, 0.1, 1e-5
 exact = bar_impact(LENGTH, E, RHO, AREA, V0, GAP)
@@ -17,20 +18,8 @@ exact = bar_impact(LENGTH, E, RHO, AREA, V0, GAP)
 
 def simulate(n_elements: int, scheme: str = "theta", courant: float = 0.5) -> dict:
     """Run one discretisation; return contact start/duration, impulse, rebound velocity."""
-    model = fr.bar_model(
-        n_elements=n_elements,
-        clamped=False,
-        total_mass=None,
-        density=RHO,
-        young=E,
-        area=AREA,
-        length=LENGTH,
-        force_amplitude=0.0,
-        coupling="none",
-        alpha=0.0,
-        gap=GAP,
-        initial_velocity=V0,
-        restitution=0.0,
+    model = impact_bar_model(
+        n_elements, velocity=V0, gap=GAP, young=E, density=RHO, area=AREA, length=LENGTH
     )
     c = np.sqrt(E / RHO)
     h = courant * (LENGTH / n_elements) / c

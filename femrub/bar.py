@@ -20,7 +20,7 @@ from .material import Material, check_finite_positive
 from .model import FirstOrderModel
 from .thermoelastic import ThermoelasticMatrices, assemble_thermoelastic
 
-__all__ = ["BarCase", "PAPER", "bar_matrices", "bar_model", "rpm"]
+__all__ = ["BarCase", "PAPER", "bar_matrices", "bar_model", "impact_bar_model", "rpm"]
 
 
 def rpm(value: float) -> float:
@@ -180,3 +180,38 @@ def bar_model(case: BarCase = PAPER, **changes) -> FirstOrderModel:
         model = model.with_(x0=x0)
     model.info.update(case=case.as_dict(), tip_dof=tip, n_t_assembled=n_t)
     return model
+
+
+def impact_bar_model(
+    n_elements: int,
+    *,
+    velocity: float = 0.1,
+    gap: float = 1e-5,
+    young: float = 110e9,
+    density: float = 4500.0,
+    area: float = 1e-6,
+    length: float = 0.3,
+    **changes,
+) -> FirstOrderModel:
+    """A free bar moving at ``velocity`` (m/s) towards a rigid obstacle ``gap`` (m) away.
+
+    The benchmark with an exact solution (:func:`femrub.analytic.bar_impact`): no clamp, no
+    load, no thermal part, consistent density (no lumped total mass), e = 0 at the contact.
+    """
+    case = dict(
+        n_elements=n_elements,
+        clamped=False,
+        total_mass=None,
+        density=density,
+        young=young,
+        area=area,
+        length=length,
+        force_amplitude=0.0,
+        coupling="none",
+        alpha=0.0,
+        gap=gap,
+        initial_velocity=velocity,
+        restitution=0.0,
+    )
+    case.update(changes)
+    return bar_model(PAPER, **case)
