@@ -20,7 +20,7 @@ from pathlib import Path
 import numpy as np
 
 import femrub as fr
-from femrub.analytic import bar_impact
+from femrub.cases.analytic import bar_impact
 
 ROOT = Path(__file__).resolve().parents[1]
 DOCS = ROOT / "docs"
@@ -43,7 +43,7 @@ def paper_model(alpha: float = ALPHA, coupled: bool = True, **changes) -> fr.Fir
 
 def impact_model(n_elements: int, **changes) -> fr.FirstOrderModel:
     """Free bar of ``n_elements`` elements moving at ``V0`` towards an obstacle ``GAP`` away."""
-    from femrub.bar import impact_bar_model
+    from femrub.cases.bar import impact_bar_model
 
     return impact_bar_model(
         n_elements, velocity=V0, gap=GAP, young=E, density=RHO, area=AREA, length=LENGTH, **changes

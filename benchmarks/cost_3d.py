@@ -28,10 +28,10 @@ FULL_STEPPING_BELOW = 40_000  # FE dofs: the full model's sparse factorisation a
 def one_size(h_mesh: float) -> dict:
     """Build, reduce and step one box blade; return the timings (s) and sizes."""
     import femrub as fr
-    from femrub.casing import Lobed
+    from femrub.contact.casing import Lobed
+    from femrub.fem.solid import solid_model
     from femrub.geometry import box_blade
     from femrub.reduction import craig_bampton_thermal
-    from femrub.solid import solid_model
 
     t0 = time.perf_counter()
     blade = box_blade(span=0.1, chord=0.03, thickness=0.003, h=h_mesh, hub_radius=0.3, n_contact=8)

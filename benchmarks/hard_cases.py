@@ -22,7 +22,7 @@ from pathlib import Path
 import numpy as np
 
 import femrub as fr
-from femrub.first_order import ContactSpec, Load, first_order_model
+from femrub.model.build import ContactSpec, Load, first_order_model
 
 try:
     from . import _common as C

@@ -31,7 +31,7 @@ import numpy as np
 import skfem as fem
 
 import femrub as fr
-from femrub.first_order import ContactSpec, Load, first_order_model
+from femrub.model.build import ContactSpec, Load, first_order_model
 from femrub.reduction import ThermoelasticCraigBampton
 
 L, W, H = 0.1, 0.02, 0.004  # m

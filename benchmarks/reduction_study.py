@@ -23,7 +23,8 @@ from pathlib import Path
 import numpy as np
 
 import femrub as fr
-from femrub.reduction import PAPER_SIZES, PROJECTIONS, ThermoelasticCraigBampton
+from femrub.cases.paper_models import PAPER_SIZES
+from femrub.reduction import PROJECTIONS, ThermoelasticCraigBampton
 
 ALPHA, H, T_END = 3.0, 1e-4, 0.4
 GRID_UV = (0, 2, 3, 4, 6, 8, 12, 20, 38)

@@ -9,8 +9,8 @@ Results are module-level names (``exact``, ``rows``) that the tests import.
 import numpy as np
 
 import femrub as fr
-from femrub.analytic import bar_impact
-from femrub.bar import impact_bar_model
+from femrub.cases.analytic import bar_impact
+from femrub.cases.bar import impact_bar_model
 
 E, RHO, AREA, LENGTH, V0, GAP = 110e9, 4500.0, 1e-6, 0.3, 0.1, 1e-5
 exact = bar_impact(LENGTH, E, RHO, AREA, V0, GAP)

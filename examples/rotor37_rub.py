@@ -22,11 +22,11 @@ import time
 from pathlib import Path
 
 import femrub as fr
-from femrub.casing import TwoLobePiollet
+from femrub.contact.casing import TwoLobePiollet
+from femrub.fem.solid import solid_model
 from femrub.geometry import read_rotor37_mesh, shared_data_dir
+from femrub.output.run_folder import run_to_folder
 from femrub.reduction import craig_bampton_thermal
-from femrub.run_folder import run_to_folder
-from femrub.solid import solid_model
 
 OMEGA = 1344.0  # rad/s
 FRICTION = 0.15

@@ -19,11 +19,11 @@ from pathlib import Path
 import numpy as np
 
 import femrub as fr
-from femrub.casing import Lobed
+from femrub.contact.casing import Lobed
+from femrub.fem.solid import solid_model
 from femrub.geometry import naca_blade
+from femrub.output.run_folder import run_to_folder
 from femrub.reduction import craig_bampton_thermal
-from femrub.run_folder import run_to_folder
-from femrub.solid import solid_model
 
 OUT = Path(os.environ.get("FEMRUB_EXAMPLE_OUT", "twisted-blade-out"))
 OMEGA = 1500.0  # rad/s

@@ -3,13 +3,13 @@
 SI units throughout (m, kg, s, K, N, W, J, Pa).
 """
 
-from .bar import PAPER, BarCase, bar_matrices, bar_model, rpm
-from .first_order import ContactSpec, Load, first_order_model
-from .material import Material
-from .model import Contact, EnergyForms, FirstOrderModel, Layout, LoadTerm
-from .results import Results
+from .cases.bar import PAPER, BarCase, bar_matrices, bar_model, rpm
+from .fem.assembly import ThermoelasticMatrices, assemble_thermoelastic
+from .fem.material import Material
+from .model.build import ContactSpec, Load, first_order_model
+from .model.first_order import Contact, EnergyForms, FirstOrderModel, Layout, LoadTerm
+from .output.results import Results
 from .steppers import Carpenter, Penalty, ThetaMethod, make_stepper
-from .thermoelastic import ThermoelasticMatrices, assemble_thermoelastic
 
 __version__ = "0.1.0"
 

@@ -5,8 +5,8 @@ import json
 import numpy as np
 import pytest
 
-from femrub.cli import main
-from femrub.results import Results
+from femrub.app.cli import main
+from femrub.output.results import Results
 
 REQUIRED = {
     "figure", "label", "scheme", "h", "alpha", "coupled", "first_contact_time", "contact_phases",

@@ -5,7 +5,7 @@ import json
 
 import pytest
 
-from femrub.cli import main
+from femrub.app.cli import main
 from femrub.steppers import ThetaMethod
 
 TINY = """

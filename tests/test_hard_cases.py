@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 import femrub as fr
-from femrub.first_order import ContactSpec, Load, first_order_model
+from femrub.model.build import ContactSpec, Load, first_order_model
 
 
 @pytest.mark.parametrize("h", [5e-4, 1e-3, 5e-3])

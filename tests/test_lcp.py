@@ -5,7 +5,7 @@ import itertools
 import numpy as np
 import pytest
 
-from femrub.lcp import LCPError, LCPResult, solve_lcp
+from femrub.contact.lcp import LCPError, LCPResult, solve_lcp
 
 
 def brute_force(M, q):

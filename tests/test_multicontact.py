@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 import femrub as fr
-from femrub.first_order import ContactSpec, Load, first_order_model
+from femrub.model.build import ContactSpec, Load, first_order_model
 
 
 def _two_contact_bar(e=0.0, alpha=2.0):

@@ -7,14 +7,13 @@ import scipy.sparse.linalg as spla
 import skfem as fem
 
 import femrub as fr
-from femrub.first_order import ContactSpec, Load, first_order_model
+from femrub.cases.paper_models import paper_reduced_model, paper_reductor
+from femrub.model.build import ContactSpec, Load, first_order_model
 from femrub.reduction import (
     PROJECTIONS,
     ThermoelasticCraigBampton,
     contact_boundary,
     craig_bampton_thermal,
-    paper_reduced_model,
-    paper_reductor,
 )
 
 ALPHA = 3.0

@@ -2,9 +2,9 @@
 
 import pytest
 
-from femrub.scenes import (
+from femrub.app import build
+from femrub.scene import (
     SceneError,
-    build,
     builtin_scenes,
     builtin_text,
     load_scene,
@@ -12,7 +12,7 @@ from femrub.scenes import (
     parse_value,
     resolve_key,
 )
-from femrub.scenes.units import to_si
+from femrub.scene.units import to_si
 
 TINY = """
 name = "tiny"
@@ -109,7 +109,7 @@ def test_paper_scene_is_the_paper_case():
 def test_docs_list_every_key():
     from pathlib import Path
 
-    from femrub.scenes import schema_rows
+    from femrub.scene import schema_rows
 
     text = (Path(__file__).resolve().parents[1] / "docs" / "scenes.md").read_text()
     missing = sorted({k for k, _, _ in schema_rows() if f"`{k}`" not in text})

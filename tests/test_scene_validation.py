@@ -9,9 +9,10 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from femrub.scenes import SceneError, build, load_scene
-from femrub.scenes.scene import Scene, tomllib
-from femrub.scenes.validate import normalize
+from femrub.app import build
+from femrub.scene import SceneError, load_scene
+from femrub.scene.scene import Scene, tomllib
+from femrub.scene.validate import normalize
 
 BASE = {
     "name": "base",
@@ -276,7 +277,7 @@ def test_random_invalid_scenes_fail_cleanly(key, value):
 
 
 def test_cli_never_prints_a_traceback(tmp_path, capsys):
-    from femrub.cli import main
+    from femrub.app.cli import main
 
     bad = tmp_path / "bad.toml"
     bad.write_text('[scheme]\nh = "1 m"\nt_end = 0.1\n')
@@ -292,7 +293,7 @@ def test_cli_never_prints_a_traceback(tmp_path, capsys):
     assert sys.exc_info() == (None, None, None)
 
 
-ALL_KEYS = sorted({k for k, _, _ in __import__("femrub.scenes", fromlist=["x"]).schema_rows()})
+ALL_KEYS = sorted({k for k, _, _ in __import__("femrub.scene", fromlist=["x"]).schema_rows()})
 KINDS = st.sampled_from(["bar", "box", "naca", "sections", "mesh"])
 
 

@@ -9,11 +9,11 @@ import scipy.sparse.linalg as spla
 import skfem as fem
 
 import femrub as fr
-from femrub.casing import Concentric, Lobed, TwoLobePiollet, casing_profile
-from femrub.damping import lowest_frequencies
+from femrub.contact.casing import Concentric, Lobed, TwoLobePiollet, casing_profile
+from femrub.fem.damping import lowest_frequencies
+from femrub.fem.solid import solid_matrices, solid_model
 from femrub.geometry import GeometryError, box_blade
-from femrub.solid import solid_matrices, solid_model
-from femrub.vtk_output import VTKSeries
+from femrub.output.vtk import VTKSeries
 
 P = fr.PAPER
 

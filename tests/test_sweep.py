@@ -5,9 +5,9 @@ import json
 
 import pytest
 
-from femrub.cli import main
-from femrub.scenes import SceneError
-from femrub.sweep import grid, parse_param
+from femrub.app.cli import main
+from femrub.app.sweep import grid, parse_param
+from femrub.scene import SceneError
 
 TINY = """
 name = "tiny"

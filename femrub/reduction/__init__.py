@@ -6,20 +6,16 @@ run the full model; ``reconstruct()`` maps reduced states back to the full state
 """
 
 from .blocks import InteriorSolver, ModelBlocks, contact_boundary, split_blocks
-from .craig_bampton_thermal import PROJECTIONS, ThermoelasticCraigBampton, craig_bampton_thermal
+from .craig_bampton import PROJECTIONS, ThermoelasticCraigBampton, craig_bampton_thermal
 from .modes import clamped_modes
-from .paper_models import PAPER_SIZES, paper_reduced_model, paper_reductor
 
 __all__ = [
     "InteriorSolver",
     "ModelBlocks",
-    "PAPER_SIZES",
     "PROJECTIONS",
     "ThermoelasticCraigBampton",
     "clamped_modes",
     "contact_boundary",
     "craig_bampton_thermal",
-    "paper_reduced_model",
-    "paper_reductor",
     "split_blocks",
 ]

@@ -21,8 +21,8 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.sparse as sp
 
-from ..linalg import sparse_lu
-from ..model import FirstOrderModel
+from ..fem.linalg import sparse_lu
+from ..model.first_order import FirstOrderModel
 
 __all__ = ["ModelBlocks", "split_blocks", "contact_boundary", "InteriorSolver"]
 

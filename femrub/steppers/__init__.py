@@ -3,7 +3,7 @@
 from .base import NumericalInstability, State, Stepper, check_step
 from .carpenter import Carpenter
 from .penalty import Penalty
-from .theta_method import ACTIVATION_RULES, ThetaMethod
+from .theta import ACTIVATION_RULES, ThetaMethod
 
 SCHEMES = {"theta": ThetaMethod, "carpenter": Carpenter, "penalty": Penalty}
 

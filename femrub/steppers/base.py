@@ -19,10 +19,10 @@ import scipy.sparse as sp
 from threadpoolctl import threadpool_limits
 from tqdm.auto import tqdm
 
-from ..energy import EnergyMeter
-from ..linalg import compact
-from ..model import FirstOrderModel
-from ..results import Results
+from ..fem.linalg import compact
+from ..model.first_order import FirstOrderModel
+from ..output.energy import EnergyMeter
+from ..output.results import Results
 
 __all__ = ["State", "Stepper", "NumericalInstability", "check_step"]
 

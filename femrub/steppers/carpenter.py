@@ -31,9 +31,9 @@ import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-from ..linalg import Factorised
+from ..contact.impulses import solve_impulses
+from ..fem.linalg import Factorised
 from .base import Stepper
-from .contact_solve import solve_impulses
 
 __all__ = ["Carpenter"]
 

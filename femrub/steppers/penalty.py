@@ -20,7 +20,7 @@ from __future__ import annotations
 import numpy as np
 from scipy.integrate import BDF, Radau
 
-from ..linalg import Factorised, compact
+from ..fem.linalg import Factorised, compact
 from .base import Stepper
 
 __all__ = ["Penalty"]

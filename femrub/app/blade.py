@@ -14,7 +14,7 @@ import numpy as np
 
 from ..geometry import GeometryError, box_blade, naca_blade, read_mesh, sections_blade
 from ..geometry.readers import detect_format
-from .spec import SceneError, fail
+from ..scene.spec import SceneError, fail
 
 __all__ = ["load_blade"]
 

@@ -25,8 +25,8 @@ import scipy.linalg as sla
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-from ..reduction import ThermoelasticCraigBampton, contact_boundary, split_blocks
-from .spec import SceneError, fail
+from ..scene.spec import SceneError, fail
+from . import ThermoelasticCraigBampton, contact_boundary, split_blocks
 
 __all__ = ["natural_frequencies", "reduce_model"]
 

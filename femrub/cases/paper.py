@@ -21,10 +21,10 @@ from pathlib import Path
 
 import numpy as np
 
-from . import __version__
+from .. import __version__
+from ..output.plots import energy_panel, savefig, tip_panels
+from ..steppers import make_stepper
 from .bar import PAPER, bar_model
-from .plotting import energy_panel, savefig, tip_panels
-from .steppers import make_stepper
 
 __all__ = ["Run", "FIGURES", "ALPHA_DEFAULT", "LIMITS", "MODELS", "run_case", "reproduce"]
 
@@ -57,7 +57,7 @@ def _full(alpha: float, coupled: bool):
 
 def _reduced(name: str) -> Callable:
     def build(alpha: float, coupled: bool):
-        from .reduction import paper_reduced_model
+        from .paper_models import paper_reduced_model
 
         return paper_reduced_model(name, alpha, coupled)
 

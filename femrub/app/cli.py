@@ -18,7 +18,7 @@ __all__ = ["main", "build_parser"]
 
 
 def _paper(args) -> int:
-    from .paper import FIGURES, reproduce
+    from ..cases.paper import FIGURES, reproduce
 
     out = Path(args.out)
     figures = args.figures.split(",") if args.figures else None
@@ -36,7 +36,7 @@ def _paper(args) -> int:
 
 
 def _changes(args) -> dict:
-    from .scenes import SceneError, parse_value
+    from ..scene import SceneError, parse_value
 
     out = {}
     for item in args.set or []:
@@ -48,7 +48,7 @@ def _changes(args) -> dict:
 
 
 def _load(args):
-    from .scenes import load_scene
+    from ..scene import load_scene
 
     return load_scene(args.scene, _changes(args))
 
@@ -58,7 +58,7 @@ def _log(args):
 
 
 def _run(args) -> int:
-    from .scenes import run_scene
+    from .run import run_scene
 
     scene = _load(args)
     out = Path(args.out or f"{scene.name}-out")
@@ -106,7 +106,7 @@ def _run(args) -> int:
 
 
 def _check(args) -> int:
-    from .scenes import build
+    from .simulation import build
 
     scene = _load(args)
     if args.schema_only:
@@ -128,7 +128,7 @@ def _check(args) -> int:
 
 
 def _scenes(args) -> int:
-    from .scenes import builtin_scenes
+    from ..scene import builtin_scenes
 
     for name, desc in builtin_scenes().items():
         print(f"{name:<14} {desc}")
@@ -136,7 +136,7 @@ def _scenes(args) -> int:
 
 
 def _scene_show(args) -> int:
-    from .scenes import builtin_text
+    from ..scene import builtin_text
 
     sys.stdout.write(builtin_text(args.name))
     return 0
@@ -229,7 +229,7 @@ def build_parser() -> argparse.ArgumentParser:
     pp.add_argument("--quiet", "-q", action="store_true", help="no progress output")
     pp.set_defaults(func=_paper)
     try:
-        from .geometry.cli import add_mesh_parser, run_mesh
+        from ..geometry.cli import add_mesh_parser, run_mesh
     except ImportError:  # geometry extras not installed
         pass
     else:
@@ -247,7 +247,7 @@ def main(argv=None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
     if args.version:
-        from . import __version__
+        from .. import __version__
 
         print(f"femrub {__version__}")
         return 0

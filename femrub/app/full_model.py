@@ -15,10 +15,10 @@ import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-from ..bar import BarCase, bar_model
-from ..casing import casing_profile
-from ..material import Material
-from ..model import Contact
+from ..cases.bar import BarCase, bar_model
+from ..contact.casing import casing_profile
+from ..fem.material import Material
+from ..model.first_order import Contact
 from ..reduction.blocks import split_blocks
 
 __all__ = ["ForceLaw", "build_full", "contact_reach", "restrict_contacts", "thermal_choice"]
@@ -133,7 +133,7 @@ def build_full(scene, thermal: bool, blade=None):
         if force:
             model.loads = [replace(term, signal=force[1]) for term in model.loads]
         return model, None
-    from ..solid import solid_model
+    from ..fem.solid import solid_model
 
     tip_force = None
     if force:

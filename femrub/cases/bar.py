@@ -15,10 +15,10 @@ from dataclasses import asdict, dataclass, field, replace
 import numpy as np
 import skfem as fem
 
-from .first_order import ContactSpec, Load, first_order_model
-from .material import Material, check_finite_positive
-from .model import FirstOrderModel
-from .thermoelastic import ThermoelasticMatrices, assemble_thermoelastic
+from ..fem.assembly import ThermoelasticMatrices, assemble_thermoelastic
+from ..fem.material import Material, check_finite_positive
+from ..model.build import ContactSpec, Load, first_order_model
+from ..model.first_order import FirstOrderModel
 
 __all__ = ["BarCase", "PAPER", "bar_matrices", "bar_model", "impact_bar_model", "rpm"]
 

@@ -15,12 +15,12 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..reduction.sizes import natural_frequencies, reduce_model
+from ..scene.spec import SceneError, fail
 from ..steppers import make_stepper
 from .blade import load_blade
 from .explain import explain
-from .model import build_full, contact_reach, heat_possible, restrict_contacts, thermal_choice
-from .reduce import natural_frequencies, reduce_model
-from .spec import SceneError, fail
+from .full_model import build_full, contact_reach, heat_possible, restrict_contacts, thermal_choice
 
 __all__ = ["Built", "build"]
 

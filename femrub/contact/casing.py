@@ -20,7 +20,7 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
-from .material import check_finite_positive
+from ..fem.material import check_finite_positive
 
 __all__ = ["CasingProfile", "Concentric", "Lobed", "TwoLobePiollet", "casing_profile", "PROFILES"]
 

@@ -23,12 +23,12 @@ import scipy.sparse as sp
 import skfem as fem
 from scipy.spatial import cKDTree
 
-from .casing import CasingProfile, Concentric
-from .first_order import ContactSpec, Load, first_order_model
+from ..contact.casing import CasingProfile, Concentric
+from ..model.build import ContactSpec, Load, first_order_model
+from ..model.first_order import FirstOrderModel
+from .assembly import assemble_thermoelastic
 from .forms import lame_parameters
 from .material import Material, check_finite_positive
-from .model import FirstOrderModel
-from .thermoelastic import assemble_thermoelastic
 
 __all__ = ["FieldMap", "ContactNodes", "locate_contacts", "solid_matrices", "solid_model"]
 

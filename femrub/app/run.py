@@ -14,9 +14,9 @@ import json
 import math
 from pathlib import Path
 
-from ..run_folder import ResultExists, run_to_folder
-from .build import build
-from .scene import Scene
+from ..output.run_folder import ResultExists, run_to_folder
+from ..scene.scene import Scene
+from .simulation import build
 
 __all__ = ["FINISHED", "folder_status", "run_scene", "versions"]
 

@@ -23,8 +23,9 @@ from pathlib import Path
 
 import numpy as np
 
-from .scenes import FINISHED, SceneError, folder_status, parse_value, resolve_key, run_scene
-from .scenes.scene import Scene
+from ..scene import SceneError, parse_value, resolve_key
+from ..scene.scene import Scene
+from .run import FINISHED, folder_status, run_scene
 
 __all__ = ["parse_param", "grid", "run_point", "point_metrics", "run_sweep"]
 
@@ -163,7 +164,7 @@ def run_sweep(
     for r in rows:
         r["x"] = _x(scene.with_changes(r["params"]), keys[0])
     _write_csv(rows, keys, out / "interaction.csv")
-    from .scenes.interaction import plot_interaction_map
+    from ..output.interaction import plot_interaction_map
 
     plot_interaction_map(rows, keys, scene.data, out / "interaction.png")
     return rows

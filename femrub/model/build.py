@@ -18,8 +18,8 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.sparse as sp
 
-from .model import Contact, EnergyForms, FirstOrderModel, Layout, LoadTerm
-from .thermoelastic import ThermoelasticMatrices
+from ..fem.assembly import ThermoelasticMatrices
+from .first_order import Contact, EnergyForms, FirstOrderModel, Layout, LoadTerm
 
 __all__ = ["ContactSpec", "Load", "first_order_model"]
 

@@ -44,9 +44,9 @@ from __future__ import annotations
 import numpy as np
 import scipy.sparse as sp
 
-from ..linalg import Factorised, compact
+from ..contact.impulses import solve_impulses
+from ..fem.linalg import Factorised, compact
 from .base import Stepper
-from .contact_solve import solve_impulses
 
 __all__ = ["ThetaMethod", "ACTIVATION_RULES"]
 

@@ -19,8 +19,8 @@ from pathlib import Path
 
 import numpy as np
 
-from . import __version__
-from .plotting import savefig, tip_panels
+from .. import __version__
+from .plots import savefig, tip_panels
 
 __all__ = ["run_to_folder", "ResultExists"]
 
@@ -93,7 +93,7 @@ def run_to_folder(
     _write_json(summary_path, doc)
     series = None
     if fields is not None and vtk_stride:
-        from .vtk_output import VTKSeries
+        from .vtk import VTKSeries
 
         series = VTKSeries(out / "vtk", model, fields, h=stepper.h, stride=vtk_stride)
     t0 = time.perf_counter()
@@ -112,7 +112,7 @@ def run_to_folder(
             out / "signals.png",
         )
     if series is not None and series.frames and snapshot and plots:
-        from .vtk_output import snapshot_png
+        from .vtk import snapshot_png
 
         try:
             snapshot_png(series.dir / series.frames[-1][1], out / "snapshot.png")

@@ -13,7 +13,7 @@ import math
 
 import numpy as np
 
-from ..plotting import plt, savefig
+from .plots import plt, savefig
 
 __all__ = ["engine_orders", "plot_interaction_map"]
 

@@ -8,9 +8,9 @@ of variables and reproduces the full model to round-off.
 
 from __future__ import annotations
 
-from ..bar import PAPER, bar_model
-from ..model import FirstOrderModel
-from .craig_bampton_thermal import ThermoelasticCraigBampton
+from ..model.first_order import FirstOrderModel
+from ..reduction.craig_bampton import ThermoelasticCraigBampton
+from .bar import PAPER, bar_model
 
 __all__ = ["PAPER_SIZES", "DEFAULT_PROJECTION", "paper_reduced_model", "paper_reductor"]
 

@@ -19,7 +19,7 @@ import meshio
 import numpy as np
 from scipy.spatial import cKDTree
 
-from .solid import FieldMap
+from ..fem.solid import FieldMap
 
 __all__ = ["VTKSeries", "von_mises", "snapshot_png"]
 

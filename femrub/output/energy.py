@@ -18,8 +18,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from .linalg import compact
-from .model import EnergyForms, FirstOrderModel
+from ..fem.linalg import compact
+from ..model.first_order import EnergyForms, FirstOrderModel
 from .results import ENERGY_KEYS
 
 __all__ = ["EnergyMeter"]

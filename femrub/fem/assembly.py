@@ -18,7 +18,7 @@ import numpy as np
 import scipy.sparse as sp
 from skfem import Basis
 
-from . import forms
+from .. import forms
 from .lumping import lump
 from .material import Material, check_finite_positive
 

@@ -45,7 +45,7 @@ import warnings
 import numpy as np
 import scipy.sparse as sp
 
-from ..model import FirstOrderModel, Layout, LoadTerm
+from ..model.first_order import FirstOrderModel, Layout, LoadTerm
 from .blocks import InteriorSolver, contact_boundary, split_blocks
 from .modes import clamped_modes, normalise_columns
 

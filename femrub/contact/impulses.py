@@ -24,7 +24,7 @@ def solve_impulses(W: np.ndarray, q: np.ndarray, active: np.ndarray, warm=None) 
             raise FloatingPointError("non-positive Delassus operator at a contact")
         P[i] = max(0.0, -q[i] / w)
         return P
-    from ..lcp import solve_lcp
+    from .lcp import solve_lcp
 
     ws = None if warm is None else np.asarray(warm)[idx]
     res = solve_lcp(W[np.ix_(idx, idx)], q[idx], warm_start=ws)

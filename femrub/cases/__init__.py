@@ -1,0 +1,1 @@
+"""Reference cases: the paper's bar and its reproduction, analytic solutions."""
