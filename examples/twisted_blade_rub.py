@@ -2,10 +2,10 @@
 
 Meshes a twisted, tapered NACA 0012 blade with gmsh (:func:`femrub.geometry.naca_blade`,
 contact nodes embedded on the tip camber line), builds its first-order thermoelastic model
-(:func:`femrub.solid.solid_model`: P2 displacement, P1 temperature, physical coupling,
+(:func:`femrub.fem.solid.solid_model`: P2 displacement, P1 temperature, physical coupling,
 frictional heat ``μ Ω r λ`` at the contacts) facing a rigid casing with three lobes that
 intrude by 20 µm, reduces it (thermoelastic Craig–Bampton, paper Sec. 2), integrates with the
-θ-method and writes the results folder (:func:`femrub.run_folder.run_to_folder`): history,
+θ-method and writes the results folder (:func:`femrub.output.run_folder.run_to_folder`): history,
 summary, plots and a ParaView series ``vtk/rub.pvd``. About 10 s.
 
 Run: ``python examples/twisted_blade_rub.py`` (writes ``twisted-blade-out/``, or the folder

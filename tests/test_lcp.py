@@ -1,4 +1,4 @@
-"""Tests for femrub.lcp: exact LCP solver (Lemke + semi-smooth Newton fallback)."""
+"""Tests for femrub.contact.lcp: exact LCP solver (Lemke + semi-smooth Newton fallback)."""
 
 import itertools
 

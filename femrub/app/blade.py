@@ -3,7 +3,7 @@
 :func:`load_blade` returns a :class:`~femrub.geometry.BladeMesh` whose ``root`` node set is
 the clamped face (``boundary.root``) and whose contact points are the scene's candidates
 (``contact.group`` or ``contact.nodes``). Missing groups, nodes or units are reported as a
-one-line :class:`~femrub.scenes.spec.SceneError` naming the scene key.
+one-line :class:`~femrub.scene.spec.SceneError` naming the scene key.
 """
 
 from __future__ import annotations
@@ -126,7 +126,7 @@ def load_blade(scene, log=None):
 
     Parameters
     ----------
-    scene : :class:`~femrub.scenes.scene.Scene` with a 3D geometry.
+    scene : :class:`~femrub.scene.scene.Scene` with a 3D geometry.
     log : optional callable for progress messages.
 
     Returns

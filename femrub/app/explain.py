@@ -72,7 +72,7 @@ def _reduction(r: dict) -> list[str]:
 
 
 def explain(report: dict, reach_key=None) -> str:
-    """Format a build report (:func:`femrub.scenes.build.build`) as aligned text."""
+    """Format a build report (:func:`femrub.app.simulation.build`) as aligned text."""
     rows = [("scene", f"{report['scene']} ({report['source']})"), ("geometry", report["geometry"])]
     full, model = report["full"], report["model"]
     line = _dofs(model)

@@ -112,7 +112,7 @@ def casing_of(scene):
 
 
 def build_full(scene, thermal: bool, blade=None):
-    """Full model (and :class:`~femrub.solid.FieldMap` in 3D, else ``None``)."""
+    """Full model (and :class:`~femrub.fem.solid.FieldMap` in 3D, else ``None``)."""
     g, p, c = scene["geometry"], scene["physics"], scene["contact"]
     force = force_law(scene)
     lumping = p["lumping"]

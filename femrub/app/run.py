@@ -1,6 +1,6 @@
-"""Run a scene into a results folder (:func:`femrub.run_folder.run_to_folder`).
+"""Run a scene into a results folder (:func:`femrub.output.run_folder.run_to_folder`).
 
-Besides what :func:`~femrub.run_folder.run_to_folder` writes (``history.csv``/``.npz``,
+Besides what :func:`~femrub.output.run_folder.run_to_folder` writes (``history.csv``/``.npz``,
 ``summary.json``, ``signals.png``, ``vtk/``, ``snapshot.png``), the folder gets
 ``scene.toml`` (the normalised scene, paths made absolute: ``femrub run`` reruns it) and
 ``explain.txt``. ``summary.json["inputs"]`` holds the scene, the build report and the
@@ -77,7 +77,7 @@ def run_scene(
 
     Parameters
     ----------
-    scene : the :class:`~femrub.scenes.scene.Scene`.
+    scene : the :class:`~femrub.scene.scene.Scene`.
     out : results folder.
     overwrite : replace a finished result (otherwise :class:`ResultExists`); an unfinished
         one (interrupted, failed, killed) is always replaced.

@@ -2,12 +2,12 @@
 
 ``femrub sweep SCENE --param rotation_speed=200:2000:50 -o DIR`` runs every point of the
 grid (cartesian product of the ``--param`` values) as one task that writes its own results
-folder ``DIR/runs/NNN_key=value/`` (:func:`femrub.scenes.run_scene`). Tasks run on a
+folder ``DIR/runs/NNN_key=value/`` (:func:`femrub.scene.run_scene`). Tasks run on a
 ``LocalCluster`` of this machine (2 worker processes, 1 thread each, by default) or on the
 cluster behind ``--scheduler ADDRESS`` (the output folder must then be shared). A point
 whose folder holds a finished result is skipped, so rerunning the command after a failure
 or an interruption only runs what is missing. At the end ``DIR/interaction.csv`` and
-``DIR/interaction.png`` (:mod:`femrub.scenes.interaction`) summarise the sweep.
+``DIR/interaction.png`` (:mod:`femrub.output.interaction`) summarise the sweep.
 
 Parameter values: ``start:stop:step`` (stop included), ``a,b,c`` or one value; a unit may
 follow the numbers (``1000:3000:500rpm``); plain numbers are SI.
@@ -130,7 +130,7 @@ def run_sweep(
 
     Parameters
     ----------
-    scene : base :class:`~femrub.scenes.scene.Scene`.
+    scene : base :class:`~femrub.scene.scene.Scene`.
     params : list of ``(dotted key, values)`` (:func:`parse_param`).
     out : sweep folder.
     scheduler : address of a dask scheduler; ``None``: a ``LocalCluster`` of ``workers``.

@@ -195,7 +195,7 @@ def impact_bar_model(
 ) -> FirstOrderModel:
     """A free bar moving at ``velocity`` (m/s) towards a rigid obstacle ``gap`` (m) away.
 
-    The benchmark with an exact solution (:func:`femrub.analytic.bar_impact`): no clamp, no
+    The benchmark with an exact solution (:func:`femrub.cases.analytic.bar_impact`): no clamp, no
     load, no thermal part, consistent density (no lumped total mass), e = 0 at the contact.
     """
     case = dict(

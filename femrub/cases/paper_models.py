@@ -23,7 +23,7 @@ DEFAULT_PROJECTION = "petrov-galerkin"
 def paper_reductor(
     name: str, alpha: float, coupled: bool, *, projection: str = DEFAULT_PROJECTION, **changes
 ) -> ThermoelasticCraigBampton:
-    """Reductor of the paper bar (``femrub.bar.bar_model``) for ``name`` in PAPER_SIZES."""
+    """Reductor of the paper bar (``femrub.cases.bar.bar_model``) for ``name`` in PAPER_SIZES."""
     if name not in PAPER_SIZES:
         raise ValueError(f"unknown reduced model {name!r}; use one of {', '.join(PAPER_SIZES)}")
     full = bar_model(PAPER, alpha=alpha, coupling="paper" if coupled else "none", **changes)

@@ -3,7 +3,7 @@
 A contact node at angular position ``φ`` (rad, around the machine axis) of a blade turning
 at ``Ω`` (rad/s) sees the casing at angle ``ψ = Ω t + φ``; its undeformed radial gap is the
 profile ``g(ψ)`` (m). The deformed gap is ``g(ψ) − n · u`` with ``n`` the outward radial
-direction at the node (see :mod:`femrub.solid`).
+direction at the node (see :mod:`femrub.fem.solid`).
 
 * :class:`Concentric`: ``g(ψ) = c``.
 * :class:`Lobed`: ``g(ψ) = c − δ cos(k (ψ − ψ0))``, an ovalised casing with ``k`` lobes;

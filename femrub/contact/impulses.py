@@ -1,7 +1,7 @@
 """Impulses of the active contacts: the per-step LCP ``0 <= P ⊥ W P + q >= 0``.
 
 One active contact has the closed form ``P = max(0, −q / W)`` (the paper's prox, Eq. 25b);
-several are solved exactly by :func:`femrub.lcp.solve_lcp` (Lemke pivoting), never by penalty.
+several are solved exactly by :func:`femrub.contact.lcp.solve_lcp` (Lemke pivoting), never by penalty.
 """
 
 from __future__ import annotations

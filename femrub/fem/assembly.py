@@ -18,7 +18,7 @@ import numpy as np
 import scipy.sparse as sp
 from skfem import Basis
 
-from .. import forms
+from . import forms
 from .lumping import lump
 from .material import Material, check_finite_positive
 
@@ -129,7 +129,7 @@ def assemble_thermoelastic(
         Displacement basis (``ElementVector`` of a Lagrange element) and temperature basis
         (scalar Lagrange element) on the same mesh.
     material
-        :class:`~femrub.material.Material`.
+        :class:`~femrub.fem.material.Material`.
     area
         Cross-section (m²) for a 1D bar; 1 for 2D/3D solids.
     lumping

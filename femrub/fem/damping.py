@@ -7,25 +7,7 @@
 
 from __future__ import annotations
 
-import numpy as np
-import scipy.linalg as sla
-import scipy.sparse.linalg as spla
-
-from .linalg import sparse_lu
-
-__all__ = ["rayleigh_coefficients", "lowest_frequencies"]
-
-
-def lowest_frequencies(K, M, n: int) -> np.ndarray:
-    """The ``n`` lowest angular frequencies (rad/s) of ``K φ = ω² M φ`` (shift-invert)."""
-    N = K.shape[0]
-    if N <= 400:
-        w2 = sla.eigh(K.toarray(), M.toarray(), eigvals_only=True)[:n]
-    else:
-        lu = sparse_lu(K, symmetric=True, what="stiffness (is the structure clamped?)")
-        op = spla.LinearOperator(K.shape, matvec=lu.solve, dtype=float)
-        w2 = spla.eigsh(K.tocsc(), k=n, M=M.tocsc(), sigma=0.0, which="LM", OPinv=op)[0]
-    return np.sqrt(np.sort(np.abs(w2)))
+__all__ = ["rayleigh_coefficients"]
 
 
 def rayleigh_coefficients(zeta: float, omega1: float, omega2: float) -> tuple[float, float]:

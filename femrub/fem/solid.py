@@ -1,13 +1,13 @@
 """3D blade rubbing a rigid casing: the first-order model of a :class:`BladeMesh`.
 
-Same forms and first-order builder as the 1D bar (:mod:`femrub.thermoelastic`,
-:mod:`femrub.first_order`), with vector P2 displacement (P1 tetrahedra lock in bending) and
+Same forms and first-order builder as the 1D bar (:mod:`femrub.fem.assembly`,
+:mod:`femrub.model.build`), with vector P2 displacement (P1 tetrahedra lock in bending) and
 P1 temperature on the linear tetrahedra of the mesh, HRZ-lumped mass (row-sum lumping of P2
 goes negative), isotropic thermal-stress coupling, root face clamped and held at ambient.
 
 Contact ``i`` at point ``p_i`` of the tip: the normal is the casing radial direction ``n_i``
 (away from the machine axis), the gap ``g_i(t) = g(Ω t + φ_i) − n_i · u(p_i)`` follows the
-casing profile ``g`` (:mod:`femrub.casing`) swept at the rotation speed ``Ω`` from the node's
+casing profile ``g`` (:mod:`femrub.contact.casing`) swept at the rotation speed ``Ω`` from the node's
 angular position ``φ_i``, and the frictional heat ``α_i λ_i`` with ``α_i = μ Ω r_i`` (Coulomb
 friction ``μ``, sliding speed ``Ω r_i``) enters as a uniform flux over the part of the tip
 face nearest to ``p_i`` (its tributary area), not into one vertex.
@@ -272,10 +272,11 @@ def solid_model(
     contacts = locate_contacts(blade, basis_u, basis_t)
     t1 = time.perf_counter()
     if damping_ratio:
-        from .damping import lowest_frequencies, rayleigh_coefficients
+        from .damping import rayleigh_coefficients
+        from .eigen import angular_frequencies
 
         i, j = damping_modes
-        w = lowest_frequencies(mats.K, mats.M, max(i, j))
+        w = angular_frequencies(mats.K, mats.M, max(i, j))
         a, b = rayleigh_coefficients(float(damping_ratio), w[i - 1], w[j - 1])
         mats.C = (a * mats.M + b * mats.K).tocsr()
         rayleigh = (a, b)

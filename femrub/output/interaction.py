@@ -45,7 +45,7 @@ def _groups(rows, keys):
 
 
 def plot_interaction_map(rows, keys, scene, path) -> None:
-    """Draw the interaction map of sweep ``rows`` (see :func:`femrub.sweep.run_sweep`)."""
+    """Draw the interaction map of sweep ``rows`` (see :func:`femrub.app.sweep.run_sweep`)."""
     x_key = keys[0]
     campbell = x_key == "loads.rotation_speed"
     n = len(_PANELS) + int(campbell)

@@ -1,6 +1,6 @@
 """Blocks of a full first-order model (paper Eq. 9), its boundary and interior dofs.
 
-A full :class:`~femrub.model.FirstOrderModel` built by :func:`femrub.first_order_model` has::
+A full :class:`~femrub.model.first_order.FirstOrderModel` built by :func:`femrub.first_order_model` has::
 
         [I  0   0  ]        [ 0      I      0    ]
     A = [0  M   0  ],   B = [−K^uu  −C^uu  −K^uθ ],   X = [u, v, θ]          (Eq. 9)

@@ -1,6 +1,6 @@
 """First-order thermoelastic Craig–Bampton reduction (paper Sec. 2, Eqs. 10–15).
 
-:class:`ThermoelasticCraigBampton` takes a full :class:`~femrub.model.FirstOrderModel` of the
+:class:`ThermoelasticCraigBampton` takes a full :class:`~femrub.model.first_order.FirstOrderModel` of the
 form of Eq. (9) (1D or 3D, sparse, any number of contacts) and builds
 
 * the right basis ``R`` of Eq. (13), ``X ≈ R X̄``: the boundary dofs ``u_b, v_b, θ_b``
@@ -21,7 +21,7 @@ form of Eq. (9) (1D or 3D, sparse, any number of contacts) and builds
 
   ``docs/reduction.md`` derives them and compares them on the paper case;
 * the reduced model ``Ā = R̃ᵀ A R``, ``B̄ = R̃ᵀ B R`` (Eqs. 14–15), a
-  :class:`~femrub.model.FirstOrderModel` that every stepper runs unchanged.
+  :class:`~femrub.model.first_order.FirstOrderModel` that every stepper runs unchanged.
 
 The reduced state is ordered in the three blocks the steppers expect (the paper's "split
 arbitrarily q^uv", after Eq. 15)::
@@ -45,9 +45,9 @@ import warnings
 import numpy as np
 import scipy.sparse as sp
 
+from ..fem.eigen import lowest_modes, normalise_columns
 from ..model.first_order import FirstOrderModel, Layout, LoadTerm
 from .blocks import InteriorSolver, contact_boundary, split_blocks
-from .modes import clamped_modes, normalise_columns
 
 __all__ = ["PROJECTIONS", "ThermoelasticCraigBampton", "craig_bampton_thermal"]
 
@@ -59,7 +59,7 @@ class ThermoelasticCraigBampton:
 
     Parameters
     ----------
-    model : full :class:`~femrub.model.FirstOrderModel` of the form of Eq. (9).
+    model : full :class:`~femrub.model.first_order.FirstOrderModel` of the form of Eq. (9).
     n_uv : number of first-order mechanical shapes (``None``: all, ``2 n_i``).
     n_theta : number of thermal modes (``None``: all interior temperature dofs).
     projection : ``"petrov-galerkin"``, ``"galerkin"`` or ``"adjoint"`` (module docstring).
@@ -69,7 +69,7 @@ class ThermoelasticCraigBampton:
     Attributes
     ----------
     R, left : (N, r) right and left bases (dense), rows in the full state order.
-    layout : reduced :class:`~femrub.model.Layout`.
+    layout : reduced :class:`~femrub.model.first_order.Layout`.
     omega2 : (n_qv,) clamped mechanical eigenvalues ω² (rad²/s²) of the shapes kept.
     mu : (n_θ,) clamped thermal eigenvalues (1/s) of ``K^θθ χ = μ C^θθ χ``.
     timings : seconds spent in the static shapes, the modes and the bases.
@@ -109,8 +109,8 @@ class ThermoelasticCraigBampton:
         psi = solver.solve(-B_ib)  # Eq. (11)
         self.timings["static_shapes"] = time.perf_counter() - t0
         t0 = time.perf_counter()
-        self.omega2, phi = clamped_modes(solver.K, solver.M, self.n_qv, solver.solve_K)
-        self.mu, chi = clamped_modes(solver.Ktt, solver.Ctt, n_theta, solver.solve_T)
+        self.omega2, phi = lowest_modes(solver.K, solver.M, self.n_qv, solver.solve_K)
+        self.mu, chi = lowest_modes(solver.Ktt, solver.Ctt, n_theta, solver.solve_T)
         phi_ut = -solver.solve_K(solver.Kut @ chi)  # K_ii Φ^uθ = −K^uθ_ii Φ^θθ
         self.timings["modes"] = time.perf_counter() - t0
         t0 = time.perf_counter()

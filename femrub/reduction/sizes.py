@@ -25,8 +25,10 @@ import scipy.linalg as sla
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
+from ..fem import eigen
 from ..scene.spec import SceneError, fail
-from . import ThermoelasticCraigBampton, contact_boundary, split_blocks
+from .blocks import contact_boundary, split_blocks
+from .craig_bampton import ThermoelasticCraigBampton
 
 __all__ = ["natural_frequencies", "reduce_model"]
 
@@ -34,19 +36,7 @@ __all__ = ["natural_frequencies", "reduce_model"]
 def natural_frequencies(model, k: int) -> np.ndarray:
     """The ``k`` lowest natural frequencies (Hz) of a full model, contacts free."""
     b = split_blocks(model)
-    n = b.n_u
-    k = min(k, n)
-    if k == 0:
-        return np.zeros(0)
-    if n <= 400:
-        lam = sla.eigh(b.K.toarray(), b.M.toarray(), eigvals_only=True, subset_by_index=[0, k - 1])
-    else:
-        K, M = sp.csc_matrix(b.K), sp.csc_matrix(b.M)
-        try:
-            lam = spla.eigsh(K, k=k, M=M, sigma=0.0, which="LM", return_eigenvectors=False)
-        except RuntimeError:  # singular stiffness (free structure)
-            lam = spla.eigsh(K, k=k, M=M, sigma=-1.0, which="LM", return_eigenvectors=False)
-    return np.sqrt(np.clip(np.sort(lam), 0.0, None)) / (2.0 * np.pi)
+    return eigen.natural_frequencies(b.K, b.M, k)
 
 
 def _freq_error(K, M, V, nb, k, ref, modes) -> float:

@@ -1,6 +1,6 @@
 """Scene objects: load (file, text or built-in name), change keys, dump back to TOML.
 
-A :class:`Scene` holds the normalised data (:func:`~femrub.scenes.validate.normalize`:
+A :class:`Scene` holds the normalised data (:func:`~femrub.scene.validate.normalize`:
 every section present, defaults filled in, SI floats) and the folder its relative paths
 start from. ``load → dump → load`` gives an equal scene.
 """
@@ -123,7 +123,7 @@ def loads_scene(text: str, source: str = "<string>", base_dir=None) -> Scene:
 
 
 def _builtin_dir():
-    return resources.files("femrub.scenes") / "builtin"
+    return resources.files("femrub.scene") / "builtin"
 
 
 def builtin_scenes() -> dict[str, str]:

@@ -1,7 +1,7 @@
 """The scene schema: every section, key, unit, default and allowed value (SI units).
 
-``SCHEMA`` maps a section to its keys (:class:`~femrub.scenes.spec.Spec`) or to a
-:class:`~femrub.scenes.spec.Variant` whose keys depend on a selector. ``docs/scenes.md``
+``SCHEMA`` maps a section to its keys (:class:`~femrub.scene.spec.Spec`) or to a
+:class:`~femrub.scene.spec.Variant` whose keys depend on a selector. ``docs/scenes.md``
 documents the same table; :func:`schema_rows` lists it for the docs and the tests.
 """
 
@@ -128,7 +128,7 @@ BOUNDARY = {
 CASING = Variant(
     "kind",
     default="concentric",
-    doc="rigid casing profile swept at the rotation speed (femrub.casing)",
+    doc="rigid casing profile swept at the rotation speed (femrub.contact.casing)",
     variants={
         "concentric": {"clearance": _f(1e-4, "length", "radial clearance", **NONNEG)},
         "lobed": {

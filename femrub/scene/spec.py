@@ -55,7 +55,7 @@ class Spec:
         ``"pair"`` (two floats), ``"ints"`` (list of int), ``"strs"`` (list of str).
     default : value used when the key is absent (``REQUIRED``: must be given; ``None``:
         left to the builder).
-    dim : unit dimension of a float (:mod:`femrub.scenes.units`).
+    dim : unit dimension of a float (:mod:`femrub.scene.units`).
     lo, hi : bounds of a number; ``lo_open`` / ``hi_open`` exclude them.
     choices : allowed strings of a ``choice``, or words accepted besides a number
         (``reach = "auto"``) or a list (``signals = "all"``).

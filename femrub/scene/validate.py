@@ -2,7 +2,7 @@
 
 :func:`normalize` turns a parsed TOML document into the normalised scene data (every
 section present, defaults filled in, quantities as SI floats) or raises a one-line
-:class:`~femrub.scenes.spec.SceneError`. It does no heavy work and touches no file;
+:class:`~femrub.scene.spec.SceneError`. It does no heavy work and touches no file;
 :func:`check_files` checks the paths a scene references.
 """
 

@@ -1,9 +1,9 @@
 """Common machinery of the time steppers: ``step()``, ``iterate()`` and ``run()``.
 
-A stepper works on any :class:`~femrub.model.FirstOrderModel`. Subclasses implement
+A stepper works on any :class:`~femrub.model.first_order.FirstOrderModel`. Subclasses implement
 ``_step()`` (advance one step, return the new state and the contact impulses); the public
 ``step()`` validates and records, ``iterate()`` yields states, ``run()`` collects a
-:class:`~femrub.results.Results` with the energy balance, a progress bar, physical stop
+:class:`~femrub.output.results.Results` with the energy balance, a progress bar, physical stop
 criteria and protection against numerical blow-up. Whatever stops a run (instability, a
 stop criterion, Ctrl-C, an exception), ``run()`` returns what was computed so far.
 """
@@ -129,7 +129,7 @@ class Stepper:
         on_state=None,
         label: str | None = None,
     ) -> Results:
-        """Integrate to ``t_end`` and collect :class:`~femrub.results.Results`.
+        """Integrate to ``t_end`` and collect :class:`~femrub.output.results.Results`.
 
         Parameters
         ----------

@@ -29,9 +29,9 @@ import math
 
 import numpy as np
 import scipy.sparse as sp
-import scipy.sparse.linalg as spla
 
 from ..contact.impulses import solve_impulses
+from ..fem.eigen import largest_modulus
 from ..fem.linalg import Factorised
 from .base import Stepper
 
@@ -118,27 +118,12 @@ class Carpenter(Stepper):
         limits = []
         if L.n_u:
             mech = np.r_[np.arange(L.u.start, L.u.stop), np.arange(L.v.start, L.v.stop)]
-            lam = _largest_modulus(A[mech][:, mech], B[mech][:, mech])
+            lam = largest_modulus(A[mech][:, mech], B[mech][:, mech])
             if lam > 0:
                 limits.append(2.0 / lam)
         if L.n_t:
             th = np.arange(L.t.start, L.t.stop)
-            lam = _largest_modulus(A[th][:, th], B[th][:, th])
+            lam = largest_modulus(A[th][:, th], B[th][:, th])
             if lam > 0:
                 limits.append(2.0 / lam)
         return min(limits) if limits else math.inf
-
-
-def _largest_modulus(A, B) -> float:
-    """Largest |eigenvalue| of ``A⁻¹ B`` (sparse, ARPACK; dense for small blocks)."""
-    n = A.shape[0]
-    if n <= 400:
-        import scipy.linalg as sla
-
-        ev = sla.eigvals(B.toarray(), A.toarray())
-        ev = ev[np.isfinite(ev)]
-        return float(np.max(np.abs(ev))) if ev.size else 0.0
-    lu = spla.splu(A.tocsc())
-    op = spla.LinearOperator((n, n), matvec=lambda x: lu.solve(B @ x), dtype=float)
-    ev = spla.eigs(op, k=2, which="LM", return_eigenvectors=False, tol=1e-6, maxiter=5000)
-    return float(np.max(np.abs(ev)))

@@ -21,7 +21,7 @@ approaching contacts (``ġ_k <= 0``). A contact still closed but already separat
 midpoint condition ``(ġ_{k+1} + ġ_k) / 2 >= 0`` (``e = 1`` for that step): with Newton's law
 there, the step's contact work ``P (1 − e) ġ_k / 2`` would be positive and energy would be
 created. With this choice the contact work of every step is ``<= 0`` (see
-:mod:`femrub.energy`). Active contacts:
+:mod:`femrub.output.energy`). Active contacts:
 
 * ``"paper"``: the gap at ``t_{k+1}`` is closed (``g_{k+1} <= 0``, paper Eq. 25b), iterated
   to a fixed point with the impulse (the role of the paper's semi-smooth Newton loop); a
@@ -58,7 +58,7 @@ class ThetaMethod(Stepper):
 
     Parameters
     ----------
-    model : :class:`~femrub.model.FirstOrderModel`.
+    model : :class:`~femrub.model.first_order.FirstOrderModel`.
     h : time step (s).
     gamma : θ-method parameter γ in [1/2, 1] (1/2: trapezoidal, no numerical dissipation).
     gamma_thermal : γ of the heat-equation rows (default: ``gamma``). The trapezoidal rule is

@@ -1,0 +1,122 @@
+"""The eigen-solvers of femrub, in one place.
+
+* :func:`lowest_modes`: the ``k`` lowest eigenpairs of ``K x = λ M x`` (``K``, ``M``
+  symmetric, ``M`` positive): LAPACK ``eigh`` on dense matrices below
+  :data:`DENSE_EIGEN_BELOW` unknowns, else ARPACK ``eigsh`` in shift-invert mode about
+  σ = 0, reusing a given factorisation of ``K`` (``solve``). Shapes are normalised to a unit
+  largest amplitude, with that entry positive (:func:`normalise_columns`), so modal
+  coordinates carry the units of the physical dofs and the basis is deterministic.
+* :func:`angular_frequencies`, :func:`natural_frequencies`: ``ω = √λ`` (rad/s) and
+  ``f = ω / 2π`` (Hz) of the lowest modes; a free structure (singular ``K``) is shifted.
+* :func:`largest_modulus`: the largest ``|λ|`` of ``A⁻¹ B`` (non-symmetric), which bounds
+  the step of an explicit scheme (``h < 2 / |λ|_max``).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import scipy.linalg as sla
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
+from threadpoolctl import threadpool_limits
+
+__all__ = [
+    "DENSE_EIGEN_BELOW",
+    "angular_frequencies",
+    "largest_modulus",
+    "lowest_modes",
+    "natural_frequencies",
+    "normalise_columns",
+]
+
+#: Problem sizes below which dense LAPACK solvers replace ARPACK.
+DENSE_EIGEN_BELOW = 400
+#: Shift used when the stiffness is singular (free structure): σ = −1 rad²/s².
+FREE_SHIFT = -1.0
+
+
+def _dense(M) -> np.ndarray:
+    return M.toarray() if sp.issparse(M) else np.asarray(M)
+
+
+def normalise_columns(V: np.ndarray) -> np.ndarray:
+    """Scale each column to a largest absolute entry of +1."""
+    V = np.array(V, dtype=float, copy=True)
+    if V.size == 0:
+        return V
+    idx = np.argmax(np.abs(V), axis=0)
+    peak = V[idx, np.arange(V.shape[1])]
+    peak[peak == 0.0] = 1.0
+    return V / peak
+
+
+def lowest_modes(K, M, k: int, solve=None, *, tol: float = 1e-12, vectors: bool = True):
+    """The ``k`` lowest eigenpairs of ``K x = λ M x``.
+
+    Parameters
+    ----------
+    K, M : (n, n) sparse or dense, symmetric; ``M`` positive definite.
+    k : number of modes (0 <= k <= n).
+    solve : optional callable ``rhs -> K⁻¹ rhs`` (an existing factorisation), used as the
+        shift-invert operator about σ = 0; without it ``K`` is factorised here, and shifted by
+        :data:`FREE_SHIFT` when singular.
+    vectors : also return the shapes.
+
+    Returns
+    -------
+    lam : (k,) eigenvalues in increasing order (ω² in rad²/s², or μ in 1/s).
+    V : (n, k) shapes normalised by :func:`normalise_columns` (when ``vectors``).
+    """
+    n = K.shape[0]
+    if not 0 <= k <= n:
+        raise ValueError(f"asked for {k} modes of a {n}-dof problem")
+    if k == 0:
+        return (np.zeros(0), np.zeros((n, 0))) if vectors else np.zeros(0)
+    if n < DENSE_EIGEN_BELOW or k >= n - 1:
+        with threadpool_limits(limits=1, user_api="blas"):  # threads only slow small problems
+            out = sla.eigh(
+                _dense(K), _dense(M), subset_by_index=[0, k - 1], eigvals_only=not vectors
+            )
+        lam, V = (out, None) if not vectors else out
+    else:
+        Kc, Mc = sp.csc_matrix(K), sp.csc_matrix(M)
+        kw = dict(k=k, M=Mc, which="LM", tol=tol, return_eigenvectors=vectors)
+        if solve is not None:
+            opinv = spla.LinearOperator((n, n), matvec=solve, dtype=float)
+            out = spla.eigsh(Kc, sigma=0.0, OPinv=opinv, **kw)
+        else:
+            try:
+                out = spla.eigsh(Kc, sigma=0.0, **kw)
+            except RuntimeError:  # singular stiffness: a free structure
+                out = spla.eigsh(Kc, sigma=FREE_SHIFT, **kw)
+        lam, V = out if vectors else (out, None)
+        order = np.argsort(lam)
+        lam = lam[order]
+        V = None if V is None else V[:, order]
+    lam = np.asarray(lam)
+    return (lam, normalise_columns(V)) if vectors else lam
+
+
+def angular_frequencies(K, M, k: int, solve=None) -> np.ndarray:
+    """The ``k`` lowest angular frequencies ``ω`` (rad/s) of ``K φ = ω² M φ``."""
+    lam = lowest_modes(K, M, min(k, K.shape[0]), solve, vectors=False)
+    return np.sqrt(np.clip(lam, 0.0, None))
+
+
+def natural_frequencies(K, M, k: int) -> np.ndarray:
+    """The ``k`` lowest natural frequencies (Hz) of ``K φ = ω² M φ``."""
+    return angular_frequencies(K, M, k) / (2.0 * np.pi)
+
+
+def largest_modulus(A, B) -> float:
+    """Largest ``|λ|`` of ``B x = λ A x`` (``A`` invertible; ARPACK above the dense size)."""
+    n = A.shape[0]
+    if n < DENSE_EIGEN_BELOW:
+        ev = sla.eigvals(_dense(B), _dense(A))
+        ev = ev[np.isfinite(ev)]
+        return float(np.max(np.abs(ev))) if ev.size else 0.0
+    lu = spla.splu(sp.csc_matrix(A))
+    Bc = sp.csr_matrix(B)
+    op = spla.LinearOperator((n, n), matvec=lambda x: lu.solve(Bc @ x), dtype=float)
+    ev = spla.eigs(op, k=2, which="LM", return_eigenvectors=False, tol=1e-6, maxiter=5000)
+    return float(np.max(np.abs(ev)))
