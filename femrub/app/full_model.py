@@ -244,7 +244,10 @@ def restrict_contacts(model, fields, keep, offset):
             else:
                 del obs[name]
     info = dict(model.info, n_contacts=int(idx.size))
-    model = model.with_(contact=contact, observations=obs, info=info)
+    L = model.layout
+    rows = lambda M, sl: np.flatnonzero(np.any(M[sl][:, idx] != 0.0, axis=1))  # noqa: E731
+    boundary = {"u": rows(c.G, L.u), "theta": rows(c.Ht, L.t) if L.n_t else np.zeros(0, int)}
+    model = model.with_(contact=contact, observations=obs, info=info, boundary=boundary)
     if fields is not None:
         k = fields.contacts
         sub = replace(

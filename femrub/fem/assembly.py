@@ -12,7 +12,7 @@ the paper and a 3D blade go through this same function; only the bases differ.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 import scipy.sparse as sp
@@ -66,6 +66,18 @@ class ThermoelasticMatrices:
     def t_index(self, full_dofs) -> np.ndarray:
         """Positions in the free numbering of temperature dofs given in full numbering."""
         return _positions(self.free_t, self.n_t_all, full_dofs, "temperature")
+
+    def mechanical(self) -> ThermoelasticMatrices:
+        """The same blocks without the thermal part (``n_θ = 0``)."""
+        z = sp.csr_matrix
+        return replace(
+            self,
+            Kut=z((self.n_u, 0)),
+            Ctu=z((0, self.n_u)),
+            Ctt=z((0, 0)),
+            Ktt=z((0, 0)),
+            free_t=np.zeros(0, dtype=int),
+        )
 
     def prolongation_u(self) -> sp.csr_matrix:
         """Sparse map from free displacement dofs to all dofs (zeros on Dirichlet dofs)."""

@@ -133,6 +133,7 @@ def first_order_model(
             raise ValueError(f"load field must be 'u' or 'theta', got {ld.field!r}")
 
     con = None
+    boundary = {"u": np.zeros(0, dtype=int), "theta": np.zeros(0, dtype=int)}
     if contact is not None:
         N = _rows(contact.normals, nu)
         nc = N.shape[0]
@@ -140,6 +141,7 @@ def first_order_model(
         G[L.u] = -N.T.toarray()
         Gv = np.zeros((n, nc))
         Gv[L.v] = -N.T.toarray()
+        boundary["u"] = np.unique(N.indices).astype(int)
         Ht = np.zeros((n, nc))
         if nt and contact.heat_dofs is not None:
             hd = np.asarray(contact.heat_dofs)
@@ -147,6 +149,7 @@ def first_order_model(
                 Ht[L.t.start + hd.astype(int), np.arange(nc)] = 1.0
             else:
                 Ht[L.t] = hd.T
+        boundary["theta"] = np.flatnonzero(np.any(Ht[L.t] != 0.0, axis=1))
         con = Contact(
             G=G,
             Gv=Gv,
@@ -213,6 +216,8 @@ def first_order_model(
         contact=con,
         observations=observations,
         energy=energy,
+        blocks=mats if nt else mats.mechanical(),
+        boundary=boundary,
         to_full=to_full,
         x0=x0,
         info=info,

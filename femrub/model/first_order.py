@@ -195,6 +195,10 @@ class FirstOrderModel:
     contact : :class:`Contact` or ``None``.
     observations : name -> sparse (k, N) rows giving physical signals (tip displacement, ...).
     energy : :class:`EnergyForms` or ``None``.
+    blocks : the Eq. (2) matrices of a full model (``None`` for a reduced one), so a reductor
+        reads them instead of recovering them from ``A`` and ``B``.
+    boundary : ``{"u": positions in the u-block, "theta": positions in the θ-block}`` of the
+        dofs the contacts act on (paper Eq. 10), set by the constructor of a full model.
     to_full : optional (n_full, N) map from the state to the full-mesh physical state
         ``[u_all, v_all, θ_all]`` (Dirichlet dofs included); used for VTK output.
     x0 : initial state (zeros by default).
@@ -208,6 +212,8 @@ class FirstOrderModel:
     contact: Contact | None = None
     observations: dict[str, sp.spmatrix] = field(default_factory=dict)
     energy: EnergyForms | None = None
+    blocks: object = None
+    boundary: dict | None = None
     to_full: object = None
     x0: np.ndarray | None = None
     info: dict = field(default_factory=dict)
