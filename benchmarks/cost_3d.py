@@ -29,8 +29,8 @@ def one_size(h_mesh: float) -> dict:
     """Build, reduce and step one box blade; return the timings (s) and sizes."""
     import femrub as fr
     from femrub.contact.casing import Lobed
-    from femrub.fem.solid import solid_model
     from femrub.geometry import box_blade
+    from femrub.model.rub import solid_model
     from femrub.reduction import craig_bampton_thermal
 
     t0 = time.perf_counter()

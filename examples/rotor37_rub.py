@@ -23,8 +23,8 @@ from pathlib import Path
 
 import femrub as fr
 from femrub.contact.casing import TwoLobePiollet
-from femrub.fem.solid import solid_model
 from femrub.geometry import read_rotor37_mesh, shared_data_dir
+from femrub.model.rub import solid_model
 from femrub.output.run_folder import run_to_folder
 from femrub.reduction import craig_bampton_thermal
 

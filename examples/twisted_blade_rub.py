@@ -2,7 +2,7 @@
 
 Meshes a twisted, tapered NACA 0012 blade with gmsh (:func:`femrub.geometry.naca_blade`,
 contact nodes embedded on the tip camber line), builds its first-order thermoelastic model
-(:func:`femrub.fem.solid.solid_model`: P2 displacement, P1 temperature, physical coupling,
+(:func:`femrub.model.rub.solid_model`: P2 displacement, P1 temperature, physical coupling,
 frictional heat ``μ Ω r λ`` at the contacts) facing a rigid casing with three lobes that
 intrude by 20 µm, reduces it (thermoelastic Craig–Bampton, paper Sec. 2), integrates with the
 θ-method and writes the results folder (:func:`femrub.output.run_folder.run_to_folder`): history,
@@ -20,8 +20,8 @@ import numpy as np
 
 import femrub as fr
 from femrub.contact.casing import Lobed
-from femrub.fem.solid import solid_model
 from femrub.geometry import naca_blade
+from femrub.model.rub import solid_model
 from femrub.output.run_folder import run_to_folder
 from femrub.reduction import craig_bampton_thermal
 

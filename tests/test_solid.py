@@ -10,9 +10,10 @@ import skfem as fem
 
 import femrub as fr
 from femrub.contact.casing import Concentric, Lobed, TwoLobePiollet, casing_profile
+from femrub.fem.discretisation import assemble, discretise
 from femrub.fem.eigen import angular_frequencies
-from femrub.fem.solid import solid_matrices, solid_model
 from femrub.geometry import GeometryError, box_blade
+from femrub.model.rub import solid_model
 from femrub.output.vtk import VTKSeries
 
 P = fr.PAPER
@@ -24,7 +25,7 @@ def test_cantilever_bending_converges_to_euler_bernoulli():
     w_eb = 1.8751**2 * np.sqrt(E * b * t**3 / 12 / (rho * b * t * L**4))
     errs = []
     for h in (0.01, 0.005, 0.0025):
-        mats, _, _ = solid_matrices(box_blade(span=L, chord=b, thickness=t, h=h), mat)
+        mats = assemble(discretise(box_blade(span=L, chord=b, thickness=t, h=h)), mat)
         errs.append(angular_frequencies(mats.K, mats.M, 1)[0] / w_eb - 1)
     assert errs[0] > errs[1] > errs[2] > 0  # stiff from above, converging
     assert errs[2] < 0.01
@@ -77,7 +78,8 @@ def slender_box():
 
 def test_slender_box_axial_frequency_matches_bar(slender_box):
     blade, mat = slender_box
-    mats, bu, _ = solid_matrices(blade, mat, coupling="none")
+    disc = discretise(blade)
+    mats, bu = assemble(disc, mat, coupling="none"), disc.basis_u
     w_ax = np.pi / 2 * np.sqrt(P.young / mat.rho) / P.length
     w2, V = spla.eigsh(mats.K.tocsc(), k=8, M=mats.M.tocsc(), sigma=(0.9 * w_ax) ** 2)
     z = np.arange(bu.N)[mats.free_u] % 3 == 2  # span along z

@@ -6,6 +6,6 @@ Eq. 2 blocks -> contact points -> first-order model -> reduced model -> stepper)
 """
 
 from .run import FINISHED, folder_status, run_scene
-from .simulation import Built, build
+from .simulation import Simulation, build
 
-__all__ = ["FINISHED", "Built", "build", "folder_status", "run_scene"]
+__all__ = ["FINISHED", "Simulation", "build", "folder_status", "run_scene"]

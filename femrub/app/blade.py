@@ -1,4 +1,4 @@
-"""The blade of a 3D scene: gmsh parametric blade, sections or a mesh file, with its groups.
+"""The blade of a scene: the paper's bar, a gmsh parametric blade, sections or a mesh file.
 
 :func:`load_blade` returns a :class:`~femrub.geometry.BladeMesh` whose ``root`` node set is
 the clamped face (``boundary.root``) and whose contact points are the scene's candidates
@@ -13,6 +13,7 @@ from dataclasses import replace
 import numpy as np
 
 from ..geometry import GeometryError, box_blade, naca_blade, read_mesh, sections_blade
+from ..geometry.bar import bar_mesh
 from ..geometry.readers import detect_format
 from ..scene.spec import SceneError, fail
 
@@ -28,6 +29,8 @@ def _build(scene):
     kind = g["kind"]
     size = {k: g[k] for k in ("h", "h_min") if g.get(k) is not None}
     tips = {"n_contact": g.get("n_contact"), "contact_margin": g.get("contact_margin")}
+    if kind == "bar":
+        return bar_mesh(g["length"], g["n_elements"], g["grading"])
     if kind == "box":
         return box_blade(
             g["span"], g["chord"], g["thickness"], hub_radius=g["hub_radius"], **tips, **size
@@ -126,7 +129,7 @@ def load_blade(scene, log=None):
 
     Parameters
     ----------
-    scene : :class:`~femrub.scene.scene.Scene` with a 3D geometry.
+    scene : :class:`~femrub.scene.scene.Scene`.
     log : optional callable for progress messages.
 
     Returns

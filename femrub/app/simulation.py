@@ -1,10 +1,16 @@
-"""Build what a scene needs, and only that: model, contacts, reduction, stepper.
+"""The single pipeline from a scene to a runnable simulation, each object built once.
 
-:func:`build` validates the files, meshes or reads the blade, assembles the full model
-(temperature dofs only when something heats the blade), keeps the contacts the casing can
-reach, keeps the requested signals, reduces when asked, creates the stepper and checks the
-step against Carpenter's stability limit, all before any time step. ``Built.report`` says
-what was built and why (``femrub run SCENE --explain``).
+::
+
+    Scene -> BladeMesh -> Discretisation -> Eq. 2 blocks -> ContactPoints (reach-filtered)
+          -> FirstOrderModel -> reductor.reduce(dims) -> stepper
+
+:meth:`Simulation.from_scene` builds what a scene needs and only that: temperature dofs only
+when something heats the blade, only the contacts the casing can reach, only the requested
+signals; it checks the step against Carpenter's stability limit, all before any time step.
+``report`` says what was built and why (``femrub run SCENE --explain``); ``timings`` holds
+the seconds spent meshing, assembling and reducing. The paper's bar and a 3D blade go
+through the same path.
 """
 
 from __future__ import annotations
@@ -15,18 +21,23 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..contact.heat import heat_coefficients
+from ..contact.points import locate_contacts
+from ..contact.reach import contact_reach, normal_deflection
+from ..fem.discretisation import assemble, discretise
+from ..model.rub import rub_model, tip_load
 from ..reduction.sizes import natural_frequencies, reduce_model
 from ..scene.spec import SceneError, fail
 from ..steppers import make_stepper
+from . import translate as tr
 from .blade import load_blade
 from .explain import explain
-from .full_model import build_full, contact_reach, heat_possible, restrict_contacts, thermal_choice
 
-__all__ = ["Built", "build"]
+__all__ = ["Simulation", "build"]
 
 
 @dataclass
-class Built:
+class Simulation:
     """A built scene: the model that runs, the full model, the stepper and the report."""
 
     scene: object
@@ -37,19 +48,159 @@ class Built:
     stepper: object
     limits: dict
     report: dict = field(default_factory=dict)
+    timings: dict = field(default_factory=dict)
 
     def explain(self) -> str:
         """What was built and why, as text (``femrub run SCENE --explain``)."""
         return explain(self.report)
 
+    @classmethod
+    def from_scene(cls, scene, *, log=None, modes: int = 0) -> Simulation:
+        """Build ``scene``; ``modes``: natural frequencies to report.
+
+        Raises
+        ------
+        SceneError
+            A one-line message naming the key at fault (missing file or group, step above
+            the stability limit, ...).
+        """
+        return _build(scene, log, modes)
+
+
+def build(scene, *, log=None, modes: int = 0) -> Simulation:
+    """:meth:`Simulation.from_scene`."""
+    return Simulation.from_scene(scene, log=log, modes=modes)
+
+
+class _Clock:
+    """Seconds per pipeline stage, with a log line when a stage ends."""
+
+    def __init__(self, log):
+        self.log, self.timings, self._t = log, {}, time.perf_counter()
+
+    def done(self, stage: str, result: str) -> None:
+        now = time.perf_counter()
+        self.timings[stage] = self.timings.get(stage, 0.0) + now - self._t
+        self._t = now
+        if self.log:
+            self.log(f"{stage} done in {self.timings[stage]:.2f} s: {result}")
+
 
 def _scheme_options(scene) -> dict:
     s = scene["scheme"]
     if s["name"] == "theta":
-        return {"gamma": s["gamma"], "activation": s["activation"]}
+        return {
+            "gamma": s["gamma"],
+            "gamma_thermal": s.get("gamma_thermal"),
+            "activation": s["activation"],
+        }
     if s["name"] == "penalty":
         return {"stiffness": s["stiffness"], "damping": s["damping"], "method": s["method"]}
     return {}
+
+
+def _build(scene, log, modes) -> Simulation:
+    scene.check_files()
+    clock = _Clock(log)
+    c, p = scene["contact"], scene["physics"]
+    report = {
+        "scene": scene.name,
+        "source": scene.source,
+        "kind": scene["geometry"]["kind"],
+        "dropped": [],
+        "reach_key": c["reach"],
+    }
+    blade = load_blade(scene, log)
+    report["geometry"] = blade.summary()
+    clock.done("mesh", f"{blade.n_vertices} vertices")
+    if log:
+        log("assembling the full model ...")
+    material, casing = tr.material_of(scene), tr.casing_of(scene)
+    omega = scene["loads"]["rotation_speed"]
+    try:
+        disc = discretise(blade, p["order"] if blade.dim == 3 else 1,
+                          clamped=scene["boundary"]["clamped"])  # fmt: skip
+        mats = assemble(
+            disc, material, area=tr.area_of(scene), lumping=p["lumping"],
+            coupling=tr.coupling_of(scene), beta=p["beta"], strain_heating=p["strain_heating"],
+            rayleigh=tuple(p["rayleigh"]), damping_ratio=p["damping_ratio"],
+            damping_modes=tuple(p["damping_modes"]),
+        )  # fmt: skip
+        candidates = locate_contacts(disc)
+        force = tr.force_law(scene)
+        loads = []
+        if force:
+            amplitude, signal, _ = force
+            vector = amplitude * tr.force_direction(scene, candidates)
+            loads = [tip_load(disc, mats, vector, signal)]
+        reach = contact_reach(
+            candidates, casing, rotation_speed=omega, gap_reference=c["gap_reference"],
+            reach=c["reach"], margin=c["reach_margin"],
+            deflection=normal_deflection(mats, candidates.normal_rows(mats),
+                                         loads[0].vector if loads else None, force and force[2]),
+        )  # fmt: skip
+        points = candidates.restrict(reach.keep)
+        alpha = heat_coefficients(
+            points.radii, tr.heat_law_of(scene), alpha=c["heat_coefficient"],
+            friction=c["friction"], rotation_speed=omega, heat_partition=c["heat_partition"],
+        )  # fmt: skip
+        keep_t, report["thermal"] = tr.thermal_choice(scene, bool(np.any(alpha > 0)), points.n > 0)
+        full, fields = rub_model(
+            disc, mats, points, material, casing=casing, rotation_speed=omega, alpha=alpha,
+            restitution=c["restitution"], offset=reach.offset[reach.keep], loads=loads,
+            thermal=keep_t, observe_at=points if points.n else candidates,
+        )  # fmt: skip
+    except ValueError as exc:  # a value the schema cannot see (e.g. a singular clamp)
+        if isinstance(exc, SceneError):
+            raise
+        raise SceneError(f"building the model of {scene.source}: {exc}") from None
+    clock.done("assembly", f"{full.n_dofs} state dofs")
+    report["dropped"] += [d for d in full.info.get("dropped", []) if "temperature" not in d]
+    report["full"] = {"n_dofs": full.n_dofs, "fe_dofs": mats.n_u + mats.n_t, **_layout(full)}
+    report["contacts"] = _contacts_report(candidates, reach)
+    model, limits = _select_signals(scene, full, report)
+    if modes:
+        report["natural_frequencies_hz"] = natural_frequencies(model, modes).tolist()
+    reduced, reductor, report["reduction"] = reduce_model(model, scene, log)
+    clock.done("reduction", f"{reduced.n_dofs} dofs")
+    report["model"] = {"n_dofs": reduced.n_dofs, **_layout(reduced)}
+    stepper = _stepper(scene, reduced, report)
+    report["outputs"] = {
+        "vtk_stride": scene["outputs"]["vtk_stride"],
+        "plots": scene["outputs"]["plots"],
+    }
+    report["timings"] = clock.timings
+    return Simulation(
+        scene, reduced, full, fields, reductor, stepper, limits, report, clock.timings
+    )
+
+
+def _stepper(scene, model, report):
+    s = scene["scheme"]
+    options = _scheme_options(scene)
+    try:
+        stepper = make_stepper(s["name"], model, s["h"], **options)
+    except ValueError as exc:
+        raise SceneError(f"scheme ({s['name']}): {exc}") from None
+    report["scheme"] = {
+        "name": s["name"],
+        "h": s["h"],
+        "t_end": s["t_end"],
+        "steps": int(round(s["t_end"] / s["h"])),
+        **{k: v for k, v in options.items() if v is not None},
+    }
+    if s["name"] == "carpenter":
+        limit = stepper.stability_limit()
+        report["scheme"]["stability_limit"] = limit
+        if s["h"] > limit:
+            fail(
+                "scheme.h",
+                s["h"],
+                f"exceeds the stability limit {limit:.3g} s of Carpenter's "
+                f"explicit scheme for this model; use scheme.h <= {_floor(limit)} or "
+                "scheme.name = 'theta'",
+            )
+    return stepper
 
 
 def _select_signals(scene, model, report):
@@ -73,125 +224,21 @@ def _select_signals(scene, model, report):
     return model.with_(observations=obs), kept_limits
 
 
-def _contacts_report(full, reach, fields) -> dict:
-    names = list(full.contact.names) if full.contact is not None else []
-    keep = reach["keep"]
+def _contacts_report(points, reach) -> dict:
+    keep = reach.keep
     return {
-        "candidates": len(names),
-        "kept": [n for n, k in zip(names, keep) if k],
+        "candidates": points.n,
+        "kept": [n for n, k in zip(points.names, keep) if k],
         "dropped": [
-            {"name": n, "min_gap": float(g)} for n, g, k in zip(names, reach["min_gap"], keep)
+            {"name": n, "min_gap": float(g)} for n, g, k in zip(points.names, reach.min_gap, keep)
             if not k
         ],
-        "min_gap_kept": [float(g) for g, k in zip(reach["min_gap"], keep) if k],
-        "reach": reach["reach"],
-        "deflection": reach["deflection"],
-        "intrusion": reach["intrusion"],
-        "max_offset": float(np.max(reach["offset"])) if len(names) else 0.0,
+        "min_gap_kept": [float(g) for g, k in zip(reach.min_gap, keep) if k],
+        "reach": reach.reach,
+        "deflection": reach.deflection,
+        "intrusion": reach.intrusion,
+        "max_offset": float(np.max(reach.offset)) if points.n else 0.0,
     }  # fmt: skip
-
-
-def build(scene, *, log=None, modes: int = 0) -> Built:
-    """Build ``scene`` (see the module docstring); ``modes``: natural frequencies to report.
-
-    Raises
-    ------
-    SceneError
-        A one-line message naming the key at fault (missing file or group, step above the
-        stability limit, ...).
-    """
-    timings, t0 = {}, time.perf_counter()
-    scene.check_files()
-    kind = scene["geometry"]["kind"]
-    report = {
-        "scene": scene.name,
-        "source": scene.source,
-        "kind": kind,
-        "dropped": [],
-        "reach_key": scene["contact"]["reach"],
-    }
-    blade = None
-    if kind != "bar":
-        blade = load_blade(scene, log)
-        report["geometry"] = blade.summary()
-        timings["geometry"] = time.perf_counter() - t0
-        _done(log, "geometry", timings["geometry"], f"{blade.n_tets} tetrahedra")
-    else:
-        g = scene["geometry"]
-        report["geometry"] = f"1D bar, L = {g['length']:g} m, {g['n_elements']} elements"
-    heated = heat_possible(scene)
-    keep_t, why = thermal_choice(scene, heated)
-    t1 = time.perf_counter()
-    if log:
-        log("assembling the full model ...")
-    try:
-        full, fields = build_full(scene, keep_t, blade)
-        reach = contact_reach(scene, full, fields)
-        if heated and keep_t and not reach["keep"].any():
-            keep2, why2 = thermal_choice(scene, False, reachable=False)
-            if keep2 != keep_t:
-                keep_t, why = keep2, why2
-                full, fields = build_full(scene, keep_t, blade)
-    except SceneError:
-        raise
-    except ValueError as exc:  # a value the schema cannot see (e.g. a singular clamp)
-        raise SceneError(f"building the model of {scene.source}: {exc}") from None
-    timings["assembly"] = time.perf_counter() - t1
-    _done(log, "assembly", timings["assembly"], f"{full.n_dofs} state dofs")
-    report["thermal"] = why
-    report["dropped"] += [d for d in full.info.get("dropped", []) if "temperature" not in d]
-    report["full"] = {"n_dofs": full.n_dofs, **_layout(full)}
-    if "fe_dofs" in full.info:
-        report["full"]["fe_dofs"] = full.info["fe_dofs"]
-    report["contacts"] = _contacts_report(full, reach, fields)
-    model, fields = restrict_contacts(full, fields, reach["keep"], reach["offset"])
-    model, limits = _select_signals(scene, model, report)
-    if modes:
-        report["natural_frequencies_hz"] = natural_frequencies(model, modes).tolist()
-    t2 = time.perf_counter()
-    reduced, reductor, red_report = reduce_model(model, scene, log)
-    timings["reduction"] = time.perf_counter() - t2
-    if reductor is not None:
-        _done(log, "reduction", timings["reduction"], f"{reduced.n_dofs} dofs")
-    report["reduction"] = red_report
-    report["model"] = {"n_dofs": reduced.n_dofs, **_layout(reduced)}
-    s = scene["scheme"]
-    t3 = time.perf_counter()
-    try:
-        stepper = make_stepper(s["name"], reduced, s["h"], **_scheme_options(scene))
-    except ValueError as exc:
-        raise SceneError(f"scheme ({s['name']}): {exc}") from None
-    report["scheme"] = {
-        "name": s["name"],
-        "h": s["h"],
-        "t_end": s["t_end"],
-        "steps": int(round(s["t_end"] / s["h"])),
-        **_scheme_options(scene),
-    }
-    if s["name"] == "carpenter":
-        limit = stepper.stability_limit()
-        report["scheme"]["stability_limit"] = limit
-        if s["h"] > limit:
-            fail(
-                "scheme.h",
-                s["h"],
-                f"exceeds the stability limit {limit:.3g} s of Carpenter's "
-                f"explicit scheme for this model; use scheme.h <= {_floor(limit)} or "
-                "scheme.name = 'theta'",
-            )
-    timings["stepper"] = time.perf_counter() - t3
-    report["outputs"] = {
-        "vtk_stride": scene["outputs"]["vtk_stride"],
-        "plots": scene["outputs"]["plots"],
-    }
-    timings["total"] = time.perf_counter() - t0
-    report["timings"] = timings
-    return Built(scene, reduced, full, fields, reductor, stepper, limits, report)
-
-
-def _done(log, what: str, seconds: float, result: str) -> None:
-    if log:
-        log(f"{what} done in {seconds:.2f} s: {result}")
 
 
 def _layout(model) -> dict:

@@ -13,12 +13,16 @@ import math
 from dataclasses import asdict, dataclass, field, replace
 
 import numpy as np
-import skfem as fem
 
-from ..fem.assembly import ThermoelasticMatrices, assemble_thermoelastic
+from ..contact.casing import Concentric
+from ..contact.heat import heat_coefficients
+from ..contact.points import locate_contacts
+from ..fem.assembly import ThermoelasticMatrices
+from ..fem.discretisation import assemble, discretise
 from ..fem.material import Material, check_finite_positive
-from ..model.build import ContactSpec, Load, first_order_model
+from ..geometry.bar import bar_mesh
 from ..model.first_order import FirstOrderModel
+from ..model.rub import rub_model, tip_load
 
 __all__ = ["BarCase", "PAPER", "bar_matrices", "bar_model", "impact_bar_model", "rpm"]
 
@@ -110,22 +114,11 @@ class BarCase:
 PAPER = BarCase()
 
 
-def bar_matrices(case: BarCase = PAPER) -> tuple[ThermoelasticMatrices, int]:
-    """Assemble the bar's matrices with scikit-fem; return them and the tip's free dof.
-
-    Nodes sit at ``x = L (1 − (1 − ξ)^p)`` with ``ξ`` uniform and ``p = case.grading``
-    (1: uniform; > 1: elements refined towards the tip).
-    """
-    xi = np.linspace(0.0, 1.0, case.n_elements + 1)
-    mesh = fem.MeshLine(case.length * (1.0 - (1.0 - xi) ** case.grading))
-    basis_u = fem.Basis(mesh, fem.ElementVector(fem.ElementLineP1()))
-    basis_t = fem.Basis(mesh, fem.ElementLineP1())
-    x = mesh.p[0]
-    root_node = int(np.argmin(x))
-    tip_node = int(np.argmax(x))
-    mats = assemble_thermoelastic(
-        basis_u,
-        basis_t,
+def _bar_parts(case: BarCase):
+    """Discretisation, Eq. (2) blocks and contact point (the tip) of the bar."""
+    disc = discretise(bar_mesh(case.length, case.n_elements, case.grading), 1, clamped=case.clamped)
+    mats = assemble(
+        disc,
         case.material,
         area=case.area,
         lumping=case.lumping,
@@ -133,52 +126,45 @@ def bar_matrices(case: BarCase = PAPER) -> tuple[ThermoelasticMatrices, int]:
         beta=case.beta,
         strain_heating=case.strain_heating,
         rayleigh=case.rayleigh,
-        fixed_u=[root_node] if case.clamped else None,
-        fixed_t=[root_node] if case.clamped else None,
     )
-    tip = int(mats.u_index([tip_node])[0])
-    return mats, tip
+    return disc, mats, locate_contacts(disc)
+
+
+def bar_matrices(case: BarCase = PAPER) -> tuple[ThermoelasticMatrices, int]:
+    """The bar's Eq. (2) blocks (scikit-fem) and the tip's free displacement dof."""
+    _, mats, tip = _bar_parts(case)
+    return mats, int(mats.u_index(tip.u_dofs[0])[0])
 
 
 def bar_model(case: BarCase = PAPER, **changes) -> FirstOrderModel:
     """First-order model of the bar rubbing a rigid casing at its tip (paper Sec. 1).
 
+    Built through the same path as a 3D blade (:func:`femrub.model.rub.rub_model`).
     Observed signals: ``tip_displacement`` (m), ``tip_velocity`` (m/s), ``tip_temperature``
     (K above ambient, when the thermal part is kept).
     """
     if changes:
         case = case.with_(**changes)
-    mats, tip = bar_matrices(case)
-    tip_t = int(mats.t_index([mats.free_u[tip]])[0])
-    e_tip = np.zeros(mats.n_u)
-    e_tip[tip] = 1.0
+    disc, mats, tip = _bar_parts(case)
     F0, Om = float(case.force_amplitude), float(case.force_frequency)
-    loads = []
-    if F0 != 0.0:
-        loads.append(Load(F0 * e_tip, lambda t: np.sin(Om * t), "u", "tip_force"))
-    contact = ContactSpec(
-        normals=e_tip[None, :],
-        gap=case.gap,
-        heat_dofs=[tip_t],
+    force = None if F0 == 0.0 else ([F0], lambda t: np.sin(Om * t))
+    model, _ = rub_model(
+        disc,
+        mats,
+        tip,
+        case.material,
+        casing=Concentric(case.gap),
+        alpha=heat_coefficients(tip.radii, "alpha", alpha=case.alpha),
         restitution=case.restitution,
-        heat_coefficient=case.alpha,
-        names=["tip"],
-    )
-    observe = {
-        "tip_displacement": ("u", [tip]),
-        "tip_velocity": ("v", [tip]),
-        "tip_temperature": ("theta", [tip_t]),
-    }
-    x0 = None
-    n_t = mats.n_t
-    model = first_order_model(
-        mats, contact=contact, loads=loads, observe=observe, thermal=case.thermal
+        loads=[] if force is None else [tip_load(disc, mats, *force)],
+        thermal=case.thermal,
     )
     if case.initial_velocity:
         x0 = np.zeros(model.n_dofs)
         x0[model.layout.v] = case.initial_velocity
         model = model.with_(x0=x0)
-    model.info.update(case=case.as_dict(), tip_dof=tip, n_t_assembled=n_t)
+    tip_dof = int(mats.u_index(tip.u_dofs[0])[0])
+    model.info.update(case=case.as_dict(), tip_dof=tip_dof, n_t_assembled=mats.n_t)
     return model
 
 

@@ -3,7 +3,7 @@
 A contact node at angular position ``φ`` (rad, around the machine axis) of a blade turning
 at ``Ω`` (rad/s) sees the casing at angle ``ψ = Ω t + φ``; its undeformed radial gap is the
 profile ``g(ψ)`` (m). The deformed gap is ``g(ψ) − n · u`` with ``n`` the outward radial
-direction at the node (see :mod:`femrub.fem.solid`).
+direction at the node (see :mod:`femrub.model.rub`).
 
 * :class:`Concentric`: ``g(ψ) = c``.
 * :class:`Lobed`: ``g(ψ) = c − δ cos(k (ψ − ψ0))``, an ovalised casing with ``k`` lobes;
@@ -22,7 +22,15 @@ import numpy as np
 
 from ..fem.material import check_finite_positive
 
-__all__ = ["CasingProfile", "Concentric", "Lobed", "TwoLobePiollet", "casing_profile", "PROFILES"]
+__all__ = [
+    "CasingProfile",
+    "Concentric",
+    "Lobed",
+    "TwoLobePiollet",
+    "casing_profile",
+    "PROFILES",
+    "swept_gap",
+]
 
 
 class CasingProfile:
@@ -121,3 +129,24 @@ def casing_profile(kind: str, **params) -> CasingProfile:
         return PROFILES[kind](**params)
     except TypeError as exc:
         raise ValueError(f"casing profile {kind!r}: {exc}") from None
+
+
+def swept_gap(profile: CasingProfile, angles, rotation_speed: float, offset=0.0):
+    """Gap ``g_i(t) = g(Ω t + φ_i) + offset_i`` of contacts at ``angles`` and its rate.
+
+    Returns ``(gap, gap_rate)``: constant arrays and ``None`` when the gap does not move
+    (concentric casing or ``Ω = 0``), else callables ``t -> (n_c,)`` (m and m/s).
+    """
+    angles = np.asarray(angles, dtype=float)
+    offset = np.broadcast_to(np.asarray(offset, dtype=float), angles.shape).copy()
+    omega = float(rotation_speed)
+    if isinstance(profile, Concentric) or omega == 0.0:
+        return np.asarray(profile.gap(angles), dtype=float) + offset, None
+
+    def gap(t):
+        return profile.gap(omega * t + angles) + offset
+
+    def gap_rate(t):
+        return omega * profile.slope(omega * t + angles)
+
+    return gap, gap_rate

@@ -27,7 +27,8 @@ _HINTS = {
 
 @dataclass
 class BladeMesh:
-    """A blade discretised by linear tetrahedra, with its named node groups.
+    """A blade discretised by linear tetrahedra (or, for the paper's bar, a radial line of
+    linear elements along ``+x``), with its named node groups.
 
     Attributes
     ----------
@@ -37,7 +38,7 @@ class BladeMesh:
         Vertex indices of named groups; at least ``"root"`` (clamped face) and
         ``"tip"`` (contact face) for meshes built or read by this package.
     contact_points : numpy.ndarray
-        Coordinates in metres of the contact nodes, shape ``(3, n_c)``. They may be
+        Coordinates in metres of the contact nodes, shape ``(dim, n_c)``. They may be
         mid-side nodes of a quadratic source mesh and so not mesh vertices.
     radial_axis : str or numpy.ndarray
         Rotation axis of the machine (``"x"``, ``"y"``, ``"z"`` or a 3-vector); the
@@ -64,7 +65,8 @@ class BladeMesh:
 
     def __post_init__(self) -> None:
         axis_vector(self.radial_axis)
-        self.contact_points = np.asarray(self.contact_points, dtype=float).reshape(3, -1)
+        dim = self.mesh.p.shape[0]
+        self.contact_points = np.asarray(self.contact_points, dtype=float).reshape(dim, -1)
         n_vertices = self.mesh.p.shape[1]
         for name, idx in list(self.node_sets.items()):
             idx = np.asarray(idx, dtype=np.int64).reshape(-1)
@@ -108,6 +110,11 @@ class BladeMesh:
         return axis_vector(self.radial_axis)
 
     @property
+    def dim(self) -> int:
+        """Space dimension: 3 for a blade, 1 for the paper's bar."""
+        return int(self.mesh.p.shape[0])
+
+    @property
     def n_vertices(self) -> int:
         """Number of mesh vertices."""
         return int(self.mesh.p.shape[1])
@@ -118,12 +125,19 @@ class BladeMesh:
         return int(self.mesh.t.shape[1])
 
     def radius(self, points: np.ndarray | None = None) -> np.ndarray:
-        """Distance to the rotation axis of ``points`` (default: mesh vertices)."""
-        return radial_coordinates(self.mesh.p if points is None else points, self.axis)[0]
+        """Distance to the rotation axis of ``points`` (default: mesh vertices).
+
+        A bar is radial: its ``x`` coordinate is the distance from its root."""
+        pts = self.mesh.p if points is None else points
+        if self.dim == 1:
+            return np.asarray(pts, dtype=float).reshape(-1)
+        return radial_coordinates(pts, self.axis)[0]
 
     def radial_direction(self, points: np.ndarray | None = None) -> np.ndarray:
         """Unit radial direction at ``points`` (default: contact points), shape ``(3, n)``."""
         pts = self.contact_points if points is None else points
+        if self.dim == 1:
+            return np.ones((1, np.asarray(pts).reshape(1, -1).shape[1]))
         return radial_coordinates(pts, self.axis)[1]
 
     def volume(self) -> float:
@@ -132,6 +146,8 @@ class BladeMesh:
 
     def summary(self) -> str:
         """One-line description: sizes, sets, radius range and source."""
+        if self.dim == 1:
+            return f"1D {self.source}"
         r = self.radius()
         sets = ", ".join(f"{k}:{v.size}" for k, v in self.node_sets.items())
         return (

@@ -3,7 +3,7 @@
 :func:`run_to_folder` integrates a model with a stepper and writes, into ``out``:
 ``history.csv`` and ``history.npz`` (every observed signal, gaps, contact forces and
 impulses, energy balance), ``summary.json`` (inputs, versions, timings, energy balance,
-status), ``signals.png`` and, when a :class:`~femrub.fem.solid.FieldMap` is given, ``vtk/``
+status), ``signals.png`` and, when a :class:`~femrub.model.rub.FieldMap` is given, ``vtk/``
 (``.pvd`` + ``.vtu``, written as the run goes) and ``snapshot.png``. A run that is
 interrupted or fails keeps everything written so far and says so in ``summary.json``.
 A finished result (status ok, unstable or diverged-physically) is not overwritten unless

@@ -19,7 +19,7 @@ import meshio
 import numpy as np
 from scipy.spatial import cKDTree
 
-from ..fem.solid import FieldMap
+from ..model.rub import FieldMap
 
 __all__ = ["VTKSeries", "von_mises", "snapshot_png"]
 
@@ -48,7 +48,7 @@ class VTKSeries:
     ----------
     directory : output folder (created).
     model : the (full or reduced) model run; needs ``model.to_full``.
-    fields : the :class:`~femrub.fem.solid.FieldMap` of the full model.
+    fields : the :class:`~femrub.model.rub.FieldMap` of the full model.
     h : the run's time step (s), to turn contact impulses into forces.
     stride : write every ``stride``-th step (the initial state is always written).
     """

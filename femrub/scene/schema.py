@@ -149,8 +149,15 @@ CONTACT = {
     "nodes": Spec("ints", None, doc="node numbers of the contact points (mesh files)"),
     "casing": CASING,
     "restitution": _f(0.0, "none", "Newton's restitution coefficient e", lo=0.0, hi=1.0),
-    "friction": _f(0.0, "none", "3D: Coulomb coefficient; heat input = friction * Ω r λ", **NONNEG),
-    "heat_coefficient": _f(0.0, "velocity", "bar: α of the heat input α λ", **NONNEG),
+    "friction": _f(
+        0.0, "none", "3D: Coulomb coefficient; heat input = heat_partition friction Ω r λ", **NONNEG
+    ),
+    "heat_coefficient": _f(
+        0.0, "velocity", "bar: α of the heat input heat_partition α λ", **NONNEG
+    ),
+    "heat_partition": _f(
+        1.0, "none", "fraction of the frictional power that enters the blade", lo=0.0, hi=1.0
+    ),
     "reach": Spec(
         F,
         "auto",
@@ -220,6 +227,18 @@ PHYSICS = {
     "beta": _f(-4.5e-7, "length_per_K", "β of the paper coupling K^uθ = β K^uu"),
     "strain_heating": Spec(B, False, doc="strain-rate heating C^θu = −T0 (K^uθ)ᵀ"),
     "rayleigh": Spec("pair", [0.0, 0.0], doc="Rayleigh damping [a (1/s), b (s)]", lo=0.0),
+    "damping_ratio": _f(
+        0.0,
+        "none",
+        "modal damping ratio ζ, as Rayleigh damping with ratio ζ at damping_modes "
+        "(instead of rayleigh)",
+        lo=0.0,
+        hi=1.0,
+        hi_open=True,
+    ),
+    "damping_modes": Spec(
+        "ints", [1, 5], doc="the two clamped modes (1-based) damped exactly at damping_ratio"
+    ),
     "order": Spec(I, 2, lo=1, hi=2, doc="3D displacement element order"),
     "lumping": Spec(
         C,
@@ -240,6 +259,13 @@ SCHEME = Variant(
     variants={
         "theta": {
             "gamma": _f(0.5, "none", "θ of the θ-method", lo=0.5, hi=1.0),
+            "gamma_thermal": _f(
+                None,
+                "none",
+                "θ of the heat-equation rows (default: gamma; 1 damps stiff thermal modes)",
+                lo=0.5,
+                hi=1.0,
+            ),
             "activation": Spec(C, "paper", choices=("paper", "predicted"), doc="contact rule"),
         },
         "carpenter": {},

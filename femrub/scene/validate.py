@@ -23,6 +23,7 @@ MAX_STEPS = 20_000_000
 _BAR_SIGNALS = ("tip_displacement", "tip_velocity", "tip_temperature", "contact_force")
 _SOLID_SIGNALS = (
     "tip_displacement",
+    "tip_velocity",
     "tip_temperature",
     "contact_displacement",
     "contact_temperature",
@@ -84,6 +85,18 @@ def _table(prefix: str, value, spec) -> dict:
         elif s.default is not None:
             out[k] = copy.deepcopy(s.default)
     return out
+
+
+def _check_damping(physics: dict) -> None:
+    modes = physics["damping_modes"]
+    if len(modes) != 2 or not 1 <= modes[0] < modes[1]:
+        fail("physics.damping_modes", modes, "give two mode numbers 1 <= i < j, e.g. [1, 5]")
+    if physics["damping_ratio"] and any(physics["rayleigh"]):
+        fail(
+            "physics.damping_ratio",
+            physics["damping_ratio"],
+            "give either a modal damping ratio or physics.rayleigh, not both",
+        )
 
 
 def _cross_check(d: dict) -> None:
@@ -182,6 +195,7 @@ def _cross_check(d: dict) -> None:
                 d["limits"][name],
                 f"no such signal for geometry.kind = {kind!r}; limits apply to {', '.join(known)}",
             )
+    _check_damping(physics)
     h, t_end = scheme["h"], scheme["t_end"]
     if t_end < h:
         fail("scheme.t_end", t_end, f"must be >= scheme.h = {h:g} s")

@@ -1,0 +1,187 @@
+"""Contact points of a blade: where they are, their dofs, normals and heat weights.
+
+:func:`locate_contacts` finds, for each contact point ``p_i`` of a
+:class:`~femrub.fem.discretisation.Discretisation`, its displacement dofs, the casing
+normal ``n_i`` (the radial direction, away from the machine axis; ``+x`` on the paper's
+bar), its radius ``r_i`` and angular position ``φ_i`` around the axis, and the weights that
+spread its frictional heat over its tributary part of the tip face (see
+:func:`tributary_heat_weights`). :meth:`ContactPoints.restrict` keeps a subset (the points
+the casing can reach), before any model exists.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+
+import numpy as np
+import scipy.sparse as sp
+from scipy.spatial import cKDTree
+
+__all__ = ["ContactPoints", "locate_contacts", "tributary_heat_weights"]
+
+#: Distance (relative to the blade size) within which a point is taken to be a mesh node.
+NODE_TOLERANCE = 1e-6
+
+
+@dataclass(frozen=True)
+class ContactPoints:
+    """Contact points of a discretised blade (full dof numbering of the bases).
+
+    Attributes
+    ----------
+    points : (dim, n_c) coordinates (m).
+    normals : (dim, n_c) outward radial unit vectors.
+    radii : (n_c,) distance to the machine axis (m).
+    angles : (n_c,) angular position around the axis (rad).
+    u_dofs : (dim, n_c) displacement dofs of each point (one per component).
+    heat : (n_c, n_t_all) sparse weights on the temperature dofs (rows sum to 1).
+    names : labels of the points.
+    """
+
+    points: np.ndarray
+    normals: np.ndarray
+    radii: np.ndarray
+    angles: np.ndarray
+    u_dofs: np.ndarray
+    heat: sp.csr_matrix
+    names: tuple[str, ...]
+
+    @property
+    def n(self) -> int:
+        return self.points.shape[1]
+
+    def restrict(self, keep) -> ContactPoints:
+        """The points where the boolean mask (or index array) ``keep`` holds."""
+        idx = np.flatnonzero(keep) if np.asarray(keep).dtype == bool else np.asarray(keep)
+        return replace(
+            self,
+            points=self.points[:, idx],
+            normals=self.normals[:, idx],
+            radii=self.radii[idx],
+            angles=self.angles[idx],
+            u_dofs=self.u_dofs[:, idx],
+            heat=self.heat[idx],
+            names=tuple(self.names[i] for i in idx),
+        )
+
+    def normal_rows(self, mats) -> sp.csr_matrix:
+        """(n_c, n_u) rows giving the normal displacement ``n_i · u(p_i)`` on the free dofs."""
+        dim, nc = self.u_dofs.shape
+        cols = mats.u_index(self.u_dofs.T.ravel())
+        rows = np.repeat(np.arange(nc), dim)
+        return sp.csr_matrix((self.normals.T.ravel(), (rows, cols)), shape=(nc, mats.n_u))
+
+    def heat_rows(self, mats) -> sp.csr_matrix:
+        """(n_c, n_θ) heat weights on the free temperature dofs."""
+        return sp.csr_matrix(self.heat[:, mats.free_t])
+
+
+def _component_of(basis) -> np.ndarray:
+    """Component of every dof of a vector Lagrange basis (rows interleave components)."""
+    comp = np.full(basis.N, -1)
+    dim = basis.mesh.p.shape[0]
+    for name in ("nodal_dofs", "edge_dofs", "facet_dofs", "interior_dofs"):
+        d = getattr(basis, name, None)
+        if d is not None and d.size:
+            comp[d] = (np.arange(d.shape[0]) % dim)[:, None]
+    return comp
+
+
+def _axis_frame(axis):
+    a = np.asarray(axis, dtype=float)
+    a = a / np.linalg.norm(a)
+    e1 = np.eye(3)[np.argmin(np.abs(a))]
+    e1 = e1 - (e1 @ a) * a
+    e1 /= np.linalg.norm(e1)
+    return a, e1, np.cross(a, e1)
+
+
+def locate_contacts(disc, points=None) -> ContactPoints:
+    """Dofs, normals, radii, angles and heat weights of the contact points of ``disc``.
+
+    ``points`` defaults to ``disc.blade.contact_points``.
+    """
+    blade, basis_u = disc.blade, disc.basis_u
+    dim = blade.dim
+    pts = np.asarray(blade.contact_points if points is None else points, dtype=float)
+    pts = pts.reshape(dim, -1)
+    if pts.shape[1] == 0:
+        raise ValueError(f"blade mesh from {blade.source} has no contact points; give some")
+    scale = float(np.ptp(blade.mesh.p, axis=1).max())
+    tol = NODE_TOLERANCE * scale
+    dist, idx = cKDTree(basis_u.doflocs.T).query(pts.T, k=dim)
+    dist, idx = dist.reshape(pts.shape[1], dim), idx.reshape(pts.shape[1], dim)
+    if np.any(dist > tol):
+        bad = int(np.argmax(dist.max(axis=1)))
+        raise ValueError(
+            f"contact point {bad} at {pts[:, bad]} is not a displacement node; use P2 "
+            "displacement (order=2) for mid-edge points or pick mesh nodes"
+        )
+    comp = _component_of(basis_u)[idx]  # (n_c, dim)
+    if np.any(np.sort(comp, axis=1) != np.arange(dim)):
+        raise ValueError("a contact point does not have one displacement dof per component")
+    u_dofs = np.empty((dim, pts.shape[1]), dtype=int)
+    u_dofs[comp.T, np.arange(pts.shape[1])] = idx.T
+    weights = tributary_heat_weights(blade, pts, tol)
+    tdofs = disc.basis_t.nodal_dofs[0]
+    heat = sp.csr_matrix(
+        (weights.data, tdofs[weights.indices], weights.indptr),
+        shape=(pts.shape[1], disc.basis_t.N),
+    )
+    radii = blade.radius(pts)
+    if np.any(radii <= 0):
+        raise ValueError("a contact point lies on the machine axis: no radial direction")
+    normals = blade.radial_direction(pts)
+    if dim == 1:
+        angles = np.zeros(pts.shape[1])
+    else:
+        _, e1, e2 = _axis_frame(blade.axis)
+        angles = np.arctan2(e2 @ pts, e1 @ pts)
+    names = tuple(f"contact{i}" for i in range(pts.shape[1]))
+    return ContactPoints(pts, normals, radii, angles, u_dofs, heat, names)
+
+
+def tributary_heat_weights(blade, pts, tol) -> sp.csr_matrix:
+    """(n_c, n_vertices) weights spreading each contact's heat over its share of the tip.
+
+    The frictional heat of contact ``i`` is generated over the part ``S_i`` of the tip face
+    closer to ``p_i`` than to any other contact point, as a uniform flux: the weight of
+    vertex ``j`` is ``∫_{S_i} N_j ds / |S_i|`` (rows sum to 1). Dumping it into one vertex
+    would make the temperature depend on the mesh (a point source in 3D); without a usable
+    ``tip`` face (and on the bar) the heat goes to the nearest vertex (or the two ends of
+    the mid-edge).
+    """
+    mesh = blade.mesh
+    n_c, n_v = pts.shape[1], mesh.p.shape[1]
+    tip = blade.node_sets.get("tip")
+    facets = np.zeros(0, dtype=int)
+    if blade.dim == 3 and tip is not None and tip.size:
+        bf = mesh.boundary_facets()
+        facets = bf[np.all(np.isin(mesh.facets[:, bf], tip), axis=0)]
+    if facets.size >= n_c:
+        tri = mesh.facets[:, facets]  # (3, n_f)
+        P = mesh.p[:, tri]  # (3 coords, 3 vertices, n_f)
+        area = 0.5 * np.linalg.norm(np.cross(P[:, 1] - P[:, 0], P[:, 2] - P[:, 0], axis=0), axis=0)
+        owner = cKDTree(pts.T).query(P.mean(axis=1).T)[1]
+        if np.unique(owner).size == n_c:
+            rows = np.repeat(owner, 3)
+            vals = np.repeat(area / 3.0, 3)  # ∫ N_j ds over a linear triangle = area / 3
+            W = sp.csr_matrix((vals, (rows, tri.T.ravel())), shape=(n_c, n_v))
+            return sp.diags(1.0 / np.asarray(W.sum(axis=1)).ravel()) @ W
+    vd, vi = cKDTree(mesh.p.T).query(pts.T)
+    on_vertex = vd <= tol
+    rows, cols, vals = [np.flatnonzero(on_vertex)], [vi[on_vertex]], [np.ones(on_vertex.sum())]
+    off = np.flatnonzero(~on_vertex)
+    if off.size:
+        edges = mesh.edges
+        mid = 0.5 * (mesh.p[:, edges[0]] + mesh.p[:, edges[1]])
+        ed, ei = cKDTree(mid.T).query(pts[:, off].T)
+        if np.any(ed > tol):
+            j = off[int(np.argmax(ed))]
+            raise ValueError(f"contact point {j} at {pts[:, j]} is neither a vertex nor mid-edge")
+        rows += [off, off]
+        cols += [edges[0, ei], edges[1, ei]]
+        vals += [np.full(off.size, 0.5)] * 2
+    return sp.csr_matrix(
+        (np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))), shape=(n_c, n_v)
+    )

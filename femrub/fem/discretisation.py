@@ -1,0 +1,135 @@
+"""Finite-element spaces of a blade: displacement and temperature bases, clamped root dofs.
+
+:func:`discretise` turns a :class:`~femrub.geometry.BladeMesh` into a
+:class:`Discretisation`: vector Lagrange displacement (P2 on tetrahedra by default: P1
+tetrahedra lock in bending; P1 on the paper's bar) and scalar P1 temperature on the same
+cells, with the ``root`` faces clamped and held at ambient temperature (Dirichlet dofs).
+:func:`assemble` then assembles the paper's Eq. (2) blocks on it
+(:func:`~femrub.fem.assembly.assemble_thermoelastic`) with the mass lumping the element
+needs: row-sum for linear elements, HRZ for quadratic ones (row-sum lumping of P2 goes
+negative); the P1 heat capacity is row-sum lumped beside an HRZ mass.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+
+import numpy as np
+import skfem as fem
+
+from .assembly import ThermoelasticMatrices, assemble_thermoelastic
+from .damping import rayleigh_coefficients
+from .eigen import angular_frequencies
+from .material import Material
+
+__all__ = ["Discretisation", "assemble", "discretise"]
+
+_ELEMENTS = {
+    (1, 1): fem.ElementLineP1,
+    (3, 1): fem.ElementTetP1,
+    (3, 2): fem.ElementTetP2,
+}
+
+
+@dataclass(frozen=True)
+class Discretisation:
+    """Bases of a blade and its Dirichlet dofs (full numbering of each basis).
+
+    Attributes
+    ----------
+    blade : the :class:`~femrub.geometry.BladeMesh` (named node sets, contact points).
+    basis_u : vector displacement basis; ``basis_t`` : scalar temperature basis.
+    fixed_u, fixed_t : clamped displacement dofs and temperature dofs held at ambient.
+    order : displacement element order.
+    """
+
+    blade: object
+    basis_u: fem.Basis
+    basis_t: fem.Basis
+    fixed_u: np.ndarray
+    fixed_t: np.ndarray
+    order: int
+
+    @property
+    def mesh(self):
+        return self.blade.mesh
+
+    @property
+    def dim(self) -> int:
+        return self.blade.dim
+
+    def facets_of(self, name: str) -> np.ndarray:
+        """Boundary facets whose vertices all belong to node set ``name``."""
+        mesh = self.mesh
+        bf = mesh.boundary_facets()
+        return bf[np.all(np.isin(mesh.facets[:, bf], self.blade.require(name)), axis=0)]
+
+
+def discretise(blade, order: int = 2, *, clamped: bool = True) -> Discretisation:
+    """Bases of ``blade`` with displacement ``order`` (1 or 2; the bar is linear)."""
+    dim = blade.dim
+    if (dim, order) not in _ELEMENTS:
+        allowed = sorted(o for d, o in _ELEMENTS if d == dim)
+        raise ValueError(f"displacement order {order!r} on a {dim}D mesh: use one of {allowed}")
+    basis_u = fem.Basis(blade.mesh, fem.ElementVector(_ELEMENTS[dim, order]()))
+    basis_t = basis_u.with_element(_ELEMENTS[dim, 1]())  # same quadrature as basis_u
+    empty = np.zeros(0, dtype=int)
+    disc = Discretisation(blade, basis_u, basis_t, empty, empty, order)
+    if not clamped:
+        return disc
+    facets = disc.facets_of("root")
+    if facets.size == 0:
+        raise ValueError(
+            f"the 'root' node set of {blade.source} covers no boundary face; clamp a face"
+        )
+    fixed_u = basis_u.get_dofs(facets).all()
+    fixed_t = basis_t.get_dofs(facets).all()
+    return replace(disc, fixed_u=fixed_u, fixed_t=fixed_t)
+
+
+def default_lumping(order: int) -> str:
+    """Mass lumping an element order needs: row-sum (P1) or HRZ (P2)."""
+    return "hrz" if order == 2 else "row-sum"
+
+
+def assemble(
+    disc: Discretisation,
+    material: Material,
+    *,
+    area: float = 1.0,
+    lumping: str = "auto",
+    coupling: str = "physical",
+    beta: float | None = None,
+    strain_heating: bool = False,
+    rayleigh: tuple[float, float] = (0.0, 0.0),
+    damping_ratio: float | None = None,
+    damping_modes: tuple[int, int] = (1, 5),
+) -> ThermoelasticMatrices:
+    """Eq. (2) blocks of ``disc`` (see :func:`~femrub.fem.assembly.assemble_thermoelastic`).
+
+    ``damping_ratio`` ζ replaces ``rayleigh``: ``C = a M + b K`` with ``ζ(ω_i) = ζ(ω_j) = ζ``
+    at the clamped modes ``damping_modes = (i, j)`` (1-based); ``info["rayleigh"]`` holds
+    the ``(a, b)`` used.
+    """
+    lumping = default_lumping(disc.order) if lumping == "auto" else lumping
+    mats = assemble_thermoelastic(
+        disc.basis_u,
+        disc.basis_t,
+        material,
+        area=area,
+        lumping=lumping,
+        heat_lumping="row-sum" if lumping == "hrz" else lumping,
+        coupling=coupling,
+        beta=beta,
+        strain_heating=strain_heating,
+        rayleigh=rayleigh,
+        fixed_u=disc.fixed_u,
+        fixed_t=disc.fixed_t,
+    )
+    if damping_ratio:
+        i, j = damping_modes
+        w = angular_frequencies(mats.K, mats.M, max(i, j))
+        rayleigh = rayleigh_coefficients(float(damping_ratio), w[i - 1], w[j - 1])
+        mats = replace(mats, C=(rayleigh[0] * mats.M + rayleigh[1] * mats.K).tocsr())
+    mats.info["rayleigh"] = tuple(float(x) for x in rayleigh)
+    return mats

@@ -1,0 +1,205 @@
+"""A blade (3D, or the paper's 1D bar) rubbing a rigid casing, as a first-order model.
+
+The one path from a discretised blade to a :class:`~femrub.model.FirstOrderModel`
+(paper Eqs. 8-9): the Eq. (2) blocks of :func:`femrub.fem.discretisation.assemble`, the
+:class:`~femrub.contact.points.ContactPoints` (already restricted to those the casing can
+reach), the casing gap swept at the rotation speed (:func:`~femrub.contact.casing.swept_gap`)
+and the frictional heat coefficients (:mod:`femrub.contact.heat`) go through
+:func:`~femrub.model.build.first_order_model`.
+
+Contact ``i`` at point ``p_i``: normal ``n_i`` (radial), gap ``g_i(t) = g(Ω t + φ_i) −
+n_i · u(p_i)``, heat ``α_i λ_i`` spread over its tributary part of the tip face. Observed
+signals: ``tip_displacement``, ``tip_velocity`` and ``tip_temperature`` (means over the
+contacts; the tip itself on the bar) and, with several contacts, ``contact_displacement`` and
+``contact_temperature`` per contact.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.sparse as sp
+import skfem as fem
+
+from ..contact.casing import CasingProfile, Concentric, swept_gap
+from ..contact.heat import heat_coefficients
+from ..contact.points import ContactPoints, locate_contacts
+from ..fem.discretisation import Discretisation, assemble, discretise
+from ..fem.forms import lame_parameters
+from ..fem.material import Material
+from .build import ContactSpec, Load, first_order_model
+from .first_order import FirstOrderModel
+
+__all__ = ["DEFAULT_CLEARANCE", "FieldMap", "rub_model", "solid_model", "tip_load"]
+
+#: Casing clearance (m) of :func:`solid_model` when no casing is given.
+DEFAULT_CLEARANCE = 1e-4
+
+
+@dataclass(frozen=True)
+class FieldMap:
+    """What output needs to turn a state into fields on the mesh (VTK, plots)."""
+
+    disc: Discretisation
+    contacts: ContactPoints
+    lam: float
+    mu: float
+
+    @property
+    def mesh(self):
+        return self.disc.mesh
+
+    @property
+    def basis_u(self) -> fem.Basis:
+        return self.disc.basis_u
+
+    @property
+    def basis_t(self) -> fem.Basis:
+        return self.disc.basis_t
+
+
+def tip_load(disc: Discretisation, mats, force, signal) -> Load:
+    """Total force ``force`` (N, a ``dim``-vector) spread as a uniform traction on the tip
+    faces (the tip node of the bar), times ``signal(t)``."""
+    facets = disc.facets_of("tip")
+    if facets.size == 0:
+        raise ValueError(f"the 'tip' node set of {disc.blade.source} covers no boundary face")
+    fb = fem.FacetBasis(disc.mesh, disc.basis_u.elem, facets=facets)
+    area = float(fem.Functional(lambda w: 1.0 + 0.0 * w.x[0]).assemble(fb))
+    traction = np.asarray(force, dtype=float).reshape(disc.dim) / area
+
+    @fem.LinearForm
+    def load(v, w):
+        return sum(traction[i] * v[i] for i in range(disc.dim))
+
+    return Load(load.assemble(fb)[mats.free_u], signal, "u", "tip_force")
+
+
+def _observations(normal_rows, heat_rows) -> dict:
+    nc = normal_rows.shape[0]
+    mean = sp.csr_matrix(np.full((1, nc), 1.0 / nc))
+    observe = {
+        "tip_displacement": ("u", mean @ normal_rows),
+        "tip_velocity": ("v", mean @ normal_rows),
+        "tip_temperature": ("theta", mean @ heat_rows),
+    }
+    if nc > 1:
+        observe["contact_displacement"] = ("u", normal_rows)
+        observe["contact_temperature"] = ("theta", heat_rows)
+    return observe
+
+
+def rub_model(
+    disc: Discretisation,
+    mats,
+    points: ContactPoints,
+    material: Material,
+    *,
+    casing: CasingProfile,
+    rotation_speed: float = 0.0,
+    alpha=0.0,
+    restitution: float = 0.0,
+    offset=0.0,
+    loads=(),
+    thermal: str | bool = "auto",
+    observe_at: ContactPoints | None = None,
+) -> tuple[FirstOrderModel, FieldMap]:
+    """First-order model of ``disc`` rubbing ``casing`` at ``points`` (module docstring).
+
+    Parameters
+    ----------
+    mats : Eq. (2) blocks of ``disc``.
+    alpha : heat coefficients ``α_i`` (m/s) of the contacts (:mod:`femrub.contact.heat`).
+    offset : clearance added to each contact's gap (m).
+    loads : :class:`~femrub.model.build.Load` terms (e.g. :func:`tip_load`).
+    thermal : keep the temperature dofs: ``"auto"`` (when something heats the blade),
+        ``True`` or ``False``.
+    observe_at : points whose signals are observed (default ``points``; with no contact in
+        reach, the candidate points still show the tip's response).
+    """
+    N, Q = points.normal_rows(mats), points.heat_rows(mats)
+    observed = points if observe_at is None else observe_at
+    observe = _observations(observed.normal_rows(mats), observed.heat_rows(mats))
+    gap, gap_rate = swept_gap(casing, points.angles, rotation_speed, offset)
+    spec = None if points.n == 0 else ContactSpec(
+        normals=N,
+        gap=gap,
+        gap_rate=gap_rate,
+        heat_dofs=Q.toarray(),
+        restitution=restitution,
+        heat_coefficient=np.broadcast_to(np.asarray(alpha, dtype=float), (points.n,)).copy(),
+        names=list(points.names),
+    )
+    model = first_order_model(
+        mats, contact=spec, loads=loads, observe=observe, thermal=thermal
+    )
+    lam, mu = lame_parameters(material.young, material.poisson, disc.dim)
+    model.info.update(
+        blade=disc.blade.source,
+        order=disc.order,
+        n_contacts=points.n,
+        fe_dofs=mats.n_u + mats.n_t,
+        casing=casing.as_dict(),
+        rotation_speed=float(rotation_speed),
+        rayleigh=mats.info.get("rayleigh", (0.0, 0.0)),
+    )
+    return model, FieldMap(disc, points, lam, mu)
+
+
+def solid_model(
+    blade,
+    material: Material,
+    *,
+    casing: CasingProfile | None = None,
+    rotation_speed: float = 0.0,
+    friction: float = 0.0,
+    heat_partition: float = 1.0,
+    restitution: float = 0.0,
+    order: int = 2,
+    coupling: str = "physical",
+    strain_heating: bool = False,
+    rayleigh: tuple[float, float] = (0.0, 0.0),
+    damping_ratio: float | None = None,
+    lumping: str = "auto",
+    tip_force=None,
+    thermal: str | bool = "auto",
+) -> tuple[FirstOrderModel, FieldMap]:
+    """A blade rubbing a casing in one call: discretise, assemble, locate contacts, model.
+
+    Vector P2 displacement (``order=2``, HRZ-lumped mass) and P1 temperature, root clamped
+    and held at ambient, heat law ``α_i = η μ |Ω| r_i`` (``friction`` μ, ``heat_partition``
+    η), casing default: concentric with :data:`DEFAULT_CLEARANCE`. ``damping_ratio`` ζ gives
+    Rayleigh damping with ratio ζ at the first and fifth clamped modes. Returns ``(model,
+    fields)``.
+    """
+    disc = discretise(blade, order)
+    mats = assemble(
+        disc,
+        material,
+        lumping=lumping,
+        coupling=coupling,
+        strain_heating=strain_heating,
+        rayleigh=rayleigh,
+        damping_ratio=damping_ratio,
+    )
+    points = locate_contacts(disc)
+    alpha = heat_coefficients(
+        points.radii,
+        "friction",
+        friction=friction,
+        rotation_speed=rotation_speed,
+        heat_partition=heat_partition,
+    )
+    return rub_model(
+        disc,
+        mats,
+        points,
+        material,
+        casing=casing or Concentric(DEFAULT_CLEARANCE),
+        rotation_speed=rotation_speed,
+        alpha=alpha,
+        restitution=restitution,
+        loads=[] if tip_force is None else [tip_load(disc, mats, *tip_force)],
+        thermal=thermal,
+    )
