@@ -102,6 +102,10 @@ def _run(args) -> int:
         vtk = " and vtk/rub.pvd (ParaView)" if built.fields is not None and scene[
             "outputs.vtk_stride"] else ""  # fmt: skip
         print(f"  results in {out}/: summary.json, history.csv, signals.png{vtk}")
+    if args.explain:
+        from .explain import format_timings
+
+        print(f"  {'timings':<10} {format_timings(res.info['timings'])}")
     return 0
 
 

@@ -115,5 +115,8 @@ def run_scene(
         progress=progress,
         overwrite=True,
         snapshot=o["plots"],
+        timings=built.timings,
+        n_full=built.full.n_dofs,
+        rotation_speed=scene["loads"]["rotation_speed"],
     )
     return res, built

@@ -122,18 +122,20 @@ def rub_model(
     observed = points if observe_at is None else observe_at
     observe = _observations(observed.normal_rows(mats), observed.heat_rows(mats))
     gap, gap_rate = swept_gap(casing, points.angles, rotation_speed, offset)
-    spec = None if points.n == 0 else ContactSpec(
-        normals=N,
-        gap=gap,
-        gap_rate=gap_rate,
-        heat_dofs=Q.toarray(),
-        restitution=restitution,
-        heat_coefficient=np.broadcast_to(np.asarray(alpha, dtype=float), (points.n,)).copy(),
-        names=list(points.names),
+    spec = (
+        None
+        if points.n == 0
+        else ContactSpec(
+            normals=N,
+            gap=gap,
+            gap_rate=gap_rate,
+            heat_dofs=Q.toarray(),
+            restitution=restitution,
+            heat_coefficient=np.broadcast_to(np.asarray(alpha, dtype=float), (points.n,)).copy(),
+            names=list(points.names),
+        )
     )
-    model = first_order_model(
-        mats, contact=spec, loads=loads, observe=observe, thermal=thermal
-    )
+    model = first_order_model(mats, contact=spec, loads=loads, observe=observe, thermal=thermal)
     lam, mu = lame_parameters(material.young, material.poisson, disc.dim)
     model.info.update(
         blade=disc.blade.source,

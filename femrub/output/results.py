@@ -102,6 +102,18 @@ class Results:
         )
         return float(np.max(np.abs(e["energy_error"])) / scale)
 
+    def heat_error(self) -> float:
+        """Largest heat-balance residual relative to the heat scale of the run (0 when no
+        heat enters or leaves; NaN without a heat balance)."""
+        e = self.energy
+        if "heat_error" not in e or self.t.size < 2:
+            return float("nan")
+        scale = max(
+            np.max(np.abs(e[k]))
+            for k in ("heat_content", "friction_heat", "heat_load", "heat_outflow")
+        )
+        return float(np.max(np.abs(e["heat_error"])) / scale) if scale > 0 else 0.0
+
     def columns(self) -> dict[str, np.ndarray]:
         """Flat table: time, every signal component, gap, force, impulse, energy."""
         cols = {"t": self.t}

@@ -22,7 +22,10 @@ import numpy as np
 from .. import __version__
 from .plots import savefig, tip_panels
 
-__all__ = ["run_to_folder", "ResultExists"]
+__all__ = ["STAGES", "run_to_folder", "ResultExists"]
+
+#: Pipeline stages timed in ``summary.json["timings"]`` (seconds).
+STAGES = ("mesh", "assembly", "reduction", "stepping", "output")
 
 
 class ResultExists(FileExistsError):
@@ -62,10 +65,18 @@ def run_to_folder(
     overwrite: bool = False,
     snapshot: bool = True,
     plots: bool = True,
+    timings: dict | None = None,
+    n_full: int | None = None,
+    rotation_speed: float = 0.0,
 ):
     """Run ``stepper`` to ``t_end`` and write the results folder ``out`` (module docstring).
 
-    Returns the :class:`~femrub.output.results.Results`.
+    ``timings`` holds the seconds of the stages before the run (``mesh``, ``assembly``,
+    ``reduction``); ``summary.json["timings"]`` adds ``stepping`` (the run without the
+    output it streams) and ``output`` (VTK frames, histories, plots). ``n_full``: state dofs
+    of the full model when ``stepper.model`` is reduced; ``rotation_speed`` (rad/s) counts the
+    ``revolutions`` reached. Returns the
+    :class:`~femrub.output.results.Results`.
     """
     out = Path(out)
     summary_path = out / "summary.json"
@@ -85,6 +96,7 @@ def run_to_folder(
         "h": stepper.h,
         "t_end": t_end,
         "n_dofs": model.n_dofs,
+        "n_full": model.n_dofs if n_full is None else int(n_full),
         "n_contacts": model.n_contacts,
         "model": model.info,
         "inputs": inputs or {},
@@ -99,6 +111,8 @@ def run_to_folder(
     t0 = time.perf_counter()
     res = stepper.run(t_end, progress=progress, limits=limits, on_state=series)
     wall = time.perf_counter() - t0
+    vtk_wall, vtk_cpu = (series.seconds, series.cpu_seconds) if series is not None else (0.0, 0.0)
+    t_out = time.perf_counter()
     res.save_csv(out / "history.csv")
     res.save_npz(out / "history.npz")
     panels = [k for k in ("tip_displacement", "tip_temperature") if k in res.signals]
@@ -119,17 +133,25 @@ def run_to_folder(
         except Exception as exc:  # rendering is optional (no OpenGL on the machine)
             doc["snapshot_error"] = f"{type(exc).__name__}: {exc}"
     e = res.energy
+    stepping_cpu = max(res.cpu_seconds - vtk_cpu, 0.0)
+    omega = float(rotation_speed)
+    stages = {k: 0.0 for k in STAGES} | dict(timings or {})
+    stages.update(stepping=wall - vtk_wall, output=vtk_wall + time.perf_counter() - t_out)
+    res.info["timings"] = {k: stages[k] for k in STAGES}
     doc.update(
         status=res.status,
         message=res.message,
         steps=res.steps,
         t_reached=float(res.t[-1]),
+        revolutions=float(res.t[-1]) * omega / (2.0 * np.pi),
         cpu_seconds=res.cpu_seconds,
         wall_seconds=wall,
-        cpu_per_step_us=1e6 * res.cpu_seconds / max(res.steps, 1),
+        cpu_per_step_us=1e6 * stepping_cpu / max(res.steps, 1),
+        timings=res.info["timings"],
         first_contact_time=res.first_contact_time(),
         max_contact_force=float(res.force.max()) if res.force.size else 0.0,
         energy_error=res.energy_error(),
+        heat_error=res.heat_error(),
         energy={k: float(v[-1]) for k, v in e.items()} if e else {},
         vtk=str(series.pvd_path.relative_to(out)) if series is not None else None,
         vtk_frames=len(series.frames) if series is not None else 0,

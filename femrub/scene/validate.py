@@ -215,17 +215,12 @@ def _cross_check(d: dict) -> None:
         )
 
 
-def shared_dir() -> Path:
-    """Reference-data folder: ``$FEMRUB_SHARED_DATA`` or ``<project>/../shared/data``."""
-    from ..geometry import shared_data_dir
-
-    return shared_data_dir()
-
-
 def resolve_path(text: str, base_dir: Path) -> Path:
     """A scene path: ``{shared}/...`` in the reference-data folder, else from ``base_dir``."""
     if text.startswith("{shared}"):
-        return shared_dir() / text[len("{shared}") :].lstrip("/\\")
+        from ..geometry.rotor37 import shared_data_dir  # the one data-path lookup
+
+        return shared_data_dir() / text[len("{shared}") :].lstrip("/\\")
     path = Path(os.path.expanduser(text))
     return path if path.is_absolute() else Path(base_dir) / path
 
@@ -248,7 +243,6 @@ def check_files(data: dict, base_dir: Path) -> None:
             hint = ""
             if text.startswith("{shared}"):
                 hint = (
-                    f"; the reference data folder {shared_dir()} is absent or incomplete "
-                    "(set FEMRUB_SHARED_DATA)"
+                    "; the reference data folder is absent or incomplete (set FEMRUB_SHARED_DATA)"
                 )
             fail(key, text, f"{what} {path} not found{hint}")
