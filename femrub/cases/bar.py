@@ -164,7 +164,7 @@ def bar_model(case: BarCase = PAPER, **changes) -> FirstOrderModel:
         x0[model.layout.v] = case.initial_velocity
         model = model.with_(x0=x0)
     tip_dof = int(mats.u_index(tip.u_dofs[0])[0])
-    model.info.update(case=case.as_dict(), tip_dof=tip_dof, n_t_assembled=mats.n_t)
+    model.info.update(case=case.as_dict(), tip_dof=tip_dof)
     return model
 
 

@@ -35,6 +35,7 @@ class ContactPoints:
     angles : (n_c,) angular position around the axis (rad).
     u_dofs : (dim, n_c) displacement dofs of each point (one per component).
     heat : (n_c, n_t_all) sparse weights on the temperature dofs (rows sum to 1).
+    vertices : (n_c,) the mesh vertex nearest to each point (where output draws its force).
     names : labels of the points.
     """
 
@@ -44,6 +45,7 @@ class ContactPoints:
     angles: np.ndarray
     u_dofs: np.ndarray
     heat: sp.csr_matrix
+    vertices: np.ndarray
     names: tuple[str, ...]
 
     @property
@@ -61,6 +63,7 @@ class ContactPoints:
             angles=self.angles[idx],
             u_dofs=self.u_dofs[:, idx],
             heat=self.heat[idx],
+            vertices=self.vertices[idx],
             names=tuple(self.names[i] for i in idx),
         )
 
@@ -122,7 +125,8 @@ def locate_contacts(disc, points=None) -> ContactPoints:
         raise ValueError("a contact point does not have one displacement dof per component")
     u_dofs = np.empty((dim, pts.shape[1]), dtype=int)
     u_dofs[comp.T, np.arange(pts.shape[1])] = idx.T
-    weights = tributary_heat_weights(blade, pts, tol)
+    vertices = cKDTree(blade.mesh.p.T).query(pts.T)[1]
+    weights = tributary_heat_weights(blade, pts, tol, vertices)
     tdofs = disc.basis_t.nodal_dofs[0]
     heat = sp.csr_matrix(
         (weights.data, tdofs[weights.indices], weights.indptr),
@@ -138,18 +142,18 @@ def locate_contacts(disc, points=None) -> ContactPoints:
         _, e1, e2 = _axis_frame(blade.axis)
         angles = np.arctan2(e2 @ pts, e1 @ pts)
     names = tuple(f"contact{i}" for i in range(pts.shape[1]))
-    return ContactPoints(pts, normals, radii, angles, u_dofs, heat, names)
+    return ContactPoints(pts, normals, radii, angles, u_dofs, heat, vertices, names)
 
 
-def tributary_heat_weights(blade, pts, tol) -> sp.csr_matrix:
+def tributary_heat_weights(blade, pts, tol, vertices) -> sp.csr_matrix:
     """(n_c, n_vertices) weights spreading each contact's heat over its share of the tip.
 
     The frictional heat of contact ``i`` is generated over the part ``S_i`` of the tip face
     closer to ``p_i`` than to any other contact point, as a uniform flux: the weight of
     vertex ``j`` is ``∫_{S_i} N_j ds / |S_i|`` (rows sum to 1). Dumping it into one vertex
     would make the temperature depend on the mesh (a point source in 3D); without a usable
-    ``tip`` face (and on the bar) the heat goes to the nearest vertex (or the two ends of
-    the mid-edge).
+    ``tip`` face (and on the bar) the heat goes to the point's vertex ``vertices`` (or the
+    two ends of its mid-edge).
     """
     mesh = blade.mesh
     n_c, n_v = pts.shape[1], mesh.p.shape[1]
@@ -168,8 +172,8 @@ def tributary_heat_weights(blade, pts, tol) -> sp.csr_matrix:
             vals = np.repeat(area / 3.0, 3)  # ∫ N_j ds over a linear triangle = area / 3
             W = sp.csr_matrix((vals, (rows, tri.T.ravel())), shape=(n_c, n_v))
             return sp.diags(1.0 / np.asarray(W.sum(axis=1)).ravel()) @ W
-    vd, vi = cKDTree(mesh.p.T).query(pts.T)
-    on_vertex = vd <= tol
+    vi = np.asarray(vertices)
+    on_vertex = np.linalg.norm(mesh.p[:, vi] - pts, axis=0) <= tol
     rows, cols, vals = [np.flatnonzero(on_vertex)], [vi[on_vertex]], [np.ones(on_vertex.sum())]
     off = np.flatnonzero(~on_vertex)
     if off.size:

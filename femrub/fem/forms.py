@@ -22,7 +22,7 @@ Units: SI throughout (m, kg, s, K, N, W).
 
 from __future__ import annotations
 
-from skfem import BilinearForm, LinearForm
+from skfem import BilinearForm
 from skfem.helpers import ddot, dot, eye, grad, sym_grad, trace
 
 __all__ = [
@@ -33,8 +33,6 @@ __all__ = [
     "heat_capacity",
     "conductivity",
     "strain_heating",
-    "body_load",
-    "heat_source",
 ]
 
 
@@ -94,15 +92,3 @@ def strain_heating(u, eta, w):
     Trial space: displacement; test space: temperature. Parameters ``T0`` (K), ``b``, ``area``.
     """
     return w.area * w.T0 * w.b * trace(sym_grad(u)) * eta
-
-
-@LinearForm
-def body_load(v, w):
-    """Load vector of a uniform body force density ``w.f`` (N/m³, a vector) times ``area``."""
-    return w.area * dot(w.f, v)
-
-
-@LinearForm
-def heat_source(eta, w):
-    """Load vector of a uniform volumetric heat source ``w.q`` (W/m³) times ``area``."""
-    return w.area * w.q * eta

@@ -18,7 +18,6 @@ from xml.sax.saxutils import quoteattr
 
 import meshio
 import numpy as np
-from scipy.spatial import cKDTree
 
 from ..model.rub import FieldMap
 
@@ -76,7 +75,7 @@ class VTKSeries:
         self._tdofs = bt.nodal_dofs[0]
         self._has_t = model.layout.n_t > 0
         c = fields.contacts
-        self._contact_vertex = cKDTree(mesh.p.T).query(c.points.T)[1]  # nearest vertex
+        self._contact_vertex = c.vertices
         self._normals = c.normals
 
     @property
