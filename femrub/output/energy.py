@@ -5,13 +5,14 @@ Over a step ``(t_k, t_{k+1}]`` with midpoint state ``X_m = (X_k + X_{k+1}) / 2``
     ΔW_ext = h Σ_j s̄_j (p_jᵀ X_m)          s̄_j = (s_j(t_k) + s_j(t_{k+1})) / 2
     ΔW_th  = h X_mᵀ P_th X_m               work of the thermal stresses −K^uθ θ
     ΔW_d   = h X_mᵀ P_d X_m                 damping (<= 0)
-    ΔW_c   = Pᵀ ġ(X_m)                      contact impulse times mean gap velocity (<= 0)
+    ΔW_c   = Pᵀ Gvᵀ X_m                     impulse times the structure's mean gap velocity
 
 For the θ-method with γ = 1/2 (trapezoidal rule) these increments make the balance
 ``E_{k+1} − E_k = ΔW_ext + ΔW_th + ΔW_d + ΔW_c`` exact up to round-off, so
 ``energy_error`` measures the scheme's own energy error; ``ΔW_c <= 0`` checks that no
 energy is created at impacts (with Newton's law and e <= 1 the impulse satisfies
-``P (ġ_{k+1} + e ġ_k) = 0``, hence ``ΔW_c = −P ġ_k (1 − e) / 2 <= 0``).
+``P (ġ_{k+1} + e ġ_k) = 0``, hence ``ΔW_c = −P ġ_k (1 − e) / 2 <= 0`` for a fixed casing;
+a moving casing, ``ġ = ġ0(t) + Gvᵀ X``, can also do work on the structure).
 """
 
 from __future__ import annotations
@@ -47,8 +48,7 @@ class EnergyMeter:
             np.column_stack([term.power for term in model.loads]) if model.loads else None
         )
         self._heats = np.array([term.heat for term in model.loads])
-        c = model.contact
-        self._GvT = None if c is None else np.ascontiguousarray(c.Gv.T)
+        self.contact = model.contact
         self.data = {k: np.zeros(capacity) for k in ENERGY_KEYS}
         self._E0 = self._Q0 = 0.0
         self.scale = 0.0
@@ -84,8 +84,8 @@ class EnergyMeter:
             inc["heat_load"] = h * (Sbar @ self._heats)
         inc["thermal_work"] = h * self._quad(f.Pth, Xm)
         inc["damping_work"] = h * self._quad(f.Pd, Xm)
-        if self._GvT is not None:
-            dwc = np.einsum("ij,ij->i", impulse, Xm @ self._GvT.T)
+        if self.contact is not None:
+            dwc = np.einsum("ij,ij->i", impulse, self.contact.structure_velocity(Xm))
             inc["contact_work"] = dwc
             inc["impact_dissipation"] = -dwc
             inc["friction_heat"] = np.einsum("ij,ij->i", alpha, impulse)

@@ -92,7 +92,7 @@ class Stepper:
         c = self.model.contact
         if c is None:
             return np.zeros(0), np.zeros(0)
-        return c.gap_at(t) + c.G.T @ X, c.rate_at(t) + c.Gv.T @ X
+        return c.gap(t, X), c.gap_velocity(t, X)
 
     @property
     def state(self) -> State:
@@ -163,7 +163,6 @@ class Stepper:
             message = f"h = {h:.3g} s exceeds the stability limit {h_lim:.3g} s of {self.name}"
         # states are post-processed in chunks; the callback gets the checked ones afterwards
         chunk = int(max(1, min(512, 2_000_000 // max(N, 1))))
-        GvT = None if c is None else np.ascontiguousarray(c.Gv.T)
 
         def deliver(i0, last):
             """Call ``on_state`` for the checked rows ``i0 + 1 .. last`` of the buffer."""
@@ -171,11 +170,10 @@ class Stepper:
                 return
             for r in range(i0 + 1, last + 1):
                 X = buf[r - i0]
-                gdot = c.rate_at(t[r]) + GvT @ X if nc else np.zeros(0)
+                gdot = c.gap_velocity(t[r], X) if nc else np.zeros(0)
                 on_state(State(r, t[r], X, imp[r], gap[r], gdot))
 
         buf = np.empty((chunk + 1, N))
-        GT = None if c is None else np.ascontiguousarray(c.G.T)
 
         def flush(i0, m):
             """Post-process rows i0+1..i0+m from the buffer; return the last valid row."""
@@ -188,9 +186,8 @@ class Stepper:
             if O is not None:
                 obs[rows] = X[1:] @ O.T if isinstance(O, np.ndarray) else (O @ X[1:].T).T
             if nc:
-                g0 = np.array([c.gap_at(tt) for tt in t[rows]])
-                gap[rows] = g0 + X[1:] @ GT.T
-                alpha[rows] = np.array([c.alpha_at(tt) for tt in t[rows]])
+                gap[rows] = c.gap(t[rows], X[1:])
+                alpha[rows] = c.alpha_at(t[rows])
             if meter is not None and m:
                 with np.errstate(all="ignore"):
                     meter.update(i0, X, imp[rows], t[i0 : rows.stop], h, alpha[rows])

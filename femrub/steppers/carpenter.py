@@ -64,7 +64,7 @@ class Carpenter(Stepper):
         if c is not None:
             self._Cm = self._impulse_map(c.Hm)
             self._Ct = self._impulse_map(c.Ht)
-            self._Wm, self._Wt = c.G.T @ self._Cm, c.G.T @ self._Ct
+            self._Wm, self._Wt = c.GT @ self._Cm, c.GT @ self._Ct
 
     def _solve(self, rhs):
         if self._diagA is not None:
@@ -102,7 +102,7 @@ class Carpenter(Stepper):
         if c is not None:
             t1 = self.t + h
             alpha = c.alpha_at(t1)
-            gp = c.gap_at(t1) + c.G.T @ Xp
+            gp = c.gap(t1, Xp)
             if np.any(gp < 0.0):
                 Wc = self._Wm + self._Wt * alpha
                 P = solve_impulses(Wc, gp, np.ones(c.n, dtype=bool), gp < 0.0)

@@ -74,7 +74,6 @@ class Penalty(Stepper):
         c = m.contact
         self._nc = 0 if c is None else c.n
         if c is not None:
-            self._GT, self._GvT = np.ascontiguousarray(c.G.T), np.ascontiguousarray(c.Gv.T)
             self._AHm, self._AHt = self._lu.solve(c.Hm), self._lu.solve(c.Ht)
         self._Y = np.concatenate([self.X, np.zeros(self._nc)])
         self._lam_out = np.zeros(self._nc)
@@ -83,8 +82,8 @@ class Penalty(Stepper):
     # -- the regularised dynamics ----------------------------------------------------------
     def _forces(self, t, X):
         c = self.model.contact
-        g = c.gap_at(t) + self._GT @ X
-        gd = self._GvT @ X
+        g = c.gap(t, X)
+        gd = c.structure_velocity(X)
         closed = g < 0.0
         lam = np.where(closed, np.maximum(0.0, -self.stiffness * g - self.damping * gd), 0.0)
         return lam, closed & (lam > 0.0)
@@ -110,9 +109,9 @@ class Penalty(Stepper):
         if self._nc:
             _, act = self._forces(t, Y[:n])
             if act.any():
-                dlam = -(self.stiffness * self._GT + self.damping * self._GvT) * act[:, None]
-                alpha = m.contact.alpha_at(t)
-                J[:n, :n] += (self._AHm + self._AHt * alpha) @ dlam
+                c = m.contact
+                dlam = -(self.stiffness * c.GT + self.damping * c.GvT) * act[:, None]
+                J[:n, :n] += (self._AHm + self._AHt * c.alpha_at(t)) @ dlam
                 J[n:, :n] = dlam
         return J
 
