@@ -3,11 +3,12 @@
 What a Python user would write instead of a nonsmooth scheme: the unilateral contact is
 replaced by a spring (and optional dashpot) that acts only when the gap is closed::
 
-    λ(X) = max(0, −k_p g − c_p ġ) if g < 0 else 0,      g = g0(t) + Gᵀ X,  ġ = Gvᵀ X
-    Ẋ = A⁻¹ (B X + F(t) + (Hm + Ht diag α) λ(X))
+    λ(t, X) = max(0, −k_p g − c_p ġ) if g < 0 else 0,   g = g0(t) + Gᵀ X,  ġ = ġ0(t) + Gvᵀ X
+    Ẋ = A⁻¹ (B X + F(t) + (Hm + Ht diag α) λ(t, X))
 
 integrated by scipy's ``Radau`` or ``BDF`` (the solvers behind ``solve_ivp``) with an
-analytic Jacobian. The right-hand side is only piecewise smooth, so the solver is restarted
+analytic Jacobian. The dashpot acts on the relative normal velocity ``ġ``, casing motion
+``ġ0`` included. The right-hand side is only piecewise smooth, so the solver is restarted
 at every contact closing/opening (an event located on the dense output), as ``solve_ivp``
 event handling would. The accumulated impulse ``∫ λ dt`` is integrated with the state, so
 the contact impulse per output step is exact to the solver tolerance. Output is on the
@@ -83,7 +84,7 @@ class Penalty(Stepper):
     def _forces(self, t, X):
         c = self.model.contact
         g = c.gap(t, X)
-        gd = c.structure_velocity(X)
+        gd = c.gap_velocity(t, X)
         closed = g < 0.0
         lam = np.where(closed, np.maximum(0.0, -self.stiffness * g - self.damping * gd), 0.0)
         return lam, closed & (lam > 0.0)
