@@ -12,7 +12,8 @@ For the θ-method with γ = 1/2 (trapezoidal rule) these increments make the bal
 ``energy_error`` measures the scheme's own energy error; ``ΔW_c <= 0`` checks that no
 energy is created at impacts (with Newton's law and e <= 1 the impulse satisfies
 ``P (ġ_{k+1} + e ġ_k) = 0``, hence ``ΔW_c = −P ġ_k (1 − e) / 2 <= 0`` for a fixed casing;
-a moving casing, ``ġ = ġ0(t) + Gvᵀ X``, can also do work on the structure).
+a moving casing, ``ġ = ġ0(t) + Gvᵀ X``, can also do work on the structure). The frictional
+heat of a step is ``Σ_i α_i(t_{k+1}) P_i``.
 """
 
 from __future__ import annotations
@@ -32,7 +33,7 @@ _HEATS = ("friction_heat", "heat_load", "heat_outflow")
 class EnergyMeter:
     """Accumulates the energy balance over blocks of steps (see module docstring).
 
-    ``update(i0, X, impulse, t, h, alpha)`` takes the states ``X[0..m]`` at times ``t[0..m]``
+    ``update(i0, X, impulse, t, h)`` takes the states ``X[0..m]`` at times ``t[0..m]``
     (``X[0]`` already recorded as row ``i0``) and the impulses of the ``m`` steps, and fills
     rows ``i0 + 1 .. i0 + m`` with vectorised increments.
     """
@@ -70,7 +71,7 @@ class EnergyMeter:
         self._Q0 = d["heat_content"][0]
         self.scale, self.heat_scale = abs(self._E0), abs(self._Q0)
 
-    def update(self, i0, X, impulse, t, h, alpha) -> None:
+    def update(self, i0, X, impulse, t, h) -> None:
         """Fill rows ``i0 + 1 .. i0 + m`` from a block of states (see class docstring)."""
         f, d = self.forms, self.data
         m = X.shape[0] - 1
@@ -84,10 +85,12 @@ class EnergyMeter:
             inc["heat_load"] = h * (Sbar @ self._heats)
         inc["thermal_work"] = h * self._quad(f.Pth, Xm)
         inc["damping_work"] = h * self._quad(f.Pd, Xm)
-        if self.contact is not None:
-            dwc = np.einsum("ij,ij->i", impulse, self.contact.structure_velocity(Xm))
+        c = self.contact
+        if c is not None:
+            dwc = np.einsum("ij,ij->i", impulse, c.structure_velocity(Xm))
             inc["contact_work"] = dwc
             inc["impact_dissipation"] = -dwc
+            alpha = np.broadcast_to(c.alpha_at(t[1:]), impulse.shape)
             inc["friction_heat"] = np.einsum("ij,ij->i", alpha, impulse)
         inc["heat_outflow"] = h * (Xm @ f.heat_outflow)
         for k, v in inc.items():
