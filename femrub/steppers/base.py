@@ -57,6 +57,7 @@ class Stepper:
         self.X = model.x0.copy()
         nc = model.n_contacts
         self.impulse = np.zeros(nc)
+        self._h_lim = None
         self._setup()
 
     # -- to be implemented by subclasses ---------------------------------------------------
@@ -67,11 +68,17 @@ class Stepper:
         """Advance from ``(self.t, self.X)`` by ``h``; return ``(X_new, impulse)``."""
         raise NotImplementedError
 
-    def stability_limit(self) -> float:
+    def _stability_limit(self) -> float:
         """Largest stable step (s); ``inf`` for unconditionally stable schemes."""
         return math.inf
 
     # -- public API ------------------------------------------------------------------------
+    def stability_limit(self) -> float:
+        """Largest stable step (s), computed once per stepper (an eigen-solve for Carpenter)."""
+        if self._h_lim is None:
+            self._h_lim = self._stability_limit()
+        return self._h_lim
+
     @property
     def state(self) -> State:
         c, t, X = self.model.contact, self.t, self.X

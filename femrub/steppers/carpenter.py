@@ -19,8 +19,9 @@ same step.
 
 The scheme is conditionally stable: ``h < 2 / ω_max`` for the mechanical part and
 ``h < 2 / μ_max`` for the explicit heat equation; :meth:`Carpenter.stability_limit` computes
-both from sparse eigen-solvers, and ``run()`` reports ``status = "unstable"`` above it (and
-stops on blow-up, keeping what it computed) instead of returning NaN.
+both from sparse eigen-solvers, once per stepper, and ``run()`` reports
+``status = "unstable"`` above it (and stops on blow-up, keeping what it computed) instead of
+returning NaN.
 """
 
 from __future__ import annotations
@@ -111,7 +112,7 @@ class Carpenter(Stepper):
         self._a = self._deriv(Xp, m.load(self.t + h))
         return Xp, P
 
-    def stability_limit(self) -> float:
+    def _stability_limit(self) -> float:
         """Largest stable step (s): ``min(2 / ω_max, 2 / μ_max)`` of the explicit parts."""
         m, L = self.model, self.model.layout
         A, B = m.A.tocsc(), m.B.tocsc()

@@ -168,6 +168,3 @@ class Penalty(Stepper):
             if hi - lo <= 1e-14 * max(1.0, abs(hi)):
                 break
         return hi
-
-    def stability_limit(self) -> float:
-        return np.inf
