@@ -24,7 +24,11 @@ from ..fem.linalg import compact
 from ..model.first_order import EnergyForms, FirstOrderModel
 from .results import ENERGY_KEYS
 
-__all__ = ["EnergyMeter"]
+__all__ = ["BLOWUP_FACTOR", "EnergyMeter"]
+
+# a balance residual this many times the energy exchanged so far is created from nothing
+# (a physical runaway keeps the balance closed): numerical blow-up
+BLOWUP_FACTOR = 1e3
 
 _WORKS = ("external_work", "thermal_work", "damping_work", "contact_work")
 _HEATS = ("friction_heat", "heat_load", "heat_outflow")
@@ -108,7 +112,7 @@ class EnergyMeter:
         self._heat_rows = np.maximum.accumulate(np.maximum(heat, self.heat_scale))
         self.scale, self.heat_scale = self._scale_rows[-1], self._heat_rows[-1]
 
-    def blown_up(self, rows: slice, factor: float = 1e3) -> int | None:
+    def blown_up(self, rows: slice, factor: float = BLOWUP_FACTOR) -> int | None:
         """First row in ``rows`` where a balance residual dwarfs the energy put in or taken out.
 
         A physical runaway is fed by the thermal work and keeps the balance closed; a

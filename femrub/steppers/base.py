@@ -20,11 +20,7 @@ from ..model.first_order import FirstOrderModel
 from ..output.recorder import Recorder, State
 from ..output.results import Results
 
-__all__ = ["State", "Stepper", "NumericalInstability", "check_step"]
-
-
-class NumericalInstability(RuntimeError):
-    """Raised by a stepper whose solution blows up (never returned as NaN)."""
+__all__ = ["State", "Stepper", "check_step"]
 
 
 def check_step(h, t_end=None) -> float:

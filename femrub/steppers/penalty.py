@@ -27,6 +27,12 @@ from .base import Stepper
 __all__ = ["Penalty"]
 
 _SOLVERS = {"Radau": Radau, "BDF": BDF}
+# default absolute tolerance per unit of relative tolerance (states in m, m/s, K)
+ATOL_PER_RTOL = 1e-9
+# bisection on the switching function: at most this many halvings of the bracket ...
+EVENT_BISECTIONS = 60
+# ... stopping once the bracket is this narrow relative to max(1 s, |t|)
+EVENT_TIME_RTOL = 1e-14
 
 
 class Penalty(Stepper):
@@ -37,7 +43,7 @@ class Penalty(Stepper):
     stiffness : penalty stiffness k_p (N/m).
     damping : penalty damping c_p (N s/m), acting only while the gap is closed.
     method : "Radau" or "BDF".
-    rtol, atol : integrator tolerances (``atol`` defaults to ``1e-9 × rtol`` scaled in m).
+    rtol, atol : integrator tolerances (``atol`` defaults to ``ATOL_PER_RTOL × rtol``).
     """
 
     name = "penalty"
@@ -63,7 +69,7 @@ class Penalty(Stepper):
             raise ValueError(f"unknown method {method!r}; use one of {', '.join(_SOLVERS)}")
         self.stiffness, self.damping, self.method = k, float(damping), method
         self.rtol = float(rtol)
-        self.atol = float(atol) if atol is not None else 1e-9 * self.rtol
+        self.atol = float(atol) if atol is not None else ATOL_PER_RTOL * self.rtol
         self.n_rhs = 0
         super().__init__(model, h, t0=t0)
 
@@ -159,12 +165,12 @@ class Penalty(Stepper):
             return not np.array_equal(self._closed(t, sol(t)), state0)
 
         lo, hi = ta, tb
-        for _ in range(60):  # bisection on the switching function
+        for _ in range(EVENT_BISECTIONS):
             mid = 0.5 * (lo + hi)
             if changed(mid):
                 hi = mid
             else:
                 lo = mid
-            if hi - lo <= 1e-14 * max(1.0, abs(hi)):
+            if hi - lo <= EVENT_TIME_RTOL * max(1.0, abs(hi)):
                 break
         return hi
