@@ -1,12 +1,15 @@
 """Impulses of the active contacts: the per-step LCP ``0 <= P ⊥ W P + q >= 0``.
 
 One active contact has the closed form ``P = max(0, −q / W)`` (the paper's prox, Eq. 25b);
-several are solved exactly by :func:`femrub.contact.lcp.solve_lcp` (Lemke pivoting), never by penalty.
+several are solved exactly by :func:`femrub.contact.lcp.solve_lcp` (Lemke pivoting), never
+by penalty.
 """
 
 from __future__ import annotations
 
 import numpy as np
+
+from .lcp import solve_lcp
 
 __all__ = ["solve_impulses"]
 
@@ -24,8 +27,6 @@ def solve_impulses(W: np.ndarray, q: np.ndarray, active: np.ndarray, warm=None) 
             raise FloatingPointError("non-positive Delassus operator at a contact")
         P[i] = max(0.0, -q[i] / w)
         return P
-    from .lcp import solve_lcp
-
     ws = None if warm is None else np.asarray(warm)[idx]
     res = solve_lcp(W[np.ix_(idx, idx)], q[idx], warm_start=ws)
     P[idx] = res.z

@@ -5,14 +5,9 @@ reduced one (paper Eq. 15, built by a reductor) are the same type. The state is 
 three blocks, ``X = [u, v, θ]`` (``layout``); in a reduced model these blocks hold reduced
 coordinates and ``A`` may have off-diagonal blocks (``A_21``, ``A_23``, ...).
 
-Contact (paper Eq. 8b) is described in gap form, independent of the model's coordinates::
-
-    g(t, X) = g0(t) + Gᵀ X          normal gap at each contact (m), g >= 0 means open
-    ġ       = ġ0(t) + Gvᵀ X         normal gap velocity (m/s); ġ0 = dg0/dt (moving casing)
-    force   = Hm λ + Ht (α λ)       reaction λ >= 0 (N) and frictional heat α λ (W)
-
-The paper's tip node is the case ``G = −e_u(n)``, ``Gv = Hm = −e_v(n)``, ``Ht = e_θ(n)``:
-the reaction pushes the tip away from the casing and the heat input ``α λ`` is never negative.
+Contact (paper Eq. 8b) is described in gap form, independent of the model's coordinates,
+by :class:`~femrub.contact.gap.Contact` (``g = g0(t) + Gᵀ X``, ``ġ = ġ0(t) + Gvᵀ X``, force
+``Hm λ + Ht (α λ)``).
 """
 
 from __future__ import annotations
@@ -22,6 +17,8 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 import scipy.sparse as sp
+
+from ..contact.gap import Contact
 
 __all__ = ["Layout", "LoadTerm", "Contact", "EnergyForms", "FirstOrderModel"]
 
@@ -74,82 +71,6 @@ class LoadTerm:
 
     def __post_init__(self):
         self.signal = _as_signal(self.signal)
-
-
-@dataclass
-class Contact:
-    """Unilateral contacts in gap form (see module docstring).
-
-    Parameters
-    ----------
-    G, Gv, Hm, Ht : (N, n_c) arrays (dense; n_c is small).
-    gap0 : (n_c,) initial gaps (m) or a callable ``t -> (n_c,)`` (rotating casing profile).
-    gap_rate : ``dg0/dt``, a callable ``t -> (n_c,)`` (m/s) when ``gap0`` moves; ``None``: 0.
-    restitution : Newton restitution coefficient e in [0, 1].
-    heat_coefficient : α (m/s) per contact, scalar, array or callable ``t -> (n_c,)``.
-    names : labels of the contacts.
-    """
-
-    G: np.ndarray
-    Gv: np.ndarray
-    Hm: np.ndarray
-    Ht: np.ndarray
-    gap0: np.ndarray | Callable
-    restitution: float = 0.0
-    heat_coefficient: float | np.ndarray | Callable = 0.0
-    names: list[str] = field(default_factory=list)
-    gap_rate: Callable | None = None
-
-    def __post_init__(self):
-        self.G, self.Gv, self.Hm, self.Ht = (
-            np.atleast_2d(np.asarray(a, dtype=float).T).T
-            for a in (self.G, self.Gv, self.Hm, self.Ht)
-        )
-        e = float(self.restitution)
-        if not (0.0 <= e <= 1.0):
-            raise ValueError(f"restitution must be in [0, 1], got {self.restitution!r}")
-        if not callable(self.gap0):
-            self.gap0 = np.broadcast_to(np.asarray(self.gap0, dtype=float), (self.n,)).copy()
-            if not np.all(np.isfinite(self.gap0)):
-                raise ValueError("contact gap must be finite")
-        if not callable(self.heat_coefficient):
-            a = np.broadcast_to(np.asarray(self.heat_coefficient, dtype=float), (self.n,)).copy()
-            if not np.all(np.isfinite(a)) or np.any(a < 0):
-                raise ValueError(f"heat coefficient alpha must be finite and >= 0, got {a}")
-            self.heat_coefficient = a
-        if not self.names:
-            self.names = [f"c{i}" for i in range(self.n)]
-
-    @property
-    def n(self) -> int:
-        return self.G.shape[1]
-
-    def gap_at(self, t: float) -> np.ndarray:
-        return np.asarray(self.gap0(t), dtype=float) if callable(self.gap0) else self.gap0
-
-    def rate_at(self, t: float) -> np.ndarray | float:
-        """``dg0/dt`` at ``t`` (0 for a fixed obstacle)."""
-        return 0.0 if self.gap_rate is None else np.asarray(self.gap_rate(t), dtype=float)
-
-    def alpha_at(self, t: float) -> np.ndarray:
-        if callable(self.heat_coefficient):
-            return np.asarray(self.heat_coefficient(t), dtype=float)
-        return self.heat_coefficient
-
-    @property
-    def has_heat(self) -> bool:
-        a = self.heat_coefficient
-        return callable(a) or bool(np.any(np.asarray(a) > 0) and np.any(self.Ht))
-
-    def project(self, left: np.ndarray, right: np.ndarray) -> Contact:
-        """Contact of the model reduced by ``X = right X̄`` and left projection ``leftᵀ``."""
-        return replace(
-            self,
-            G=right.T @ self.G,
-            Gv=right.T @ self.Gv,
-            Hm=left.T @ self.Hm,
-            Ht=left.T @ self.Ht,
-        )
 
 
 @dataclass

@@ -1,6 +1,6 @@
 """Time steppers for first-order models with unilateral contact."""
 
-from .base import NumericalInstability, State, Stepper, check_step
+from .base import State, Stepper, check_step
 from .carpenter import Carpenter
 from .penalty import Penalty
 from .theta import ACTIVATION_RULES, ThetaMethod
@@ -20,7 +20,6 @@ def make_stepper(scheme: str, model, h, **options) -> Stepper:
 __all__ = [
     "ACTIVATION_RULES",
     "Carpenter",
-    "NumericalInstability",
     "Penalty",
     "SCHEMES",
     "State",

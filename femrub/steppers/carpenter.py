@@ -19,8 +19,9 @@ same step.
 
 The scheme is conditionally stable: ``h < 2 / ω_max`` for the mechanical part and
 ``h < 2 / μ_max`` for the explicit heat equation; :meth:`Carpenter.stability_limit` computes
-both from sparse eigen-solvers, and ``run()`` reports ``status = "unstable"`` above it (and
-stops on blow-up, keeping what it computed) instead of returning NaN.
+both from sparse eigen-solvers, once per stepper, and ``run()`` reports
+``status = "unstable"`` above it (and stops on blow-up, keeping what it computed) instead of
+returning NaN.
 """
 
 from __future__ import annotations
@@ -64,7 +65,7 @@ class Carpenter(Stepper):
         if c is not None:
             self._Cm = self._impulse_map(c.Hm)
             self._Ct = self._impulse_map(c.Ht)
-            self._Wm, self._Wt = c.G.T @ self._Cm, c.G.T @ self._Ct
+            self._Wm, self._Wt = c.GT @ self._Cm, c.GT @ self._Ct
 
     def _solve(self, rhs):
         if self._diagA is not None:
@@ -102,7 +103,7 @@ class Carpenter(Stepper):
         if c is not None:
             t1 = self.t + h
             alpha = c.alpha_at(t1)
-            gp = c.gap_at(t1) + c.G.T @ Xp
+            gp = c.gap(t1, Xp)
             if np.any(gp < 0.0):
                 Wc = self._Wm + self._Wt * alpha
                 P = solve_impulses(Wc, gp, np.ones(c.n, dtype=bool), gp < 0.0)
@@ -111,7 +112,7 @@ class Carpenter(Stepper):
         self._a = self._deriv(Xp, m.load(self.t + h))
         return Xp, P
 
-    def stability_limit(self) -> float:
+    def _stability_limit(self) -> float:
         """Largest stable step (s): ``min(2 / ω_max, 2 / μ_max)`` of the explicit parts."""
         m, L = self.model, self.model.layout
         A, B = m.A.tocsc(), m.B.tocsc()

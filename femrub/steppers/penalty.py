@@ -3,11 +3,12 @@
 What a Python user would write instead of a nonsmooth scheme: the unilateral contact is
 replaced by a spring (and optional dashpot) that acts only when the gap is closed::
 
-    λ(X) = max(0, −k_p g − c_p ġ) if g < 0 else 0,      g = g0(t) + Gᵀ X,  ġ = Gvᵀ X
-    Ẋ = A⁻¹ (B X + F(t) + (Hm + Ht diag α) λ(X))
+    λ(t, X) = max(0, −k_p g − c_p ġ) if g < 0 else 0,   g = g0(t) + Gᵀ X,  ġ = ġ0(t) + Gvᵀ X
+    Ẋ = A⁻¹ (B X + F(t) + (Hm + Ht diag α) λ(t, X))
 
 integrated by scipy's ``Radau`` or ``BDF`` (the solvers behind ``solve_ivp``) with an
-analytic Jacobian. The right-hand side is only piecewise smooth, so the solver is restarted
+analytic Jacobian. The dashpot acts on the relative normal velocity ``ġ``, casing motion
+``ġ0`` included. The right-hand side is only piecewise smooth, so the solver is restarted
 at every contact closing/opening (an event located on the dense output), as ``solve_ivp``
 event handling would. The accumulated impulse ``∫ λ dt`` is integrated with the state, so
 the contact impulse per output step is exact to the solver tolerance. Output is on the
@@ -26,6 +27,12 @@ from .base import Stepper
 __all__ = ["Penalty"]
 
 _SOLVERS = {"Radau": Radau, "BDF": BDF}
+# default absolute tolerance per unit of relative tolerance (states in m, m/s, K)
+ATOL_PER_RTOL = 1e-9
+# bisection on the switching function: at most this many halvings of the bracket ...
+EVENT_BISECTIONS = 60
+# ... stopping once the bracket is this narrow relative to max(1 s, |t|)
+EVENT_TIME_RTOL = 1e-14
 
 
 class Penalty(Stepper):
@@ -36,7 +43,7 @@ class Penalty(Stepper):
     stiffness : penalty stiffness k_p (N/m).
     damping : penalty damping c_p (N s/m), acting only while the gap is closed.
     method : "Radau" or "BDF".
-    rtol, atol : integrator tolerances (``atol`` defaults to ``1e-9 × rtol`` scaled in m).
+    rtol, atol : integrator tolerances (``atol`` defaults to ``ATOL_PER_RTOL × rtol``).
     """
 
     name = "penalty"
@@ -62,7 +69,7 @@ class Penalty(Stepper):
             raise ValueError(f"unknown method {method!r}; use one of {', '.join(_SOLVERS)}")
         self.stiffness, self.damping, self.method = k, float(damping), method
         self.rtol = float(rtol)
-        self.atol = float(atol) if atol is not None else 1e-9 * self.rtol
+        self.atol = float(atol) if atol is not None else ATOL_PER_RTOL * self.rtol
         self.n_rhs = 0
         super().__init__(model, h, t0=t0)
 
@@ -74,7 +81,6 @@ class Penalty(Stepper):
         c = m.contact
         self._nc = 0 if c is None else c.n
         if c is not None:
-            self._GT, self._GvT = np.ascontiguousarray(c.G.T), np.ascontiguousarray(c.Gv.T)
             self._AHm, self._AHt = self._lu.solve(c.Hm), self._lu.solve(c.Ht)
         self._Y = np.concatenate([self.X, np.zeros(self._nc)])
         self._lam_out = np.zeros(self._nc)
@@ -83,8 +89,8 @@ class Penalty(Stepper):
     # -- the regularised dynamics ----------------------------------------------------------
     def _forces(self, t, X):
         c = self.model.contact
-        g = c.gap_at(t) + self._GT @ X
-        gd = self._GvT @ X
+        g = c.gap(t, X)
+        gd = c.gap_velocity(t, X)
         closed = g < 0.0
         lam = np.where(closed, np.maximum(0.0, -self.stiffness * g - self.damping * gd), 0.0)
         return lam, closed & (lam > 0.0)
@@ -110,9 +116,9 @@ class Penalty(Stepper):
         if self._nc:
             _, act = self._forces(t, Y[:n])
             if act.any():
-                dlam = -(self.stiffness * self._GT + self.damping * self._GvT) * act[:, None]
-                alpha = m.contact.alpha_at(t)
-                J[:n, :n] += (self._AHm + self._AHt * alpha) @ dlam
+                c = m.contact
+                dlam = -(self.stiffness * c.GT + self.damping * c.GvT) * act[:, None]
+                J[:n, :n] += (self._AHm + self._AHt * c.alpha_at(t)) @ dlam
                 J[n:, :n] = dlam
         return J
 
@@ -159,15 +165,12 @@ class Penalty(Stepper):
             return not np.array_equal(self._closed(t, sol(t)), state0)
 
         lo, hi = ta, tb
-        for _ in range(60):  # bisection on the switching function
+        for _ in range(EVENT_BISECTIONS):
             mid = 0.5 * (lo + hi)
             if changed(mid):
                 hi = mid
             else:
                 lo = mid
-            if hi - lo <= 1e-14 * max(1.0, abs(hi)):
+            if hi - lo <= EVENT_TIME_RTOL * max(1.0, abs(hi)):
                 break
         return hi
-
-    def stability_limit(self) -> float:
-        return np.inf

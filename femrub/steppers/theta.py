@@ -120,9 +120,10 @@ class ThetaMethod(Stepper):
         if c is not None:
             self._Zm = self._lu.solve(c.Hm)
             self._Zt = self._lu.solve(c.Ht)
-            self._Wm, self._Wt = c.Gv.T @ self._Zm, c.Gv.T @ self._Zt
-            self._GvT, self._GT = np.ascontiguousarray(c.Gv.T), np.ascontiguousarray(c.G.T)
-            # one contact, constant gap and α, fixed obstacle, dense: scalar fast path
+            self._Wm, self._Wt = c.GvT @ self._Zm, c.GvT @ self._Zt
+            # one contact, constant gap and α, fixed obstacle, dense: scalar fast path, with
+            # Contact.gap and gap_velocity written out for that contact (the paper case's
+            # step is a few dot products; method calls and arrays would dominate it)
             if (
                 c.n == 1
                 and self._lu.dense
@@ -134,7 +135,7 @@ class ThetaMethod(Stepper):
                 self._fast = True
                 self._z = (self._Zm + self._Zt * a)[:, 0].copy()
                 self._w = float((self._Wm + self._Wt * a)[0, 0])
-                self._gv, self._gr = self._GvT[0].copy(), self._GT[0].copy()
+                self._gv, self._gr = c.GvT[0].copy(), c.GT[0].copy()
                 self._g0, self._e = float(c.gap0[0]), float(c.restitution)
                 if self._w <= 0.0:
                     raise ValueError("non-positive Delassus operator at the contact")
@@ -181,20 +182,19 @@ class ThetaMethod(Stepper):
         alpha = c.alpha_at(t1)
         Z = self._Zm + self._Zt * alpha
         W = self._Wm + self._Wt * alpha
-        gdot_k = c.rate_at(self.t) + self._GvT @ Xk
-        gdot_p = c.rate_at(t1) + self._GvT @ Xp
+        gdot_k = c.gap_velocity(self.t, Xk)
+        gdot_p = c.gap_velocity(t1, Xp)
         # Newton's law for approaching contacts; midpoint law (e = 1) for separating ones
         e = np.where(gdot_k > 0.0, 1.0, c.restitution)
         q = (gdot_p + e * gdot_k) / (1.0 + e)
         Wn = W / (1.0 + e)[:, None]
+        gap_k = c.gap(self.t, Xk)
         if self.activation == "predicted":
-            gap_k = c.gap_at(self.t) + self._GT @ Xk
             active = gap_k + g * h * gdot_k <= 0.0
             P = solve_impulses(Wn, q, active, self._warm)
         else:
-            gap_k = c.gap_at(self.t) + self._GT @ Xk
-            gap_p = c.gap_at(t1) + self._GT @ Xp
-            GZ = self._GT @ Z
+            gap_p = c.gap(t1, Xp)
+            GZ = c.GT @ Z
             closed = gap_k <= 0.0
             active = closed | (gap_p <= 0.0)
             seen = []
