@@ -19,7 +19,6 @@ from ..cases.bar import BarCase, bar_model
 from ..contact.casing import casing_profile
 from ..fem.material import Material
 from ..model.first_order import Contact
-from ..reduction.blocks import split_blocks
 
 __all__ = ["ForceLaw", "build_full", "contact_reach", "restrict_contacts", "thermal_choice"]
 
@@ -158,7 +157,7 @@ def _max_normal_displacement(model, omega) -> float:
     if not model.loads or model.contact is None:
         return 0.0
     L = model.layout
-    blocks = split_blocks(model)
+    blocks = model.blocks
     f = sum(term.vector[L.v] for term in model.loads)
     N = -model.contact.G[L.u].T
     out = 0.0
