@@ -98,7 +98,7 @@ def worker(nx: int, ny: int, nz: int, simulate: bool) -> dict:
     out.update(
         reduction_s=time.perf_counter() - t0,
         reduction_cpu_s=time.process_time() - c0,
-        timings=red.timings,
+        timings=rom.info["timings"],
         tracemalloc_peak_mib=tracemalloc.get_traced_memory()[1] / 2**20,
         rss_peak_mib=_rss_mib(),
         n_reduced=rom.n_dofs,

@@ -156,8 +156,8 @@ def _wp_section(wp) -> str:
         f"**paper-short**: the same over the first {cfg['t_short']} s, where the penalty "
         f"baseline (BDF, restarts at contact switches, output every {cfg['penalty_h']:g} s) can "
         "be afforded (it takes 4–16 s per run there, against 0.05–1.6 s for the θ-method). "
-        "**impact**: free bar hitting a rigid obstacle (`femrub.cases.analytic.bar_impact`), errors "
-        "against the *exact* solution of the continuous bar; mesh and step are refined "
+        "**impact**: free bar hitting a rigid obstacle (`femrub.cases.analytic.bar_impact`), "
+        "errors against the *exact* solution of the continuous bar; mesh and step are refined "
         "together at a fixed Courant number ν = c h / Δx (25 to 800 elements), so the error "
         "contains the spatial error and tends to zero.",
         "![error vs CPU time](performance/work_precision.png)\n\n"

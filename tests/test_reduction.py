@@ -9,12 +9,7 @@ import skfem as fem
 import femrub as fr
 from femrub.cases.paper_models import paper_reduced_model, paper_reductor
 from femrub.model.build import ContactSpec, Load, first_order_model
-from femrub.reduction import (
-    PROJECTIONS,
-    ThermoelasticCraigBampton,
-    contact_boundary,
-    craig_bampton_thermal,
-)
+from femrub.reduction import PROJECTIONS, ThermoelasticCraigBampton, craig_bampton_thermal
 
 ALPHA = 3.0
 SIGNALS = ("tip_displacement", "tip_temperature")
@@ -39,7 +34,7 @@ def _same_run(res, ref, tol):
 
 # -- layout, boundary, API -----------------------------------------------------------------
 def test_boundary_and_layout_of_paper_models(paper):
-    mb, tb = contact_boundary(paper)
+    mb, tb = paper.boundary["u"], paper.boundary["theta"]
     assert mb.tolist() == [paper.info["tip_dof"]] and tb.size == 1
     sizes = {"RM1": (1 + 1, 1 + 2, 1 + 12), "RM2": (1 + 1, 1 + 1, 1 + 5)}
     for name, (nu, nv, nt) in sizes.items():
@@ -110,7 +105,7 @@ def _static_full(model, mb, tb, ub, thb):
 @pytest.mark.parametrize("coupling", ["paper", "physical"])
 def test_static_shapes_reproduce_prescribed_boundary_response(coupling):
     model = fr.bar_model(alpha=ALPHA, coupling=coupling)
-    mb, tb = contact_boundary(model)
+    mb, tb = model.boundary["u"], model.boundary["theta"]
     for ub, thb in [(1e-5, 0.0), (0.0, 40.0), (-3e-6, 12.0)]:
         X = _static_full(model, mb, tb, ub, thb)
         for projection in PROJECTIONS:

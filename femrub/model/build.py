@@ -60,7 +60,8 @@ class Load:
 
 
 def _rows(a, n_cols):
-    a = sp.csr_matrix(a) if sp.issparse(a) else sp.csr_matrix(np.atleast_2d(a))
+    a = sp.csr_matrix(a, copy=True) if sp.issparse(a) else sp.csr_matrix(np.atleast_2d(a))
+    a.eliminate_zeros()  # a zero normal component is no boundary dof
     if a.shape[1] != n_cols:
         raise ValueError(f"contact normals must have {n_cols} columns, got {a.shape[1]}")
     return a

@@ -1,13 +1,14 @@
 """First-order thermoelastic Craig–Bampton reduction (paper Sec. 2, Eqs. 10–15).
 
-:class:`ThermoelasticCraigBampton` takes a full :class:`~femrub.model.first_order.FirstOrderModel` of the
-form of Eq. (9) (1D or 3D, sparse, any number of contacts) and builds
+:class:`ThermoelasticCraigBampton` takes a full
+:class:`~femrub.model.first_order.FirstOrderModel` of the form of Eq. (9) (1D or 3D, sparse,
+any number of contacts) and builds
 
 * the right basis ``R`` of Eq. (13), ``X ≈ R X̄``: the boundary dofs ``u_b, v_b, θ_b``
-  (Eq. 10, found from the contact data) kept as physical dofs with their static shapes
-  ``Ψ = −B_ii⁻¹ B_ib`` (Eq. 11), ``n_uv`` first-order mechanical shapes (clamped modes
-  ``φ_j`` used as displacement and as velocity shapes) and ``n_θ`` thermal modes ``χ_k``
-  with the coupling correction ``Φ^uθ = −K_ii⁻¹ K^uθ_ii χ`` (after Eq. 11);
+  (Eq. 10, ``model.boundary``: the dofs the contacts act on) kept as physical dofs with
+  their static shapes ``Ψ = −B_ii⁻¹ B_ib`` (Eq. 11), ``n_uv`` first-order mechanical shapes
+  (clamped modes ``φ_j`` used as displacement and as velocity shapes) and ``n_θ`` thermal
+  modes ``χ_k`` with the coupling correction ``Φ^uθ = −K_ii⁻¹ K^uθ_ii χ`` (after Eq. 11);
 * the left basis ``R̃`` of Eq. (14), chosen by ``projection``:
 
   - ``"petrov-galerkin"`` (default): the boundary equations are kept as in the full model
@@ -22,6 +23,10 @@ form of Eq. (9) (1D or 3D, sparse, any number of contacts) and builds
   ``docs/reduction.md`` derives them and compares them on the paper case;
 * the reduced model ``Ā = R̃ᵀ A R``, ``B̄ = R̃ᵀ B R`` (Eqs. 14–15), a
   :class:`~femrub.model.first_order.FirstOrderModel` that every stepper runs unchanged.
+
+The reductor computes the bases once for the largest sizes it is given; ``reduce(n_uv,
+n_theta)`` projects on their leading shapes, so one reductor yields the reduced models of
+every smaller size (``reconstruct`` and ``restrict`` take the same sizes).
 
 The reduced state is ordered in the three blocks the steppers expect (the paper's "split
 arbitrarily q^uv", after Eq. 15)::
@@ -47,51 +52,76 @@ import scipy.sparse as sp
 
 from ..fem.eigen import lowest_modes, normalise_columns
 from ..model.first_order import FirstOrderModel, Layout, LoadTerm
-from .blocks import InteriorSolver, contact_boundary, split_blocks
+from .interior import InteriorSolver
 
 __all__ = ["PROJECTIONS", "ThermoelasticCraigBampton", "craig_bampton_thermal"]
 
 PROJECTIONS = ("petrov-galerkin", "galerkin", "adjoint")
+#: Relative gap within which entries of a shape tie for its largest (mirror-symmetric modes).
+PEAK_TIE = 1e-8
 
 
 class ThermoelasticCraigBampton:
     """Reductor of a full first-order thermoelastic model (paper Sec. 2).
 
+    The expensive work is done once, in the constructor, for the largest sizes: the LU
+    factorisations of ``K_ii`` and ``K^θθ_ii``, the static shapes (Eq. 11), the clamped modes
+    and the right and left bases (Eqs. 13–14). :meth:`reduce` then builds a reduced model of
+    any sizes up to those from the leading columns of each block of the bases (pyMOR's
+    ``reduce(dims)``): the truncated bases are those a reductor built with the smaller sizes
+    computes (to round-off; to ARPACK's tolerance above ``DENSE_EIGEN_BELOW`` interior dofs),
+    so nothing is factorised or solved again.
+
     Parameters
     ----------
-    model : full :class:`~femrub.model.first_order.FirstOrderModel` of the form of Eq. (9).
-    n_uv : number of first-order mechanical shapes (``None``: all, ``2 n_i``).
-    n_theta : number of thermal modes (``None``: all interior temperature dofs).
+    fom : full :class:`~femrub.model.first_order.FirstOrderModel` of the form of Eq. (9),
+        carrying its Eq. (2) matrices (``fom.blocks``) and contact boundary
+        (``fom.boundary``), as :func:`~femrub.model.build.first_order_model` builds it.
+    max_n_uv : largest number of first-order mechanical shapes (``None``: all, ``2 n_i``).
+    max_n_theta : largest number of thermal modes (``None``: all interior temperature dofs).
     projection : ``"petrov-galerkin"``, ``"galerkin"`` or ``"adjoint"`` (module docstring).
-    boundary : optional ``{"u": positions in the u-block, "theta": positions in the θ-block}``;
-        default: the contact dofs (:func:`~femrub.reduction.blocks.contact_boundary`).
+    boundary : optional ``{"u": positions in the u-block, "theta": positions in the θ-block}``
+        overriding ``fom.boundary``.
 
     Attributes
     ----------
-    R, left : (N, r) right and left bases (dense), rows in the full state order.
-    layout : reduced :class:`~femrub.model.first_order.Layout`.
+    n_uv, n_theta : the largest sizes (``max_n_uv``, ``max_n_theta`` resolved).
+    n_qu, n_qv : displacement and velocity shapes of ``n_uv`` (``⌊n_uv/2⌋``, ``⌈n_uv/2⌉``).
+    R, left : (N, r) right and left bases (dense) of the largest sizes, rows in the full state
+        order, columns in the order of ``layout``.
+    layout : reduced :class:`~femrub.model.first_order.Layout` of the largest sizes.
+    boundary : ``{"u": ..., "theta": ...}`` boundary dofs used (Eq. 10).
     omega2 : (n_qv,) clamped mechanical eigenvalues ω² (rad²/s²) of the shapes kept.
-    mu : (n_θ,) clamped thermal eigenvalues (1/s) of ``K^θθ χ = μ C^θθ χ``.
-    timings : seconds spent in the static shapes, the modes and the bases.
+    mu : (n_theta,) clamped thermal eigenvalues (1/s) of ``K^θθ χ = μ C^θθ χ``.
+    solver : the :class:`~femrub.reduction.interior.InteriorSolver` (LU factorisations of
+        ``K_ii`` and ``K^θθ_ii``), kept for further solves on the same interior (the full
+        model's modes, :func:`~femrub.reduction.interior.condensed_solve`).
+    timings : seconds spent in the static shapes, the modes and the bases (the projection
+        time of a reduced model is in its ``info["timings"]``).
     """
 
     def __init__(
-        self, model, n_uv=None, n_theta=None, *, projection="petrov-galerkin", boundary=None
+        self, fom, max_n_uv=None, max_n_theta=None, *, projection="petrov-galerkin", boundary=None
     ):
         if projection not in PROJECTIONS:
             raise ValueError(f"unknown projection {projection!r}; use one of {PROJECTIONS}")
-        if not isinstance(model, FirstOrderModel):
+        if not isinstance(fom, FirstOrderModel):
             raise TypeError("ThermoelasticCraigBampton needs a femrub.FirstOrderModel")
-        self.fom, self.projection = model, projection
-        blocks = split_blocks(model)
-        L = model.layout
+        if fom.blocks is None:
+            raise ValueError(
+                "model.blocks is None: the model is already reduced (a full model of Eq. (9) "
+                "carries its blocks); reduce the full model"
+            )
+        self.fom, self.projection = fom, projection
+        blocks, L = fom.blocks, fom.layout
         nu, nt = L.n_u, L.n_t
-        mb, tb = contact_boundary(model) if boundary is None else _given(boundary, nu, nt)
+        if boundary is None and fom.boundary is None:
+            raise ValueError("the model has no contact boundary (model.boundary is None)")
+        mb, tb = _given(fom.boundary if boundary is None else boundary, nu, nt)
         mi, ti = np.setdiff1d(np.arange(nu), mb), np.setdiff1d(np.arange(nt), tb)
-        n_uv = 2 * mi.size if n_uv is None else _count("n_uv", n_uv, 2 * mi.size)
-        n_theta = ti.size if n_theta is None else _count("n_theta", n_theta, ti.size)
-        self.n_uv, self.n_theta = n_uv, n_theta
-        self.n_qu, self.n_qv = n_uv // 2, (n_uv + 1) // 2
+        self.n_uv = 2 * mi.size if max_n_uv is None else _count("n_uv", max_n_uv, 2 * mi.size)
+        self.n_theta = ti.size if max_n_theta is None else _count("n_theta", max_n_theta, ti.size)
+        self.n_qu, self.n_qv = self.n_uv // 2, (self.n_uv + 1) // 2
         self.boundary = {"u": mb, "theta": tb}
         if sp.csr_matrix(blocks.M)[mb][:, mi].count_nonzero():
             warnings.warn(
@@ -101,21 +131,22 @@ class ThermoelasticCraigBampton:
             )
         self.timings = {}
         t0 = time.perf_counter()
-        solver = InteriorSolver(blocks, mi, ti)
+        self.solver = solver = InteriorSolver(blocks, mi, ti)
         self._bnd = np.r_[mb, nu + mb, 2 * nu + tb].astype(int)
         self._int = np.r_[mi, nu + mi, 2 * nu + ti].astype(int)
-        B = model.B.tocsr()
+        B = fom.B.tocsr()
         B_ib = B[self._int][:, self._bnd].toarray()
         psi = solver.solve(-B_ib)  # Eq. (11)
         self.timings["static_shapes"] = time.perf_counter() - t0
         t0 = time.perf_counter()
         self.omega2, phi = lowest_modes(solver.K, solver.M, self.n_qv, solver.solve_K)
-        self.mu, chi = lowest_modes(solver.Ktt, solver.Ctt, n_theta, solver.solve_T)
+        self.mu, chi = lowest_modes(solver.Ktt, solver.Ctt, self.n_theta, solver.solve_T)
+        phi, chi = _orient(phi), _orient(chi)
         phi_ut = -solver.solve_K(solver.Kut @ chi)  # K_ii Φ^uθ = −K^uθ_ii Φ^θθ
         self.timings["modes"] = time.perf_counter() - t0
         t0 = time.perf_counter()
         self._idx = (mb, mi, tb, ti)
-        self.layout = Layout(mb.size + self.n_qu, mb.size + self.n_qv, tb.size + n_theta)
+        self.layout = self._layout(self.n_uv, self.n_theta)
         self.R = self._assemble(psi, phi[:, : self.n_qu], phi, chi, phi_ut)
         if projection == "galerkin":
             self.left = self.R
@@ -124,12 +155,16 @@ class ThermoelasticCraigBampton:
                 psi_l = solver.solve_transposed(-B[self._bnd][:, self._int].T.toarray())
             else:  # boundary equations kept as in the full model
                 psi_l = np.zeros_like(psi)
-            mphi = normalise_columns(solver.M @ phi[:, : self.n_qu])
+            mphi = _orient(normalise_columns(solver.M @ phi[:, : self.n_qu]))
             self.left = self._assemble(psi_l, mphi, phi, chi, solver.Ctu.T @ chi)
         self.timings["bases"] = time.perf_counter() - t0
-        self._rom = None
 
     # -- bases -----------------------------------------------------------------------------
+    def _layout(self, n_uv: int, n_theta: int) -> Layout:
+        """Reduced layout ``(n_b + n_qu, n_b + n_qv, n_θb + n_θ)`` of the sizes given."""
+        nb, ntb = self.boundary["u"].size, self.boundary["theta"].size
+        return Layout(nb + n_uv // 2, nb + (n_uv + 1) // 2, ntb + n_theta)
+
     def _assemble(self, psi, u_shapes, v_shapes, chi, chi_u) -> np.ndarray:
         """A basis in the full state order with the reduced column order of the layout."""
         mb, mi, tb, ti = self._idx
@@ -152,6 +187,20 @@ class ThermoelasticCraigBampton:
         V[mi[:, None], cq_t[None, :]] = chi_u
         return V
 
+    def _columns(self, n_uv, n_theta) -> tuple[int, int, np.ndarray, Layout]:
+        """Sizes (``None``: the largest), columns of ``R`` they keep and their layout.
+
+        Each block of ``R`` is ``[boundary dofs, shapes in increasing eigenvalue order]``, so
+        smaller sizes keep the leading columns of the ``u``, ``v`` and ``θ`` blocks.
+        """
+        n_uv = self.n_uv if n_uv is None else _count("n_uv", n_uv, self.n_uv)
+        n_theta = self.n_theta if n_theta is None else _count("n_theta", n_theta, self.n_theta)
+        Lr, Lm = self._layout(n_uv, n_theta), self.layout
+        cols = np.r_[
+            np.arange(Lr.n_u), Lm.v.start + np.arange(Lr.n_v), Lm.t.start + np.arange(Lr.n_t)
+        ]
+        return n_uv, n_theta, cols, Lr
+
     def mechanical_basis(self) -> np.ndarray:
         """Second-order Craig–Bampton basis of the displacements: ``[[I, 0], [Ψ_uu, Φ]]``."""
         L, Lr = self.fom.layout, self.layout
@@ -163,12 +212,17 @@ class ThermoelasticCraigBampton:
         return self.R[L.t, Lr.t]
 
     # -- reduction -------------------------------------------------------------------------
-    def reduce(self) -> FirstOrderModel:
-        """The reduced model of Eqs. (14)–(15) (built once, then cached)."""
-        if self._rom is not None:
-            return self._rom
+    def reduce(self, n_uv=None, n_theta=None) -> FirstOrderModel:
+        """The reduced model of Eqs. (14)–(15) with ``n_uv`` shapes and ``n_theta`` modes.
+
+        ``None`` gives the largest sizes of the reductor; smaller sizes truncate its bases
+        (class docstring), so this only projects: ``Ā = R̃ᵀ A R``, ``B̄ = R̃ᵀ B R``.
+        """
+        n_uv, n_theta, cols, layout = self._columns(n_uv, n_theta)
         t0 = time.perf_counter()
-        m, R, Lt = self.fom, self.R, self.left
+        m = self.fom
+        R = np.take(self.R, cols, axis=1)  # C-ordered copies: faster sparse products
+        Lt = R if self.projection == "galerkin" else np.take(self.left, cols, axis=1)
         Ar = Lt.T @ np.asarray(m.A @ R)
         Br = Lt.T @ np.asarray(m.B @ R)
         loads = [
@@ -177,38 +231,37 @@ class ThermoelasticCraigBampton:
         ]
         contact = None if m.contact is None else m.contact.project(Lt, R)
         obs = {k: np.asarray(O @ R) for k, O in m.observations.items()}
-        energy = None if m.energy is None else self._energy(Ar, Br)
+        energy = None if m.energy is None else self._energy(R, Ar, Br)
         to_full = None if m.to_full is None else np.asarray(m.to_full @ R)
-        self.timings["projection"] = time.perf_counter() - t0
+        x0 = self.restrict(m.x0, n_uv, n_theta)
         info = {
             "reduction": "thermoelastic Craig-Bampton (paper Sec. 2)",
             "projection": self.projection,
-            "n_uv": self.n_uv,
-            "n_theta": self.n_theta,
-            "n_qu": self.n_qu,
-            "n_qv": self.n_qv,
+            "n_uv": n_uv,
+            "n_theta": n_theta,
+            "n_qu": n_uv // 2,
+            "n_qv": (n_uv + 1) // 2,
             "n_boundary_u": int(self.boundary["u"].size),
             "n_boundary_theta": int(self.boundary["theta"].size),
             "n_full": m.n_dofs,
-            "n_reduced": self.layout.n,
-            "timings": dict(self.timings),
+            "n_reduced": layout.n,
+            "timings": dict(self.timings, projection=time.perf_counter() - t0),
             "full_info": dict(m.info),
         }
-        self._rom = FirstOrderModel(
+        return FirstOrderModel(
             A=sp.csc_matrix(Ar),
             B=sp.csc_matrix(Br),
-            layout=self.layout,
+            layout=layout,
             loads=loads,
             contact=contact,
             observations=obs,
             energy=energy,
             to_full=to_full,
-            x0=self.restrict(m.x0),
+            x0=x0,
             info=info,
         )
-        return self._rom
 
-    def _energy(self, Ar, Br):
+    def _energy(self, R, Ar, Br):
         """Energy forms projected on ``R``; the thermal-stress power uses ``u̇``, not ``v``.
 
         The full model's thermal power ``vᵀ(−K^uθ θ)`` equals ``u̇ᵀ(−K^uθ θ)`` because
@@ -216,7 +269,7 @@ class ThermoelasticCraigBampton:
         ``R_u X̄``, which holds thermal-expansion shapes that ``v`` lacks), so the power of the
         thermal stresses on the reduced displacement is ``(R_u Ā⁻¹ B̄ X̄)ᵀ(−K^uθ)(R_θ X̄)``.
         """
-        m, R = self.fom, self.R
+        m = self.fom
         forms = m.energy.project(R)
         L = m.layout
         if L.n_t:
@@ -226,26 +279,55 @@ class ThermoelasticCraigBampton:
             forms.Pth = sp.csr_matrix(rate.T @ (R.T @ np.asarray(P_u @ R)))
         return forms
 
-    def reconstruct(self, Xr: np.ndarray) -> np.ndarray:
-        """Full state ``R X̄`` of a reduced state (r,) or of the rows of an (m, r) array."""
-        Xr = np.asarray(Xr, dtype=float)
-        if Xr.shape[-1] != self.layout.n:
-            raise ValueError(f"a reduced state has {self.layout.n} entries, got {Xr.shape}")
-        return self.R @ Xr if Xr.ndim == 1 else Xr @ self.R.T
+    def reconstruct(self, Xr: np.ndarray, n_uv=None, n_theta=None) -> np.ndarray:
+        """Full state ``R X̄`` of a reduced state (r,) or of the rows of an (m, r) array.
 
-    def restrict(self, X: np.ndarray) -> np.ndarray:
-        """Least-squares reduced state of a full state (exact when ``X`` is in span R)."""
+        ``n_uv``, ``n_theta``: the sizes the reduced model was built with (``reduce``'s
+        arguments, also in its ``info``); ``None``: the largest sizes.
+        """
+        *_, cols, layout = self._columns(n_uv, n_theta)
+        Xr = np.asarray(Xr, dtype=float)
+        if Xr.shape[-1] != layout.n:
+            raise ValueError(f"a reduced state has {layout.n} entries, got {Xr.shape}")
+        R = self.R[:, cols]
+        return R @ Xr if Xr.ndim == 1 else Xr @ R.T
+
+    def restrict(self, X: np.ndarray, n_uv=None, n_theta=None) -> np.ndarray:
+        """Least-squares reduced state of a full state (exact when ``X`` is in span R).
+
+        ``n_uv``, ``n_theta``: sizes of the reduced model, as in :meth:`reconstruct`.
+        """
+        *_, cols, layout = self._columns(n_uv, n_theta)
         X = np.asarray(X, dtype=float)
         if not np.any(X):
-            return np.zeros(X.shape[:-1] + (self.layout.n,))
-        sol = np.linalg.lstsq(self.R, X.T if X.ndim == 2 else X, rcond=None)[0]
+            return np.zeros(X.shape[:-1] + (layout.n,))
+        sol = np.linalg.lstsq(self.R[:, cols], X.T if X.ndim == 2 else X, rcond=None)[0]
         return sol.T if X.ndim == 2 else sol
 
 
 def craig_bampton_thermal(model, n_uv=None, n_theta=None, **kw):
-    """Reduce ``model``; return ``(reduced model, reductor)`` (``reductor.reconstruct``)."""
+    """Reduce ``model``; return ``(reduced model, reductor)`` (``reductor.reconstruct``).
+
+    The reductor is built with ``n_uv``, ``n_theta`` as its largest sizes, so
+    ``reductor.reduce(smaller sizes)`` gives smaller models from the same bases.
+    """
     red = ThermoelasticCraigBampton(model, n_uv, n_theta, **kw)
     return red.reduce(), red
+
+
+def _orient(V: np.ndarray) -> np.ndarray:
+    """Shapes with the first of their largest entries (ties within :data:`PEAK_TIE`) positive.
+
+    :func:`~femrub.fem.eigen.normalise_columns` makes the largest entry positive; when two
+    entries tie (a mirror-symmetric mode), round-off picks one, and it changes with the
+    number of modes solved for. This sign is the same for any number of modes, so a basis
+    truncated by :meth:`ThermoelasticCraigBampton.reduce` equals one computed at that size.
+    """
+    if V.size == 0:
+        return V
+    mag = np.abs(V)
+    first = np.argmax(mag >= (1.0 - PEAK_TIE) * mag.max(axis=0), axis=0)
+    return V * np.where(V[first, np.arange(V.shape[1])] < 0.0, -1.0, 1.0)
 
 
 def _count(name, value, most) -> int:

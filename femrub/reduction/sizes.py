@@ -15,7 +15,8 @@ its bases that meets ``target``:
   capacity) and the simulated temperature error is mostly set by the mechanical shapes, so
   the thermal target is often missed at ``max_n_theta``: the report says so.
 
-The model is then reduced once more with the chosen sizes.
+The chosen model is then projected on the leading columns of that reductor's bases
+(``reductor.reduce(n_uv, n_theta)``): nothing is factorised or solved twice.
 """
 
 from __future__ import annotations
@@ -27,59 +28,64 @@ import scipy.sparse.linalg as spla
 
 from ..fem import eigen
 from ..scene.spec import SceneError, fail
-from .blocks import contact_boundary, split_blocks
 from .craig_bampton import ThermoelasticCraigBampton
+from .interior import condensed_solve
 
 __all__ = ["natural_frequencies", "reduce_model"]
 
 
 def natural_frequencies(model, k: int) -> np.ndarray:
-    """The ``k`` lowest natural frequencies (Hz) of a full model, contacts free."""
-    b = split_blocks(model)
-    return eigen.natural_frequencies(b.K, b.M, k)
+    """The ``k`` lowest natural frequencies (Hz) of a full model's ``blocks``, contacts free."""
+    return eigen.natural_frequencies(model.blocks.K, model.blocks.M, k)
 
 
-def _freq_error(K, M, V, nb, k, ref, modes) -> float:
-    Vk = V[:, : nb + k]
-    if Vk.shape[1] < modes:
-        return np.inf
-    Kr, Mr = Vk.T @ (K @ Vk), Vk.T @ (M @ Vk)
-    lam = sla.eigh(Kr, Mr, eigvals_only=True, subset_by_index=[0, modes - 1])
-    f = np.sqrt(np.clip(lam, 0.0, None)) / (2.0 * np.pi)
+def _freq_errors(K, M, V, nb, ref) -> list[float]:
+    """Largest relative error of the ``ref.size`` lowest frequencies of ``V[:, :nb + k]``.
+
+    One entry per ``k = 0 … V.shape[1] − nb`` (``inf`` while the basis has fewer columns
+    than ``ref``); Rayleigh–Ritz on the leading block of ``Vᵀ K V``, ``Vᵀ M V``.
+    """
+    modes = ref.size
+    Kr, Mr = V.T @ (K @ V), V.T @ (M @ V)
     scale = np.maximum(ref, 1e-9 * ref.max() + 1e-300)
-    return float(np.max(np.abs(f - ref) / scale))
-
-
-def _thermal_errors(C, K, Q, T, ntb, n_max, svals) -> list[float]:
-    full = []
-    for s in svals:
-        lu = spla.splu(sp.csc_matrix(s * C + K))
-        full.append(np.einsum("ij,ij->j", Q, lu.solve(Q)))
     errs = []
-    for k in range(n_max + 1):
-        Tk = T[:, : ntb + k]
-        Qk = Tk.T @ Q
-        e = 0.0
-        for s, H in zip(svals, full):
-            Ar = Tk.T @ ((s * C + K) @ Tk)
-            Hr = np.einsum("ij,ij->j", Qk, np.linalg.solve(Ar, Qk))
-            e = max(e, float(np.max(np.abs(H - Hr) / np.maximum(np.abs(H), 1e-300))))
-        errs.append(e)
+    for n in range(nb, V.shape[1] + 1):
+        if n < modes:
+            errs.append(np.inf)
+            continue
+        lam = sla.eigh(Kr[:n, :n], Mr[:n, :n], eigvals_only=True, subset_by_index=[0, modes - 1])
+        f = np.sqrt(np.clip(lam, 0.0, None)) / (2.0 * np.pi)
+        errs.append(float(np.max(np.abs(f - ref) / scale)))
     return errs
 
 
-def _auto_sizes(model, opts: dict, t_end: float, report: dict) -> tuple[int, int]:
-    L = model.layout
-    mb, tb = contact_boundary(model)
-    n_i, n_ti = L.n_u - mb.size, L.n_t - tb.size
-    max_uv = min(opts["max_n_uv"], 2 * n_i) // 2 * 2
-    max_t = min(opts["max_n_theta"], n_ti) if L.n_t else 0
-    red = ThermoelasticCraigBampton(model, max_uv, max_t, projection=opts["projection"])
-    b = split_blocks(model)
+def _thermal_errors(C, K, Q, T, ntb, svals) -> list[float]:
+    """Largest relative error of ``H_ii(s)`` (module docstring) of ``T[:, :ntb + k]``.
+
+    One entry per ``k = 0 … T.shape[1] − ntb``; Galerkin on the leading block of
+    ``Tᵀ (s C + K) T`` against the full response.
+    """
+    errs = np.zeros(T.shape[1] - ntb + 1)
+    for s in svals:
+        D = sp.csc_matrix(s * C + K)
+        H = np.einsum("ij,ij->j", Q, spla.splu(D).solve(Q))
+        Dr, Qr = T.T @ (D @ T), T.T @ Q
+        for k in range(errs.size):
+            n = ntb + k
+            Hr = np.einsum("ij,ij->j", Qr[:n], np.linalg.solve(Dr[:n, :n], Qr[:n]))
+            err = np.max(np.abs(H - Hr) / np.maximum(np.abs(H), 1e-300))
+            errs[k] = max(errs[k], err)
+    return errs.tolist()
+
+
+def _auto_sizes(red, model, opts: dict, t_end: float, report: dict) -> tuple[int, int]:
+    """Smallest sizes whose sub-bases of ``red`` (built at the largest sizes) meet the target."""
+    L, b = model.layout, model.blocks
+    nb, ntb = red.boundary["u"].size, red.boundary["theta"].size
     target, modes = opts["target"], min(opts["modes"], L.n_u)
-    ref = natural_frequencies(model, modes)
-    V = red.mechanical_basis()
-    errs = [_freq_error(b.K, b.M, V, mb.size, k, ref, modes) for k in range(max_uv // 2 + 1)]
+    solve = condensed_solve(b.K, red.boundary["u"], red.solver)  # no factorisation of K
+    ref = eigen.angular_frequencies(b.K, b.M, modes, solve) / (2.0 * np.pi)
+    errs = _freq_errors(b.K, b.M, red.mechanical_basis(), nb, ref)
     k_uv = next((k for k, e in enumerate(errs) if e <= target), len(errs) - 1)
     report.update(
         natural_frequencies_hz=ref.tolist(),
@@ -88,16 +94,27 @@ def _auto_sizes(model, opts: dict, t_end: float, report: dict) -> tuple[int, int
     )
     n_theta = 0
     Q = model.contact.Ht[L.t] if (model.contact is not None and L.n_t) else np.zeros((L.n_t, 0))
-    if max_t and Q.size and np.any(Q):
+    if red.n_theta and Q.size and np.any(Q):
         svals = [0.0, 1.0 / t_end, 10.0 / t_end]
-        terrs = _thermal_errors(b.Ctt, b.Ktt, Q, red.thermal_basis(), tb.size, max_t, svals)
+        terrs = _thermal_errors(b.Ctt, b.Ktt, Q, red.thermal_basis(), ntb, svals)
         n_theta = next((k for k, e in enumerate(terrs) if e <= target), len(terrs) - 1)
         report.update(thermal_error=terrs[n_theta], thermal_target_met=terrs[n_theta] <= target)
     return 2 * k_uv, n_theta
 
 
+def _max_sizes(model, opts: dict) -> tuple[int, int]:
+    """``max_n_uv`` (even) and ``max_n_theta`` bounded by the interior dofs of ``model``."""
+    L, bnd = model.layout, model.boundary
+    n_i, n_ti = L.n_u - len(bnd["u"]), L.n_t - len(bnd["theta"])
+    return min(opts["max_n_uv"], 2 * n_i) // 2 * 2, min(opts["max_n_theta"], n_ti)
+
+
 def reduce_model(model, scene, log=None):
-    """Reduce ``model`` as ``scene["reduction"]`` asks; return ``(model, reductor, report)``."""
+    """Reduce ``model`` as ``scene["reduction"]`` asks; return ``(model, reductor, report)``.
+
+    ``reductor`` is the one reductor built (at the largest sizes for ``"auto"``);
+    ``report["n_uv"]``, ``report["n_theta"]`` are the sizes of the returned model.
+    """
     opts = scene["reduction"]
     method = opts["method"]
     if method == "none":
@@ -113,8 +130,7 @@ def reduce_model(model, scene, log=None):
     if log:
         log(f"reduction ({method}) of {model.n_dofs} dofs ...")
     if method == "auto":
-        n_uv, n_theta = _auto_sizes(model, opts, scene["scheme"]["t_end"], report)
-        report["target"] = opts["target"]
+        n_uv, n_theta = _max_sizes(model, opts)
     else:
         n_uv, n_theta = opts["n_uv"], opts["n_theta"]
         if model.layout.n_t == 0 and n_theta:
@@ -126,7 +142,10 @@ def reduce_model(model, scene, log=None):
         text = str(exc)
         key = next((f"reduction.{k}" for k in ("n_theta", "n_uv") if k in text), None)
         raise SceneError(f"{key or f'reduction.method = {method!r}'}: {text}") from None
-    reduced = red.reduce()
+    if method == "auto":
+        n_uv, n_theta = _auto_sizes(red, model, opts, scene["scheme"]["t_end"], report)
+        report["target"] = opts["target"]
+    reduced = red.reduce(n_uv, n_theta)
     report.update(
         n_uv=n_uv,
         n_theta=n_theta,

@@ -1,0 +1,147 @@
+"""One reductor, many sizes: ``ThermoelasticCraigBampton.reduce(n_uv, n_theta)`` (pyMOR style).
+
+A reductor built at the largest sizes must give, for any smaller sizes, the reduced model a
+reductor built directly with those sizes gives (round-off for dense eigen-solves; ARPACK's
+tolerance for the 3D blade), and the ``"auto"`` scene reduction must reuse its one reductor.
+"""
+
+import numpy as np
+import pytest
+import scipy.sparse.linalg as spla
+
+import femrub as fr
+from femrub.fem.material import Material
+from femrub.geometry import box_blade
+from femrub.model.rub import solid_model
+from femrub.reduction import PROJECTIONS, ThermoelasticCraigBampton, craig_bampton_thermal
+from femrub.reduction.interior import condensed_solve
+from femrub.reduction.sizes import reduce_model
+from femrub.scene.scene import load_scene
+
+ALPHA = 3.0
+#: dense LAPACK eigen-solves (paper bar): the truncated bases agree to round-off
+TOL_DENSE = 1e-12
+#: ARPACK (3D blade, interior above DENSE_EIGEN_BELOW dofs): its convergence tolerance
+TOL_ARPACK = 1e-9
+
+
+def _rel(a, b) -> float:
+    a, b = np.asarray(a), np.asarray(b)
+    return float(np.max(np.abs(a - b)) / max(np.max(np.abs(b)), 1e-300)) if b.size else 0.0
+
+
+def _arrays(rom) -> dict:
+    """Every operator of a reduced model, dense."""
+    dense = lambda X: X.toarray() if hasattr(X, "toarray") else np.asarray(X)  # noqa: E731
+    out = {"A": dense(rom.A), "B": dense(rom.B), "x0": rom.x0}
+    out.update({n: getattr(rom.contact, n) for n in ("G", "Gv", "Hm", "Ht")})
+    for i, t in enumerate(rom.loads):
+        out[f"load{i}"], out[f"power{i}"] = t.vector, t.power
+    out.update({f"obs:{k}": dense(O) for k, O in rom.observations.items()})
+    e = rom.energy
+    out.update({n: dense(getattr(e, n)) for n in ("Qk", "Qe", "Pth", "Pd")})
+    out.update(heat_content=e.heat_content, heat_outflow=e.heat_outflow)
+    if rom.to_full is not None:
+        out["to_full"] = dense(rom.to_full)
+    return out
+
+
+def _assert_same_model(rom, ref, tol):
+    assert rom.layout == ref.layout
+    a, b = _arrays(rom), _arrays(ref)
+    assert a.keys() == b.keys()
+    for k in b:
+        assert a[k].shape == b[k].shape, k
+        assert _rel(a[k], b[k]) <= tol, k
+    for k in ("n_uv", "n_theta", "n_qu", "n_qv", "n_reduced", "projection"):
+        assert rom.info[k] == ref.info[k], k
+
+
+@pytest.fixture(scope="module")
+def paper():
+    full = fr.bar_model(alpha=ALPHA)
+    x0 = np.zeros(full.n_dofs)
+    x0[full.layout.t] = np.linspace(0.0, 30.0, full.layout.n_t)  # K: exercises restrict()
+    return full.with_(x0=x0)
+
+
+@pytest.mark.parametrize("projection", PROJECTIONS)
+def test_paper_sizes_from_the_full_size_reductor(paper, projection):
+    big = ThermoelasticCraigBampton(paper, projection=projection)  # every shape
+    assert (big.n_uv, big.n_theta) == (38, 19)
+    for sizes in [(3, 12), (2, 5), (7, 0), (0, 4), (38, 19)]:  # RM1, RM2, edges, full basis
+        direct = ThermoelasticCraigBampton(paper, *sizes, projection=projection)
+        _assert_same_model(big.reduce(*sizes), direct.reduce(), TOL_DENSE)
+        Xr = np.random.default_rng(3).standard_normal((4, direct.layout.n))
+        assert _rel(big.reconstruct(Xr, *sizes), direct.reconstruct(Xr)) < TOL_DENSE
+        X = direct.reconstruct(Xr)
+        assert _rel(big.restrict(X, *sizes), direct.restrict(X)) < 1e-9
+    # no arguments: the largest sizes, as the reductor's attributes describe them
+    rom = big.reduce()
+    assert rom.layout == big.layout and rom.info["n_uv"] == big.n_uv
+    assert rom.n_dofs == big.R.shape[1] == big.left.shape[1]
+
+
+def test_dims_errors(paper):
+    red = ThermoelasticCraigBampton(paper, 4, 6)
+    with pytest.raises(ValueError, match="n_uv"):
+        red.reduce(5, 6)
+    with pytest.raises(ValueError, match="n_theta"):
+        red.reduce(4, 7)
+    rom = red.reduce(2, 3)
+    with pytest.raises(ValueError, match="entries"):
+        red.reconstruct(np.zeros(rom.n_dofs))  # sizes of the largest model by default
+    assert red.reconstruct(np.zeros(rom.n_dofs), 2, 3).shape == (paper.n_dofs,)
+    with pytest.raises(ValueError, match="already reduced") as err:
+        ThermoelasticCraigBampton(rom)
+    assert "\n" not in str(err.value)
+    rom2, red2 = craig_bampton_thermal(paper, 4, 6)
+    assert (red2.n_uv, red2.n_theta) == (4, 6) and rom2.layout == red.layout
+
+
+@pytest.fixture(scope="module")
+def blade():
+    """A coarse 3D box blade rubbing a casing (P1, two contact points), interior > 400 dofs."""
+    mesh = box_blade(h=0.008, n_contact=2)
+    mat = Material(young=110e9, rho=4500.0, rho_c=4500.0 * 585.0, conductivity=7.0)
+    model, _ = solid_model(mesh, mat, rotation_speed=1000.0, friction=0.3, order=1)
+    return model
+
+
+@pytest.mark.parametrize("projection", ["petrov-galerkin", "adjoint"])
+def test_3d_box_blade_sizes_from_one_reductor(blade, projection):
+    assert blade.layout.n_u - blade.boundary["u"].size > 400  # ARPACK, not dense LAPACK
+    big = ThermoelasticCraigBampton(blade, 20, 16, projection=projection)
+    for sizes in [(10, 8), (7, 3)]:
+        direct = ThermoelasticCraigBampton(blade, *sizes, projection=projection)
+        _assert_same_model(big.reduce(*sizes), direct.reduce(), TOL_ARPACK)
+
+
+def test_condensed_solve_is_the_full_stiffness_solve(paper, blade):
+    for model in (paper, blade):
+        red = ThermoelasticCraigBampton(model, 2, 1)
+        K = model.blocks.K
+        f = np.random.default_rng(5).standard_normal(K.shape[0])
+        x = condensed_solve(K, red.boundary["u"], red.solver)(f)
+        assert _rel(x, spla.spsolve(K.tocsc(), f)) < 1e-8
+        assert np.linalg.norm(K @ x - f) < 1e-9 * np.linalg.norm(f)
+
+
+def test_auto_reduction_reuses_its_reductor(paper):
+    scene = load_scene("paper", {"reduction.method": "auto", "reduction.max_n_theta": 12})
+    rom, red, report = reduce_model(paper, scene)
+    assert (red.n_uv, red.n_theta) == (38, 12)  # the largest sizes allowed
+    sizes = report["n_uv"], report["n_theta"]
+    assert sizes[0] < red.n_uv and rom.n_dofs == report["n_reduced"]
+    _assert_same_model(rom, red.reduce(*sizes), 0.0)
+    fixed = load_scene(
+        "paper",
+        {
+            "reduction.method": "craig-bampton",
+            "reduction.n_uv": sizes[0],
+            "reduction.n_theta": sizes[1],
+        },
+    )
+    rom_fixed, red_fixed, _ = reduce_model(paper, fixed)
+    assert (red_fixed.n_uv, red_fixed.n_theta) == sizes
+    _assert_same_model(rom, rom_fixed, TOL_DENSE)
