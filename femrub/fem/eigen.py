@@ -97,9 +97,11 @@ def lowest_modes(K, M, k: int, solve=None, *, tol: float = 1e-12, vectors: bool 
     return (lam, normalise_columns(V)) if vectors else lam
 
 
-def angular_frequencies(K, M, k: int, solve=None) -> np.ndarray:
-    """The ``k`` lowest angular frequencies ``ω`` (rad/s) of ``K φ = ω² M φ``."""
-    lam = lowest_modes(K, M, min(k, K.shape[0]), solve, vectors=False)
+def angular_frequencies(K, M, k: int, solve=None, *, tol: float = 1e-12) -> np.ndarray:
+    """The ``k`` lowest angular frequencies ``ω`` (rad/s) of ``K φ = ω² M φ``.
+
+    ``tol``: relative accuracy asked of the eigenvalues ``ω²`` (ARPACK)."""
+    lam = lowest_modes(K, M, min(k, K.shape[0]), solve, vectors=False, tol=tol)
     return np.sqrt(np.clip(lam, 0.0, None))
 
 

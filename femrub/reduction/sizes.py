@@ -33,6 +33,9 @@ from .interior import condensed_solve
 
 __all__ = ["natural_frequencies", "reduce_model"]
 
+#: Accuracy of the reference frequencies relative to the target: far below what is judged.
+REFERENCE_TOL_PER_TARGET = 1e-4
+
 
 def natural_frequencies(model, k: int) -> np.ndarray:
     """The ``k`` lowest natural frequencies (Hz) of a full model's ``blocks``, contacts free."""
@@ -84,7 +87,8 @@ def _auto_sizes(red, model, opts: dict, t_end: float, report: dict) -> tuple[int
     nb, ntb = red.boundary["u"].size, red.boundary["theta"].size
     target, modes = opts["target"], min(opts["modes"], L.n_u)
     solve = condensed_solve(b.K, red.boundary["u"], red.solver)  # no factorisation of K
-    ref = eigen.angular_frequencies(b.K, b.M, modes, solve) / (2.0 * np.pi)
+    tol = REFERENCE_TOL_PER_TARGET * opts["target"]
+    ref = eigen.angular_frequencies(b.K, b.M, modes, solve, tol=tol) / (2.0 * np.pi)
     errs = _freq_errors(b.K, b.M, red.mechanical_basis(), nb, ref)
     k_uv = next((k for k, e in enumerate(errs) if e <= target), len(errs) - 1)
     report.update(
