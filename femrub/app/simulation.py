@@ -186,7 +186,7 @@ def _stepper(scene, model, report):
         "name": s["name"],
         "h": s["h"],
         "t_end": s["t_end"],
-        "steps": int(round(s["t_end"] / s["h"])),
+        "steps": stepper.steps_to(s["t_end"]),
         **{k: v for k, v in options.items() if v is not None},
     }
     if s["name"] == "carpenter":

@@ -161,6 +161,7 @@ class Results:
             t=self.t,
             gap=self.gap,
             impulse=self.impulse,
+            normal_force=self.force,
             meta=json.dumps(meta, default=str),
             **arrays,
         )

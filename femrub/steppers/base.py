@@ -95,10 +95,14 @@ class Stepper:
         self._advance()
         return self.state
 
+    def steps_to(self, t_end: float) -> int:
+        """Number of steps from the current time to ``t_end`` (validated)."""
+        check_step(self.h, t_end)
+        return int(round((t_end - self.t) / self.h))
+
     def iterate(self, t_end: float):
         """Yield the initial state, then the state after every step until ``t_end``."""
-        check_step(self.h, t_end)
-        n = int(round((t_end - self.t) / self.h))
+        n = self.steps_to(t_end)
         yield self.state
         for _ in range(n):
             yield self.step()
@@ -129,11 +133,10 @@ class Stepper:
         on_state : callback ``f(state)`` after each step (e.g. streaming VTK output).
         label : name of the run (progress bar and ``Results.info``).
         """
-        check_step(self.h, t_end)
         recorder = Recorder(
             self.model,
             self.h,
-            int(round((t_end - self.t) / self.h)),
+            self.steps_to(t_end),
             scheme=self.name,
             stability_limit=self.stability_limit(),
             energy=energy,
