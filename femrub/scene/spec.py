@@ -153,17 +153,6 @@ class Spec:
             return list(value)
         raise AssertionError(k)  # pragma: no cover
 
-    def describe(self) -> str:
-        """Type, unit, default and allowed values, for the documentation."""
-        if self.default is REQUIRED:
-            d = "required"
-        elif self.default is None:
-            d = "builder default"
-        else:
-            d = repr(self.default)
-        allowed = f"; {' | '.join(map(repr, self.choices))}" if self.choices else ""
-        return f"{self.kind}{allowed} [{self.unit}], default {d}"
-
 
 @dataclass(frozen=True)
 class Variant:

@@ -53,9 +53,6 @@ class Carpenter(Stepper):
         else:
             self._lu = Factorised(A, what="matrix A")
         self._B = m.B.tocsr()
-        Sv = np.zeros(L.n, dtype=bool)
-        Sv[L.v] = True
-        self._Sv = Sv
         X = self.X
         self._a = self._deriv(X, m.load(self.t))
         self._vh = X[L.v] - 0.5 * h * self._a[L.v]  # v_{-1/2}

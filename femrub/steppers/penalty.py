@@ -70,7 +70,6 @@ class Penalty(Stepper):
         self.stiffness, self.damping, self.method = k, float(damping), method
         self.rtol = float(rtol)
         self.atol = float(atol) if atol is not None else ATOL_PER_RTOL * self.rtol
-        self.n_rhs = 0
         super().__init__(model, h, t0=t0)
 
     def _setup(self):
@@ -96,7 +95,6 @@ class Penalty(Stepper):
         return lam, closed & (lam > 0.0)
 
     def _rhs(self, t, Y):
-        self.n_rhs += 1
         m = self.model
         X = Y[: m.n_dofs]
         rhs = self._B @ X + m.load(t)
