@@ -36,9 +36,9 @@ from .explain import explain
 __all__ = ["Simulation", "build"]
 
 
-@dataclass
+@dataclass(frozen=True)
 class Simulation:
-    """A built scene: the model that runs, the full model, the stepper and the report."""
+    """A built scene (immutable): the model that runs, the full model, the stepper, the report."""
 
     scene: object
     model: object
