@@ -119,8 +119,10 @@ def rub_model(
         reach, the candidate points still show the tip's response).
     """
     N, Q = points.normal_rows(mats), points.heat_rows(mats)
-    observed = points if observe_at is None else observe_at
-    observe = _observations(observed.normal_rows(mats), observed.heat_rows(mats))
+    if observe_at is None or observe_at is points:
+        observe = _observations(N, Q)
+    else:
+        observe = _observations(observe_at.normal_rows(mats), observe_at.heat_rows(mats))
     gap, gap_rate = swept_gap(casing, points.angles, rotation_speed, offset)
     spec = (
         None
