@@ -46,6 +46,7 @@ class Carpenter(Stepper):
 
     def _setup(self):
         m, h, L = self.model, self.h, self.model.layout
+        self._refuse_restitution()
         A = m.A.tocsc()
         self._diagA = None
         if (A - sp.diags(A.diagonal())).count_nonzero() == 0:

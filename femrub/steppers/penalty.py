@@ -74,6 +74,7 @@ class Penalty(Stepper):
 
     def _setup(self):
         m = self.model
+        self._refuse_restitution()
         self._lu = Factorised(m.A, what="matrix A")
         self._B = compact(m.B)
         self._AinvB = self._lu.solve(m.B.toarray()) if self._lu.dense else None
