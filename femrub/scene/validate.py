@@ -196,6 +196,13 @@ def _cross_check(d: dict) -> None:
                 f"no such signal for geometry.kind = {kind!r}; limits apply to {', '.join(known)}",
             )
     _check_damping(physics)
+    if scheme["name"] in ("carpenter", "penalty") and contact["restitution"] > 0.0:
+        fail(
+            "contact.restitution",
+            contact["restitution"],
+            f"scheme.name = {scheme['name']!r} models perfectly plastic impacts only; "
+            "use scheme.name = 'theta' or contact.restitution = 0",
+        )
     h, t_end = scheme["h"], scheme["t_end"]
     if t_end < h:
         fail("scheme.t_end", t_end, f"must be >= scheme.h = {h:g} s")
