@@ -196,8 +196,9 @@ class Results:
         return flatten_columns(self.per_step())
 
     def units(self) -> dict[str, str]:
-        """SI unit of every per-step array (``history.npz`` keys and CSV columns)."""
-        names = ["t", "gap", "impulse", "normal_force", *self.signals, *self.extra]
+        """SI unit of every ``history.npz`` array, by key."""
+        names = ["t", "gap", "impulse", "normal_force", *[f"signal_{k}" for k in self.signals]]
+        names += list(self.extra)
         names += [f"energy_{k}" for k in self.energy]
         return {k: unit_of(k) for k in names}
 
