@@ -74,9 +74,8 @@ def _log(args):
 
 
 def _run(args) -> int:
-    from .run import run_scene
-
     from ..output.folder import safe_name
+    from .run import run_scene
 
     scene = _load(args)
     out = Path(args.out or f"{safe_name(scene.name)}-out")

@@ -40,7 +40,11 @@ def merge_time(scene: Scene) -> float | None:
     force = loads["tip_force"]
     w = None
     if force["law"] == "sin":
-        w = force["engine_order"] * omega if force["frequency"] == "rotation" else force["frequency"]
+        w = (
+            force["engine_order"] * omega
+            if force["frequency"] == "rotation"
+            else force["frequency"]
+        )
     elif omega > 0:
         w = omega * {"lobed": casing.get("lobes", 1), "two-lobe": 2}.get(casing["kind"], 1)
     return 0.25 * 2.0 * math.pi / w if w else None

@@ -96,7 +96,9 @@ def _check_writable(out: Path) -> None:
         probe.unlink()
     except OSError as exc:
         why = exc.strerror or type(exc).__name__
-        raise FolderError(f"cannot write to the output folder {out}: {why}; use another -o") from None
+        raise FolderError(
+            f"cannot write to the output folder {out}: {why}; use another -o"
+        ) from None
 
 
 def _check_result(out: Path, kind: str, overwrite: bool) -> None:

@@ -254,7 +254,9 @@ class Results:
             stimes = d["state_times"] if "state_times" in d.files else None
             known = {"t", "gap", "impulse", "normal_force", "meta", "states", "state_times"}
             extra = {
-                k: d[k] for k in d.files if k not in known and not k.startswith(("signal_", "energy_"))
+                k: d[k]
+                for k in d.files
+                if k not in known and not k.startswith(("signal_", "energy_"))
             }
             return cls(
                 scheme=meta["scheme"],

@@ -34,9 +34,11 @@ FIELD_UNITS = {
     "contact_force": "N",
     "von_mises": "Pa",
 }
-_UNITS_COMMENT = "<!-- femrub units: " + ", ".join(
-    f"{k} [{v}]" for k, v in FIELD_UNITS.items()
-) + " ; time in s -->"
+_UNITS_COMMENT = (
+    "<!-- femrub units: "
+    + ", ".join(f"{k} [{v}]" for k, v in FIELD_UNITS.items())
+    + " ; time in s -->"
+)
 
 
 def von_mises(fields: FieldMap, u_all: np.ndarray) -> np.ndarray:
