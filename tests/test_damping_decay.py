@@ -35,7 +35,7 @@ def test_rayleigh_damped_bar_modes_decay_at_the_analytic_rate():
     h, t_end = 2 * np.pi / w[1] / 200, 5 * 2 * np.pi / w[0]
     res = fr.ThetaMethod(model.with_(x0=x0), h).run(t_end, store_every=1, energy=False)
     u = res.states[:, model.layout.u]
-    q = np.linalg.lstsq(1e-6 * V, u.T, rcond=None)[0]  # modal coordinates (exact: V spans the motion)
+    q = np.linalg.lstsq(1e-6 * V, u.T, rcond=None)[0]  # modal coordinates (V spans the motion)
     for k in range(2):
         exact = damped_mode(res.state_times, w[k], zeta[k])
         assert np.abs(q[k] - exact).max() <= _trapezoid_tolerance(w[k], h, t_end)
