@@ -11,6 +11,7 @@ from dataclasses import replace
 
 import numpy as np
 import pytest
+import scipy.linalg as sla
 import skfem as fem
 
 import femrub as fr
@@ -270,3 +271,16 @@ def test_zener_damping_of_a_vibrating_bar():
     assert env < 0.85 and np.exp(-zeta * w * t2[-1]) == pytest.approx(env, rel=0.05)
     peak = np.abs(u2[-len(u2) // 6 :]).max() / 1e-6
     assert peak == pytest.approx(np.exp(-zeta * w * t2[-1]), rel=0.05)
+
+
+@pytest.mark.parametrize("coupling", ["paper", "physical"])
+def test_strain_heating_is_the_adjoint_of_the_thermal_stress(coupling):
+    # C^θu = −T0 (K^uθ)ᵀ makes the free energy ½uᵀKu + ½vᵀMv + θᵀC^θθθ/(2 T0) a Lyapunov
+    # function: its rate is −vᵀCv − θᵀK^θθθ / T0 ≤ 0, so no eigenvalue grows
+    model = fr.bar_model(gap=1.0, alpha=0.0, strain_heating=True, coupling=coupling)
+    mats = model.blocks
+    T0 = fr.PAPER.material.reference_temperature
+    assert abs(mats.Ctu).max() > 0
+    assert np.allclose(mats.Ctu.toarray(), -T0 * mats.Kut.T.toarray(), rtol=1e-12, atol=0)
+    ev = sla.eigvals(model.B.toarray(), model.A.toarray())
+    assert ev.real.max() <= 1e-9 * np.abs(ev).max()
