@@ -12,6 +12,7 @@ import copy
 import os
 from pathlib import Path
 
+from .bounds import check_physical
 from .schema import SCHEMA, TOP
 from .spec import REQUIRED, SceneError, Variant, fail, unknown_key
 
@@ -79,6 +80,7 @@ def _table(prefix: str, value, spec) -> dict:
             out[k] = _table(dotted, value.get(k, {}), s)
         elif k in value:
             out[k] = s.check(dotted, value[k])
+            check_physical(dotted, s, out[k])
         elif s.default is REQUIRED:
             unit = f" in {s.unit}" if s.unit != "-" else ""
             raise SceneError(f"{dotted} is required{where}: {s.doc}{unit}")
