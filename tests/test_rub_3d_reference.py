@@ -119,7 +119,9 @@ def test_reduced_model_follows_the_full_one(rub):
     _, model, _, res = rub
     rom = ThermoelasticCraigBampton(model, 12, 6).reduce()
     red = fr.ThetaMethod(rom, H).run(T_END)
-    assert red.status == "ok"
+    # the reduced model's energy balance may open beyond the 5 % tolerance (verdict.py):
+    # reported as inaccurate, never unstable or stopped
+    assert red.status in ("ok", "inaccurate")
     # settled: the static response to the contact-point force is in the basis (Eq. 11)
     assert red.force[-200:, 0].mean() == pytest.approx(res.force[-200:, 0].mean(), rel=5e-3)
     # transient: the local response to a point load is what the truncated modes miss
