@@ -22,6 +22,7 @@ from pathlib import Path
 import numpy as np
 
 from .. import __version__
+from ..contact.activation import DEFAULT_RULE
 from ..output.plots import energy_panel, savefig, tip_panels
 from ..steppers import make_stepper
 from .bar import PAPER, bar_model
@@ -45,7 +46,7 @@ class Run:
     alpha: float = ALPHA_DEFAULT
     coupled: bool = True
     model: str = "full"
-    activation: str = "paper"
+    activation: str = DEFAULT_RULE
 
     def key(self) -> tuple:
         return (self.scheme, self.h, self.alpha, self.coupled, self.model, self.activation)
