@@ -19,8 +19,13 @@ def test_scalar_closed_form_matches_general_solver(rule):
         gz = 0.5 * h * w
         a = impulse_one(rule, g_k, gd_k, g_p, gd_p, w, gz, e, h, gamma)
         b = impulses(
-            rule, *(np.array([x]) for x in (g_k, gd_k, g_p, gd_p)),
-            np.array([[w]]), np.array([[gz]]), np.array([e]), h, gamma,
+            rule,
+            *(np.array([x]) for x in (g_k, gd_k, g_p, gd_p)),
+            np.array([[w]]),
+            np.array([[gz]]),
+            np.array([e]),
+            h,
+            gamma,
         )[0]
         assert a == pytest.approx(b, rel=1e-9, abs=1e-18)
 

@@ -93,7 +93,7 @@ FIGURES: dict[str, dict] = {
         ],
     },
     "fig4": {
-        "title": f"Fig. 4: complete model vs reduced models, two left bases (α = {ALPHA_DEFAULT} m/s)",
+        "title": f"Fig. 4: complete vs reduced models, two left bases (α = {ALPHA_DEFAULT} m/s)",
         "panels": ("tip_temperature", "phase_impulse", "contact_force"),
         "runs": [
             (Run("complete model (60 dofs)"), _S["solid"]),
@@ -275,7 +275,9 @@ def reproduce(
             res, model = cache[run.key()]
             rows.append(summarise(fig, run, res, model))
             drawn.append((run.label, res, style))
-            named.append((run.label if run.model == "full" else f"{run.label}, {run.basis}", res, style))
+            named.append(
+                (run.label if run.model == "full" else f"{run.label}, {run.basis}", res, style)
+            )
             _write_summary(out, rows, started)
         if spec.get("plot", True):
             cols = spec.get("columns")

@@ -126,8 +126,8 @@ def _capped(g_k, gd_k, g_p, gd_p, W, GZ, e, h, warm):
     """``0 <= P ⊥ max(r_v, r_g) >= 0`` by switching each contact's binding row.
 
     ``r_v = W P + ġ_p + e ġ_k`` (Newton) and ``r_g = (2/h)(GZ P + g_p − g*)``
-    (cap, ``g*`` of :func:`_target`). Each row choice is an LCP; a contact with ``P > 0`` whose other residual is
-    positive switches rows, until the choice is consistent.
+    (cap, ``g*`` of :func:`_target`). Each row choice is an LCP; a contact with ``P > 0``
+    whose other residual is positive switches rows, until the choice is consistent.
     """
     qv = gd_p + e * gd_k
     qg = (2.0 / h) * (g_p - _target(g_k, e))

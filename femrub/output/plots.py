@@ -52,8 +52,10 @@ def phase_impulses(res, merge: float) -> tuple[np.ndarray, np.ndarray]:
     return np.array(mids), np.array(total)
 
 
-def _draw(ax, key, runs, *, tlim, scale_t, gap, merge, log):
+def _draw(ax, key, runs, *, tlim, scale_t, gap, merge, log, titles):
     ylabel, scale = _PANELS[key]
+    if titles and key in titles:
+        ax.set_title(titles[key], fontsize=8.5, loc="left")
     for label, res, style in runs:
         style = dict(style or {})
         if key == "phase_impulse":
@@ -95,13 +97,15 @@ def tip_panels(
     merge: float = 0.0,
     log_panels=(),
     columns=None,
+    titles=None,
 ):
     """Stacked panels (paper Figs. 2–7) for ``runs = [(label, results, style_dict), ...]``.
 
     ``columns = [(column_title, runs), ...]`` draws one column per group with shared y axes
     (``runs`` is then ignored). The legend sits above the panels, off the data.
     ``"phase_impulse"`` draws the impulse of each contact phase (impacts closer than
-    ``merge`` seconds merged) at the phase's mid-time; ``log_panels`` get a symlog y axis.
+    ``merge`` seconds merged) at the phase's mid-time; ``log_panels`` get a symlog y axis;
+    ``titles`` (by panel key) says above a panel what its curve is.
     """
     scale_t = 1e3 if time_unit == "ms" else 1.0
     cols = columns or [("", runs)]
@@ -116,13 +120,20 @@ def tip_panels(
     for j, (ctitle, cruns) in enumerate(cols):
         for i, key in enumerate(panels):
             _draw(
-                axes[i, j], key, cruns, tlim=tlim, scale_t=scale_t, gap=gap, merge=merge,
+                axes[i, j],
+                key,
+                cruns,
+                tlim=tlim,
+                scale_t=scale_t,
+                gap=gap,
+                merge=merge,
                 log=key in log_panels,
+                titles=titles,
             )
             if j:
                 axes[i, j].set_ylabel("")
         if ctitle:
-            axes[0, j].set_title(ctitle, fontsize=9)
+            axes[0, j].set_title(ctitle, fontsize=9)  # (panel titles apply to single columns)
         axes[-1, j].set_xlabel(f"time ({time_unit})")
         if tlim is not None:
             axes[-1, j].set_xlim(tlim[0] * scale_t, tlim[1] * scale_t)
@@ -137,8 +148,13 @@ def tip_panels(
     top = 1.0 - (0.1 + 0.2 * nrows + 0.3 * bool(title)) / fig.get_figheight()
     fig.tight_layout(rect=(0, 0, 1, top))
     fig.legend(
-        [handles[l_] for l_ in labels], labels, loc="lower center", ncol=ncol, fontsize=8,
-        bbox_to_anchor=(0.5, top), frameon=False,
+        [handles[l_] for l_ in labels],
+        labels,
+        loc="lower center",
+        ncol=ncol,
+        fontsize=8,
+        bbox_to_anchor=(0.5, top),
+        frameon=False,
     )
     if title:
         fig.suptitle(title, fontsize=10, y=0.995)

@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import json
 import platform
+import sys
 import time
 from pathlib import Path
 
@@ -44,6 +45,20 @@ def _jsonable(x):
     if isinstance(x, float | int | str | bool) or x is None:
         return x
     return str(x)
+
+
+#: what each curve of signals.png is, for several contact points
+SIGNAL_TITLES = {
+    "tip_displacement": "mean normal displacement of the contact points",
+    "tip_temperature": "mean temperature rise of the contact points "
+    "(summary: signals_max_abs.tip_temperature)",
+    "contact_force": "sum over the contact points of impulse / h "
+    "(summary: max_total_contact_force; one point: max_contact_force)",
+}
+
+
+def _max_or_none(arr) -> float | None:
+    return float(np.max(arr)) if arr is not None and np.size(arr) else None
 
 
 def _write_json(path: Path, doc: dict) -> None:
@@ -122,6 +137,7 @@ def run_to_folder(
                 [(stepper.name, res, {})],
                 panels=(*panels, "contact_force"),
                 title=f"{stepper.name}, h = {stepper.h:g} s: {res.status}",
+                titles=SIGNAL_TITLES if model.n_contacts > 1 else None,
             ),
             out / "signals.png",
         )
@@ -132,6 +148,11 @@ def run_to_folder(
             snapshot_png(series.dir / series.frames[-1][1], out / "snapshot.png")
         except Exception as exc:  # rendering is optional (no OpenGL on the machine)
             doc["snapshot_error"] = f"{type(exc).__name__}: {exc}"
+            print(
+                f"femrub: snapshot.png not written ({doc['snapshot_error']}); "
+                f"open {series.pvd_path} in ParaView instead",
+                file=sys.stderr,
+            )
     e = res.energy
     stepping_cpu = max(res.cpu_seconds - vtk_cpu, 0.0)
     omega = float(rotation_speed)
@@ -150,6 +171,8 @@ def run_to_folder(
         timings=res.info["timings"],
         first_contact_time=res.first_contact_time(),
         max_contact_force=float(res.force.max()) if res.force.size else 0.0,
+        max_total_contact_force=float(res.force.sum(axis=1).max()) if res.force.size else 0.0,
+        max_contact_temperature=_max_or_none(res.signals.get("contact_temperature")),
         energy_error=res.energy_error(),
         heat_error=res.heat_error(),
         energy={k: float(v[-1]) for k, v in e.items()} if e else {},
