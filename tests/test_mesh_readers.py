@@ -98,7 +98,9 @@ def tiny_deck(tmp_path_factory) -> dict:
         "*ELSET, ELSET=FIRST_TWO, GENERATE", "1, 2",
         f"*NSET, NSET=CAP\n{nid('a1')}, {nid('b1')}, {nid('c1')}, {nid('apex')}",
         f"*NSET, NSET=RIM\n{nid('apex', 'c1')}, {nid('apex')}",
-        "*MATERIAL, NAME=STEEL", "*ELASTIC", "210000., 0.3",
+        "*MATERIAL, NAME=STEEL", "*ELASTIC", "210000., 0.3", "*DENSITY", "7.85e-9",
+        "*EXPANSION", "1.2e-5", "*CONDUCTIVITY", "50.", "*SPECIFIC HEAT", "4.6e8",
+        "*SOLID SECTION, ELSET=WEDGES, MATERIAL=STEEL",
         "*BOUNDARY", "BOTTOM, 1, 3",
         "*STEP", "*STATIC", "*END STEP",
     ]  # fmt: skip
@@ -115,6 +117,31 @@ def test_tiny_deck_volume_and_units(tiny_deck):
     assert np.all(tet_volumes(blade.mesh.p, blade.mesh.t) > 0)
     closed, n_facets = _boundary_is_closed_sphere(blade.mesh.p, blade.mesh.t)
     assert closed and n_facets == 14  # conforming on the shared quad face
+
+
+def test_tiny_deck_material_in_si(tiny_deck):
+    # N-mm-t-s deck: MPa, t/mm^3, mJ/(t K), mW/(mm K) -> Pa, kg/m^3, J/(kg K), W/(m K)
+    mat = read_abaqus(tiny_deck["path"], "mm", radial_axis="z", tip="CAP").info["material"]
+    expected = {"young": 210e9, "poisson": 0.3, "density": 7850.0, "expansion": 1.2e-5,
+                "conductivity": 50.0, "specific_heat": 460.0}  # fmt: skip
+    assert mat == pytest.approx(expected, rel=1e-12)
+    assert read_abaqus(tiny_deck["path"], "cm", radial_axis="z", tip="CAP").info["material"] == {}
+
+
+def test_scene_values_override_the_deck_material():
+    from femrub.app.translate import material_of
+    from femrub.scene import loads_scene
+
+    deck = {"young": 210e9, "density": 7850.0, "conductivity": 50.0}
+    base = 'name = "d"\n[geometry]\nkind = "box"\n[scheme]\nh = 1e-6\nt_end = 1e-3\n'
+    text = base + '[material]\nyoung = "100 GPa"\n'
+    notes = []
+    mat = material_of(loads_scene(text), deck, notes)
+    assert mat.young == 100e9 and mat.rho == 7850.0 and mat.conductivity == 50.0
+    assert any("material.young" in n and "overrides" in n for n in notes)
+    assert any("density" in n and "mesh file" in n for n in notes)
+    scene = loads_scene(base)
+    assert material_of(scene.with_changes({"material.density": 4000.0}), deck).rho == 4000.0
 
 
 def test_tiny_deck_sets_contact_and_elset(tiny_deck):

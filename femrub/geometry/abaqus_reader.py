@@ -17,7 +17,17 @@ from .tet_ops import compact_vertices, orient_positive
 from .tip_detection import detect_tip
 from .units import length_scale
 
-__all__ = ["MIDSIDE_EDGES", "read_abaqus"]
+__all__ = ["MATERIAL_SI", "MIDSIDE_EDGES", "deck_material", "read_abaqus"]
+
+#: Factors to SI of the material constants of a deck in a consistent unit system chosen by
+#: its length unit: m -> N-m-kg-s, mm -> N-mm-t-s (MPa, t/mm^3, mJ/(t K) = 1e-6 J/(kg K),
+#: mW/(mm K) = W/(m K)). A cm deck has no standard consistent system: its material is not read.
+MATERIAL_SI = {
+    "m": {"young": 1.0, "poisson": 1.0, "density": 1.0, "expansion": 1.0,
+          "conductivity": 1.0, "specific_heat": 1.0},
+    "mm": {"young": 1e6, "poisson": 1.0, "density": 1e12, "expansion": 1.0,
+           "conductivity": 1.0, "specific_heat": 1e-6},
+}  # fmt: skip
 
 #: Corner pair (0-based) of every mid-side node, per element node count (Abaqus order).
 MIDSIDE_EDGES = {
@@ -87,6 +97,28 @@ def _contact_edges(model, table, old_to_new, contact_cols, vertex) -> np.ndarray
     return edge
 
 
+def deck_material(model: AbaqusModel, length_unit: str, elset: str | None = None) -> dict:
+    """Material of the deck's solid section in SI (keys of :data:`MATERIAL_SI`), or ``{}``.
+
+    The section of ``elset`` if given, else the only ``*SOLID SECTION`` (or the only
+    ``*MATERIAL``). Several materials without a way to choose, or a ``cm`` deck: ``{}``.
+    """
+    factors = MATERIAL_SI.get(str(length_unit).strip().lower())
+    if factors is None or not model.materials:
+        return {}
+    name = None
+    if elset is not None:
+        name = next((m for e, m in model.sections.items() if e.upper() == elset.upper()), None)
+    if name is None and len(set(model.sections.values())) == 1:
+        name = next(iter(model.sections.values()))
+    if name is None and len(model.materials) == 1:
+        name = next(iter(model.materials))
+    mat = next((v for k, v in model.materials.items() if k.upper() == str(name).upper()), None)
+    if not mat:
+        return {}
+    return {k: v * factors[k] for k, v in mat.items()}
+
+
 def read_abaqus(
     path: str | Path,
     length_unit: str,
@@ -130,7 +162,8 @@ def read_abaqus(
     -------
     BladeMesh
         Node sets ``root``, ``tip``, every NSET (restricted to vertices) and
-        ``contact`` when all contact nodes are vertices.
+        ``contact`` when all contact nodes are vertices; ``info["material"]``: the deck's
+        ``*MATERIAL`` in SI (:func:`deck_material`).
 
     Raises
     ------
@@ -217,6 +250,7 @@ def read_abaqus(
             "n_source_nodes": int(model.node_ids.size),
             "files": model.files,
             "contact_map": contact_map,
+            "material": deck_material(model, length_unit, elset),
             "read_time_s": time.perf_counter() - start,
         },
     )
