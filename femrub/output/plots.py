@@ -74,7 +74,7 @@ def _draw(ax, key, runs, *, tlim, scale_t, gap, merge, log, titles):
         if tlim is not None:
             sel = (t >= tlim[0]) & (t <= tlim[1])
             t, y = t[sel], y[sel]
-        if key == "contact_force" and tlim is None:
+        if key == "contact_force":
             style.update(_THIN)
         ax.plot(t * scale_t, y * scale, label=label, **style)
     if key == "tip_displacement" and gap is not None:
