@@ -371,3 +371,56 @@ def test_rotor37_tets_valid_and_volume_stable(rotor37):
     t = split_into_tets("wedge", cols, global_ids=-corners)
     other = np.abs(tet_volumes(model.coords * 1e-3, t)).sum()
     assert other == pytest.approx(rotor37.volume(), rel=1e-3)
+
+
+def _edge_mid(blade, xa, xb):
+    """Stored curved midpoint of the tetrahedral edge between the vertices at xa, xb."""
+    p, e = blade.mesh.p, blade.mesh.edges
+    va = int(np.argmin(np.linalg.norm(p - xa[:, None], axis=0)))
+    vb = int(np.argmin(np.linalg.norm(p - xb[:, None], axis=0)))
+    k = np.flatnonzero((np.minimum(*e) == min(va, vb)) & (np.maximum(*e) == max(va, vb)))
+    assert k.size == 1
+    return blade.info["edge_midpoints"][:, k[0]]
+
+
+def test_quadratic_geometry_kept(tiny_deck, tmp_path):
+    import skfem
+
+    from femrub.fem.discretisation import discretise
+
+    xyz, nid = tiny_deck["xyz"], tiny_deck["nid"]
+    blade = read_abaqus(tiny_deck["path"], "m", radial_axis="z", tip="CAP")
+    straight = 0.5 * (blade.mesh.p[:, blade.mesh.edges[0]] + blade.mesh.p[:, blade.mesh.edges[1]])
+    assert np.allclose(blade.info["edge_midpoints"], straight, atol=1e-12)  # straight deck
+    # bend: move the mid-side node of the wedge edge a0-b0 by d (the deck is in metres here)
+    d = np.array([0.0, -1.0, 0.0])
+    text = (tiny_deck["path"].parent / "mesh" / "tiny_mesh.inp").read_text()
+    old = f"{nid('a0', 'b0')}, " + ", ".join(f"{v:.6f}" for v in xyz[("a0", "b0")])
+    new_xyz = xyz[("a0", "b0")] + d
+    assert old in text
+    bent = tmp_path / "mesh"
+    bent.mkdir()
+    (bent / "tiny_mesh.inp").write_text(
+        text.replace(old, f"{nid('a0', 'b0')}, " + ", ".join(f"{v:.6f}" for v in new_xyz))
+    )
+    deck = tmp_path / "tiny.inp"
+    deck.write_text(tiny_deck["path"].read_text())
+    blade = read_abaqus(deck, "m", radial_axis="z", tip="CAP")
+    a0, b0, a1, b1 = (xyz[k] for k in ("a0", "b0", "a1", "b1"))
+    assert np.allclose(_edge_mid(blade, a0, b0), new_xyz, atol=1e-9)
+    # a diagonal of the quad face a0-b0-b1-a1: serendipity centre, moved by d / 2
+    try:
+        diag = _edge_mid(blade, a0, b1)
+    except AssertionError:
+        diag = _edge_mid(blade, b0, a1)
+    assert np.allclose(diag, 0.25 * (a0 + b0 + a1 + b1) + 0.5 * d, atol=1e-9)
+    # the P2 basis maps the curved cells: the face bulges out by d times the serendipity
+    # shape function of that mid-side node, which adds |d| A / 3 (A: area of the face)
+    disc = discretise(blade, 2, clamped=False)
+    one = skfem.Functional(lambda w: 1.0 + 0.0 * w.x[0])
+    vol = one.assemble(disc.basis_t)
+    flat = one.assemble(skfem.Basis(blade.mesh, skfem.ElementTetP1()))
+    area = np.linalg.norm(b0 - a0) * np.linalg.norm(a1 - a0)
+    assert vol - flat == pytest.approx(np.linalg.norm(d) * area / 3.0, rel=1e-9)
+    # linear displacement keeps straight cells
+    assert one.assemble(discretise(blade, 1, clamped=False).basis_t) == pytest.approx(flat)
