@@ -297,7 +297,7 @@ def reproduce(
         if fig == "fig5":  # energy balances of the two schemes at the same step
             for run, _ in spec["runs"][:2]:
                 res = cache[run.key()][0]
-                title = f"Energy balance: {run.label} (residual {res.energy_error():.1e})"
+                title = f"Energy balance: {run.label}"
                 savefig(energy_panel(res, title=title), out / f"energy_{run.scheme}.png")
     return rows
 
