@@ -55,3 +55,27 @@ def test_plain_rule_can_create_energy():
 def test_unknown_rule_is_rejected():
     with pytest.raises(ValueError, match="position"):
         fr.ThetaMethod(fr.bar_model(), 1e-4, activation="sometimes")
+
+
+@pytest.mark.parametrize("rule", ["position", "capped"])
+def test_two_contacts_complementarity_and_no_open_push(rule):
+    from test_multicontact import _two_contact_bar
+
+    model = _two_contact_bar()
+    st = fr.ThetaMethod(model, 1e-4, activation=rule)
+    both, prev = 0, None
+    for s in st.iterate(0.1):
+        P = s.impulse
+        assert np.all(P >= 0.0)
+        both += int(np.all(P > 0))
+        if prev is not None:
+            target = np.minimum(prev, 0.0)  # e = 0
+            assert np.all(s.gap[P > 0] <= target[P > 0] + 1e-15)  # never lifted, never open
+            if rule == "position":  # Signorini at the target: closed exactly where P > 0
+                assert np.all(s.gap >= target - 1e-15)
+                assert np.all(np.abs(s.gap - target)[P > 0] <= 1e-15)
+        prev = s.gap.copy()
+    assert both > 10
+    res = fr.ThetaMethod(model, 1e-4, activation=rule).run(0.1)
+    assert res.status == "ok" and res.energy_error() < 1e-9
+    assert np.all(np.diff(res.energy["contact_work"]) <= 1e-15)

@@ -100,7 +100,14 @@ def impulses(rule, g_k, gd_k, g_p, gd_p, W, GZ, e, h, gamma, warm=None) -> np.nd
         return _capped(g_k, gd_k, g_p, gd_p, W, GZ, e, h, warm)
     if rule == "position":
         q = (2.0 / h) * (g_p - _target(g_k, e))
-        return solve_impulses((2.0 / h) * GZ, q, q < 0.0, warm)
+        M = (2.0 / h) * GZ
+        active = q < 0.0
+        while True:  # add contacts that the others' impulses pull below their target
+            P = solve_impulses(M, q, active, warm)
+            low = ~active & (M @ P + q < -1e-12 * np.abs(q).max())
+            if not low.any():
+                return P
+            active |= low
     if rule == "plain":
         return solve_impulses(W, gd_p + e * gd_k, g_p <= 0.0, warm)
     e = np.where(gd_k > 0.0, 1.0, e)  # midpoint law on separating contacts
