@@ -22,7 +22,8 @@ except ``"plain"``:
 
   An open contact whose free step crosses the casing lands on it (``g_{k+1} = 0`` for
   ``e = 0``; at ``e g_k`` for ``e > 0``, which for ``e = 1`` is Newton's elastic law); a
-  closed contact is held where it is (``g_{k+1} = g_k``, the midpoint law). ``P > 0``
+  closed contact is held where it is (``g_{k+1} = g_k``, the midpoint law). An open
+  contact takes an impulse only when its free step ends inside the casing (``g_p < 0``). ``P > 0``
   implies ``g_{k+1} <= g_k``, so ``ΔW_c <= 0``, and ``g_{k+1} <= e max(g_k, 0)``: for
   ``e = 0`` no impulse ever acts at an open gap. Residual penetration comes only from the
   crossing step and round-off. It needs no activation set.
@@ -68,11 +69,13 @@ def impulse_one(rule, g_k, gd_k, g_p, gd_p, w, gz, e, h, gamma) -> float:
 
     ``w = ∂ġ_{k+1}/∂P > 0`` and ``gz = ∂g_{k+1}/∂P > 0``.
     """
-    if rule == "capped":
+    if rule in ("capped", "position"):
+        if g_k > 0.0 and g_p >= 0.0:  # open, and the free step does not reach the casing
+            return 0.0
         p_cap = (_target(g_k, e) - g_p) / gz
+        if rule == "position":
+            return max(0.0, p_cap)
         return max(0.0, min(-(gd_p + e * gd_k) / w, p_cap))
-    if rule == "position":
-        return max(0.0, (_target(g_k, e) - g_p) / gz)
     if rule == "plain":
         return max(0.0, -(gd_p + e * gd_k) / w) if g_p <= 0.0 else 0.0
     if rule == "predicted":
@@ -101,10 +104,12 @@ def impulses(rule, g_k, gd_k, g_p, gd_p, W, GZ, e, h, gamma, warm=None) -> np.nd
     if rule == "position":
         q = (2.0 / h) * (g_p - _target(g_k, e))
         M = (2.0 / h) * GZ
-        active = q < 0.0
+        closed = g_k <= 0.0
+        active = (q < 0.0) & (closed | (g_p < 0.0))
         while True:  # add contacts that the others' impulses pull below their target
             P = solve_impulses(M, q, active, warm)
-            low = ~active & (M @ P + q < -1e-12 * np.abs(q).max())
+            r = M @ P + q
+            low = ~active & (r < -1e-12 * np.abs(q).max()) & (closed | (g_p + GZ @ P < 0.0))
             if not low.any():
                 return P
             active |= low
@@ -139,7 +144,8 @@ def _capped(g_k, gd_k, g_p, gd_p, W, GZ, e, h, warm):
     qv = gd_p + e * gd_k
     qg = (2.0 / h) * (g_p - _target(g_k, e))
     Wg = (2.0 / h) * GZ
-    cand = qg < 0.0  # a contact whose free step stays above the cap takes no impulse
+    # a contact whose free step stays above the cap, or open and off the casing, takes none
+    cand = (qg < 0.0) & ((g_k <= 0.0) | (g_p < 0.0))
     if not cand.any():
         return np.zeros(g_k.size)
     use_g = np.zeros(g_k.size, dtype=bool)
