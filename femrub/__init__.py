@@ -3,18 +3,36 @@
 SI units throughout (m, kg, s, K, N, W, J, Pa).
 """
 
-from .cases.bar import PAPER, BarCase, bar_matrices, bar_model, rpm
-from .fem.assembly import ThermoelasticMatrices, assemble_thermoelastic
-from .fem.material import Material
-from .model.build import ContactSpec, Load, first_order_model
-from .model.first_order import Contact, EnergyForms, FirstOrderModel, Layout, LoadTerm
-from .output.results import Results
-from .steppers import Carpenter, Penalty, ThetaMethod, make_stepper
+from importlib import import_module as _import
 
 __version__ = "0.1.0"
 
+# imported on first use (PEP 562): `femrub --help` and `femrub scenes` stay fast
+_LAZY = {
+    "PAPER": ".cases.bar",
+    "BarCase": ".cases.bar",
+    "bar_matrices": ".cases.bar",
+    "bar_model": ".cases.bar",
+    "rpm": ".cases.bar",
+    "ThermoelasticMatrices": ".fem.assembly",
+    "assemble_thermoelastic": ".fem.assembly",
+    "Material": ".fem.material",
+    "ContactSpec": ".model.build",
+    "Load": ".model.build",
+    "first_order_model": ".model.build",
+    "Contact": ".model.first_order",
+    "EnergyForms": ".model.first_order",
+    "FirstOrderModel": ".model.first_order",
+    "Layout": ".model.first_order",
+    "LoadTerm": ".model.first_order",
+    "Results": ".output.results",
+    "Carpenter": ".steppers",
+    "Penalty": ".steppers",
+    "ThetaMethod": ".steppers",
+    "make_stepper": ".steppers",
+}
+
 __all__ = [
-    "PAPER",
     "BarCase",
     "Carpenter",
     "Contact",
@@ -25,6 +43,7 @@ __all__ = [
     "Load",
     "LoadTerm",
     "Material",
+    "PAPER",
     "Penalty",
     "Results",
     "ThermoelasticMatrices",
@@ -36,3 +55,15 @@ __all__ = [
     "make_stepper",
     "rpm",
 ]
+
+
+def __getattr__(name):
+    if name not in _LAZY:
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    value = getattr(_import(_LAZY[name], __name__), name)
+    globals()[name] = value
+    return value
+
+
+def __dir__():
+    return sorted(set(globals()) | set(__all__))

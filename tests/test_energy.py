@@ -20,7 +20,7 @@ def _free_vibration(e, n_elements=20):
 
 
 @pytest.mark.parametrize("e", [0.0, 0.5, 1.0])
-@pytest.mark.parametrize("activation", ["paper", "predicted"])
+@pytest.mark.parametrize("activation", ["position", "capped", "paper", "predicted"])
 def test_energy_never_increases(e, activation):
     model = _free_vibration(e)
     res = fr.ThetaMethod(model, 2e-5, activation=activation).run(0.05)

@@ -98,7 +98,9 @@ def tiny_deck(tmp_path_factory) -> dict:
         "*ELSET, ELSET=FIRST_TWO, GENERATE", "1, 2",
         f"*NSET, NSET=CAP\n{nid('a1')}, {nid('b1')}, {nid('c1')}, {nid('apex')}",
         f"*NSET, NSET=RIM\n{nid('apex', 'c1')}, {nid('apex')}",
-        "*MATERIAL, NAME=STEEL", "*ELASTIC", "210000., 0.3",
+        "*MATERIAL, NAME=STEEL", "*ELASTIC", "210000., 0.3", "*DENSITY", "7.85e-9",
+        "*EXPANSION", "1.2e-5", "*CONDUCTIVITY", "50.", "*SPECIFIC HEAT", "4.6e8",
+        "*SOLID SECTION, ELSET=WEDGES, MATERIAL=STEEL",
         "*BOUNDARY", "BOTTOM, 1, 3",
         "*STEP", "*STATIC", "*END STEP",
     ]  # fmt: skip
@@ -115,6 +117,31 @@ def test_tiny_deck_volume_and_units(tiny_deck):
     assert np.all(tet_volumes(blade.mesh.p, blade.mesh.t) > 0)
     closed, n_facets = _boundary_is_closed_sphere(blade.mesh.p, blade.mesh.t)
     assert closed and n_facets == 14  # conforming on the shared quad face
+
+
+def test_tiny_deck_material_in_si(tiny_deck):
+    # N-mm-t-s deck: MPa, t/mm^3, mJ/(t K), mW/(mm K) -> Pa, kg/m^3, J/(kg K), W/(m K)
+    mat = read_abaqus(tiny_deck["path"], "mm", radial_axis="z", tip="CAP").info["material"]
+    expected = {"young": 210e9, "poisson": 0.3, "density": 7850.0, "expansion": 1.2e-5,
+                "conductivity": 50.0, "specific_heat": 460.0}  # fmt: skip
+    assert mat == pytest.approx(expected, rel=1e-12)
+    assert read_abaqus(tiny_deck["path"], "cm", radial_axis="z", tip="CAP").info["material"] == {}
+
+
+def test_scene_values_override_the_deck_material():
+    from femrub.app.translate import material_of
+    from femrub.scene import loads_scene
+
+    deck = {"young": 210e9, "density": 7850.0, "conductivity": 50.0}
+    base = 'name = "d"\n[geometry]\nkind = "box"\n[scheme]\nh = 1e-6\nt_end = 1e-3\n'
+    text = base + '[material]\nyoung = "100 GPa"\n'
+    notes = []
+    mat = material_of(loads_scene(text), deck, notes)
+    assert mat.young == 100e9 and mat.rho == 7850.0 and mat.conductivity == 50.0
+    assert any("material.young" in n and "overrides" in n for n in notes)
+    assert any("density" in n and "mesh file" in n for n in notes)
+    scene = loads_scene(base)
+    assert material_of(scene.with_changes({"material.density": 4000.0}), deck).rho == 4000.0
 
 
 def test_tiny_deck_sets_contact_and_elset(tiny_deck):
@@ -344,3 +371,56 @@ def test_rotor37_tets_valid_and_volume_stable(rotor37):
     t = split_into_tets("wedge", cols, global_ids=-corners)
     other = np.abs(tet_volumes(model.coords * 1e-3, t)).sum()
     assert other == pytest.approx(rotor37.volume(), rel=1e-3)
+
+
+def _edge_mid(blade, xa, xb):
+    """Stored curved midpoint of the tetrahedral edge between the vertices at xa, xb."""
+    p, e = blade.mesh.p, blade.mesh.edges
+    va = int(np.argmin(np.linalg.norm(p - xa[:, None], axis=0)))
+    vb = int(np.argmin(np.linalg.norm(p - xb[:, None], axis=0)))
+    k = np.flatnonzero((np.minimum(*e) == min(va, vb)) & (np.maximum(*e) == max(va, vb)))
+    assert k.size == 1
+    return blade.info["edge_midpoints"][:, k[0]]
+
+
+def test_quadratic_geometry_kept(tiny_deck, tmp_path):
+    import skfem
+
+    from femrub.fem.discretisation import discretise
+
+    xyz, nid = tiny_deck["xyz"], tiny_deck["nid"]
+    blade = read_abaqus(tiny_deck["path"], "m", radial_axis="z", tip="CAP")
+    straight = 0.5 * (blade.mesh.p[:, blade.mesh.edges[0]] + blade.mesh.p[:, blade.mesh.edges[1]])
+    assert np.allclose(blade.info["edge_midpoints"], straight, atol=1e-12)  # straight deck
+    # bend: move the mid-side node of the wedge edge a0-b0 by d (the deck is in metres here)
+    d = np.array([0.0, -1.0, 0.0])
+    text = (tiny_deck["path"].parent / "mesh" / "tiny_mesh.inp").read_text()
+    old = f"{nid('a0', 'b0')}, " + ", ".join(f"{v:.6f}" for v in xyz[("a0", "b0")])
+    new_xyz = xyz[("a0", "b0")] + d
+    assert old in text
+    bent = tmp_path / "mesh"
+    bent.mkdir()
+    (bent / "tiny_mesh.inp").write_text(
+        text.replace(old, f"{nid('a0', 'b0')}, " + ", ".join(f"{v:.6f}" for v in new_xyz))
+    )
+    deck = tmp_path / "tiny.inp"
+    deck.write_text(tiny_deck["path"].read_text())
+    blade = read_abaqus(deck, "m", radial_axis="z", tip="CAP")
+    a0, b0, a1, b1 = (xyz[k] for k in ("a0", "b0", "a1", "b1"))
+    assert np.allclose(_edge_mid(blade, a0, b0), new_xyz, atol=1e-9)
+    # a diagonal of the quad face a0-b0-b1-a1: serendipity centre, moved by d / 2
+    try:
+        diag = _edge_mid(blade, a0, b1)
+    except AssertionError:
+        diag = _edge_mid(blade, b0, a1)
+    assert np.allclose(diag, 0.25 * (a0 + b0 + a1 + b1) + 0.5 * d, atol=1e-9)
+    # the P2 basis maps the curved cells: the face bulges out by d times the serendipity
+    # shape function of that mid-side node, which adds |d| A / 3 (A: area of the face)
+    disc = discretise(blade, 2, clamped=False)
+    one = skfem.Functional(lambda w: 1.0 + 0.0 * w.x[0])
+    vol = one.assemble(disc.basis_t)
+    flat = one.assemble(skfem.Basis(blade.mesh, skfem.ElementTetP1()))
+    area = np.linalg.norm(b0 - a0) * np.linalg.norm(a1 - a0)
+    assert vol - flat == pytest.approx(np.linalg.norm(d) * area / 3.0, rel=1e-9)
+    # linear displacement keeps straight cells
+    assert one.assemble(discretise(blade, 1, clamped=False).basis_t) == pytest.approx(flat)

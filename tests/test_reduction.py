@@ -334,9 +334,13 @@ def test_3d_cantilever_with_three_contacts():
     assert full.n_contacts == 3
     red = ThermoelasticCraigBampton(full)
     assert red.boundary["u"].size == 3 and red.boundary["theta"].size == 3
-    ref = fr.ThetaMethod(full, 1e-6).run(5e-4)
+    # "capped": the default "position" rule holds closed contacts without dissipating the
+    # reflected velocity, so three contacts chattering at the casing amplify round-off (full
+    # vs exact reduction differ by about 1 % after 500 steps); a dissipative rule keeps the
+    # comparison at round-off
+    ref = fr.ThetaMethod(full, 1e-6, activation="capped").run(5e-4)
     assert len(ref.contact_phases()) >= 2 and ref.signal("tip_temperature")[-1] > 0
-    _same_run(fr.ThetaMethod(red.reduce(), 1e-6).run(5e-4), ref, 1e-8)
+    _same_run(fr.ThetaMethod(red.reduce(), 1e-6, activation="capped").run(5e-4), ref, 1e-8)
     small = ThermoelasticCraigBampton(full, 6, 5)
     assert small.reduce().n_dofs == (3 + 3) + (3 + 3) + (3 + 5)
     X = _static_full(full, small.boundary["u"], small.boundary["theta"], 1e-6, 10.0)

@@ -127,7 +127,7 @@ def test_many_contacts_lcp_complementarity(rub):
     a = model.contact.alpha_at(0.0)
     assert np.allclose(a, 0.05 * 1000.0 * 0.4, rtol=1e-3)  # α = μ Ω r at r = 0.4 m
     prev, several = None, 0
-    for s in fr.ThetaMethod(model, 1e-5).iterate(0.004):
+    for s in fr.ThetaMethod(model, 1e-5, activation="paper").iterate(0.004):
         P_ = s.impulse
         assert np.all(P_ >= 0)
         several += int((P_ > 0).sum() >= 2)
@@ -137,6 +137,12 @@ def test_many_contacts_lcp_complementarity(rub):
             tol = 1e-9 * (1 + np.abs(s.gap_velocity).max())
             assert np.all(U[P_ > 0] >= -tol) and np.all(np.abs(P_ * U) <= tol * (1 + P_.max()))
         prev = s.gap_velocity.copy()
+    assert several > 10
+    # default rule: no impulse at an open gap, several contacts at once
+    prev, several = None, 0
+    for s in fr.ThetaMethod(model, 1e-5).iterate(0.004):
+        several += int((s.impulse > 0).sum() >= 2)
+        assert np.all(s.impulse >= 0) and np.all(s.gap[s.impulse > 0] <= 1e-15)
     assert several > 10
 
 

@@ -112,7 +112,8 @@ def _run(args) -> int:
         force = res.force.max() if res.force.size else 0.0
         print(
             f"done in {time.perf_counter() - t0:.1f} s: status {res.status}, {res.steps} "
-            f"steps, max contact force {force:.4g} N, max temperature rise {peak:.4g} K"
+            f"steps, max force at one contact point {force:.4g} N, max temperature rise "
+            f"at a contact point {peak:.4g} K"
         )
         if res.status != "ok":
             print(f"  note: {res.message}")

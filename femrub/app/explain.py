@@ -86,6 +86,7 @@ def explain(report: dict, reach_key=None) -> str:
     if "fe_dofs" in full:
         line += f"; {full['fe_dofs']} FE dofs"
     rows.append(("model", line))
+    rows += [("material", note) for note in report.get("material", [])]
     rows.append(("thermal", report["thermal"]))
     for d in report["dropped"]:
         rows.append(("dropped", d))

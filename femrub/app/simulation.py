@@ -176,7 +176,11 @@ def _build(scene, log, modes) -> Simulation:
     clock.done("mesh", f"{blade.n_vertices} vertices")
     if log:
         log("assembling the full model ...")
-    material, casing = tr.material_of(scene), tr.casing_of(scene)
+    report["material"] = []
+    material = tr.material_of(scene, blade.info.get("material"), report["material"])
+    casing = tr.casing_of(scene)
+    for note in report["material"] if log else ():
+        log(f"notice: {note}")
     omega = scene["loads"]["rotation_speed"]
     try:
         disc = discretise(blade, p["order"] if blade.dim == 3 else 1,

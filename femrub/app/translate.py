@@ -84,9 +84,22 @@ def area_of(scene) -> float:
     return scene["geometry"]["area"] if is_bar(scene) else 1.0
 
 
-def material_of(scene) -> Material:
-    """Material of the scene; a bar with ``total_mass`` spreads that mass along its length."""
-    m, g = scene["material"], scene["geometry"]
+def material_of(scene, deck: dict | None = None, notes: list | None = None) -> Material:
+    """Material of the scene; a bar with ``total_mass`` spreads that mass along its length.
+
+    ``deck``: material read from the mesh file (SI, keys of ``[material]``); it replaces the
+    scene's defaults, while values the scene sets itself win, each with a line in ``notes``.
+    """
+    m, g = dict(scene["material"]), scene["geometry"]
+    for key, value in (deck or {}).items():
+        if f"material.{key}" not in scene.given:
+            m[key] = value
+        elif notes is not None and not math.isclose(m[key], value, rel_tol=1e-9):
+            notes.append(f"material.{key} = {m[key]:.6g} (scene) overrides {value:.6g} (mesh file)")
+    if deck and notes is not None:
+        used = sorted(k for k in deck if f"material.{k}" not in scene.given)
+        if used:
+            notes.append(f"material from the mesh file: {', '.join(used)}")
     rho = m["density"]
     if is_bar(scene) and g["total_mass"] != "density":
         rho = g["total_mass"] / (g["area"] * g["length"])

@@ -28,6 +28,7 @@ from pathlib import Path
 import numpy as np
 
 from .. import __version__
+from ..contact.activation import DEFAULT_RULE
 from ..output.folder import claim
 from ..output.interrupts import interruptible
 from ..output.jsonfile import write_json
@@ -57,26 +58,28 @@ class Run:
     alpha: float = ALPHA_DEFAULT
     coupled: bool = True
     model: str = "full"
-    activation: str = "paper"
+    activation: str = DEFAULT_RULE
+    basis: str = "petrov-galerkin"  # left basis of the reduced models (ignored for "full")
 
     def key(self) -> tuple:
-        return (self.scheme, self.h, self.alpha, self.coupled, self.model, self.activation)
+        basis = None if self.model == "full" else self.basis
+        return (self.scheme, self.h, self.alpha, self.coupled, self.model, self.activation, basis)
 
 
-def _full(alpha: float, coupled: bool):
+def _full(alpha: float, coupled: bool, basis: str | None = None):
     return bar_model(PAPER, alpha=alpha, coupling="paper" if coupled else "none")
 
 
 def _reduced(name: str) -> Callable:
-    def build(alpha: float, coupled: bool):
+    def build(alpha: float, coupled: bool, basis: str = "petrov-galerkin"):
         from .paper_models import paper_reduced_model
 
-        return paper_reduced_model(name, alpha, coupled)
+        return paper_reduced_model(name, alpha, coupled, projection=basis)
 
     return build
 
 
-#: Model builders by name: ``f(alpha, coupled) -> FirstOrderModel``.
+#: Model builders by name: ``f(alpha, coupled, basis) -> FirstOrderModel``.
 MODELS: dict[str, Callable] = {"full": _full, "RM1": _reduced("RM1"), "RM2": _reduced("RM2")}
 
 _S = {
@@ -93,6 +96,8 @@ FIGURES: dict[str, dict] = {
     },
     "fig3": {
         "title": "Fig. 3: influence of α in the heat flux α λ",
+        "log_panels": ("tip_temperature",),
+        "panels": ("tip_displacement", "tip_temperature", "phase_impulse"),
         "runs": [
             (Run("α = 1 m/s", alpha=1.0), _S["solid"]),
             (Run("α = 3 m/s", alpha=3.0), _S["solid"]),
@@ -100,15 +105,28 @@ FIGURES: dict[str, dict] = {
         ],
     },
     "fig4": {
-        "title": f"Fig. 4: complete model vs reduced models (α = {ALPHA_DEFAULT} m/s)",
+        "title": f"Fig. 4: complete vs reduced models, two left bases (α = {ALPHA_DEFAULT} m/s)",
+        "panels": ("tip_temperature", "phase_impulse", "contact_force"),
         "runs": [
-            (Run("complete model"), _S["solid"]),
-            (Run("RM1 (n_uv = 3, n_θ = 12)", model="RM1"), _S["dashed"]),
-            (Run("RM2 (n_uv = 2, n_θ = 5)", model="RM2"), _S["dotted"]),
+            (Run("complete model (60 dofs)"), _S["solid"]),
+            *(
+                (Run(label, model=name, basis=basis), style)
+                for basis in ("petrov-galerkin", "adjoint")
+                for name, label, style in (
+                    ("RM1", "RM1 (n_uv = 3, n_θ = 12; 18 dofs)", _S["dashed"]),
+                    ("RM2", "RM2 (n_uv = 2, n_θ = 5; 10 dofs)", _S["dotted"]),
+                )
+            ),
+        ],
+        # one column per left basis, each with the complete model (run 0)
+        "columns": [
+            ("default: Petrov–Galerkin left basis", (0, 1, 2)),
+            ("adjoint left basis (closest to the paper)", (0, 3, 4)),
         ],
     },
     "fig5": {
         "title": "Fig. 5: Carpenter's scheme vs the θ-method",
+        "panels": ("tip_displacement", "tip_temperature", "phase_impulse", "contact_force"),
         "runs": [
             (Run("Carpenter, h = 1e-5 s", scheme="carpenter", h=1e-5), _S["dashed"]),
             (Run("θ-method, h = 1e-5 s", h=1e-5), _S["solid"]),
@@ -129,6 +147,7 @@ FIGURES: dict[str, dict] = {
     },
     "fig7": {
         "title": "Fig. 7: influence of the time step (θ-method)",
+        "panels": ("tip_displacement", "tip_temperature", "phase_impulse", "contact_force"),
         "runs": [
             (Run("h = 1e-5 s", h=1e-5), _S["solid"]),
             (Run("h = 1e-4 s", h=1e-4), _S["dotted"]),
@@ -147,7 +166,7 @@ def run_case(run: Run, t_end: float = T_END, *, progress: bool = False):
     """Build the model of ``run`` and integrate it to ``t_end``; return ``(results, model)``."""
     if run.model not in MODELS:
         raise ValueError(f"unknown model {run.model!r}; available: {', '.join(MODELS)}")
-    model = MODELS[run.model](run.alpha, run.coupled)
+    model = MODELS[run.model](run.alpha, run.coupled, run.basis)
     opts = {"activation": run.activation} if run.scheme == "theta" else {}
     stepper = make_stepper(run.scheme, model, run.h, **opts)
     t0 = time.perf_counter()
@@ -187,6 +206,7 @@ def summarise(figure: str, run: Run, res, model) -> dict:
         "scheme": run.scheme,
         "activation": run.activation if run.scheme == "theta" else None,
         "model": run.model,
+        "basis": None if run.model == "full" else run.basis,
         "h": run.h,
         "alpha": run.alpha,
         "coupled": run.coupled,
@@ -283,14 +303,14 @@ def _figures(out, names, t_end, progress, log, rows, started) -> None:
     cache: dict[tuple, tuple] = {}
     for fig in names:
         spec = FIGURES[fig]
-        drawn = []
+        drawn, named = [], []
         for run, style in spec["runs"]:
             if run.key() not in cache:
                 res, model = run_case(run, t_end, progress=progress)
                 if res.status == "interrupted":  # the run caught the signal: stop here too
                     raise KeyboardInterrupt(f"interrupted during {fig} / {run.label}")
                 cache[run.key()] = (res, model)
-                stem = "_".join(str(k) for k in run.key()).replace(" ", "")
+                stem = "_".join(str(k) for k in run.key() if k is not None).replace(" ", "")
                 res.save_csv(out / "runs" / f"{stem}.csv")
                 res.save_npz(out / "runs" / f"{stem}.npz")
                 log(
@@ -300,8 +320,12 @@ def _figures(out, names, t_end, progress, log, rows, started) -> None:
             res, model = cache[run.key()]
             rows.append(summarise(fig, run, res, model))
             drawn.append((run.label, res, style))
+            named.append(
+                (run.label if run.model == "full" else f"{run.label}, {run.basis}", res, style)
+            )
             _write_summary(out, rows, started)
         if spec.get("plot", True):
+            cols = spec.get("columns")
             f = tip_panels(
                 drawn,
                 title=spec["title"],
@@ -309,13 +333,16 @@ def _figures(out, names, t_end, progress, log, rows, started) -> None:
                 tlim=spec.get("tlim"),
                 time_unit=spec.get("time_unit", "s"),
                 gap=PAPER.gap,
+                merge=0.25 * 2.0 * math.pi / PAPER.force_frequency,
+                log_panels=spec.get("log_panels", ()),
+                columns=cols and [(t, [drawn[i] for i in idx]) for t, idx in cols],
             )
             savefig(f, out / f"{fig}.png")
-            _figure_csv(out / f"{fig}.csv", drawn)
+            _figure_csv(out / f"{fig}.csv", named)
         if fig == "fig5":  # energy balances of the two schemes at the same step
             for run, _ in spec["runs"][:2]:
                 res = cache[run.key()][0]
-                title = f"Energy balance: {run.label} (residual {res.energy_error():.1e})"
+                title = f"Energy balance: {run.label}"
                 savefig(energy_panel(res, title=title), out / f"energy_{run.scheme}.png")
 
 

@@ -107,7 +107,7 @@ def _stiffness_bases(basis_u: Basis, basis_t: Basis) -> tuple[Basis, Basis]:
     p_u = int(getattr(basis_u.elem, "maxdeg", 1))
     p_t = int(getattr(basis_t.elem, "maxdeg", 1))
     order = max(2 * (p_u - 1), p_t + p_u - 1, 1)
-    bu = Basis(basis_u.mesh, basis_u.elem, intorder=order)
+    bu = Basis(basis_u.mesh, basis_u.elem, mapping=basis_u.mapping, intorder=order)
     return bu, bu.with_element(basis_t.elem)
 
 

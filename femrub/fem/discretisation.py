@@ -65,13 +65,34 @@ class Discretisation:
         return bf[np.all(np.isin(mesh.facets[:, bf], self.blade.require(name)), axis=0)]
 
 
+def curved_mapping(blade, order: int):
+    """Isoparametric P2 mapping of a mesh read with quadratic geometry, else ``None``.
+
+    Readers of quadratic elements (C3D10, C3D15, C3D20) keep, in
+    ``blade.info["edge_midpoints"]``, the curved position of every tetrahedral edge's
+    midpoint (in ``mesh.edges`` order); with quadratic displacement the cells are then
+    curved P2 tetrahedra (``skfem.MeshTet2``), with linear displacement they stay straight.
+    """
+    mid = getattr(blade, "info", {}).get("edge_midpoints")
+    if order != 2 or mid is None or blade.dim != 3:
+        return None
+    mesh = blade.mesh
+    return fem.MeshTet2(np.hstack([mesh.p, mid]), mesh.t)._mapping()
+
+
 def discretise(blade, order: int = 2, *, clamped: bool = True) -> Discretisation:
-    """Bases of ``blade`` with displacement ``order`` (1 or 2; the bar is linear)."""
+    """Bases of ``blade`` with displacement ``order`` (1 or 2; the bar is linear).
+
+    Quadratic geometry read from the mesh file is kept for ``order = 2``
+    (:func:`curved_mapping`).
+    """
     dim = blade.dim
     if (dim, order) not in _ELEMENTS:
         allowed = sorted(o for d, o in _ELEMENTS if d == dim)
         raise ValueError(f"displacement order {order!r} on a {dim}D mesh: use one of {allowed}")
-    basis_u = fem.Basis(blade.mesh, fem.ElementVector(_ELEMENTS[dim, order]()))
+    basis_u = fem.Basis(
+        blade.mesh, fem.ElementVector(_ELEMENTS[dim, order]()), mapping=curved_mapping(blade, order)
+    )
     basis_t = basis_u.with_element(_ELEMENTS[dim, 1]())  # same quadrature as basis_u
     empty = np.zeros(0, dtype=int)
     disc = Discretisation(blade, basis_u, basis_t, empty, empty, order)

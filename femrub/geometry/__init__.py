@@ -9,24 +9,28 @@ Builders: :func:`box_blade`, :func:`naca_blade`, :func:`sections_blade`,
 :func:`read_gmsh`, :func:`read_meshio`, :func:`read_rotor37_mesh`.
 """
 
-from .abaqus_reader import read_abaqus
-from .blade_mesh import BladeMesh
-from .box_blade import box_blade
-from .errors import GeometryError
-from .gmsh_reader import read_gmsh
-from .loft import loft_blade
-from .mesh_size import MeshSize
-from .meshio_reader import read_meshio
-from .naca_blade import naca_blade, naca_sections
-from .readers import read_mesh
-from .rotor37 import (
-    ROTOR37_CONTACT_NODES,
-    read_rotor37_mesh,
-    rotor37_sections_blade,
-    shared_data_dir,
-)
-from .section_blade import sections_blade
-from .units import length_scale
+from importlib import import_module as _import
+
+# imported on first use (PEP 562): `femrub --help` stays fast
+_LAZY = {
+    "read_abaqus": ".abaqus_reader",
+    "BladeMesh": ".blade_mesh",
+    "box_blade": ".box_blade",
+    "GeometryError": ".errors",
+    "read_gmsh": ".gmsh_reader",
+    "loft_blade": ".loft",
+    "MeshSize": ".mesh_size",
+    "read_meshio": ".meshio_reader",
+    "naca_blade": ".naca_blade",
+    "naca_sections": ".naca_blade",
+    "read_mesh": ".readers",
+    "ROTOR37_CONTACT_NODES": ".rotor37",
+    "read_rotor37_mesh": ".rotor37",
+    "rotor37_sections_blade": ".rotor37",
+    "shared_data_dir": ".rotor37",
+    "sections_blade": ".section_blade",
+    "length_scale": ".units",
+}
 
 __all__ = [
     "ROTOR37_CONTACT_NODES",
@@ -47,3 +51,15 @@ __all__ = [
     "sections_blade",
     "shared_data_dir",
 ]
+
+
+def __getattr__(name):
+    if name not in _LAZY:
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    value = getattr(_import(_LAZY[name], __name__), name)
+    globals()[name] = value
+    return value
+
+
+def __dir__():
+    return sorted(set(globals()) | set(__all__))

@@ -19,6 +19,14 @@ SOLID_TYPES = {
     8: ("hexahedron", 8), 20: ("hexahedron", 8),
 }  # fmt: skip
 _TYPE_RE = re.compile(r"^C3D(\d+)[A-Z]*$")
+#: material keywords read, and the quantities of their first data line (Abaqus order)
+_MATERIAL_KEYS = {
+    "ELASTIC": ("young", "poisson"),
+    "DENSITY": ("density",),
+    "EXPANSION": ("expansion",),
+    "CONDUCTIVITY": ("conductivity",),
+    "SPECIFIC HEAT": ("specific_heat",),
+}
 _SUPPORTED = "C3D4, C3D10, C3D6, C3D15, C3D8, C3D20 (suffixes such as R, H, M allowed)"
 
 
@@ -42,6 +50,11 @@ class AbaqusModel:
     elsets: dict[str, list[int]] = field(default_factory=dict)
     boundary: list[int] = field(default_factory=list)
     files: list[str] = field(default_factory=list)
+    #: ``*MATERIAL`` blocks by name: ``{"young", "poisson", "density", "expansion",
+    #: "conductivity", "specific_heat"}`` in the deck's units (first temperature row)
+    materials: dict[str, dict[str, float]] = field(default_factory=dict)
+    #: ``*SOLID SECTION``: ELSET name -> MATERIAL name
+    sections: dict[str, str] = field(default_factory=dict)
 
     def find_set(self, sets: dict[str, list[int]], name: str) -> list[int] | None:
         """Case-insensitive set lookup (Abaqus names are case-insensitive)."""
@@ -123,7 +136,11 @@ class _Parser:
                 data.append(line)
 
     def _block(self, keyword, params, data, where, path, depth) -> None:
-        if keyword == "INCLUDE":
+        if keyword in _MATERIAL_KEYS or keyword == "MATERIAL":
+            self._material(keyword, params, data, where)
+        elif keyword == "SOLID SECTION":
+            self.model.sections[params.get("ELSET", "")] = params.get("MATERIAL", "")
+        elif keyword == "INCLUDE":
             name = params.get("INPUT", "").strip("'\"")
             if not name:
                 raise GeometryError(f"*INCLUDE without INPUT= at {where}.")
@@ -152,6 +169,27 @@ class _Parser:
                             f"*BOUNDARY at {where} uses undefined node set {first!r}."
                         ) from None
                     self.model.boundary.extend(members)
+
+    def _material(self, keyword, params, data, where) -> None:
+        if keyword == "MATERIAL":
+            self._mat = params.get("NAME", "")
+            self.model.materials[self._mat] = {}
+            return
+        if getattr(self, "_mat", None) is None:
+            raise GeometryError(f"*{keyword} at {where} outside a *MATERIAL block.")
+        try:
+            first = [float(v) for v in data[0].split(",") if v.strip()] if data else []
+        except ValueError as exc:
+            raise GeometryError(f"Malformed *{keyword} data at {where}: {exc}.") from exc
+        names = _MATERIAL_KEYS[keyword]
+        if keyword == "ELASTIC" and params.get("TYPE", "ISOTROPIC")[:3] != "ISO":
+            raise GeometryError(
+                f"*ELASTIC, TYPE={params['TYPE']} at {where}: only isotropic elasticity is read;"
+                " give material.young and material.poisson in the scene instead."
+            )
+        if len(first) < len(names):
+            raise GeometryError(f"*{keyword} at {where} needs {len(names)} value(s), got {first}.")
+        self.model.materials[self._mat].update(zip(names, first))
 
     def _nodes(self, params, data, where) -> None:
         try:
@@ -203,8 +241,11 @@ def parse_abaqus(path: str | Path) -> AbaqusModel:
 
     Supports ``*NODE`` (with ``NSET=``), ``*ELEMENT`` (``TYPE=``, ``ELSET=``;
     continuation lines), ``*NSET``/``*ELSET`` (with ``GENERATE`` or set names),
-    ``*BOUNDARY`` (node numbers or node-set names) and ``*INCLUDE`` (relative to
-    the including file). Other keywords are skipped. Comments start with ``**``.
+    ``*BOUNDARY`` (node numbers or node-set names), ``*INCLUDE`` (relative to
+    the including file), ``*MATERIAL`` with ``*ELASTIC`` (isotropic), ``*DENSITY``,
+    ``*EXPANSION``, ``*CONDUCTIVITY``, ``*SPECIFIC HEAT`` (first line: values at the first
+    temperature) and ``*SOLID SECTION`` (ELSET -> MATERIAL). Other keywords are skipped.
+    Comments start with ``**``.
 
     Parameters
     ----------

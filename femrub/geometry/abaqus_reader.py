@@ -17,7 +17,17 @@ from .tet_ops import compact_vertices, orient_positive
 from .tip_detection import detect_tip
 from .units import length_scale
 
-__all__ = ["MIDSIDE_EDGES", "read_abaqus"]
+__all__ = ["MATERIAL_SI", "MIDSIDE_EDGES", "deck_material", "edge_midpoints", "read_abaqus"]
+
+#: Factors to SI of the material constants of a deck in a consistent unit system chosen by
+#: its length unit: m -> N-m-kg-s, mm -> N-mm-t-s (MPa, t/mm^3, mJ/(t K) = 1e-6 J/(kg K),
+#: mW/(mm K) = W/(m K)). A cm deck has no standard consistent system: its material is not read.
+MATERIAL_SI = {
+    "m": {"young": 1.0, "poisson": 1.0, "density": 1.0, "expansion": 1.0,
+          "conductivity": 1.0, "specific_heat": 1.0},
+    "mm": {"young": 1e6, "poisson": 1.0, "density": 1e12, "expansion": 1.0,
+           "conductivity": 1.0, "specific_heat": 1e-6},
+}  # fmt: skip
 
 #: Corner pair (0-based) of every mid-side node, per element node count (Abaqus order).
 MIDSIDE_EDGES = {
@@ -87,6 +97,28 @@ def _contact_edges(model, table, old_to_new, contact_cols, vertex) -> np.ndarray
     return edge
 
 
+def deck_material(model: AbaqusModel, length_unit: str, elset: str | None = None) -> dict:
+    """Material of the deck's solid section in SI (keys of :data:`MATERIAL_SI`), or ``{}``.
+
+    The section of ``elset`` if given, else the only ``*SOLID SECTION`` (or the only
+    ``*MATERIAL``). Several materials without a way to choose, or a ``cm`` deck: ``{}``.
+    """
+    factors = MATERIAL_SI.get(str(length_unit).strip().lower())
+    if factors is None or not model.materials:
+        return {}
+    name = None
+    if elset is not None:
+        name = next((m for e, m in model.sections.items() if e.upper() == elset.upper()), None)
+    if name is None and len(set(model.sections.values())) == 1:
+        name = next(iter(model.sections.values()))
+    if name is None and len(model.materials) == 1:
+        name = next(iter(model.materials))
+    mat = next((v for k, v in model.materials.items() if k.upper() == str(name).upper()), None)
+    if not mat:
+        return {}
+    return {k: v * factors[k] for k, v in mat.items()}
+
+
 def read_abaqus(
     path: str | Path,
     length_unit: str,
@@ -130,7 +162,8 @@ def read_abaqus(
     -------
     BladeMesh
         Node sets ``root``, ``tip``, every NSET (restricted to vertices) and
-        ``contact`` when all contact nodes are vertices.
+        ``contact`` when all contact nodes are vertices; ``info["material"]``: the deck's
+        ``*MATERIAL`` in SI (:func:`deck_material`).
 
     Raises
     ------
@@ -204,6 +237,9 @@ def read_abaqus(
     }
 
     mesh = skfem.MeshTet1(np.ascontiguousarray(p), np.ascontiguousarray(t))
+    curved = None
+    if any(b.nodes.shape[0] in MIDSIDE_EDGES for b in model.blocks):
+        curved = edge_midpoints(model, table, old_to_new, points, p, mesh.edges)
     return BladeMesh(
         mesh=mesh,
         node_sets=node_sets,
@@ -217,6 +253,66 @@ def read_abaqus(
             "n_source_nodes": int(model.node_ids.size),
             "files": model.files,
             "contact_map": contact_map,
+            "material": deck_material(model, length_unit, elset),
+            "edge_midpoints": curved,
             "read_time_s": time.perf_counter() - start,
         },
     )
+
+
+#: Quadrilateral faces (corner cycles, Abaqus order) of the quadratic solids.
+_QUADS = {
+    15: [(0, 1, 4, 3), (1, 2, 5, 4), (2, 0, 3, 5)],
+    20: [(0, 1, 2, 3), (4, 5, 6, 7), (0, 1, 5, 4), (1, 2, 6, 5), (2, 3, 7, 6), (3, 0, 4, 7)],
+}
+
+
+def edge_midpoints(model: AbaqusModel, table, old_to_new, points, p, edges) -> np.ndarray:
+    """Curved positions of the midpoints of the tetrahedral ``edges`` (quadratic geometry).
+
+    An edge of a quadratic source element takes its mid-side node; a diagonal of a
+    quadrilateral face (wedge or hexahedron split) takes the face centre of the 8-node
+    serendipity face, ``−¼ Σ corners + ½ Σ mid-side nodes``; a hexahedron's interior
+    diagonal its centre, ``−¼ Σ corners + ¼ Σ mid-side nodes``; every other edge (linear
+    elements) its straight midpoint. ``edges`` (2, n_e) are vertex pairs of ``p`` as in
+    ``skfem.MeshTet1.edges``.
+    """
+    nv = p.shape[1]
+    lo, hi = np.minimum(*edges), np.maximum(*edges)
+    keys = lo * nv + hi
+    order = np.argsort(keys)
+    mid = 0.5 * (p[:, edges[0]] + p[:, edges[1]])
+    set_keys, set_pos = [], []
+
+    def put(va, vb, pos):
+        set_keys.append(np.minimum(va, vb) * nv + np.maximum(va, vb))
+        set_pos.append(pos)
+
+    for block in model.blocks:
+        n = block.nodes.shape[0]
+        if n not in MIDSIDE_EDGES:
+            continue
+        n_corner = SOLID_TYPES[n][1]
+        corner = old_to_new[table[block.nodes[:n_corner]]]
+        xc = points[:, table[block.nodes[:n_corner]]]  # (3, n_corner, n_el)
+        xm = points[:, table[block.nodes[n_corner:]]]
+        index = {frozenset(e): k for k, e in enumerate(MIDSIDE_EDGES[n])}
+        for k, (a, b) in enumerate(MIDSIDE_EDGES[n]):
+            put(corner[a], corner[b], xm[:, k])
+        for quad in _QUADS.get(n, []):
+            sides = [index[frozenset((quad[i], quad[(i + 1) % 4]))] for i in range(4)]
+            centre = -0.25 * xc[:, list(quad)].sum(axis=1) + 0.5 * xm[:, sides].sum(axis=1)
+            put(corner[quad[0]], corner[quad[2]], centre)
+            put(corner[quad[1]], corner[quad[3]], centre)
+        if n == 20:
+            centre = -0.25 * xc.sum(axis=1) + 0.25 * xm.sum(axis=1)
+            for a, b in ((0, 6), (1, 7), (2, 4), (3, 5)):
+                put(corner[a], corner[b], centre)
+    if set_keys:
+        k = np.concatenate(set_keys)
+        pos = np.hstack(set_pos)
+        at = np.searchsorted(keys, k, sorter=order)
+        at = np.clip(at, 0, keys.size - 1)
+        found = keys[order[at]] == k
+        mid[:, order[at[found]]] = pos[:, found]
+    return mid

@@ -36,6 +36,10 @@ def _common(p: argparse.ArgumentParser, sizes: bool = True) -> None:
         p.add_argument(
             "--n-contact", type=int, default=None, help="number of contact nodes on the tip"
         )
+        p.add_argument(
+            "--contact-margin", type=float, default=None,
+            help="chord fraction kept free of contact nodes at each edge (default 0.05)",
+        )  # fmt: skip
 
 
 def _fill(parser: argparse.ArgumentParser) -> argparse.ArgumentParser:
@@ -45,6 +49,9 @@ def _fill(parser: argparse.ArgumentParser) -> argparse.ArgumentParser:
     box.add_argument("--span", type=float, default=0.1, help="span [m] (default 0.1)")
     box.add_argument("--chord", type=float, default=0.03, help="chord [m] (default 0.03)")
     box.add_argument("--thickness", type=float, default=0.003, help="thickness [m] (default 0.003)")
+    box.add_argument(
+        "--hub-radius", type=float, default=0.0, help="radius of the root face [m] (default 0)"
+    )
     _common(box)
     naca = kinds.add_parser("naca", help="twisted, tapered NACA 4-digit blade")
     naca.add_argument("--code", default="0012", help="NACA 4-digit code (default 0012)")
@@ -57,6 +64,17 @@ def _fill(parser: argparse.ArgumentParser) -> argparse.ArgumentParser:
     )
     naca.add_argument("--twist", type=float, default=20.0, help="tip twist [deg] (default 20)")
     naca.add_argument("--n-sections", type=int, default=5, help="lofted sections (default 5)")
+    naca.add_argument(
+        "--hub-radius", type=float, default=0.0,
+        help="radius of the root section from the machine axis (x) [m] (default 0)",
+    )  # fmt: skip
+    naca.add_argument(
+        "--stacking", type=float, default=0.25,
+        help="chord fraction of the twist axis (default 0.25)",
+    )  # fmt: skip
+    naca.add_argument(
+        "--n-points", type=int, default=40, help="points per section side (default 40)"
+    )
     _common(naca)
     sec = kinds.add_parser("sections", help="blade lofted through section files (x,y,z rows)")
     sec.add_argument("files", nargs="+", help="section files hub to tip, or one folder")
@@ -105,8 +123,9 @@ def add_mesh_parser(subparsers) -> argparse.ArgumentParser:
 
 def _sizes(args) -> dict:
     out = {"h": args.h, "h_min": args.h_min}
-    if args.n_contact is not None:
-        out["n_contact"] = args.n_contact
+    for key in ("n_contact", "contact_margin"):
+        if getattr(args, key, None) is not None:
+            out[key] = getattr(args, key)
     return out
 
 
@@ -145,11 +164,13 @@ def run_mesh(args: argparse.Namespace) -> int:
     try:
         if args.mesh_kind == "box":
             blade = box_blade(
-                args.span, args.chord, args.thickness, verbose=args.verbose, **_sizes(args)
-            )
+                args.span, args.chord, args.thickness, hub_radius=args.hub_radius,
+                verbose=args.verbose, **_sizes(args),
+            )  # fmt: skip
         elif args.mesh_kind == "naca":
             blade = naca_blade(
                 args.code, args.span, args.root_chord, args.tip_chord, args.twist, args.n_sections,
+                hub_radius=args.hub_radius, stacking=args.stacking, n_points=args.n_points,
                 verbose=args.verbose, **_sizes(args),
             )  # fmt: skip
         elif args.mesh_kind == "sections":

@@ -65,7 +65,7 @@ def tip_load(disc: Discretisation, mats, force, signal) -> Load:
     facets = disc.facets_of("tip")
     if facets.size == 0:
         raise ValueError(f"the 'tip' node set of {disc.blade.source} covers no boundary face")
-    fb = fem.FacetBasis(disc.mesh, disc.basis_u.elem, facets=facets)
+    fb = fem.FacetBasis(disc.mesh, disc.basis_u.elem, mapping=disc.basis_u.mapping, facets=facets)
     area = float(fem.Functional(lambda w: 1.0 + 0.0 * w.x[0]).assemble(fb))
     traction = np.asarray(force, dtype=float).reshape(disc.dim) / area
 

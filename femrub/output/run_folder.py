@@ -18,6 +18,7 @@ or diverged-physically) or an unreadable summary is not overwritten unless
 from __future__ import annotations
 
 import platform
+import sys
 import time
 from contextlib import nullcontext
 from pathlib import Path
@@ -35,6 +36,20 @@ __all__ = ["STAGES", "run_to_folder", "ResultExists"]
 
 #: Pipeline stages timed in ``summary.json["timings"]`` (seconds).
 STAGES = ("mesh", "assembly", "reduction", "stepping", "output")
+
+
+#: what each curve of signals.png is, for several contact points
+SIGNAL_TITLES = {
+    "tip_displacement": "mean normal displacement of the contact points",
+    "tip_temperature": "mean temperature rise of the contact points "
+    "(summary: signals_max_abs.tip_temperature)",
+    "contact_force": "sum over the contact points of impulse / h "
+    "(summary: max_total_contact_force; one point: max_contact_force)",
+}
+
+
+def _max_or_none(arr) -> float | None:
+    return float(np.max(arr)) if arr is not None and np.size(arr) else None
 
 
 def run_to_folder(
@@ -139,6 +154,7 @@ def _finish(
                 [(stepper.name, res, {})],
                 panels=(*panels, "contact_force"),
                 title=f"{stepper.name}, h = {stepper.h:g} s: {res.status}",
+                titles=SIGNAL_TITLES if stepper.model.n_contacts > 1 else None,
             ),
             out / "signals.png",
         )
@@ -149,6 +165,11 @@ def _finish(
             snapshot_png(series.dir / series.frames[-1][1], out / "snapshot.png")
         except Exception as exc:  # rendering is optional (no OpenGL on the machine)
             doc["snapshot_error"] = f"{type(exc).__name__}: {exc}"
+            print(
+                f"femrub: snapshot.png not written ({doc['snapshot_error']}); "
+                f"open {series.pvd_path} in ParaView instead",
+                file=sys.stderr,
+            )
     e = res.energy
     stepping_cpu = max(res.cpu_seconds - vtk_cpu, 0.0)
     omega = float(rotation_speed)
@@ -167,6 +188,8 @@ def _finish(
         timings=res.info["timings"],
         first_contact_time=res.first_contact_time(),
         max_contact_force=float(res.force.max()) if res.force.size else 0.0,
+        max_total_contact_force=float(res.force.sum(axis=1).max()) if res.force.size else 0.0,
+        max_contact_temperature=_max_or_none(res.signals.get("contact_temperature")),
         energy_error=res.energy_error(),
         heat_error=res.heat_error(),
         warnings=list(res.warnings),

@@ -174,9 +174,14 @@ def snapshot_png(vtu_path, png_path, *, scalars: str = "temperature", warp: floa
     """PNG of one ``.vtu`` frame coloured by ``scalars`` on the deformed blade (off-screen).
 
     ``warp`` scales the displacement (default: so that the largest displacement is 5 % of the
-    blade size).
+    blade size). Renders without a display (VTK falls back to EGL/OSMesa); VTK's console
+    warnings (e.g. "bad X server connection") are silenced, errors are raised.
     """
     import pyvista as pv
+    import vtk
+
+    vtk.vtkLogger.SetStderrVerbosity(vtk.vtkLogger.VERBOSITY_OFF)
+    vtk.vtkObject.GlobalWarningDisplayOff()
 
     grid = pv.read(str(vtu_path))
     disp = np.asarray(grid.point_data["displacement"])

@@ -42,6 +42,8 @@ class Scene:
     data: dict
     source: str = "<scene>"
     base_dir: Path = field(default_factory=Path.cwd)
+    #: dotted ``section.key`` names the scene file or a change set (the others are defaults)
+    given: frozenset = frozenset()
 
     def __eq__(self, other) -> bool:
         return isinstance(other, Scene) and self.data == other.data
@@ -85,7 +87,8 @@ class Scene:
                 for k in [k for k in node if k not in allowed and k != "_"]:
                     del node[k]
         _strip_marks(data)
-        return Scene(normalize(data), self.source, self.base_dir)
+        given = self.given | {resolve_key(k) for k in changes}
+        return Scene(normalize(data), self.source, self.base_dir, given)
 
     def dumps(self) -> str:
         """TOML text of the normalised scene (SI units, every default written)."""
@@ -124,7 +127,10 @@ def loads_scene(text: str, source: str = "<string>", base_dir=None) -> Scene:
         raise SceneError(
             f"{source}: tables nested too deeply (a scene needs at most 3 levels)"
         ) from None
-    return Scene(data, source, Path(base_dir) if base_dir else Path.cwd())
+    given = frozenset(
+        f"{sec}.{key}" for sec, tbl in doc.items() if isinstance(tbl, dict) for key in tbl
+    )
+    return Scene(data, source, Path(base_dir) if base_dir else Path.cwd(), given)
 
 
 def _builtin_dir():

@@ -7,6 +7,7 @@ documents the same table; :func:`schema_rows` lists it for the docs and the test
 
 from __future__ import annotations
 
+from ..contact.activation import DEFAULT_RULE, RULES
 from .spec import REQUIRED, Spec, Variant
 
 __all__ = ["SCHEMA", "SIGNALS", "TOP", "schema_rows"]
@@ -266,7 +267,9 @@ SCHEME = Variant(
                 lo=0.5,
                 hi=1.0,
             ),
-            "activation": Spec(C, "paper", choices=("paper", "predicted"), doc="contact rule"),
+            "activation": Spec(
+                C, DEFAULT_RULE, choices=RULES, doc="contact rule (femrub.contact.activation)"
+            ),
         },
         "carpenter": {},
         "penalty": {

@@ -15,25 +15,10 @@ impact law in velocity form (Eqs. 21–23), an LCP::
 
     0 <= P  ⊥  (ġ_{k+1} + e ġ_k) / (1 + e) >= 0
 
-which for one contact is the paper's prox formula (Eq. 25b). Newton's law applies to
-approaching contacts (``ġ_k <= 0``). A contact still closed but already separating at
-``t_k`` (``ġ_k > 0``) that the free motion pulls back during the step is held by the
-midpoint condition ``(ġ_{k+1} + ġ_k) / 2 >= 0`` (``e = 1`` for that step): with Newton's law
-there, the step's contact work ``P (1 − e) ġ_k / 2`` would be positive and energy would be
-created. With this choice the contact work of every step is ``<= 0`` (see
-:mod:`femrub.output.energy`). Active contacts:
-
-* ``"paper"``: the gap at ``t_{k+1}`` is closed (``g_{k+1} <= 0``, paper Eq. 25b), iterated
-  to a fixed point with the impulse (the role of the paper's semi-smooth Newton loop); a
-  contact already closed at ``t_k`` stays active (it opens through ``P = 0``). At the step
-  where the tip crosses the casing the fixed point may not exist (closing it leaves the gap
-  slightly open, leaving it open closes it): the contact is then kept active, so the
-  impulse and its heat enter at the crossing step. Taking the free step instead delays the
-  impulse by one step; on the paper case (α = 3 m/s, 0.4 s, reference h = 2e-6 s) that
-  misses the tip temperature at 0.4 s by −33 % at h = 1e-4 s and −71 % at 5e-4 s, against
-  −7 % and +5 % when kept. Residual penetration stays below ``h |ġ|`` (paper Sec. 4.3);
-* ``"predicted"``: Moreau–Jean (Siconos) rule ``g_k + γ h ġ_k <= 0``; on the same case it
-  behaves like the free step (−36 % at 1e-4 s, −71 % at 5e-4 s).
+which for one contact is the paper's prox formula (Eq. 25b). Which contacts take an impulse
+and under which law (Newton's law, capped or not, midpoint law on separating contacts) is
+the activation rule of :mod:`femrub.contact.activation`; the default ``"safe"`` never
+pushes at an open gap and never creates energy.
 
 The heat input ``α P`` enters the same step as the impulse. Penetration is not prevented at
 the position level; it stays below ``h |ġ|`` (paper Sec. 4.3).
@@ -44,13 +29,13 @@ from __future__ import annotations
 import numpy as np
 import scipy.sparse as sp
 
-from ..contact.impulses import solve_impulses
+from ..contact.activation import DEFAULT_RULE, RULES, check_rule, impulse_one, impulses
 from ..fem.linalg import Factorised, compact
 from .base import Stepper
 
 __all__ = ["ThetaMethod", "ACTIVATION_RULES"]
 
-ACTIVATION_RULES = ("paper", "predicted")
+ACTIVATION_RULES = RULES
 
 
 class ThetaMethod(Stepper):
@@ -66,7 +51,7 @@ class ThetaMethod(Stepper):
         conductivity) its stiff thermal modes ring from step to step, and through the
         coupling and the frictional heat this can drive a spurious runaway. 1 (backward
         Euler on the heat rows) damps them while the mechanics stays trapezoidal.
-    activation : ``"paper"`` or ``"predicted"`` (see module docstring).
+    activation : one of :data:`femrub.contact.activation.RULES` (default ``"safe"``).
     """
 
     name = "theta"
@@ -78,7 +63,7 @@ class ThetaMethod(Stepper):
         *,
         gamma: float = 0.5,
         gamma_thermal: float | None = None,
-        activation: str = "paper",
+        activation: str = DEFAULT_RULE,
         t0=0.0,
     ):
         gamma = float(gamma)
@@ -86,10 +71,7 @@ class ThetaMethod(Stepper):
         for name, val in (("gamma", gamma), ("gamma_thermal", gamma_t)):
             if not (0.5 <= val <= 1.0):
                 raise ValueError(f"{name} must be in [0.5, 1] for a stable θ-method, got {val!r}")
-        if activation not in ACTIVATION_RULES:
-            raise ValueError(
-                f"unknown activation rule {activation!r}; use one of {', '.join(ACTIVATION_RULES)}"
-            )
+        check_rule(activation)
         self.gamma, self.gamma_thermal, self.activation = gamma, gamma_t, activation
         super().__init__(model, h, t0=t0)
 
@@ -137,7 +119,8 @@ class ThetaMethod(Stepper):
                 self._w = float((self._Wm + self._Wt * a)[0, 0])
                 self._gv, self._gr = c.GvT[0].copy(), c.GT[0].copy()
                 self._g0, self._e = float(c.gap0[0]), float(c.restitution)
-                if self._w <= 0.0:
+                self._gz = float(self._gr @ self._z)
+                if self._w <= 0.0 or self._gz <= 0.0:
                     raise ValueError("non-positive Delassus operator at the contact")
         self._warm = None
 
@@ -145,21 +128,22 @@ class ThetaMethod(Stepper):
         return np.array([float(sig(t)) for sig in self._signals])
 
     def _step_fast(self, Xk, Xp):
-        """One contact (see ``_setup``): the LCP and the activation fixed point in closed form.
-
-        For one contact the paper rule's fixed point is "active iff closed at t_k or
-        predicted closed at t_{k+1}"; the impulse is the prox of Eq. (25b).
-        """
-        gdk = self._gv @ Xk
-        gap_k = self._g0 + self._gr @ Xk
-        if self.activation == "predicted":
-            active = gap_k + self.gamma * self.h * gdk <= 0.0
-        else:
-            active = gap_k <= 0.0 or self._g0 + self._gr @ Xp <= 0.0
-        if not active:
+        """One contact (see ``_setup``): the impulse in closed form (``impulse_one``)."""
+        g_p = self._g0 + self._gr @ Xp
+        P = impulse_one(
+            self.activation,
+            self._g0 + self._gr @ Xk,
+            self._gv @ Xk,
+            g_p,
+            self._gv @ Xp,
+            self._w,
+            self._gz,
+            self._e,
+            self.h,
+            self.gamma,
+        )
+        if P == 0.0:
             return Xp, np.zeros(1)
-        e = 1.0 if gdk > 0.0 else self._e
-        P = max(0.0, -(self._gv @ Xp + e * gdk) / self._w)
         return Xp + P * self._z, np.array([P])
 
     def _step(self):
@@ -182,32 +166,18 @@ class ThetaMethod(Stepper):
         alpha = c.alpha_at(t1)
         Z = self._Zm + self._Zt * alpha
         W = self._Wm + self._Wt * alpha
-        gdot_k = c.gap_velocity(self.t, Xk)
-        gdot_p = c.gap_velocity(t1, Xp)
-        # Newton's law for approaching contacts; midpoint law (e = 1) for separating ones
-        e = np.where(gdot_k > 0.0, 1.0, c.restitution)
-        q = (gdot_p + e * gdot_k) / (1.0 + e)
-        Wn = W / (1.0 + e)[:, None]
-        gap_k = c.gap(self.t, Xk)
-        if self.activation == "predicted":
-            active = gap_k + g * h * gdot_k <= 0.0
-            P = solve_impulses(Wn, q, active, self._warm)
-        else:
-            gap_p = c.gap(t1, Xp)
-            GZ = c.GT @ Z
-            closed = gap_k <= 0.0
-            active = closed | (gap_p <= 0.0)
-            seen = []
-            while True:
-                P = solve_impulses(Wn, q, active, self._warm)
-                new = closed | (gap_p + GZ @ P <= 0.0)
-                if np.array_equal(new, active):
-                    break
-                if any(np.array_equal(new, a) for a in seen):  # no consistent set: keep impulse
-                    active = new | active
-                    P = solve_impulses(Wn, q, active, self._warm)
-                    break
-                seen.append(active)
-                active = new
+        P = impulses(
+            self.activation,
+            c.gap(self.t, Xk),
+            c.gap_velocity(self.t, Xk),
+            c.gap(t1, Xp),
+            c.gap_velocity(t1, Xp),
+            W,
+            c.GT @ Z,
+            np.broadcast_to(np.asarray(c.restitution, dtype=float), (c.n,)),
+            h,
+            g,
+            self._warm,
+        )
         self._warm = P > 0.0
         return Xp + Z @ P, P

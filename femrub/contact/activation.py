@@ -1,0 +1,166 @@
+"""Activation rules: which contacts take an impulse in a step, and under which law.
+
+A step of an implicit scheme (θ-method, exponential integrator) from ``t_k`` to
+``t_{k+1} = t_k + h`` gives ``X_{k+1} = X_p + Z P`` with the free prediction ``X_p`` and the
+impulse ``P >= 0`` (paper Eq. 16a, ``P = h λ_{k+1}``). The gap and the gap velocity are then
+affine in ``P``::
+
+    g_{k+1} = g_p + GZ P          ġ_{k+1} = ġ_p + W P
+
+(``GZ = Gᵀ Z``, Delassus operator ``W = Gvᵀ Z``). A rule turns ``(g_k, ġ_k, g_p, ġ_p)``
+into the impulse. With the trapezoidal rule ``g_{k+1} − g_k = h (ġ_k + ġ_{k+1}) / 2``, so
+the contact work of a step (:mod:`femrub.output.energy`) is::
+
+    ΔW_c = Pᵀ (ġ_k + ġ_{k+1}) / 2 = Pᵀ (g_{k+1} − g_k) / h
+
+Rules (``RULES``). Each keeps ``P > 0`` only where the step's contact work is ``<= 0``,
+except ``"plain"``:
+
+* ``"position"`` (default): Signorini's condition at ``t_{k+1}``, relative to a target gap::
+
+      0 <= P  ⊥  g_{k+1} − g*  >= 0,        g* = min(g_k, 0) + e max(g_k, 0)
+
+  An open contact whose free step crosses the casing lands on it (``g_{k+1} = 0`` for
+  ``e = 0``; at ``e g_k`` for ``e > 0``, which for ``e = 1`` is Newton's elastic law); a
+  closed contact is held where it is (``g_{k+1} = g_k``, the midpoint law). An open
+  contact takes an impulse only when its free step ends inside the casing (``g_p < 0``). ``P > 0``
+  implies ``g_{k+1} <= g_k``, so ``ΔW_c <= 0``, and ``g_{k+1} <= e max(g_k, 0)``: for
+  ``e = 0`` no impulse ever acts at an open gap. Residual penetration comes only from the
+  crossing step and round-off. It needs no activation set.
+* ``"capped"``: Newton's law in velocity form, capped at the same target::
+
+      0 <= P  ⊥  max(ġ_{k+1} + e ġ_k,  (2/h) (g_{k+1} − g*)) >= 0
+
+  (approaching closed contacts stop, ``ġ_{k+1} = −e ġ_k``; penetration up to ``h |ġ| / 2``).
+* ``"paper"``: active if closed at ``t_k`` or closed at ``t_{k+1}`` (``g_{k+1} <= 0``,
+  paper Eq. 25b) iterated to a fixed point with the impulse; if no consistent set exists
+  the contact is kept active. Newton's law on approaching contacts, ``e = 1`` on separating
+  ones. At the crossing step it may stop the tip short of the casing (force at a distance).
+* ``"plain"``: active if the free step's gap at ``t_{k+1}`` is closed (``g_p <= 0``),
+  Newton's law on the velocity everywhere. Not energy-safe: stopping a separating contact
+  lifts the gap (``ΔW_c = P (1 − e) ġ_k / 2 > 0``), and it may push at an open gap.
+* ``"predicted"``: Moreau–Jean (Siconos) rule ``g_k + γ h ġ_k <= 0``, ``e = 1`` on
+  separating contacts.
+
+Measured accuracy of each on the paper case: ``docs/paper-reproduction.md``.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .impulses import solve_impulses
+
+__all__ = ["RULES", "DEFAULT_RULE", "check_rule", "impulse_one", "impulses"]
+
+RULES = ("position", "capped", "paper", "plain", "predicted")
+DEFAULT_RULE = "position"
+
+
+def check_rule(rule: str) -> str:
+    """Return ``rule`` or raise a one-line error naming the valid rules."""
+    if rule not in RULES:
+        raise ValueError(f"unknown activation rule {rule!r}; use one of {', '.join(RULES)}")
+    return rule
+
+
+def impulse_one(rule, g_k, gd_k, g_p, gd_p, w, gz, e, h, gamma) -> float:
+    """Impulse of a single contact (scalar closed form of :func:`impulses`).
+
+    ``w = ∂ġ_{k+1}/∂P > 0`` and ``gz = ∂g_{k+1}/∂P > 0``.
+    """
+    if rule in ("capped", "position"):
+        if g_k > 0.0 and g_p >= 0.0:  # open, and the free step does not reach the casing
+            return 0.0
+        p_cap = (_target(g_k, e) - g_p) / gz
+        if rule == "position":
+            return max(0.0, p_cap)
+        return max(0.0, min(-(gd_p + e * gd_k) / w, p_cap))
+    if rule == "plain":
+        return max(0.0, -(gd_p + e * gd_k) / w) if g_p <= 0.0 else 0.0
+    if rule == "predicted":
+        active = g_k + gamma * h * gd_k <= 0.0
+    else:  # paper: the fixed point for one contact is "closed at t_k or predicted closed"
+        active = g_k <= 0.0 or g_p <= 0.0
+    if not active:
+        return 0.0
+    e = 1.0 if gd_k > 0.0 else e
+    return max(0.0, -(gd_p + e * gd_k) / w)
+
+
+def impulses(rule, g_k, gd_k, g_p, gd_p, W, GZ, e, h, gamma, warm=None) -> np.ndarray:
+    """Impulses of all contacts for one step under ``rule`` (see module docstring).
+
+    Parameters
+    ----------
+    g_k, gd_k : gap and gap velocity at ``t_k``, shape ``(n_c,)``.
+    g_p, gd_p : gap and gap velocity of the free step at ``t_{k+1}``.
+    W, GZ : ``∂ġ_{k+1}/∂P`` and ``∂g_{k+1}/∂P``, shape ``(n_c, n_c)``.
+    e : restitution coefficients, ``(n_c,)``.
+    warm : previous step's ``P > 0`` (warm start of the LCP), or ``None``.
+    """
+    if rule == "capped":
+        return _capped(g_k, gd_k, g_p, gd_p, W, GZ, e, h, warm)
+    if rule == "position":
+        q = (2.0 / h) * (g_p - _target(g_k, e))
+        M = (2.0 / h) * GZ
+        closed = g_k <= 0.0
+        active = (q < 0.0) & (closed | (g_p < 0.0))
+        while True:  # add contacts that the others' impulses pull below their target
+            P = solve_impulses(M, q, active, warm)
+            r = M @ P + q
+            low = ~active & (r < -1e-12 * np.abs(q).max()) & (closed | (g_p + GZ @ P < 0.0))
+            if not low.any():
+                return P
+            active |= low
+    if rule == "plain":
+        return solve_impulses(W, gd_p + e * gd_k, g_p <= 0.0, warm)
+    e = np.where(gd_k > 0.0, 1.0, e)  # midpoint law on separating contacts
+    q = (gd_p + e * gd_k) / (1.0 + e)
+    Wn = W / (1.0 + e)[:, None]
+    if rule == "predicted":
+        return solve_impulses(Wn, q, g_k + gamma * h * gd_k <= 0.0, warm)
+    closed = g_k <= 0.0
+    active = closed | (g_p <= 0.0)
+    seen = []
+    while True:
+        P = solve_impulses(Wn, q, active, warm)
+        new = closed | (g_p + GZ @ P <= 0.0)
+        if np.array_equal(new, active):
+            return P
+        if any(np.array_equal(new, a) for a in seen):  # no consistent set: keep impulse
+            return solve_impulses(Wn, q, new | active, warm)
+        seen.append(active)
+        active = new
+
+
+def _capped(g_k, gd_k, g_p, gd_p, W, GZ, e, h, warm):
+    """``0 <= P ⊥ max(r_v, r_g) >= 0`` by switching each contact's binding row.
+
+    ``r_v = W P + ġ_p + e ġ_k`` (Newton) and ``r_g = (2/h)(GZ P + g_p − g*)``
+    (cap, ``g*`` of :func:`_target`). Each row choice is an LCP; a contact with ``P > 0``
+    whose other residual is positive switches rows, until the choice is consistent.
+    """
+    qv = gd_p + e * gd_k
+    qg = (2.0 / h) * (g_p - _target(g_k, e))
+    Wg = (2.0 / h) * GZ
+    # a contact whose free step stays above the cap, or open and off the casing, takes none
+    cand = (qg < 0.0) & ((g_k <= 0.0) | (g_p < 0.0))
+    if not cand.any():
+        return np.zeros(g_k.size)
+    use_g = np.zeros(g_k.size, dtype=bool)
+    for _ in range(2 * g_k.size + 2):
+        M = np.where(use_g[:, None], Wg, W)
+        q = np.where(use_g, qg, qv)
+        P = solve_impulses(M, q, cand, warm)
+        other = np.where(use_g, W @ P + qv, Wg @ P + qg)
+        switch = cand & (P > 0.0) & (other > 1e-10 * np.maximum(np.abs(qv), np.abs(qg)))
+        if not switch.any():
+            return P
+        use_g ^= switch
+    return P
+
+
+def _target(g_k, e):
+    """Highest gap an impulse may lift a contact to: ``g* = min(g_k, 0) + e max(g_k, 0)``."""
+    return np.minimum(g_k, 0.0) + e * np.maximum(g_k, 0.0)
