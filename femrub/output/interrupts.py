@@ -22,21 +22,37 @@ def _main_thread() -> bool:
     return threading.current_thread() is threading.main_thread()
 
 
+_state = {"depth": 0, "fired": False}
+
+
 def _raise_interrupt(signum, frame):
+    if _state["fired"]:  # a second signal while the first one unwinds: already stopping
+        return
+    _state["fired"] = True
     raise KeyboardInterrupt(f"signal {signal.Signals(signum).name}")
 
 
 @contextmanager
 def interruptible():
-    """Within the block, SIGTERM raises ``KeyboardInterrupt`` like SIGINT does."""
+    """Within the block, SIGINT and SIGTERM raise ``KeyboardInterrupt``, once.
+
+    Later signals are held while the first one unwinds (the recorder keeps its rows, the
+    run folder writes its summary), so a double Ctrl-C or SIGTERM followed by Ctrl-C cannot
+    cut that in half; blocks nest and share this state until the outermost one ends.
+    """
     if not _main_thread():
         yield
         return
-    previous = signal.signal(signal.SIGTERM, _raise_interrupt)
+    previous = {s: signal.signal(s, _raise_interrupt) for s in (signal.SIGINT, signal.SIGTERM)}
+    _state["depth"] += 1
     try:
         yield
     finally:
-        signal.signal(signal.SIGTERM, previous)
+        _state["depth"] -= 1
+        for s, handler in previous.items():
+            signal.signal(s, handler)
+        if _state["depth"] == 0:
+            _state["fired"] = False
 
 
 @contextmanager
