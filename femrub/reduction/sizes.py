@@ -84,7 +84,7 @@ def _thermal_errors(C, K, Q, T, ntb, svals) -> list[float]:
 def _auto_sizes(red, model, opts: dict, t_end: float, report: dict) -> tuple[int, int]:
     """Smallest sizes whose sub-bases of ``red`` (built at the largest sizes) meet the target."""
     L, b = model.layout, model.blocks
-    nb, ntb = red.boundary["u"].size, red.boundary["theta"].size
+    nb, ntb = red.boundary["u"].size, red.n_theta_b
     target, modes = opts["target"], min(opts["modes"], L.n_u)
     solve = condensed_solve(b.K, red.boundary["u"], red.solver)  # no factorisation of K
     tol = REFERENCE_TOL_PER_TARGET * opts["target"]
@@ -141,7 +141,9 @@ def reduce_model(model, scene, log=None):
             report["note"] = f"reduction.n_theta = {n_theta} ignored: no temperature dofs"
             n_theta = 0
     try:
-        red = ThermoelasticCraigBampton(model, n_uv, n_theta, projection=opts["projection"])
+        red = ThermoelasticCraigBampton(
+            model, n_uv, n_theta, projection=opts["projection"], thermal=opts["thermal"]
+        )
     except ValueError as exc:
         text = str(exc)
         key = next((f"reduction.{k}" for k in ("n_theta", "n_uv") if k in text), None)
@@ -155,6 +157,7 @@ def reduce_model(model, scene, log=None):
         n_theta=n_theta,
         n_reduced=reduced.n_dofs,
         n_boundary_u=int(red.boundary["u"].size),
-        n_boundary_theta=int(red.boundary["theta"].size),
+        n_boundary_theta=int(red.n_theta_b),
+        thermal=red.thermal,
     )
     return reduced, red, report
