@@ -21,7 +21,7 @@ from .simulation import build
 __all__ = ["FINISHED", "folder_status", "run_scene", "versions"]
 
 #: statuses of a finished run; any other (running, interrupted, failed) may be rerun
-FINISHED = ("ok", "unstable", "diverged-physically")
+FINISHED = ("ok", "inaccurate", "unstable", "diverged-physically")
 
 
 def folder_status(out) -> str | None:
@@ -118,5 +118,6 @@ def run_scene(
         timings=built.timings,
         n_full=built.full.n_dofs,
         rotation_speed=scene["loads"]["rotation_speed"],
+        reduction_error=built.report["reduction"].get("error"),
     )
     return res, built

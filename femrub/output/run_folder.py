@@ -68,6 +68,7 @@ def run_to_folder(
     timings: dict | None = None,
     n_full: int | None = None,
     rotation_speed: float = 0.0,
+    reduction_error: dict | None = None,
 ):
     """Run ``stepper`` to ``t_end`` and write the results folder ``out`` (module docstring).
 
@@ -75,7 +76,10 @@ def run_to_folder(
     ``reduction``); ``summary.json["timings"]`` adds ``stepping`` (the run without the
     output it streams) and ``output`` (VTK frames, histories, plots). ``n_full``: state dofs
     of the full model when ``stepper.model`` is reduced; ``rotation_speed`` (rad/s) counts the
-    ``revolutions`` reached. Returns the
+    ``revolutions`` reached. ``reduction_error``: the estimate of a reduced run
+    (:mod:`femrub.reduction.estimate`, with its ``tolerance``), written as
+    ``summary.json["reduction_error"]``; a run that would be ``ok`` ends ``"inaccurate"``
+    when the estimate exceeds the tolerance (results kept). Returns the
     :class:`~femrub.output.results.Results`.
     """
     out = Path(out)
@@ -132,6 +136,14 @@ def run_to_folder(
             snapshot_png(series.dir / series.frames[-1][1], out / "snapshot.png")
         except Exception as exc:  # rendering is optional (no OpenGL on the machine)
             doc["snapshot_error"] = f"{type(exc).__name__}: {exc}"
+    if reduction_error and res.status == "ok":
+        est, tol = reduction_error.get("estimate", 0.0), reduction_error.get("tolerance", np.inf)
+        if not est <= tol:
+            res.status = "inaccurate"
+            res.message = (
+                f"estimated reduction error {100 * est:.3g} % exceeds reduction.tolerance "
+                f"{100 * tol:.3g} %: raise the reduction sizes or use reduction.method = 'auto'"
+            )
     e = res.energy
     stepping_cpu = max(res.cpu_seconds - vtk_cpu, 0.0)
     omega = float(rotation_speed)
@@ -156,6 +168,8 @@ def run_to_folder(
         vtk=str(series.pvd_path.relative_to(out)) if series is not None else None,
         vtk_frames=len(series.frames) if series is not None else 0,
     )
+    if reduction_error is not None:
+        doc["reduction_error"] = reduction_error
     for name, arr in res.signals.items():
         doc.setdefault("signals_max_abs", {})[name] = float(np.abs(arr).max()) if arr.size else 0.0
     _write_json(summary_path, doc)

@@ -23,12 +23,10 @@ full model is :func:`compare` (benchmarks/reduction_convergence_3d.py).
 
 from __future__ import annotations
 
-import time
-
 import numpy as np
 import scipy.sparse as sp
 
-__all__ = ["QUANTITIES", "compare", "estimate", "field_norms", "reference_sizes"]
+__all__ = ["QUANTITIES", "compare", "estimate", "field_norms", "reference_sizes", "simulate"]
 
 #: Relative errors reported (``summary.json["reduction_error"]``); the first three decide.
 QUANTITIES = ("contact_force", "contact_temperature", "displacement", "temperature")
@@ -95,37 +93,32 @@ def compare(run, ref, fields_run, fields_ref, norms: dict, window: float) -> dic
     return out
 
 
-def _run(stepper, t_end, store_every):
-    return stepper.run(t_end, store_every=store_every)
-
-
-def estimate(reductor, sizes, ref, make_stepper, t_end, *, window=0.0, checkpoints=5) -> dict:
-    """Estimated relative errors of the model ``reductor.reduce(*sizes)`` (module docstring).
-
-    ``ref``: sizes of the reference model; ``make_stepper(model)``: the scene's stepper.
-    Returns the errors (:data:`QUANTITIES`), ``estimate`` (the largest decisive one), the
-    sizes and the seconds spent.
-    """
-    t0 = time.perf_counter()
+def simulate(reductor, sizes, make_stepper, t_end, checkpoints=5):
+    """Step ``reductor.reduce(*sizes)``; return the results and the full states stored."""
     st = make_stepper(reductor.reduce(*sizes))
-    steps = st.steps_to(t_end)
-    every = max(1, steps // checkpoints)
-    a = _run(st, t_end, every)
-    b = _run(make_stepper(reductor.reduce(*ref)), t_end, every)
-    full = reductor.fom
-    Xa = reductor.reconstruct(a.states, *sizes)
-    Xb = reductor.reconstruct(b.states, *ref)
-    errs = compare(a, b, Xa, Xb, field_norms(full), window)
+    every = max(1, st.steps_to(t_end) // checkpoints)
+    res = st.run(t_end, store_every=every)
+    return res, reductor.reconstruct(res.states, *sizes)
+
+
+def estimate(run, ref, fom, *, window=0.0) -> dict:
+    """Estimated relative errors of ``run`` against the richer ``ref`` (module docstring).
+
+    ``run``, ``ref``: ``(sizes, results, full states)`` of :func:`simulate`; ``fom``: the
+    full model (field norms). Returns the errors (:data:`QUANTITIES`), ``estimate`` (the
+    largest of the decisive ones) and what they were measured on.
+    """
+    (sa, a, Xa), (sb, b, Xb) = run, ref
+    errs = compare(a, b, Xa, Xb, field_norms(fom), window)
     decisive = [errs[k] for k in DECISIVE if k in errs]
     return {
         **errs,
         "estimate": float(max(decisive)) if decisive else 0.0,
-        "method": "hierarchical: against the reductor's richer sub-basis model",
-        "sizes": list(sizes),
-        "reference_sizes": list(ref),
+        "method": "hierarchical: difference to a richer sub-basis model of the same reductor",
+        "sizes": list(sa),
+        "reference_sizes": list(sb),
         "checkpoints": [float(x) for x in a.state_times],
         "window": float(window),
         "status_run": a.status,
         "status_reference": b.status,
-        "seconds": time.perf_counter() - t0,
     }
