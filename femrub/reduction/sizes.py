@@ -218,7 +218,8 @@ def reduce_model(model, scene, log=None, make_stepper=None):
         if make_stepper is not None:  # a richer reductor: the reference of the estimate
             L, bnd = model.layout, model.boundary
             cap = (2 * (L.n_u - len(bnd["u"])), L.n_t)
-            n_uv, n_theta = reference_sizes(n_uv, n_theta, cap)
+            if n_uv <= cap[0] and n_theta <= cap[1]:  # else the reductor names the key
+                n_uv, n_theta = reference_sizes(n_uv, n_theta, cap)
     try:
         red = ThermoelasticCraigBampton(
             model, n_uv, n_theta, projection=opts["projection"], thermal=opts["thermal"]
