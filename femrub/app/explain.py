@@ -90,9 +90,8 @@ def _reduction(r: dict) -> list[str]:
         )
         if err.get("tried") and r["method"] == "auto":
             lines.append(
-                "tried " + ", ".join(
-                    f"{t['sizes']}: {100 * t['estimate']:.2g} %" for t in err["tried"]
-                )
+                "tried "
+                + ", ".join(f"{t['sizes']}: {100 * t['estimate']:.2g} %" for t in err["tried"])
             )
     if r.get("note"):
         lines.append(r["note"])

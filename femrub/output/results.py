@@ -46,9 +46,9 @@ class Results:
     """What a stepper's ``run()`` returns.
 
     ``status`` is ``"ok"``, ``"inaccurate"`` (a reduced run whose estimated error exceeds
-    ``reduction.tolerance``, set by the run folder), ``"unstable"`` (numerical blow-up or a step above the scheme's
-    stability limit), ``"diverged-physically"`` (a physical stop criterion was reached),
-    ``"interrupted"`` or ``"failed"``; the arrays hold everything computed up to then.
+    ``reduction.tolerance``, set by the run folder), ``"unstable"`` (numerical blow-up or a
+    step above the scheme's stability limit), ``"diverged-physically"`` (a physical stop
+    criterion was reached), ``"interrupted"`` or ``"failed"``; the arrays hold everything computed up to then.
     """
 
     scheme: str

@@ -295,8 +295,12 @@ REDUCTION = Variant(
             doc="thermal reduction: one shape pair per heat input, or the heated dofs kept",
         ),
         "tolerance": _f(
-            0.05, "none", "estimated relative error above which a run is inaccurate",
-            lo=0.0, hi=1.0, lo_open=True,
+            0.05,
+            "none",
+            "estimated relative error above which a run is inaccurate",
+            lo=0.0,
+            hi=1.0,
+            lo_open=True,
         ),
     },
     variants={
