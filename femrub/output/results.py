@@ -48,7 +48,8 @@ class Results:
     ``status`` is ``"ok"``, ``"inaccurate"`` (a reduced run whose estimated error exceeds
     ``reduction.tolerance``, set by the run folder), ``"unstable"`` (numerical blow-up or a
     step above the scheme's stability limit), ``"diverged-physically"`` (a physical stop
-    criterion was reached), ``"interrupted"`` or ``"failed"``; the arrays hold everything computed up to then.
+    criterion was reached), ``"interrupted"`` or ``"failed"``; the arrays hold everything
+    computed up to then.
     """
 
     scheme: str
