@@ -99,3 +99,5 @@ def test_too_small_basis_is_inaccurate(tmp_path):
     for k in ("contact_force", "contact_temperature", "displacement"):
         assert np.isfinite(err[k])
     assert doc["inputs"]["build"]["reduction"]["n_boundary_theta"] <= 2 * doc["n_contacts"] + 1
+    text = built.explain()
+    assert "estimated error" in text and "EXCEEDS tolerance 5 %" in text
