@@ -101,3 +101,22 @@ def test_too_small_basis_is_inaccurate(tmp_path):
     assert doc["inputs"]["build"]["reduction"]["n_boundary_theta"] <= 2 * doc["n_contacts"] + 1
     text = built.explain()
     assert "estimated error" in text and "EXCEEDS tolerance 5 %" in text
+
+
+def test_auto_picks_sizes_from_the_estimate():
+    from femrub.app.simulation import build
+
+    def built(tol):
+        scene = load_scene(
+            "twisted-naca",
+            {"reduction.tolerance": tol, "reduction.max_n_uv": 16, "reduction.max_n_theta": 16,
+             "scheme.t_end": 0.002, "outputs.vtk_stride": 0},
+        )  # fmt: skip
+        return build(scene).report["reduction"]
+
+    loose, tight = built(0.9), built(0.02)
+    assert loose["error"]["estimate"] <= 0.45
+    assert (loose["n_uv"], loose["n_theta"]) < (tight["n_uv"], tight["n_theta"])
+    tried = [t["sizes"] for t in tight["error"]["tried"]]
+    assert tried == sorted(tried)  # increasing sub-bases; all but the last missed 0.02 / 2
+    assert all(t["estimate"] > 0.01 for t in tight["error"]["tried"][:-1])
