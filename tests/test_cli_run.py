@@ -82,7 +82,7 @@ def test_interrupted_run_keeps_partial_results(tiny, tmp_path, capsys, monkeypat
     s = json.loads((out / "summary.json").read_text())
     assert s["status"] == "interrupted" and 0 < s["steps"] < 500
     rows = _rows(out / "history.csv")
-    assert 1 < len(rows) < 501 and float(rows[-1]["t"]) < 0.05
+    assert 1 < len(rows) < 501 and float(rows[-1]["t [s]"]) < 0.05
     # an interrupted result is not a finished one: the same command starts again
     monkeypatch.setattr(ThetaMethod, "_step", real_step)
     assert main(["run", str(tiny), "-o", str(out), "-q"]) == 0

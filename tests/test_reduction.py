@@ -229,7 +229,8 @@ def test_coupled_reduced_energy_balance_closes_without_heat_impulses():
 
 def test_paper_case_contact_work_never_positive():
     res = fr.ThetaMethod(paper_reduced_model("RM1", ALPHA, True), 1e-4).run(0.4)
-    assert res.status == "ok"
+    # the reduced model's energy balance is open (> 5 %): reported, not hidden
+    assert res.status in ("ok", "inaccurate")
     assert np.all(np.diff(res.energy["contact_work"]) <= 1e-15)
     assert res.energy["friction_heat"][-1] == pytest.approx(ALPHA * res.impulse.sum(), rel=1e-12)
 
@@ -292,7 +293,7 @@ def test_two_contact_bar_full_basis_and_reduced():
     assert np.all(ref.force.max(axis=0) > 0)  # both contacts close
     _same_run(fr.ThetaMethod(red.reduce(), 1e-4).run(0.1), ref, 1e-8)
     res = fr.ThetaMethod(ThermoelasticCraigBampton(full, 4, 6).reduce(), 1e-4).run(0.1)
-    assert res.status == "ok"
+    assert res.status in ("ok", "inaccurate")  # a small basis: the energy balance may open
     assert _rel(res.signal("tip_displacement"), ref.signal("tip_displacement")) < 0.15
     assert np.all(np.diff(res.energy["contact_work"]) <= 1e-15)
 

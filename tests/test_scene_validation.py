@@ -210,7 +210,7 @@ def valid_bar_docs(draw):
         "contact": {"casing": {"kind": "concentric",
                                "clearance": draw(st.floats(0.0, 1e-4))},
                     "heat_coefficient": draw(st.floats(0.0, 5.0)),
-                    "restitution": draw(st.floats(0.0, 1.0)),
+                    "restitution": draw(st.floats(0.0, 1.0)) if scheme == "theta" else 0.0,
                     "reach": draw(st.sampled_from(["auto", "all", 1e-5]))},
         "loads": {"rotation_speed": draw(st.floats(1.0, 3000.0)),
                   "tip_force": {"law": draw(st.sampled_from(["sin", "constant", "ramp"])),
@@ -238,7 +238,7 @@ def test_random_valid_scenes_build_and_run(doc):
     assert Scene(normalize(tomllib.loads(scene.dumps()))) == scene
     built = build(scene)
     res = built.stepper.run(scene["scheme.t_end"])
-    assert res.status in ("ok", "unstable"), res.message
+    assert res.status in ("ok", "inaccurate", "unstable"), res.message
     assert built.explain().count("\n") > 5
 
 

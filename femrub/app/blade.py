@@ -3,7 +3,10 @@
 :func:`load_blade` returns a :class:`~femrub.geometry.BladeMesh` whose ``root`` node set is
 the clamped face (``boundary.root``) and whose contact points are the scene's candidates
 (``contact.group`` or ``contact.nodes``). Missing groups, nodes or units are reported as a
-one-line :class:`~femrub.scene.spec.SceneError` naming the scene key.
+one-line :class:`~femrub.scene.spec.SceneError` naming the scene key, and so are, before
+any meshing, a gmsh blade whose estimated element count exceeds :data:`MAX_ELEMENTS`
+(:func:`estimate_elements`), and after reading, a degenerate mesh (coincident nodes or
+flat tetrahedra) and repeated contact points.
 """
 
 from __future__ import annotations
@@ -15,9 +18,84 @@ import numpy as np
 from ..geometry import GeometryError, box_blade, naca_blade, read_mesh, sections_blade
 from ..geometry.bar import bar_mesh
 from ..geometry.readers import detect_format
+from ..geometry.tet_ops import tet_volumes
 from ..scene.spec import SceneError, fail
 
-__all__ = ["load_blade"]
+__all__ = ["MAX_ELEMENTS", "estimate_elements", "load_blade"]
+
+#: largest number of tetrahedra a gmsh blade may have (the model's size grows with it)
+MAX_ELEMENTS = 2_000_000
+# tetrahedra per h³ of volume in a gmsh mesh of size h (regular tetrahedra: 6 √2)
+_TETS_PER_H3 = 8.5
+# coincident nodes: closer than this fraction of the blade size
+_SAME_POINT = 1e-9
+
+
+def estimate_elements(g: dict) -> float | None:
+    """Tetrahedra of a gmsh blade of size ``geometry.h`` (``None``: cannot estimate)."""
+    h = g.get("h")
+    if g["kind"] == "box":
+        h = h or g["thickness"]
+        t = min(g["thickness"], h)  # at least one element through the thickness
+        return _TETS_PER_H3 * g["span"] * g["chord"] * g["thickness"] / (h * h * t)
+    if g["kind"] == "naca" and h is not None:
+        ratio = int(str(g["code"])[2:]) / 100.0
+        t = min(ratio * g["root_chord"], h)
+        area = 0.685 * ratio * 0.5 * (g["root_chord"] ** 2 + g["tip_chord"] ** 2)
+        return _TETS_PER_H3 * g["span"] * area / (h * h * t)
+    return None
+
+
+def _check_size(scene) -> None:
+    g = scene["geometry"]
+    n = estimate_elements(g)
+    if n is not None and n > MAX_ELEMENTS:
+        fail(
+            "geometry.h",
+            g.get("h"),
+            f"gives about {n:.2g} tetrahedra (at most {MAX_ELEMENTS:.0e} before meshing); "
+            "raise geometry.h",
+        )
+
+
+def _check_mesh(scene, blade) -> None:
+    """Refuse coincident nodes and flat tetrahedra (a degenerate mesh)."""
+    if blade.dim != 3:
+        return
+    p = blade.mesh.p
+    size = float(np.ptp(p, axis=1).max()) or 1.0
+    keys = np.round(p.T / (_SAME_POINT * size)).astype(np.int64)
+    _, first, counts = np.unique(keys, axis=0, return_index=True, return_counts=True)
+    if (counts > 1).any():
+        i = first[np.argmax(counts > 1)]
+        where = ", ".join(f"{x:.6g}" for x in p[:, i])
+        raise SceneError(
+            f"geometry: degenerate mesh {blade.source}: {int((counts - 1).sum())} duplicate "
+            f"node(s), e.g. at ({where}) m; merge coincident nodes"
+        )
+    vol = np.abs(tet_volumes(p, blade.mesh.t))
+    flat = vol <= 1e-12 * size**3
+    if flat.any():
+        raise SceneError(
+            f"geometry: degenerate mesh {blade.source}: {int(flat.sum())} flat tetrahedra "
+            f"(zero volume), e.g. element {int(np.argmax(flat))}; repair the mesh"
+        )
+
+
+def _check_contacts(scene, pts) -> None:
+    """Refuse repeated contact nodes or points (the same contact counted twice)."""
+    contact = scene["contact"]
+    nodes = contact.get("nodes")
+    key = "contact.nodes" if nodes is not None else "contact.group"
+    if nodes is not None and len(set(nodes)) < len(nodes):
+        dup = next(n for n in nodes if nodes.count(n) > 1)
+        fail(key, nodes, f"node {dup} is listed twice; list each contact node once")
+    if pts.shape[1] > 1:
+        size = float(np.ptp(pts, axis=1).max()) or 1.0
+        keys = np.round(pts.T / (_SAME_POINT * max(size, 1e-3))).astype(np.int64)
+        if len(np.unique(keys, axis=0)) < pts.shape[1]:
+            fail(key, nodes if nodes is not None else contact["group"],
+                 "two contact points coincide; give each contact point once")  # fmt: skip
 
 
 def _groups(blade) -> str:
@@ -138,14 +216,17 @@ def load_blade(scene, log=None):
     """
     if log:
         log(f"geometry: {scene['geometry']['kind']} ...")
+    _check_size(scene)
     try:
         blade = _build(scene)
     except GeometryError as exc:
         raise SceneError(f"geometry ({scene['geometry']['kind']}): {exc}") from None
+    _check_mesh(scene, blade)
     root = scene["boundary"].get("root")
     if root is not None and scene["geometry"]["kind"] != "mesh" and root != "root":
         if root not in blade.node_sets:
             fail("boundary.root", root, f"missing mesh group; groups: {_groups(blade)}")
         blade.node_sets["root"] = blade.node_sets[root]
     pts = _contact_points(scene, blade)
+    _check_contacts(scene, pts)
     return replace(blade, contact_points=pts, node_sets=dict(blade.node_sets))

@@ -1,9 +1,11 @@
 """Command line: ``femrub run | check | sweep | scenes | scene show | paper | mesh``.
 
-Errors in the input are reported on one line (``femrub: error: ...``) with exit status 2,
-never as a traceback (set ``FEMRUB_DEBUG=1`` to see one); an interrupted run keeps what it
-wrote, says where, and exits with status 130; a run that fails keeps its partial results
-and exits with status 1.
+Errors in the input or the output folder are reported on one line (``femrub: error: ...``)
+with exit status 2, never as a traceback (set ``FEMRUB_DEBUG=1`` to see one); an
+interrupted run (Ctrl-C or SIGTERM, any command) keeps what it wrote, says where, and exits
+with status 130; a run that fails keeps its partial results and exits with status 1. The
+default output folder is made from the scene name with anything but letters, digits and
+``_.-`` replaced (it is always inside the working folder).
 """
 
 from __future__ import annotations
@@ -26,11 +28,25 @@ def _paper(args) -> int:
     t0 = time.perf_counter()
     if not args.quiet:
         print(f"femrub paper: reproducing {', '.join(figures or FIGURES)} into {out}/")
-    rows = reproduce(out, figures=figures, t_end=args.t_end, progress=not args.quiet, log=log)
+    try:
+        rows = reproduce(
+            out, figures=figures, t_end=args.t_end, progress=not args.quiet, log=log,
+            overwrite=args.overwrite,
+        )  # fmt: skip
+    except KeyboardInterrupt:
+        print(
+            f"femrub: paper interrupted; the rows of the finished runs are kept in "
+            f"{out / 'summary.json'} (status interrupted); rerun with --overwrite to start again",
+            file=sys.stderr,
+        )
+        return 130
     if not args.quiet:
         bad = [r for r in rows if r["status"] != "ok"]
         for r in bad:
             print(f"  note: {r['figure']} / {r['label']}: {r['status']} ({r['message']})")
+        for r in rows:
+            for w in r.get("warnings", []):
+                print(f"  warning: {r['figure']} / {r['label']}: {w}")
         print(f"done in {time.perf_counter() - t0:.1f} s: {out / 'summary.json'}")
     return 0
 
@@ -58,10 +74,11 @@ def _log(args):
 
 
 def _run(args) -> int:
+    from ..output.folder import safe_name
     from .run import run_scene
 
     scene = _load(args)
-    out = Path(args.out or f"{scene.name}-out")
+    out = Path(args.out or f"{safe_name(scene.name)}-out")
     if not args.quiet:
         print(f"femrub run: {scene.source} -> {out}/", flush=True)
 
@@ -99,6 +116,8 @@ def _run(args) -> int:
         )
         if res.status != "ok":
             print(f"  note: {res.message}")
+        for w in res.warnings:
+            print(f"  warning: {w}")
         vtk = " and vtk/rub.pvd (ParaView)" if built.fields is not None and scene[
             "outputs.vtk_stride"] else ""  # fmt: skip
         print(f"  results in {out}/: summary.json, history.csv, signals.png{vtk}")
@@ -147,19 +166,22 @@ def _scene_show(args) -> int:
 
 
 def _sweep(args) -> int:
+    from ..output.folder import FINISHED
     from .sweep import parse_param, run_sweep
 
     scene = _load(args)
     if not args.param:
         raise ValueError("give at least one --param KEY=START:STOP:STEP")
+    from ..output.folder import safe_name
+
     params = [parse_param(p) for p in args.param]
-    out = Path(args.out or f"{scene.name}-sweep")
+    out = Path(args.out or f"{safe_name(scene.name)}-sweep")
     t0 = time.perf_counter()
     rows = run_sweep(
         scene, params, out, scheduler=args.scheduler, workers=args.workers,
         overwrite=args.overwrite, progress=not args.quiet, log=None if args.quiet else print,
     )  # fmt: skip
-    failed = [r for r in rows if r.get("status") not in ("ok", "unstable", "diverged-physically")]
+    failed = [r for r in rows if r.get("status") not in FINISHED]
     for r in failed:
         print(
             f"femrub: point {r['point']} ({r['folder']}): {r.get('status')}: "
@@ -231,6 +253,7 @@ def build_parser() -> argparse.ArgumentParser:
     pp.add_argument("--figures", help="comma-separated subset, e.g. fig2,fig6")
     pp.add_argument("--t-end", type=float, default=0.4, help="end time in s (default 0.4)")
     pp.add_argument("--quiet", "-q", action="store_true", help="no progress output")
+    pp.add_argument("--overwrite", action="store_true", help="replace a finished reproduction")
     pp.set_defaults(func=_paper)
     try:
         from ..geometry.cli import add_mesh_parser, run_mesh
@@ -258,13 +281,21 @@ def main(argv=None) -> int:
     if not getattr(args, "func", None):
         parser.print_help()
         return 2
+    from ..output.interrupts import interruptible
+
     try:
-        return int(args.func(args) or 0)
+        with interruptible():
+            return int(args.func(args) or 0)
     except KeyboardInterrupt:
         print("femrub: interrupted; files written so far are kept", file=sys.stderr)
         return 130
     except (ValueError, FileNotFoundError, FileExistsError, KeyError) as exc:
         print(f"femrub: error: {_one_line(exc)}", file=sys.stderr)
+        return 2
+    except OSError as exc:  # e.g. a folder that became unwritable: one line, not a traceback
+        if os.environ.get("FEMRUB_DEBUG"):
+            raise
+        print(f"femrub: error: {type(exc).__name__}: {_one_line(exc)}", file=sys.stderr)
         return 2
     except Exception as exc:
         if os.environ.get("FEMRUB_DEBUG"):

@@ -3,33 +3,51 @@
 Besides what :func:`~femrub.output.run_folder.run_to_folder` writes (``history.csv``/``.npz``,
 ``summary.json``, ``signals.png``, ``vtk/``, ``snapshot.png``), the folder gets
 ``scene.toml`` (the normalised scene, paths made absolute: ``femrub run`` reruns it) and
-``explain.txt``. ``summary.json["inputs"]`` holds the scene, the build report and the
-versions of the libraries. A folder with a finished result is never overwritten silently.
+``explain.txt``. ``summary.json["inputs"]`` holds the scene, the build report, the versions
+of the libraries and ``scene_sha256`` (:func:`scene_hash`). The folder is claimed before
+the model is built (:func:`femrub.output.folder.claim`: writable, locked against a second
+run, not a paper or sweep folder, no finished or unreadable result unless ``overwrite``).
 """
 
 from __future__ import annotations
 
 import copy
+import hashlib
 import json
 import math
 from pathlib import Path
 
-from ..output.run_folder import ResultExists, run_to_folder
+from ..output.folder import FINISHED, claim, folder_status
+from ..output.run_folder import run_to_folder
 from ..scene.scene import Scene
 from .simulation import build
 
-__all__ = ["FINISHED", "folder_status", "run_scene", "versions"]
-
-#: statuses of a finished run; any other (running, interrupted, failed) may be rerun
-FINISHED = ("ok", "inaccurate", "unstable", "diverged-physically")
+__all__ = ["FINISHED", "folder_status", "merge_time", "run_scene", "scene_hash", "versions"]
 
 
-def folder_status(out) -> str | None:
-    """Status in ``out/summary.json`` (``None`` when there is no readable summary)."""
-    try:
-        return json.loads((Path(out) / "summary.json").read_text()).get("status")
-    except (OSError, ValueError):
-        return None
+def scene_hash(scene: Scene) -> str:
+    """SHA-256 of the resolved scene (SI values, defaults, absolute paths; name excluded)."""
+    data = {k: v for k, v in _resolved(scene).data.items() if k not in ("name", "description")}
+    text = json.dumps(data, sort_keys=True, default=str)
+    return hashlib.sha256(text.encode()).hexdigest()
+
+
+def merge_time(scene: Scene) -> float | None:
+    """A quarter of the excitation period (s): impulses closer than this form one contact
+    episode of the resolution check (tip force, else casing lobes passing at Ω)."""
+    loads, casing = scene["loads"], scene["contact"]["casing"]
+    omega = loads["rotation_speed"]
+    force = loads["tip_force"]
+    w = None
+    if force["law"] == "sin":
+        w = (
+            force["engine_order"] * omega
+            if force["frequency"] == "rotation"
+            else force["frequency"]
+        )
+    elif omega > 0:
+        w = omega * {"lobed": casing.get("lobes", 1), "two-lobe": 2}.get(casing["kind"], 1)
+    return 0.25 * 2.0 * math.pi / w if w else None
 
 
 def versions() -> dict:
@@ -87,21 +105,24 @@ def run_scene(
     modes : natural frequencies to compute and report (``build.natural_frequencies_hz``).
     """
     out = Path(out)
-    status = folder_status(out)
-    if status in FINISHED and not overwrite:
-        raise ResultExists(
-            f"{out} already holds a finished result (status {status}); "
-            "use another folder or --overwrite"
-        )
+    with claim(out, "run", overwrite=overwrite):
+        return _run_claimed(scene, out, progress, log, on_built, modes)
+
+
+def _run_claimed(scene, out, progress, log, on_built, modes):
     built = build(scene, log=log, modes=modes)
     if on_built is not None:
         on_built(built)
-    out.mkdir(parents=True, exist_ok=True)
     (out / "scene.toml").write_text(_resolved(scene).dumps())
     (out / "explain.txt").write_text(built.explain() + "\n")
     o = scene["outputs"]
     stride = o["vtk_stride"] if built.fields is not None else 0
-    inputs = {"scene": _finite(scene.data), "build": _finite(built.report), "versions": versions()}
+    inputs = {
+        "scene": _finite(scene.data),
+        "build": _finite(built.report),
+        "versions": versions(),
+        "scene_sha256": scene_hash(scene),
+    }
     if log:
         log(f"running {built.stepper.name} on {built.model.n_dofs} dofs -> {out}/")
     res = run_to_folder(
@@ -118,6 +139,8 @@ def run_scene(
         timings=built.timings,
         n_full=built.full.n_dofs,
         rotation_speed=scene["loads"]["rotation_speed"],
+        merge_time=merge_time(scene),
+        claimed=True,
         reduction_error=built.report["reduction"].get("error"),
     )
     return res, built

@@ -8,6 +8,11 @@
 :meth:`Simulation.from_scene` builds what a scene needs and only that: temperature dofs only
 when something heats the blade, only the contacts the casing can reach, only the requested
 signals; it checks the step against Carpenter's stability limit, all before any time step.
+It also refuses a casing clearance out of scale with the blade (a unit slip: a clearance
+above :data:`MAX_CLEARANCE_RATIO` times the blade's size), and turns on physical stop limits
+for the signals the scene does not limit (:func:`default_limits`: a temperature rise of
+:data:`MAX_TEMPERATURE_RISE` K, a displacement of :data:`MAX_DISPLACEMENT_RATIO` times the
+blade's size), so a runaway is reported as ``diverged-physically``, never as ``ok``.
 ``report`` says what was built and why (``femrub run SCENE --explain``); ``timings`` holds
 the seconds spent meshing, assembling and reducing. The paper's bar and a 3D blade go
 through the same path.
@@ -33,7 +38,60 @@ from . import translate as tr
 from .blade import load_blade
 from .explain import explain
 
-__all__ = ["Simulation", "build"]
+__all__ = [
+    "MAX_CLEARANCE_RATIO",
+    "MAX_DISPLACEMENT_RATIO",
+    "MAX_TEMPERATURE_RISE",
+    "Simulation",
+    "blade_size",
+    "build",
+    "default_limits",
+]
+
+#: default stop limit on temperature signals (K above ambient; titanium melts ~1650 K above)
+MAX_TEMPERATURE_RISE = 1500.0
+#: default stop limit on displacement signals, relative to the blade's size
+MAX_DISPLACEMENT_RATIO = 0.1
+#: largest casing clearance (or lobe depth) relative to the blade's size
+MAX_CLEARANCE_RATIO = 0.05
+
+
+def blade_size(scene, blade) -> float:
+    """Characteristic size of the blade (m): the bar's length, else the mesh's largest extent."""
+    if blade.dim == 1:
+        return float(scene["geometry"]["length"])
+    return float(np.ptp(blade.mesh.p, axis=1).max())
+
+
+def default_limits(observed, size: float) -> dict:
+    """Physical stop limits on the ``observed`` signals (see the module docstring)."""
+    out = {}
+    for name in observed:
+        if name.endswith("temperature"):
+            out[name] = MAX_TEMPERATURE_RISE
+        elif name.endswith("displacement"):
+            out[name] = MAX_DISPLACEMENT_RATIO * size
+    return out
+
+
+def _check_scale(scene, size: float) -> None:
+    """Refuse a clearance out of scale with the blade (a unit slip, module docstring)."""
+    casing = scene["contact"]["casing"]
+    g = scene["geometry"]
+    for key in ("clearance", "depth", "mean_gap"):
+        value = casing.get(key)
+        if value and value > MAX_CLEARANCE_RATIO * size:
+            hint = (
+                f"; check geometry.length_unit = {g.get('length_unit')!r}"
+                if g["kind"] in ("mesh", "sections")
+                else ""
+            )
+            fail(
+                f"contact.casing.{key}",
+                value,
+                f"is {value / size:.3g} times the blade's size {size:.3g} m (at most "
+                f"{MAX_CLEARANCE_RATIO:g}): a unit slip? e.g. write '{value:g} um'{hint}",
+            )
 
 
 @dataclass(frozen=True)
@@ -111,7 +169,10 @@ def _build(scene, log, modes) -> Simulation:
         "reach_key": c["reach"],
     }
     blade = load_blade(scene, log)
+    size = blade_size(scene, blade)
+    _check_scale(scene, size)
     report["geometry"] = blade.summary()
+    report["blade_size"] = size
     clock.done("mesh", f"{blade.n_vertices} vertices")
     if log:
         log("assembling the full model ...")
@@ -158,7 +219,7 @@ def _build(scene, log, modes) -> Simulation:
     report["dropped"] += [d for d in full.info.get("dropped", []) if "temperature" not in d]
     report["full"] = {"n_dofs": full.n_dofs, "fe_dofs": mats.n_u + mats.n_t, **_layout(full)}
     report["contacts"] = _contacts_report(candidates, reach)
-    model, limits = _select_signals(scene, full, report)
+    model, limits = _select_signals(scene, full, report, size)
     if modes:
         report["natural_frequencies_hz"] = natural_frequencies(model, modes).tolist()
     make = lambda m: _bare_stepper(scene, m)  # noqa: E731  (the reduction error estimate)
@@ -209,7 +270,7 @@ def _stepper(scene, model, report):
     return stepper
 
 
-def _select_signals(scene, model, report):
+def _select_signals(scene, model, report, size):
     outputs, limits = scene["outputs"], scene["limits"]
     wanted = set(model.observations) if outputs["signals"] == "all" else set(outputs["signals"])
     wanted |= {k for k in limits if k != "contact_force"}
@@ -226,7 +287,10 @@ def _select_signals(scene, model, report):
     for k in absent:
         if k in (outputs["signals"] if outputs["signals"] != "all" else []):
             ignored.append(f"outputs.signals: {k} is not observed (no temperature dofs)")
+    defaults = {k: v for k, v in default_limits(obs, size).items() if k not in kept_limits}
+    kept_limits.update(defaults)
     report["limits"], report["ignored"] = kept_limits, ignored
+    report["limits_default"] = sorted(defaults)
     return model.with_(observations=obs), kept_limits
 
 

@@ -6,8 +6,12 @@ folder ``DIR/runs/NNN_key=value/`` (:func:`femrub.scene.run_scene`). Tasks run o
 ``LocalCluster`` of this machine (2 worker processes, 1 thread each, by default) or on the
 cluster behind ``--scheduler ADDRESS`` (the output folder must then be shared). A point
 whose folder holds a finished result is skipped, so rerunning the command after a failure
-or an interruption only runs what is missing. At the end ``DIR/interaction.csv`` and
-``DIR/interaction.png`` (:mod:`femrub.output.interaction`) summarise the sweep.
+or an interruption only runs what is missing. A point is keyed by a hash of its resolved
+scene (:func:`femrub.app.run.scene_hash`): its folder name ends with the first characters
+of the hash, so changing the scene between two runs of the sweep runs the changed points
+into new folders (the old results stay, never reported as the new ones). The sweep folder
+is claimed like a run folder (kind ``sweep``, locked). At the end ``DIR/interaction.csv``
+and ``DIR/interaction.png`` (:mod:`femrub.output.interaction`) summarise the sweep.
 
 Parameter values: ``start:stop:step`` (stop included), ``a,b,c`` or one value; a unit may
 follow the numbers (``1000:3000:500rpm``); plain numbers are SI.
@@ -23,9 +27,11 @@ from pathlib import Path
 
 import numpy as np
 
+from ..output.folder import FINISHED, FolderError, claim, folder_status
+from ..output.jsonfile import write_json
 from ..scene import SceneError, parse_value, resolve_key
 from ..scene.scene import Scene
-from .run import FINISHED, folder_status, run_scene
+from .run import run_scene, scene_hash
 
 __all__ = ["parse_param", "grid", "run_point", "point_metrics", "run_sweep"]
 
@@ -65,9 +71,10 @@ def grid(params: list[tuple[str, list]]) -> list[dict]:
     return [dict(zip(keys, combo)) for combo in itertools.product(*(v for _, v in params))]
 
 
-def _point_name(i: int, changes: dict) -> str:
+def _point_name(i: int, changes: dict, digest: str) -> str:
     parts = [f"{k.rsplit('.', 1)[-1]}={v}" for k, v in changes.items()]
-    return re.sub(r"[^A-Za-z0-9_=.,+-]+", "", f"{i:03d}_" + "_".join(parts))[:120]
+    name = re.sub(r"[^A-Za-z0-9_=.,+-]+", "", f"{i:03d}_" + "_".join(parts))[:110]
+    return f"{name}_{digest[:10]}"
 
 
 def point_metrics(folder) -> dict:
@@ -100,14 +107,24 @@ def run_point(scene_data: dict, source: str, base_dir: str, changes: dict, out: 
         scene = Scene(scene_data, source, Path(base_dir)).with_changes(changes)
         run_scene(scene, out, overwrite=True, modes=N_MODES)
     except Exception as exc:  # a bad point must not stop the sweep
-        Path(out).mkdir(parents=True, exist_ok=True)
         msg = f"{type(exc).__name__}: {exc}".splitlines()[0]
-        if folder_status(out) in (None, "running"):
-            (Path(out) / "summary.json").write_text(
-                json.dumps({"status": "failed", "message": msg})
-            )
+        try:
+            Path(out).mkdir(parents=True, exist_ok=True)
+            if folder_status(out) in (None, "running"):
+                write_json(Path(out) / "summary.json", {"status": "failed", "message": msg})
+        except OSError:
+            pass
         return {"status": "failed", "message": msg}
     return point_metrics(out)
+
+
+def _hash_of(folder) -> str | None:
+    """``scene_sha256`` recorded in a point's ``summary.json`` (``None``: none readable)."""
+    try:
+        s = json.loads((Path(folder) / "summary.json").read_text())
+        return s.get("inputs", {}).get("scene_sha256")
+    except (OSError, ValueError, AttributeError):
+        return None
 
 
 def _client(scheduler, workers):
@@ -137,19 +154,35 @@ def run_sweep(
     overwrite : rerun points that already have a finished result.
     """
     out = Path(out)
+    if scheduler is None and (isinstance(workers, bool) or not isinstance(workers, int)
+                              or workers < 1):  # fmt: skip
+        raise FolderError(f"--workers {workers!r}: give at least 1 worker process")
     points = grid(params)
     keys = [k for k, _ in params]
-    for p in points:  # every point must be a valid scene before any work
-        scene.with_changes(p)
-    out.mkdir(parents=True, exist_ok=True)
-    doc = {"scene": scene.data, "params": {k: v for k, v in params}, "n_points": len(points)}
-    (out / "sweep.json").write_text(json.dumps(doc, indent=2, default=str))
+    scenes = [scene.with_changes(p) for p in points]  # every point valid before any work
+    with claim(out, "sweep", check_result=False):
+        return _sweep(scene, params, points, scenes, keys, out, scheduler, workers, overwrite,
+                      progress, log)  # fmt: skip
+
+
+def _sweep(scene, params, points, scenes, keys, out, scheduler, workers, overwrite, progress,
+           log):  # fmt: skip
+    hashes = [scene_hash(s) for s in scenes]
+    doc = {
+        "scene": scene.data,
+        "params": {k: v for k, v in params},
+        "n_points": len(points),
+        "scene_sha256": hashes,
+    }
+    write_json(out / "sweep.json", doc)
     (out / "scene.toml").write_text(scene.dumps())
     rows = []
-    for i, p in enumerate(points):
-        folder = out / "runs" / _point_name(i, p)
+    for i, (p, digest) in enumerate(zip(points, hashes)):
+        folder = out / "runs" / _point_name(i, p, digest)
         done = folder_status(folder) in FINISHED and not overwrite
-        rows.append({"point": i, "params": p, "folder": str(folder), "skipped": done})
+        done = done and _hash_of(folder) == digest
+        rows.append({"point": i, "params": p, "folder": str(folder), "skipped": done,
+                     "scene_sha256": digest})  # fmt: skip
     todo = [r for r in rows if not r["skipped"]]
     for r in rows:
         if r["skipped"]:

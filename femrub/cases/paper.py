@@ -5,13 +5,19 @@ one PNG and one CSV per figure, each run's history (CSV), and ``summary.json`` w
 per (figure, run). The frictional heat coefficient of Figs. 2 and 4–7 is not printed in the
 paper; :data:`ALPHA_DEFAULT` documents the choice. The paper's runaway (α = 7 m/s, Fig. 3)
 is stopped by the physical criterion :data:`LIMITS` and reported as
-``"diverged-physically"``.
+``"diverged-physically"``. Each run is judged like any other
+(:func:`femrub.output.verdict.assess`: balance tolerances, contact episodes merged over a
+quarter of the forcing period for the resolution warning).
+
+The output folder is claimed (:func:`femrub.output.folder.claim`, kind ``paper``); its
+``summary.json`` has a top-level ``status``: ``running``, ``ok`` (every figure written) or
+``interrupted`` (Ctrl-C or SIGTERM: the rows of the finished runs are kept, and
+``KeyboardInterrupt`` is raised again so that the command exits non-zero).
 """
 
 from __future__ import annotations
 
 import csv
-import json
 import math
 import platform
 import time
@@ -22,16 +28,22 @@ from pathlib import Path
 import numpy as np
 
 from .. import __version__
+from ..output.folder import claim
+from ..output.interrupts import interruptible
+from ..output.jsonfile import write_json
 from ..output.plots import energy_panel, savefig, tip_panels
+from ..output.results import UNITS
 from ..steppers import make_stepper
+from ..steppers.base import MAX_STEPS
 from .bar import PAPER, bar_model
 
 __all__ = ["Run", "FIGURES", "ALPHA_DEFAULT", "LIMITS", "MODELS", "run_case", "reproduce"]
 
 #: α (m/s) of the figures whose α the paper does not print (Figs. 2, 4, 5, 6, 7).
 ALPHA_DEFAULT = 3.0
-#: Physical stop criterion: tip temperature rise (K) beyond which titanium would melt.
-LIMITS = {"tip_temperature": 1500.0}
+#: Physical stop criteria: tip temperature rise (K) beyond which titanium would melt, and a
+#: tip displacement of a tenth of the bar's length (m).
+LIMITS = {"tip_temperature": 1500.0, "tip_displacement": 0.1 * PAPER.length}
 T_END = 0.4
 
 
@@ -139,7 +151,10 @@ def run_case(run: Run, t_end: float = T_END, *, progress: bool = False):
     opts = {"activation": run.activation} if run.scheme == "theta" else {}
     stepper = make_stepper(run.scheme, model, run.h, **opts)
     t0 = time.perf_counter()
-    res = stepper.run(t_end, progress=progress, limits=LIMITS, label=run.label)
+    period = 2.0 * math.pi / PAPER.force_frequency
+    res = stepper.run(
+        t_end, progress=progress, limits=LIMITS, label=run.label, merge_time=0.25 * period
+    )
     res.info["wall_seconds"] = time.perf_counter() - t0
     return res, model
 
@@ -192,6 +207,7 @@ def summarise(figure: str, run: Run, res, model) -> dict:
         "stability_limit": res.info.get("stability_limit"),
         "status": res.status,
         "message": res.message,
+        "warnings": list(res.warnings),
     }
 
 
@@ -207,7 +223,7 @@ def _figure_csv(path: Path, runs) -> None:
             ("contact_force", res.force.sum(axis=1)),
         ):
             cols.append(arr)
-            names.append(f"{label} | {name}")
+            names.append(f"{label} | {name} [{UNITS[name]}]")
     n = max(len(c) for c in cols)
     with path.open("w", newline="") as fh:
         w = csv.writer(fh)
@@ -223,27 +239,56 @@ def reproduce(
     t_end: float = T_END,
     progress: bool = True,
     log: Callable[[str], None] = print,
+    overwrite: bool = False,
 ) -> list[dict]:
     """Run the paper's cases, write PNGs, CSVs and ``summary.json`` into ``out_dir``.
 
     The summary is rewritten after every run, so an interrupted reproduction keeps the rows
-    of the runs it finished.
+    of the runs it finished (and raises ``KeyboardInterrupt``). A finished reproduction in
+    ``out_dir`` is not replaced unless ``overwrite``.
     """
     out = Path(out_dir)
-    (out / "runs").mkdir(parents=True, exist_ok=True)
     names = list(figures or FIGURES)
     unknown = [f for f in names if f not in FIGURES]
     if unknown:
         raise ValueError(f"unknown figure(s) {unknown}; available: {', '.join(FIGURES)}")
-    cache: dict[tuple, tuple] = {}
+    t_end = float(t_end)
+    if not (math.isfinite(t_end) and t_end > 0):
+        raise ValueError(f"--t-end {t_end!r}: give a finite end time > 0 (s)")
+    h_min = min(run.h for f in names for run, _ in FIGURES[f]["runs"])
+    if t_end / h_min > MAX_STEPS:
+        raise ValueError(
+            f"--t-end {t_end:g} s gives {t_end / h_min:.3g} steps at h = {h_min:g} s; at most "
+            f"{MAX_STEPS:.0e} allowed (lower --t-end or choose --figures)"
+        )
+    with claim(out, "paper", overwrite=overwrite), interruptible():
+        return _reproduce(out, names, t_end, progress, log)
+
+
+def _reproduce(out: Path, names, t_end, progress, log) -> list[dict]:
+    (out / "runs").mkdir(parents=True, exist_ok=True)
     rows: list[dict] = []
     started = time.perf_counter()
+    _write_summary(out, rows, started)
+    try:
+        _figures(out, names, t_end, progress, log, rows, started)
+    except KeyboardInterrupt:  # Ctrl-C / SIGTERM: keep the rows of the finished runs
+        _write_summary(out, rows, started, "interrupted")
+        raise
+    _write_summary(out, rows, started, "ok")
+    return rows
+
+
+def _figures(out, names, t_end, progress, log, rows, started) -> None:
+    cache: dict[tuple, tuple] = {}
     for fig in names:
         spec = FIGURES[fig]
         drawn = []
         for run, style in spec["runs"]:
             if run.key() not in cache:
                 res, model = run_case(run, t_end, progress=progress)
+                if res.status == "interrupted":  # the run caught the signal: stop here too
+                    raise KeyboardInterrupt(f"interrupted during {fig} / {run.label}")
                 cache[run.key()] = (res, model)
                 stem = "_".join(str(k) for k in run.key()).replace(" ", "")
                 res.save_csv(out / "runs" / f"{stem}.csv")
@@ -272,19 +317,27 @@ def reproduce(
                 res = cache[run.key()][0]
                 title = f"Energy balance: {run.label} (residual {res.energy_error():.1e})"
                 savefig(energy_panel(res, title=title), out / f"energy_{run.scheme}.png")
-    return rows
 
 
-def _write_summary(out: Path, rows, started) -> None:
+#: SI units of the numeric fields of a summary row
+_ROW_UNITS = {
+    "h": "s", "alpha": "m/s", "t_end": "s", "first_contact_time": "s", "max_contact_force": "N",
+    "tip_temperature_end": "K", "max_penetration": "m", "impact_dissipation": "J",
+    "energy_error": "-", "cpu_seconds": "s", "wall_seconds": "s", "cpu_per_step_us": "us",
+    "stability_limit": "s (null: unconditionally stable)",
+}  # fmt: skip
+
+
+def _write_summary(out: Path, rows, started, status: str = "running") -> None:
     doc = {
+        "status": status,
         "femrub_version": __version__,
         "python": platform.python_version(),
         "case": asdict(PAPER),
         "alpha_default": ALPHA_DEFAULT,
         "limits": LIMITS,
         "wall_seconds": time.perf_counter() - started,
+        "units": _ROW_UNITS,
         "runs": rows,
     }
-    tmp = out / "summary.json.tmp"
-    tmp.write_text(json.dumps(doc, indent=2, default=float))
-    tmp.replace(out / "summary.json")
+    write_json(out / "summary.json", doc)

@@ -9,8 +9,11 @@ in chunks and post-processed with row-wise products. A chunk is checked before a
 leaves it: a non-finite state or energy created from nothing ends the run with status
 ``"unstable"``, a physical stop limit ``max |s| > bound`` (or ``|P / h| > bound`` for
 ``"contact_force"``) with ``"diverged-physically"``. Only checked states reach the sinks
-(the ``on_state`` callback, e.g. a VTK series, and the stored states); whatever stops a
-run (a check, Ctrl-C, an exception), the rows recorded so far are returned.
+(the ``on_state`` callback, e.g. a VTK series, the ``on_rows`` callback, e.g. a history
+file appended chunk by chunk, and the stored states); whatever stops a run (a check,
+Ctrl-C, SIGTERM, an exception), the rows recorded so far are returned and streamed.
+Per-step arrays of any trailing shape live in :meth:`Recorder.per_step` (one place: the
+streamed chunks and the final :class:`Results` are cut from it).
 """
 
 from __future__ import annotations
@@ -73,6 +76,8 @@ class Recorder:
     limits : physical stop criteria ``{signal name or "contact_force": max |value|}``.
     store_every : keep the full state every that many steps (0: never).
     on_state : callback ``f(State)`` fed each checked state.
+    on_rows : callback ``f(arrays)`` fed each checked block of rows, ``{name: array}`` as
+        :meth:`per_step` gives them (row 0 comes with the first block).
     label : name of the run (progress bar and ``Results.info``).
     """
 
@@ -88,11 +93,15 @@ class Recorder:
         limits: dict[str, float] | None = None,
         store_every: int = 0,
         on_state: Callable | None = None,
+        on_rows: Callable | None = None,
         label: str | None = None,
     ):
         self.model, self.h, self.n, self.scheme = model, h, n_steps, scheme
         self.h_lim, self.label = stability_limit, label
-        self.store_every, self.on_state = store_every, on_state
+        self.store_every, self.on_state, self.on_rows = store_every, on_state, on_rows
+        self._streamed = -1
+        #: further per-step arrays ``(n + 1, ...)`` filled by a stepper (kept and streamed)
+        self.extra: dict[str, np.ndarray] = {}
         N, nc, n = model.n_dofs, model.n_contacts, n_steps
         self.names = list(model.observations)
         self.sizes = [model.observations[k].shape[0] for k in self.names]
@@ -146,6 +155,7 @@ class Recorder:
                     if j == self.chunk or i == n:
                         i_end = self._flush(i0, j)
                         self._deliver(i0, i_end)
+                        self._stream(i_end)
                         bar.update(j)
                         buf[0] = buf[j]
                         i0, j = i, 0
@@ -157,10 +167,15 @@ class Recorder:
                 # the last buffered step may be incomplete: keep the ones before it
                 try:
                     i_end = self._flush(i0, j - 1) if j > 1 else i0
+                    self._deliver(i0, i_end)
                 except _Stop as stop:
                     i_end = self._stopped(stop, i0, j - 1)
+                except KeyboardInterrupt:  # a second signal: keep the checked rows
+                    i_end = i0
+                self._stream(i_end)
             except Exception as exc:  # keep what was computed
                 self.status, self.message = "failed", f"{type(exc).__name__}: {exc}"
+                self._stream(i_end)
             finally:
                 bar.close()
         return self._results(i_end, time.process_time() - cpu0)
@@ -186,7 +201,16 @@ class Recorder:
         unstable = stop.status == "unstable"
         self.message = f"{self.scheme}: {stop.message}" if unstable else stop.message
         self._deliver(i0, min(stop.row, i0 + j))
+        self._stream(stop.row)
         return stop.row
+
+    def _stream(self, last: int) -> None:
+        """Feed ``on_rows`` the rows after the last streamed one, up to ``last``."""
+        if self.on_rows is None or last <= self._streamed:
+            return
+        rows = slice(self._streamed + 1, last + 1)
+        self._streamed = last
+        self.on_rows(self.per_step(rows))
 
     # -- one chunk ------------------------------------------------------------------------
     def _flush(self, i0: int, m: int) -> int:
@@ -235,6 +259,22 @@ class Recorder:
             self.on_state(State(r, self.t[r], X[k], self.imp[r], self.gap[r], gdot[k]))
 
     # -- the collected results -------------------------------------------------------------
+    def per_step(self, rows: slice) -> dict[str, np.ndarray]:
+        """Every per-step array for ``rows``, by name, in the order of the history columns."""
+        out = {"t": self.t[rows]}
+        col = 0
+        for name, size in zip(self.names, self.sizes):
+            out[name] = self.obs[rows, col : col + size]
+            col += size
+        if self.model.n_contacts:
+            out["gap"] = self.gap[rows]
+            out["contact_force"] = self.imp[rows] / self.h
+            out["contact_impulse"] = self.imp[rows]
+        out.update({k: v[rows] for k, v in self.extra.items()})
+        if self.meter is not None:
+            out.update({k: v[rows] for k, v in self.meter.data.items()})
+        return out
+
     def _results(self, i_end: int, cpu_seconds: float) -> Results:
         m = i_end + 1
         signals, col = {}, 0
@@ -263,6 +303,7 @@ class Recorder:
             states=states,
             state_times=times,
             info={"label": self.label, "stability_limit": self.h_lim, "n_dofs": self.model.n_dofs},
+            extra={k: v[:m].copy() for k, v in self.extra.items()},
         )
 
 

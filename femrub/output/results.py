@@ -11,18 +11,25 @@ opposite), ``heat_content`` (J above ambient), ``friction_heat`` (Σ α × impul
 ``heat_load``, ``heat_outflow`` (through the boundaries), and the balance residuals
 ``energy_error = E − E0 − (external + thermal + damping + contact work)`` and
 ``heat_error = Q − Q0 − (friction_heat + heat_load − heat_outflow)``.
+
+Per-step arrays of any trailing shape (``extra``, e.g. per-contact vectors) are flattened
+into CSV columns by :func:`flatten_columns`; every CSV header carries its unit
+(``t [s]``, :data:`UNITS`) and ``history.npz["meta"]`` holds the same units.
 """
 
 from __future__ import annotations
 
 import csv
 import json
+import os
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
-__all__ = ["Results", "ENERGY_KEYS"]
+from .jsonfile import jsonable
+
+__all__ = ["ENERGY_KEYS", "UNITS", "Results", "csv_header", "flatten_columns", "unit_of"]
 
 ENERGY_KEYS = (
     "kinetic",
@@ -39,6 +46,65 @@ ENERGY_KEYS = (
     "energy_error",
     "heat_error",
 )
+
+#: units of the per-step arrays (SI); energy terms are in J
+UNITS = {
+    "t": "s",
+    "tip_displacement": "m",
+    "contact_displacement": "m",
+    "tip_velocity": "m/s",
+    "tip_temperature": "K",
+    "contact_temperature": "K",
+    "gap": "m",
+    "gap_velocity": "m/s",
+    "impulse": "N s",
+    "contact_impulse": "N s",
+    "normal_force": "N",
+    "contact_force": "N",
+    "friction_force": "N",
+    "slip_velocity": "m/s",
+    "contact_state": "-",
+    "states": "SI (m, m/s, K by dof)",
+    "state_times": "s",
+    **{k: "J" for k in ENERGY_KEYS},
+}
+
+
+def unit_of(name: str) -> str:
+    """SI unit of a per-step array (``"-"`` when unknown or dimensionless)."""
+    for prefix in ("signal_", "energy_"):
+        if name.startswith(prefix) and name[len(prefix) :] in UNITS:
+            return UNITS[name[len(prefix) :]]
+    return UNITS.get(name, "-")
+
+
+def flatten_columns(arrays: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
+    """One 1D column per component: ``(rows,)`` and ``(rows, 1)`` keep their name,
+    ``(rows, k)`` gives ``name_j`` and ``(rows, k, m, ...)`` gives ``name_j_i...``."""
+    cols = {}
+    for name, arr in arrays.items():
+        a = np.asarray(arr)
+        if a.ndim == 1:
+            cols[name] = a
+            continue
+        flat = a.reshape(a.shape[0], -1)
+        if flat.shape[1] == 1 and a.ndim == 2:
+            cols[name] = flat[:, 0]
+            continue
+        for idx in np.ndindex(*a.shape[1:]):
+            cols[name + "".join(f"_{i}" for i in idx)] = a[(slice(None), *idx)]
+    return cols
+
+
+def csv_header(columns, units: dict[str, str]) -> list[str]:
+    """Header cells ``"name [unit]"`` of flattened ``columns`` (``units`` by array name)."""
+    out = []
+    for col in columns:
+        base = col
+        while base not in units and "_" in base and base.rsplit("_", 1)[1].isdigit():
+            base = base.rsplit("_", 1)[0]
+        out.append(f"{col} [{units.get(base, unit_of(base))}]")
+    return out
 
 
 @dataclass
@@ -66,6 +132,8 @@ class Results:
     states: np.ndarray | None = None
     state_times: np.ndarray | None = None
     info: dict = field(default_factory=dict)
+    extra: dict[str, np.ndarray] = field(default_factory=dict)
+    warnings: list[str] = field(default_factory=list)
 
     @property
     def force(self) -> np.ndarray:
@@ -116,31 +184,35 @@ class Results:
         )
         return float(np.max(np.abs(e["heat_error"])) / scale) if scale > 0 else 0.0
 
+    def per_step(self) -> dict[str, np.ndarray]:
+        """Every per-step array by name (rows = times), before flattening."""
+        arrays = {"t": self.t, **self.signals}
+        if self.impulse.shape[1]:
+            arrays.update(gap=self.gap, contact_force=self.force, contact_impulse=self.impulse)
+        arrays.update(self.extra)
+        arrays.update(self.energy)
+        return arrays
+
     def columns(self) -> dict[str, np.ndarray]:
-        """Flat table: time, every signal component, gap, force, impulse, energy."""
-        cols = {"t": self.t}
-        for name, arr in self.signals.items():
-            if arr.shape[1] == 1:
-                cols[name] = arr[:, 0]
-            else:
-                for j in range(arr.shape[1]):
-                    cols[f"{name}_{j}"] = arr[:, j]
-        nc = self.impulse.shape[1]
-        for j in range(nc):
-            sfx = "" if nc == 1 else f"_{j}"
-            cols[f"gap{sfx}"] = self.gap[:, j]
-            cols[f"contact_force{sfx}"] = self.force[:, j]
-            cols[f"contact_impulse{sfx}"] = self.impulse[:, j]
-        cols.update(self.energy)
-        return cols
+        """Flat table: time, every signal component, gap, force, impulse, extra, energy."""
+        return flatten_columns(self.per_step())
+
+    def units(self) -> dict[str, str]:
+        """SI unit of every ``history.npz`` array, by key."""
+        names = ["t", "gap", "impulse", "normal_force", *[f"signal_{k}" for k in self.signals]]
+        names += list(self.extra)
+        names += [f"energy_{k}" for k in self.energy]
+        return {k: unit_of(k) for k in names}
 
     def save_csv(self, path) -> Path:
         path = Path(path)
         cols = self.columns()
-        with path.open("w", newline="") as fh:
+        tmp = path.with_name(path.name + ".tmp")
+        with tmp.open("w", newline="") as fh:
             w = csv.writer(fh)
-            w.writerow(list(cols))
+            w.writerow(csv_header(cols, UNITS))
             w.writerows(np.column_stack(list(cols.values())).tolist())
+        os.replace(tmp, path)
         return path
 
     def save_npz(self, path) -> Path:
@@ -153,20 +225,25 @@ class Results:
             "steps": self.steps,
             "cpu_seconds": self.cpu_seconds,
             "info": self.info,
+            "warnings": self.warnings,
+            "units": self.units(),
         }
         arrays = {f"signal_{k}": v for k, v in self.signals.items()}
+        arrays.update(self.extra)
         arrays.update({f"energy_{k}": v for k, v in self.energy.items()})
         if self.states is not None:
             arrays["states"], arrays["state_times"] = self.states, self.state_times
+        tmp = path.with_name(path.name + ".tmp.npz")
         np.savez_compressed(
-            path,
+            tmp,
             t=self.t,
             gap=self.gap,
             impulse=self.impulse,
             normal_force=self.force,
-            meta=json.dumps(meta, default=str),
+            meta=json.dumps(jsonable(meta), allow_nan=False),
             **arrays,
         )
+        os.replace(tmp, path)
         return path
 
     @classmethod
@@ -177,6 +254,12 @@ class Results:
             energy = {k[7:]: d[k] for k in d.files if k.startswith("energy_")}
             states = d["states"] if "states" in d.files else None
             stimes = d["state_times"] if "state_times" in d.files else None
+            known = {"t", "gap", "impulse", "normal_force", "meta", "states", "state_times"}
+            extra = {
+                k: d[k]
+                for k in d.files
+                if k not in known and not k.startswith(("signal_", "energy_"))
+            }
             return cls(
                 scheme=meta["scheme"],
                 h=meta["h"],
@@ -192,4 +275,6 @@ class Results:
                 states=states,
                 state_times=stimes,
                 info=meta.get("info", {}),
+                extra=extra,
+                warnings=meta.get("warnings", []),
             )

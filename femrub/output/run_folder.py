@@ -5,51 +5,36 @@
 impulses, energy balance), ``summary.json`` (inputs, versions, timings, energy balance,
 status), ``signals.png`` and, when a :class:`~femrub.model.rub.FieldMap` is given, ``vtk/``
 (``.pvd`` + ``.vtu``, written as the run goes) and ``snapshot.png``. A run that is
-interrupted or fails keeps everything written so far and says so in ``summary.json``.
-A finished result (status ok, unstable or diverged-physically) is not overwritten unless
+interrupted (Ctrl-C or SIGTERM) or fails keeps everything written so far and says so in
+``summary.json``: ``history.csv`` is appended block by block as the run goes
+(:class:`~femrub.output.history_file.HistoryCSV`), each VTK frame is complete or absent,
+and the final files are written with signals held back (:func:`~femrub.output.interrupts.
+deferred`). The folder is claimed first (:func:`~femrub.output.folder.claim`: writable,
+locked, not another command's folder); a finished result (status ok, inaccurate, unstable
+or diverged-physically) or an unreadable summary is not overwritten unless
 ``overwrite=True``; an interrupted or failed one is simply run again.
 """
 
 from __future__ import annotations
 
-import json
 import platform
 import time
+from contextlib import nullcontext
 from pathlib import Path
 
 import numpy as np
 
 from .. import __version__
+from .folder import ResultExists, claim
+from .history_file import HistoryCSV
+from .interrupts import deferred, interruptible
+from .jsonfile import write_json as _write_json
 from .plots import savefig, tip_panels
 
 __all__ = ["STAGES", "run_to_folder", "ResultExists"]
 
 #: Pipeline stages timed in ``summary.json["timings"]`` (seconds).
 STAGES = ("mesh", "assembly", "reduction", "stepping", "output")
-
-
-class ResultExists(FileExistsError):
-    """The output folder already holds a finished result."""
-
-
-def _jsonable(x):
-    if isinstance(x, dict):
-        return {str(k): _jsonable(v) for k, v in x.items()}
-    if isinstance(x, list | tuple):
-        return [_jsonable(v) for v in x]
-    if isinstance(x, np.ndarray):
-        return x.tolist()
-    if isinstance(x, np.generic):
-        return x.item()
-    if isinstance(x, float | int | str | bool) or x is None:
-        return x
-    return str(x)
-
-
-def _write_json(path: Path, doc: dict) -> None:
-    tmp = path.with_suffix(".json.tmp")
-    tmp.write_text(json.dumps(_jsonable(doc), indent=2))
-    tmp.replace(path)
 
 
 def run_to_folder(
@@ -68,6 +53,8 @@ def run_to_folder(
     timings: dict | None = None,
     n_full: int | None = None,
     rotation_speed: float = 0.0,
+    merge_time: float | None = None,
+    claimed: bool = False,
     reduction_error: dict | None = None,
 ):
     """Run ``stepper`` to ``t_end`` and write the results folder ``out`` (module docstring).
@@ -76,22 +63,27 @@ def run_to_folder(
     ``reduction``); ``summary.json["timings"]`` adds ``stepping`` (the run without the
     output it streams) and ``output`` (VTK frames, histories, plots). ``n_full``: state dofs
     of the full model when ``stepper.model`` is reduced; ``rotation_speed`` (rad/s) counts the
-    ``revolutions`` reached. ``reduction_error``: the estimate of a reduced run
-    (:mod:`femrub.reduction.estimate`, with its ``tolerance``), written as
-    ``summary.json["reduction_error"]``; a run that would be ``ok`` ends ``"inaccurate"``
-    when the estimate exceeds the tolerance (results kept). Returns the
+    ``revolutions`` reached; ``merge_time`` (s) enables the resolution check
+    (:func:`~femrub.output.verdict.assess`); ``claimed``: the caller already holds
+    :func:`~femrub.output.folder.claim` on ``out``. ``reduction_error``: the estimate of a
+    reduced run (:mod:`femrub.reduction.estimate`, with its ``tolerance``), written as
+    ``summary.json["reduction_error"]`` and judged by the ``reduction`` rule of
+    :mod:`~femrub.output.verdict` (``inaccurate`` above the tolerance). Returns the
     :class:`~femrub.output.results.Results`.
     """
     out = Path(out)
+    with nullcontext() if claimed else claim(out, "run", overwrite=overwrite):
+        return _run(
+            stepper, t_end, out, fields, vtk_stride, inputs, limits, progress, snapshot, plots,
+            timings, n_full, rotation_speed, merge_time, reduction_error,
+        )  # fmt: skip
+
+
+def _run(
+    stepper, t_end, out, fields, vtk_stride, inputs, limits, progress, snapshot, plots, timings,
+    n_full, rotation_speed, merge_time, reduction_error,
+):  # fmt: skip
     summary_path = out / "summary.json"
-    if summary_path.exists() and not overwrite:
-        prev = json.loads(summary_path.read_text()).get("status")
-        if prev not in (None, "running", "interrupted", "failed"):
-            raise ResultExists(
-                f"{out} already holds a finished result (status {prev}); "
-                "use another folder or --overwrite"
-            )
-    out.mkdir(parents=True, exist_ok=True)
     model = stepper.model
     doc = {
         "femrub_version": __version__,
@@ -106,18 +98,46 @@ def run_to_folder(
         "inputs": inputs or {},
         "status": "running",
     }
+    if reduction_error is not None:
+        doc["reduction_error"] = reduction_error
     _write_json(summary_path, doc)
     series = None
     if fields is not None and vtk_stride:
         from .vtk import VTKSeries
 
         series = VTKSeries(out / "vtk", model, fields, h=stepper.h, stride=vtk_stride)
+    for stale in ("history.csv", "history.npz", "signals.png", "snapshot.png"):
+        (out / stale).unlink(missing_ok=True)  # results of an earlier, unfinished run
+    history = HistoryCSV(out / "history.csv")
     t0 = time.perf_counter()
-    res = stepper.run(t_end, progress=progress, limits=limits, on_state=series)
+    try:
+        with interruptible():
+            res = stepper.run(
+                t_end, progress=progress, limits=limits, on_state=series, on_rows=history,
+                merge_time=merge_time,
+                tolerances={"reduction": reduction_error} if reduction_error else None,
+            )  # fmt: skip
+    except KeyboardInterrupt:  # before the recorder took over: say so, keep the folder
+        _write_json(summary_path, {**doc, "status": "interrupted", "message": "interrupted"})
+        raise
+    finally:
+        history.close()
     wall = time.perf_counter() - t0
+    with deferred():
+        return _finish(
+            stepper, res, out, doc, series, history, wall, snapshot, plots, timings,
+            rotation_speed, summary_path,
+        )  # fmt: skip
+
+
+def _finish(
+    stepper, res, out, doc, series, history, wall, snapshot, plots, timings, rotation_speed,
+    summary_path,
+):  # fmt: skip
     vtk_wall, vtk_cpu = (series.seconds, series.cpu_seconds) if series is not None else (0.0, 0.0)
     t_out = time.perf_counter()
-    res.save_csv(out / "history.csv")
+    if history.rows != len(res.t):
+        res.save_csv(out / "history.csv")
     res.save_npz(out / "history.npz")
     panels = [k for k in ("tip_displacement", "tip_temperature") if k in res.signals]
     if plots:
@@ -136,14 +156,6 @@ def run_to_folder(
             snapshot_png(series.dir / series.frames[-1][1], out / "snapshot.png")
         except Exception as exc:  # rendering is optional (no OpenGL on the machine)
             doc["snapshot_error"] = f"{type(exc).__name__}: {exc}"
-    if reduction_error and res.status == "ok":
-        est, tol = reduction_error.get("estimate", 0.0), reduction_error.get("tolerance", np.inf)
-        if not est <= tol:
-            res.status = "inaccurate"
-            res.message = (
-                f"estimated reduction error {100 * est:.3g} % exceeds reduction.tolerance "
-                f"{100 * tol:.3g} %: raise the reduction sizes or use reduction.method = 'auto'"
-            )
     e = res.energy
     stepping_cpu = max(res.cpu_seconds - vtk_cpu, 0.0)
     omega = float(rotation_speed)
@@ -164,12 +176,12 @@ def run_to_folder(
         max_contact_force=float(res.force.max()) if res.force.size else 0.0,
         energy_error=res.energy_error(),
         heat_error=res.heat_error(),
+        warnings=list(res.warnings),
+        units=res.units(),
         energy={k: float(v[-1]) for k, v in e.items()} if e else {},
         vtk=str(series.pvd_path.relative_to(out)) if series is not None else None,
         vtk_frames=len(series.frames) if series is not None else 0,
     )
-    if reduction_error is not None:
-        doc["reduction_error"] = reduction_error
     for name, arr in res.signals.items():
         doc.setdefault("signals_max_abs", {})[name] = float(np.abs(arr).max()) if arr.size else 0.0
     _write_json(summary_path, doc)

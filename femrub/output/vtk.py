@@ -5,8 +5,11 @@ maps the state to the full mesh (``model.to_full``, which a reduced model compos
 reduction basis) and writes one ``.vtu`` with point data ``displacement`` (m, vector),
 ``velocity`` (m/s), ``temperature`` (K above ambient), ``contact_force`` (N, vector, at the
 contact vertices) and cell data ``von_mises`` (Pa, at the tetrahedron centroid). The
-``.pvd`` index is rewritten (atomically) after every file, so a run that crashes or is
-interrupted stays viewable up to its last frame.
+``.pvd`` index is rewritten (atomically) after every file, and every ``.vtu`` is written to
+a temporary name and renamed when complete, so a run that crashes or is interrupted stays
+viewable up to its last frame and never leaves a half-written frame. Frames of an earlier
+run in the same folder are removed when a series starts. Both files state the units of
+their fields (an XML comment ``femrub units: ...``; :data:`FIELD_UNITS`).
 """
 
 from __future__ import annotations
@@ -21,7 +24,21 @@ import numpy as np
 
 from ..model.rub import FieldMap
 
-__all__ = ["VTKSeries", "von_mises", "snapshot_png"]
+__all__ = ["FIELD_UNITS", "VTKSeries", "von_mises", "snapshot_png"]
+
+#: SI units of the point and cell data of every frame
+FIELD_UNITS = {
+    "displacement": "m",
+    "velocity": "m/s",
+    "temperature": "K above ambient",
+    "contact_force": "N",
+    "von_mises": "Pa",
+}
+_UNITS_COMMENT = (
+    "<!-- femrub units: "
+    + ", ".join(f"{k} [{v}]" for k, v in FIELD_UNITS.items())
+    + " ; time in s -->"
+)
 
 
 def von_mises(fields: FieldMap, u_all: np.ndarray) -> np.ndarray:
@@ -63,6 +80,8 @@ class VTKSeries:
         self.dir = Path(directory)
         self.dir.mkdir(parents=True, exist_ok=True)
         self.model, self.fields, self.stride, self.name = model, fields, int(stride), name
+        for stale in [*self.dir.glob(f"{name}_*.vtu"), *self.dir.glob("*.tmp"), self.pvd_path]:
+            stale.unlink(missing_ok=True)  # frames of an earlier run: not this run's
         self.h = float(h)
         self.frames: list[tuple[float, str]] = []
         self.seconds = self.cpu_seconds = 0.0
@@ -116,11 +135,15 @@ class VTKSeries:
         point_data["contact_force"] = force
         cell_data = {"von_mises": [von_mises(self.fields, u)]}
         fname = f"{self.name}_{len(self.frames):06d}.vtu"
+        tmp = self.dir / f"{fname}.tmp"
         meshio.write(
-            self.dir / fname,
+            tmp,
             meshio.Mesh(self._points, self._cells, point_data=point_data, cell_data=cell_data),
+            file_format="vtu",
             binary=True,
         )
+        _add_units_comment(tmp)
+        os.replace(tmp, self.dir / fname)
         self.frames.append((float(state.t), fname))
         self._write_pvd()
         return self.dir / fname
@@ -129,6 +152,7 @@ class VTKSeries:
         lines = [
             '<?xml version="1.0"?>',
             '<VTKFile type="Collection" version="0.1">',
+            _UNITS_COMMENT,
             "<Collection>",
         ]
         for t, f in self.frames:
@@ -137,6 +161,13 @@ class VTKSeries:
         tmp = self.pvd_path.with_suffix(".pvd.tmp")
         tmp.write_text("\n".join(lines))
         os.replace(tmp, self.pvd_path)
+
+
+def _add_units_comment(path: Path) -> None:
+    """Insert :data:`_UNITS_COMMENT` after the XML declaration of a ``.vtu`` file."""
+    data = path.read_bytes()
+    end = data.find(b"?>") + 2 if data.startswith(b"<?xml") else 0
+    path.write_bytes(data[:end] + b"\n" + _UNITS_COMMENT.encode() + data[end:])
 
 
 def snapshot_png(vtu_path, png_path, *, scalars: str = "temperature", warp: float | None = None):

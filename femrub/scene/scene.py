@@ -117,9 +117,14 @@ def loads_scene(text: str, source: str = "<string>", base_dir=None) -> Scene:
     """Parse and validate TOML text; relative paths start at ``base_dir`` (default cwd)."""
     try:
         doc = tomllib.loads(text)
+        data = normalize(doc)
     except tomllib.TOMLDecodeError as exc:
         raise SceneError(f"{source}: not valid TOML: {exc}") from None
-    return Scene(normalize(doc), source, Path(base_dir) if base_dir else Path.cwd())
+    except RecursionError:
+        raise SceneError(
+            f"{source}: tables nested too deeply (a scene needs at most 3 levels)"
+        ) from None
+    return Scene(data, source, Path(base_dir) if base_dir else Path.cwd())
 
 
 def _builtin_dir():
@@ -187,3 +192,5 @@ def parse_value(text: str):
         return tomllib.loads(f"v = {text}")["v"]
     except tomllib.TOMLDecodeError:
         return text
+    except RecursionError:
+        raise SceneError(f"value {text[:40]!r}...: nested too deeply") from None

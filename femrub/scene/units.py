@@ -3,7 +3,9 @@
 A quantity is either a plain number in the SI unit of its dimension (``15e-6`` for a
 length in m) or a string ``"<number> <unit>"`` (``"15 um"``, ``"2000 rpm"``, ``"110 GPa"``).
 Angles are the one exception to "plain numbers are SI": like gmsh and CAD tools, a plain
-angle is in degrees (``"0.35 rad"`` is accepted too). :func:`to_si` converts and raises a
+angle is in degrees (``"0.35 rad"`` is accepted too). A string must carry its unit: a
+quoted number without one (``clearance = "15"``) is refused, since its writer most likely
+meant a unit other than SI. :func:`to_si` converts and raises a
 one-line :class:`ValueError` naming the allowed units otherwise.
 """
 
@@ -96,6 +98,12 @@ def to_si(value, dim: str) -> float:
         raise ValueError(f"expected a number or '<number> <unit>' with unit in {allowed}")
     number, unit = float(match.group(1)), match.group(2)
     if not unit:
+        if units and dim != "angle":  # "15" in quotes is a unit slip, not 15 m
+            si = SI_LABEL[dim]
+            raise ValueError(
+                f"{value!r} is a string without a unit: write '{match.group(1)} {si}' with "
+                f"the intended unit ({allowed}) or a plain number in {si}"
+            )
         return number
     if unit not in units:
         raise ValueError(f"unit {unit!r} is not a unit of {dim.replace('_', ' ')}; use {allowed}")

@@ -12,6 +12,7 @@ import copy
 import os
 from pathlib import Path
 
+from .bounds import check_physical
 from .schema import SCHEMA, TOP
 from .spec import REQUIRED, SceneError, Variant, fail, unknown_key
 
@@ -79,6 +80,7 @@ def _table(prefix: str, value, spec) -> dict:
             out[k] = _table(dotted, value.get(k, {}), s)
         elif k in value:
             out[k] = s.check(dotted, value[k])
+            check_physical(dotted, s, out[k])
         elif s.default is REQUIRED:
             unit = f" in {s.unit}" if s.unit != "-" else ""
             raise SceneError(f"{dotted} is required{where}: {s.doc}{unit}")
@@ -196,6 +198,13 @@ def _cross_check(d: dict) -> None:
                 f"no such signal for geometry.kind = {kind!r}; limits apply to {', '.join(known)}",
             )
     _check_damping(physics)
+    if scheme["name"] in ("carpenter", "penalty") and contact["restitution"] > 0.0:
+        fail(
+            "contact.restitution",
+            contact["restitution"],
+            f"scheme.name = {scheme['name']!r} models perfectly plastic impacts only; "
+            "use scheme.name = 'theta' or contact.restitution = 0",
+        )
     h, t_end = scheme["h"], scheme["t_end"]
     if t_end < h:
         fail("scheme.t_end", t_end, f"must be >= scheme.h = {h:g} s")

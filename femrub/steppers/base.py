@@ -7,7 +7,10 @@ new state and the contact impulses); the public ``step()`` returns the new :clas
 :class:`~femrub.output.recorder.Recorder`, which collects the
 :class:`~femrub.output.results.Results` (energy balance, progress bar, physical stop criteria,
 protection against numerical blow-up). Whatever stops a run (instability, a stop criterion,
-Ctrl-C, an exception), ``run()`` returns what was computed so far.
+Ctrl-C, SIGTERM, an exception), ``run()`` returns what was computed so far; a run the
+recorder ends as ``ok`` is then judged by :func:`femrub.output.verdict.assess` (balance
+tolerances -> ``inaccurate``, resolution warnings). Every stepper refuses a model that
+starts inside the casing (initial penetration) and a run longer than :data:`MAX_STEPS`.
 """
 
 from __future__ import annotations
@@ -19,8 +22,13 @@ import numpy as np
 from ..model.first_order import FirstOrderModel
 from ..output.recorder import Recorder, State
 from ..output.results import Results
+from ..output.verdict import assess
+from ..scene.validate import MAX_STEPS
 
-__all__ = ["State", "Stepper", "check_step"]
+__all__ = ["MAX_STEPS", "PENETRATION_TOLERANCE", "State", "Stepper", "check_step"]
+
+#: initial gaps below minus this (m) are an initial penetration
+PENETRATION_TOLERANCE = 1e-12
 
 
 def check_step(h, t_end=None) -> float:
@@ -54,7 +62,32 @@ class Stepper:
         nc = model.n_contacts
         self.impulse = np.zeros(nc)
         self._h_lim = None
+        self._check_initial_gap()
         self._setup()
+
+    def _check_initial_gap(self) -> None:
+        """Refuse a model that starts inside the casing (no scheme can undo it honestly)."""
+        c = self.model.contact
+        if c is None:
+            return
+        g = np.asarray(c.gap(self.t, self.X), dtype=float)
+        if g.size and g.min() < -PENETRATION_TOLERANCE:
+            i = int(np.argmin(g))
+            raise ValueError(
+                f"initial penetration: contact {i} starts {-g[i]:.3g} m inside the casing at "
+                f"t = {self.t:g} s ({int(np.sum(g < -PENETRATION_TOLERANCE))} contact(s)); "
+                "increase the clearance or move the casing (contact.casing.phase)"
+            )
+
+    def _refuse_restitution(self) -> None:
+        """For schemes that model a perfectly plastic impact only (e = 0)."""
+        c = self.model.contact
+        e = float(getattr(c, "restitution", 0.0) or 0.0) if c is not None else 0.0
+        if e > 0.0:
+            raise ValueError(
+                f"{self.name} does not model Newton's restitution (contact.restitution = "
+                f"{e:g}); use scheme.name = 'theta' or contact.restitution = 0"
+            )
 
     # -- to be implemented by subclasses ---------------------------------------------------
     def _setup(self) -> None:
@@ -98,7 +131,13 @@ class Stepper:
     def steps_to(self, t_end: float) -> int:
         """Number of steps from the current time to ``t_end`` (validated)."""
         check_step(self.h, t_end)
-        return int(round((t_end - self.t) / self.h))
+        n = int(round((t_end - self.t) / self.h))
+        if n > MAX_STEPS:
+            raise ValueError(
+                f"h = {self.h:g} s to t_end = {t_end:g} s gives {n:.3g} steps; at most "
+                f"{MAX_STEPS:.0e} allowed (raise h or lower t_end)"
+            )
+        return n
 
     def iterate(self, t_end: float):
         """Yield the initial state, then the state after every step until ``t_end``."""
@@ -116,7 +155,10 @@ class Stepper:
         energy: bool = True,
         store_every: int = 0,
         on_state=None,
+        on_rows=None,
         label: str | None = None,
+        tolerances: dict | None = None,
+        merge_time: float | None = None,
     ) -> Results:
         """Integrate to ``t_end`` and collect :class:`~femrub.output.results.Results`.
 
@@ -131,7 +173,11 @@ class Stepper:
             blow-up (energy created from nothing).
         store_every : keep the full state every that many steps (0: never).
         on_state : callback ``f(state)`` after each step (e.g. streaming VTK output).
+        on_rows : callback ``f(arrays)`` per checked block of rows (e.g. a streamed history).
         label : name of the run (progress bar and ``Results.info``).
+        tolerances, merge_time : see :func:`femrub.output.verdict.assess` (balance
+            tolerances; contact impulses closer than ``merge_time`` s form one episode of
+            the resolution check, ``None``: no check).
         """
         recorder = Recorder(
             self.model,
@@ -143,6 +189,8 @@ class Stepper:
             limits=limits,
             store_every=store_every,
             on_state=on_state,
+            on_rows=on_rows,
             label=label,
         )
-        return recorder.record(self.state, self._advance, progress=progress)
+        res = recorder.record(self.state, self._advance, progress=progress)
+        return assess(res, tolerances=tolerances, merge_time=merge_time)

@@ -22,6 +22,9 @@ The scheme is conditionally stable: ``h < 2 / ω_max`` for the mechanical part a
 both from sparse eigen-solvers, once per stepper, and ``run()`` reports
 ``status = "unstable"`` above it (and stops on blow-up, keeping what it computed) instead of
 returning NaN.
+
+Impacts are perfectly plastic: a restitution coefficient ``e > 0`` is refused (``ValueError``)
+rather than silently ignored.
 """
 
 from __future__ import annotations
@@ -46,6 +49,7 @@ class Carpenter(Stepper):
 
     def _setup(self):
         m, h, L = self.model, self.h, self.model.layout
+        self._refuse_restitution()
         A = m.A.tocsc()
         self._diagA = None
         if (A - sp.diags(A.diagonal())).count_nonzero() == 0:

@@ -14,6 +14,9 @@ event handling would. The accumulated impulse ``∫ λ dt`` is integrated with t
 the contact impulse per output step is exact to the solver tolerance. Output is on the
 uniform grid ``t_k = k h`` like the other steppers; ``h`` is the output step, not the
 integrator's (adaptive) step.
+
+Impacts are perfectly plastic: a restitution coefficient ``e > 0`` is refused (``ValueError``)
+rather than silently ignored.
 """
 
 from __future__ import annotations
@@ -74,6 +77,7 @@ class Penalty(Stepper):
 
     def _setup(self):
         m = self.model
+        self._refuse_restitution()
         self._lu = Factorised(m.A, what="matrix A")
         self._B = compact(m.B)
         self._AinvB = self._lu.solve(m.B.toarray()) if self._lu.dense else None

@@ -1,0 +1,138 @@
+"""The one place where a finished run's status is decided after the recorder's checks.
+
+The recorder ends a run as ``unstable`` (blow-up), ``diverged-physically`` (a stop limit),
+``interrupted`` or ``failed``. A run it ends as ``ok`` is then judged here, rule by rule
+(:data:`RULES`); the first rule that fires sets the status and the message. Each rule is
+``rule(results, tolerances) -> message or None``:
+
+* ``energy_balance``: the mechanical balance residual relative to the energy scale of the
+  run (``Results.energy_error``) exceeds ``tolerances["energy"]`` -> ``"inaccurate"``;
+* ``heat_balance``: the same for the heat balance and ``tolerances["heat"]``;
+* ``reduction``: the a-posteriori estimate of a reduced run, ``tolerances["reduction"]``
+  (the dict of :func:`femrub.reduction.estimate.estimate` with its ``tolerance``, as
+  ``summary.json["reduction_error"]``), above its tolerance -> ``"inaccurate"``.
+
+Warnings do not change the status; they are listed in ``Results.warnings`` (and
+``summary.json["warnings"]``):
+
+* ``resolution``: contact episodes (impulses less than ``merge_time`` apart form one
+  episode) resolved by fewer than :data:`MIN_CONTACT_STEPS` steps (median over the
+  episodes); the warning names the step that would resolve them.
+
+A new rule (e.g. the reduction error of a reduced model) is a function appended to
+:data:`RULES`.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+__all__ = [
+    "MIN_CONTACT_STEPS",
+    "RULES",
+    "STATUSES",
+    "TOLERANCES",
+    "assess",
+    "resolution_warning",
+]
+
+#: every status a run can end with
+STATUSES = ("ok", "inaccurate", "unstable", "diverged-physically", "interrupted", "failed")
+#: default tolerances of the balance residuals (relative to the run's energy / heat scale)
+TOLERANCES = {"energy": 0.05, "heat": 0.05}
+#: fewest steps per contact episode (median) before a resolution warning
+MIN_CONTACT_STEPS = 20
+
+
+def _balance(kind: str):
+    def rule(res, tol):
+        err = res.energy_error() if kind == "energy" else res.heat_error()
+        bound = tol.get(kind)
+        if bound is None or not math.isfinite(err) or err <= bound:
+            return None
+        return (
+            f"{kind} balance residual {err:.3g} exceeds the tolerance {bound:g} "
+            "(relative to the run's scale): refine the time step or enlarge the reduced basis"
+        )
+
+    rule.__name__ = f"{kind}_balance"
+    return rule
+
+
+def reduction(res, tol):
+    """The reduced model's estimated error exceeds ``reduction.tolerance`` (issue 11)."""
+    err = tol.get("reduction")
+    if not err:
+        return None
+    est, bound = err.get("estimate", 0.0), err.get("tolerance")
+    if bound is None or est <= bound:
+        return None
+    return (
+        f"estimated reduction error {100 * est:.3g} % exceeds reduction.tolerance "
+        f"{100 * bound:.3g} %: raise the reduction sizes or use reduction.method = 'auto'"
+    )
+
+
+#: status rules applied in order to a run the recorder ended as ``ok``
+RULES = [_balance("energy"), _balance("heat"), reduction]
+
+
+def _episodes(res, merge_time: float) -> list[int]:
+    """Steps spanned by each contact episode (impulses less than ``merge_time`` apart)."""
+    on = np.flatnonzero(np.any(res.impulse > 0.0, axis=1)) if res.impulse.size else []
+    if len(on) == 0:
+        return []
+    gap_steps = max(1, int(round(merge_time / res.h)))
+    breaks = np.flatnonzero(np.diff(on) > gap_steps)
+    starts = np.r_[on[0], on[breaks + 1]]
+    ends = np.r_[on[breaks], on[-1]]
+    last = len(res.t) - 1
+    return [int(e - s + 1) for s, e in zip(starts, ends) if e < last]  # cut-off one dropped
+
+
+def resolution_warning(res, merge_time: float | None) -> str | None:
+    """Warning when contact episodes are resolved by too few steps (module docstring)."""
+    if merge_time is None or not merge_time > 0:
+        return None
+    steps = _episodes(res, merge_time)
+    if not steps:
+        return None
+    median = float(np.median(steps))
+    if median >= MIN_CONTACT_STEPS:
+        return None
+    h_needed = res.h * median / MIN_CONTACT_STEPS
+    e = math.floor(math.log10(h_needed))
+    h_text = f"{math.floor(h_needed / 10**e) * 10**e:.1g}"
+    return (
+        f"contact episodes are resolved by {median:.0f} steps (median of {len(steps)}); "
+        f"results may be off by tens of percent: use scheme.h <= {h_text} s "
+        f"(>= {MIN_CONTACT_STEPS} steps per episode)"
+    )
+
+
+def assess(res, *, tolerances: dict | None = None, merge_time: float | None = None):
+    """Judge a run in place: status rules (``ok`` -> ``inaccurate``) and warnings.
+
+    Parameters
+    ----------
+    res : :class:`~femrub.output.results.Results`.
+    tolerances : ``{"energy": ..., "heat": ...}`` overriding :data:`TOLERANCES` (``None``
+        as a value switches a rule off); ``"reduction"``: the error estimate of a reduced
+        run (with its ``tolerance``).
+    merge_time : impulses closer than this (s) form one contact episode; ``None`` skips
+        the resolution check.
+    """
+    tol = {**TOLERANCES, **(tolerances or {})}
+    if res.status == "ok":
+        for rule in RULES:
+            why = rule(res, tol)
+            if why:
+                res.status, res.message = "inaccurate", why
+                break
+    if res.status in ("ok", "inaccurate"):
+        warn = resolution_warning(res, merge_time)
+        if warn:
+            res.warnings.append(warn)
+    return res
