@@ -78,8 +78,9 @@ def test_fig4_reduced_models(summary):
     rm2 = _row(summary, "fig4", "RM2 (n_uv = 2, n_θ = 5)")
     assert (full["n_dofs"], rm1["n_dofs"], rm2["n_dofs"]) == (60, 18, 10)
     for rm in (rm1, rm2):
-        # their energy balance residual (~0.8) is far above the tolerance: not "ok"
-        assert rm["status"] == "inaccurate" and "energy balance" in rm["message"]
+        # the paper's boundary construction loses heat (heat balance residual RM1 ~6 %, RM2
+        # ~35 %; its energy balance closes since issue 11 counts the expansion jumps): not ok
+        assert rm["status"] == "inaccurate" and "heat balance" in rm["message"]
         assert rm["tip_temperature_end"] == pytest.approx(full["tip_temperature_end"], rel=0.1)
         assert rm["max_contact_force"] == pytest.approx(full["max_contact_force"], rel=0.25)
         assert abs(rm["first_contact_time"] - full["first_contact_time"]) <= 5e-4
