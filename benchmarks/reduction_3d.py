@@ -38,6 +38,8 @@ L, W, H = 0.1, 0.02, 0.004  # m
 SIZES = {"1e4": (20, 6, 3), "3e4": (28, 9, 4), "1e5": (54, 16, 4)}
 QUICK = {"3e3": (10, 4, 2)}
 N_UV, N_THETA = 6, 12
+#: Heading of the section benchmarks/reduction_convergence_3d.py writes (kept on rewrite).
+CONVERGENCE = "\n## Reduced vs full model in 3D"
 F0, OMEGA, GAP, ALPHA = 100.0, 5000.0, 0.8e-6, 3.0  # N, rad/s, m, m/s
 
 
@@ -192,7 +194,9 @@ def main(argv=None) -> None:
             f"peak RSS {r['rss_peak_mib']:.0f} MiB (process {time.perf_counter() - t0:.0f} s)"
         )
     args.out.parent.mkdir(parents=True, exist_ok=True)
-    args.out.write_text("# 3D reduction cost\n\n" + _table(results), encoding="utf-8")
+    old = args.out.read_text(encoding="utf-8") if args.out.exists() else ""
+    keep = old[old.index(CONVERGENCE) :] if CONVERGENCE in old else ""  # issue 11 studies
+    args.out.write_text("# 3D reduction cost\n\n" + _table(results) + keep, encoding="utf-8")
     args.out.with_suffix(".json").write_text(json.dumps(results, indent=1), encoding="utf-8")
     print(f"wrote {args.out}")
 

@@ -86,7 +86,9 @@ def test_fig4_reduced_models(summary):
     adj = [_rm(summary, name, "adjoint") for name in ("RM1", "RM2")]
     assert (full["n_dofs"], pg[0]["n_dofs"], pg[1]["n_dofs"]) == (60, 18, 10)
     for rm in pg:  # default basis: both reduced models follow the complete one
-        assert rm["status"] == "ok"
+        # the paper's boundary construction loses heat (heat balance residual RM1 ~6 %, RM2
+        # ~35 %; its energy balance closes since the expansion jumps are counted): not ok
+        assert rm["status"] == "inaccurate" and "heat balance" in rm["message"]
         assert rm["tip_temperature_end"] == pytest.approx(full["tip_temperature_end"], rel=0.05)
         assert rm["max_contact_force"] == pytest.approx(full["max_contact_force"], rel=0.1)
         assert abs(rm["first_contact_time"] - full["first_contact_time"]) <= 5e-4

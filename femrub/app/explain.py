@@ -49,13 +49,17 @@ def _contacts(c: dict, reach_key) -> list[str]:
     return lines
 
 
+def _thermal_word(r: dict) -> str:
+    return "input shapes" if r.get("thermal") == "inputs" else "dofs"
+
+
 def _reduction(r: dict) -> list[str]:
     if r["method"] == "none":
         return ["none (reduction.method = 'none'): the full model runs"]
     head = (
         f"{r['method']}: n_uv = {r['n_uv']}, n_theta = {r['n_theta']} -> {r['n_reduced']}"
         f" dofs (from {r['n_full']}; boundary {r['n_boundary_u']} u + "
-        f"{r['n_boundary_theta']} θ dofs, {r['projection']})"
+        f"{r['n_boundary_theta']} θ {_thermal_word(r)}, {r['projection']})"
     )
     lines = [head]
     if r["method"] == "auto":
@@ -70,6 +74,24 @@ def _reduction(r: dict) -> list[str]:
             lines.append(
                 f"contact-temperature response within {100 * r['thermal_error']:.2g} %"
                 f" ({ok} the target)"
+            )
+    err = r.get("error")
+    if err:
+        q = ", ".join(
+            f"{k.replace('_', ' ')} {100 * err[k]:.2g} %"
+            for k in ("contact_force", "contact_temperature", "displacement", "temperature")
+            if k in err
+        )
+        verdict = "within" if err["estimate"] <= err["tolerance"] else "EXCEEDS"
+        lines.append(
+            f"estimated error {100 * err['estimate']:.2g} % ({verdict} tolerance "
+            f"{100 * err['tolerance']:.2g} %; {q}) against sizes {err.get('reference_sizes')}"
+            f", {err['seconds']:.1f} s"
+        )
+        if err.get("tried") and r["method"] == "auto":
+            lines.append(
+                "tried "
+                + ", ".join(f"{t['sizes']}: {100 * t['estimate']:.2g} %" for t in err["tried"])
             )
     if r.get("note"):
         lines.append(r["note"])

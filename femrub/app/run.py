@@ -141,5 +141,6 @@ def _run_claimed(scene, out, progress, log, on_built, modes):
         rotation_speed=scene["loads"]["rotation_speed"],
         merge_time=merge_time(scene),
         claimed=True,
+        reduction_error=built.report["reduction"].get("error"),
     )
     return res, built

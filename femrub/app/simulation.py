@@ -226,7 +226,8 @@ def _build(scene, log, modes) -> Simulation:
     model, limits = _select_signals(scene, full, report, size)
     if modes:
         report["natural_frequencies_hz"] = natural_frequencies(model, modes).tolist()
-    reduced, reductor, report["reduction"] = reduce_model(model, scene, log)
+    make = lambda m: _bare_stepper(scene, m)  # noqa: E731  (the reduction error estimate)
+    reduced, reductor, report["reduction"] = reduce_model(model, scene, log, make)
     clock.done("reduction", f"{reduced.n_dofs} dofs")
     report["model"] = {"n_dofs": reduced.n_dofs, **_layout(reduced)}
     stepper = _stepper(scene, reduced, report)
@@ -240,13 +241,18 @@ def _build(scene, log, modes) -> Simulation:
     )
 
 
+def _bare_stepper(scene, model):
+    s = scene["scheme"]
+    try:
+        return make_stepper(s["name"], model, s["h"], **_scheme_options(scene))
+    except ValueError as exc:
+        raise SceneError(f"scheme ({s['name']}): {exc}") from None
+
+
 def _stepper(scene, model, report):
     s = scene["scheme"]
     options = _scheme_options(scene)
-    try:
-        stepper = make_stepper(s["name"], model, s["h"], **options)
-    except ValueError as exc:
-        raise SceneError(f"scheme ({s['name']}): {exc}") from None
+    stepper = _bare_stepper(scene, model)
     report["scheme"] = {
         "name": s["name"],
         "h": s["h"],

@@ -80,6 +80,12 @@ class EnergyForms:
     kinetic ``½ Xᵀ Qk X``, elastic ``½ Xᵀ Qe X``; powers ``Xᵀ Pth X`` (thermal stresses),
     ``Xᵀ Pd X`` (damping); heat content ``cᵀ X`` (J above ambient) and heat outflow rate
     through the boundaries and strain heating ``rᵀ X`` (W).
+
+    ``Wth`` (optional): the work of the thermal stresses over a step as a form of the state
+    increment, ``ΔW_th = (X_{k+1} − X_k)ᵀ Wth X_m`` (``Δuᵀ(−K^uθ θ_m)``). A full model does
+    not need it (``u̇ = v`` makes it ``h X_mᵀ P_th X_m``); a reduced model whose displacement
+    holds quasi-static expansion shapes moves when a heat impulse changes its temperature,
+    and this form counts the work of that motion too.
     """
 
     Qk: sp.spmatrix
@@ -88,6 +94,7 @@ class EnergyForms:
     Pd: sp.spmatrix
     heat_content: np.ndarray
     heat_outflow: np.ndarray
+    Wth: sp.spmatrix | None = None
 
     def project(self, R) -> EnergyForms:
         def pr(Q):
@@ -101,6 +108,7 @@ class EnergyForms:
             Pd=pr(self.Pd),
             heat_content=np.asarray(R.T @ self.heat_content).ravel(),
             heat_outflow=np.asarray(R.T @ self.heat_outflow).ravel(),
+            Wth=None if self.Wth is None else pr(self.Wth),
         )
 
 

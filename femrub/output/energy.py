@@ -4,6 +4,7 @@ Over a step ``(t_k, t_{k+1}]`` with midpoint state ``X_m = (X_k + X_{k+1}) / 2``
 
     ΔW_ext = h Σ_j s̄_j (p_jᵀ X_m)          s̄_j = (s_j(t_k) + s_j(t_{k+1})) / 2
     ΔW_th  = h X_mᵀ P_th X_m               work of the thermal stresses −K^uθ θ
+             (or (X_{k+1} − X_k)ᵀ W_th X_m when the model carries W_th: a reduced model)
     ΔW_d   = h X_mᵀ P_d X_m                 damping (<= 0)
     ΔW_c   = Pᵀ Gvᵀ X_m                     impulse times the structure's mean gap velocity
 
@@ -46,7 +47,10 @@ class EnergyMeter:
         self.model = model
         f = model.energy
         self.forms = EnergyForms(
-            *(compact(q) for q in (f.Qk, f.Qe, f.Pth, f.Pd)), f.heat_content, f.heat_outflow
+            *(compact(q) for q in (f.Qk, f.Qe, f.Pth, f.Pd)),
+            f.heat_content,
+            f.heat_outflow,
+            None if f.Wth is None else compact(f.Wth),
         )
         self._signals = [term.signal for term in model.loads]
         self._powers = (
@@ -87,7 +91,12 @@ class EnergyMeter:
             Sbar = 0.5 * (S[1:] + S[:-1])
             inc["external_work"] = h * np.einsum("ij,ij->i", Sbar, Xm @ self._powers)
             inc["heat_load"] = h * (Sbar @ self._heats)
-        inc["thermal_work"] = h * self._quad(f.Pth, Xm)
+        if f.Wth is None:
+            inc["thermal_work"] = h * self._quad(f.Pth, Xm)
+        else:  # work on the state increment (a reduced model's expansion shapes jump)
+            dX = X[1:] - X[:-1]
+            WX = Xm @ f.Wth.T if isinstance(f.Wth, np.ndarray) else (f.Wth @ Xm.T).T
+            inc["thermal_work"] = np.einsum("ij,ij->i", dX, np.asarray(WX))
         inc["damping_work"] = h * self._quad(f.Pd, Xm)
         c = self.contact
         if c is not None:

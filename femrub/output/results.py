@@ -111,9 +111,11 @@ def csv_header(columns, units: dict[str, str]) -> list[str]:
 class Results:
     """What a stepper's ``run()`` returns.
 
-    ``status`` is ``"ok"``, ``"unstable"`` (numerical blow-up or a step above the scheme's
-    stability limit), ``"diverged-physically"`` (a physical stop criterion was reached),
-    ``"interrupted"`` or ``"failed"``; the arrays hold everything computed up to then.
+    ``status`` is ``"ok"``, ``"inaccurate"`` (a reduced run whose estimated error exceeds
+    ``reduction.tolerance``, set by the run folder), ``"unstable"`` (numerical blow-up or a
+    step above the scheme's stability limit), ``"diverged-physically"`` (a physical stop
+    criterion was reached), ``"interrupted"`` or ``"failed"``; the arrays hold everything
+    computed up to then.
     """
 
     scheme: str

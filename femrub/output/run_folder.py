@@ -70,6 +70,7 @@ def run_to_folder(
     rotation_speed: float = 0.0,
     merge_time: float | None = None,
     claimed: bool = False,
+    reduction_error: dict | None = None,
 ):
     """Run ``stepper`` to ``t_end`` and write the results folder ``out`` (module docstring).
 
@@ -79,20 +80,23 @@ def run_to_folder(
     of the full model when ``stepper.model`` is reduced; ``rotation_speed`` (rad/s) counts the
     ``revolutions`` reached; ``merge_time`` (s) enables the resolution check
     (:func:`~femrub.output.verdict.assess`); ``claimed``: the caller already holds
-    :func:`~femrub.output.folder.claim` on ``out``. Returns the
+    :func:`~femrub.output.folder.claim` on ``out``. ``reduction_error``: the estimate of a
+    reduced run (:mod:`femrub.reduction.estimate`, with its ``tolerance``), written as
+    ``summary.json["reduction_error"]`` and judged by the ``reduction`` rule of
+    :mod:`~femrub.output.verdict` (``inaccurate`` above the tolerance). Returns the
     :class:`~femrub.output.results.Results`.
     """
     out = Path(out)
     with nullcontext() if claimed else claim(out, "run", overwrite=overwrite):
         return _run(
             stepper, t_end, out, fields, vtk_stride, inputs, limits, progress, snapshot, plots,
-            timings, n_full, rotation_speed, merge_time,
+            timings, n_full, rotation_speed, merge_time, reduction_error,
         )  # fmt: skip
 
 
 def _run(
     stepper, t_end, out, fields, vtk_stride, inputs, limits, progress, snapshot, plots, timings,
-    n_full, rotation_speed, merge_time,
+    n_full, rotation_speed, merge_time, reduction_error,
 ):  # fmt: skip
     summary_path = out / "summary.json"
     model = stepper.model
@@ -109,6 +113,8 @@ def _run(
         "inputs": inputs or {},
         "status": "running",
     }
+    if reduction_error is not None:
+        doc["reduction_error"] = reduction_error
     _write_json(summary_path, doc)
     series = None
     if fields is not None and vtk_stride:
@@ -124,6 +130,7 @@ def _run(
             res = stepper.run(
                 t_end, progress=progress, limits=limits, on_state=series, on_rows=history,
                 merge_time=merge_time,
+                tolerances={"reduction": reduction_error} if reduction_error else None,
             )  # fmt: skip
     except KeyboardInterrupt:  # before the recorder took over: say so, keep the folder
         _write_json(summary_path, {**doc, "status": "interrupted", "message": "interrupted"})

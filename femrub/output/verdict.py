@@ -7,7 +7,10 @@ The recorder ends a run as ``unstable`` (blow-up), ``diverged-physically`` (a st
 
 * ``energy_balance``: the mechanical balance residual relative to the energy scale of the
   run (``Results.energy_error``) exceeds ``tolerances["energy"]`` -> ``"inaccurate"``;
-* ``heat_balance``: the same for the heat balance and ``tolerances["heat"]``.
+* ``heat_balance``: the same for the heat balance and ``tolerances["heat"]``;
+* ``reduction``: the a-posteriori estimate of a reduced run, ``tolerances["reduction"]``
+  (the dict of :func:`femrub.reduction.estimate.estimate` with its ``tolerance``, as
+  ``summary.json["reduction_error"]``), above its tolerance -> ``"inaccurate"``.
 
 Warnings do not change the status; they are listed in ``Results.warnings`` (and
 ``summary.json["warnings"]``):
@@ -58,8 +61,22 @@ def _balance(kind: str):
     return rule
 
 
+def reduction(res, tol):
+    """The reduced model's estimated error exceeds ``reduction.tolerance`` (issue 11)."""
+    err = tol.get("reduction")
+    if not err:
+        return None
+    est, bound = err.get("estimate", 0.0), err.get("tolerance")
+    if bound is None or est <= bound:
+        return None
+    return (
+        f"estimated reduction error {100 * est:.3g} % exceeds reduction.tolerance "
+        f"{100 * bound:.3g} %: raise the reduction sizes or use reduction.method = 'auto'"
+    )
+
+
 #: status rules applied in order to a run the recorder ended as ``ok``
-RULES = [_balance("energy"), _balance("heat")]
+RULES = [_balance("energy"), _balance("heat"), reduction]
 
 
 def _episodes(res, merge_time: float) -> list[int]:
@@ -102,7 +119,8 @@ def assess(res, *, tolerances: dict | None = None, merge_time: float | None = No
     ----------
     res : :class:`~femrub.output.results.Results`.
     tolerances : ``{"energy": ..., "heat": ...}`` overriding :data:`TOLERANCES` (``None``
-        as a value switches a rule off).
+        as a value switches a rule off); ``"reduction"``: the error estimate of a reduced
+        run (with its ``tolerance``).
     merge_time : impulses closer than this (s) form one contact episode; ``None`` skips
         the resolution check.
     """

@@ -53,10 +53,13 @@ import scipy.sparse as sp
 from ..fem.eigen import lowest_modes, normalise_columns
 from ..model.first_order import FirstOrderModel, Layout, LoadTerm
 from .interior import InteriorSolver
+from .thermal_inputs import input_basis, input_distributions
 
 __all__ = ["PROJECTIONS", "ThermoelasticCraigBampton", "craig_bampton_thermal"]
 
 PROJECTIONS = ("petrov-galerkin", "galerkin", "adjoint")
+#: Thermal reductions: the paper's boundary temperature dofs, or one input distribution each.
+THERMAL = ("inputs", "boundary")
 #: Relative gap within which entries of a shape tie for its largest (mirror-symmetric modes).
 PEAK_TIE = 1e-8
 
@@ -82,6 +85,12 @@ class ThermoelasticCraigBampton:
     projection : ``"petrov-galerkin"``, ``"galerkin"`` or ``"adjoint"`` (module docstring).
     boundary : optional ``{"u": positions in the u-block, "theta": positions in the θ-block}``
         overriding ``fom.boundary``.
+    thermal : ``"boundary"`` (the paper's Eq. 10: every heated temperature dof is a boundary
+        dof with its static shape, interior on clamped thermal modes, projected like the
+        mechanics) or ``"inputs"`` (no temperature dof is kept: the thermal basis of
+        :func:`~femrub.reduction.thermal_inputs.input_basis`, ``2 m + 1`` input shapes for
+        ``m`` heat distributions plus ``max_n_theta`` modes of the whole blade, Galerkin
+        projection of the heat equation; ``docs/reduction.md`` section 8).
 
     Attributes
     ----------
@@ -101,10 +110,20 @@ class ThermoelasticCraigBampton:
     """
 
     def __init__(
-        self, fom, max_n_uv=None, max_n_theta=None, *, projection="petrov-galerkin", boundary=None
+        self,
+        fom,
+        max_n_uv=None,
+        max_n_theta=None,
+        *,
+        projection="petrov-galerkin",
+        boundary=None,
+        thermal="boundary",
     ):
         if projection not in PROJECTIONS:
             raise ValueError(f"unknown projection {projection!r}; use one of {PROJECTIONS}")
+        if thermal not in THERMAL:
+            raise ValueError(f"unknown thermal reduction {thermal!r}; use one of {THERMAL}")
+        self.thermal = thermal
         if not isinstance(fom, FirstOrderModel):
             raise TypeError("ThermoelasticCraigBampton needs a femrub.FirstOrderModel")
         if fom.blocks is None:
@@ -118,6 +137,8 @@ class ThermoelasticCraigBampton:
         if boundary is None and fom.boundary is None:
             raise ValueError("the model has no contact boundary (model.boundary is None)")
         mb, tb = _given(fom.boundary if boundary is None else boundary, nu, nt)
+        if thermal == "inputs":
+            tb = np.zeros(0, dtype=int)  # heat enters through its distributions, not dofs
         mi, ti = np.setdiff1d(np.arange(nu), mb), np.setdiff1d(np.arange(nt), tb)
         self.n_uv = 2 * mi.size if max_n_uv is None else _count("n_uv", max_n_uv, 2 * mi.size)
         self.n_theta = ti.size if max_n_theta is None else _count("n_theta", max_n_theta, ti.size)
@@ -140,8 +161,17 @@ class ThermoelasticCraigBampton:
         self.timings["static_shapes"] = time.perf_counter() - t0
         t0 = time.perf_counter()
         self.omega2, phi = lowest_modes(solver.K, solver.M, self.n_qv, solver.solve_K)
-        self.mu, chi = lowest_modes(solver.Ktt, solver.Ctt, self.n_theta, solver.solve_T)
-        phi, chi = _orient(phi), _orient(chi)
+        if thermal == "inputs":
+            Q = input_distributions(fom)
+            chi, self.n_theta_b, self.mu = input_basis(
+                solver.Ctt, solver.Ktt, solver.solve_T, Q, self.n_theta
+            )
+            self.n_theta = self.mu.size
+            self.n_inputs = Q.shape[1]
+        else:
+            self.mu, chi = lowest_modes(solver.Ktt, solver.Ctt, self.n_theta, solver.solve_T)
+            chi, self.n_theta_b, self.n_inputs = _orient(chi), tb.size, tb.size
+        phi = _orient(phi)
         phi_ut = -solver.solve_K(solver.Kut @ chi)  # K_ii Φ^uθ = −K^uθ_ii Φ^θθ
         self.timings["modes"] = time.perf_counter() - t0
         t0 = time.perf_counter()
@@ -162,8 +192,8 @@ class ThermoelasticCraigBampton:
     # -- bases -----------------------------------------------------------------------------
     def _layout(self, n_uv: int, n_theta: int) -> Layout:
         """Reduced layout ``(n_b + n_qu, n_b + n_qv, n_θb + n_θ)`` of the sizes given."""
-        nb, ntb = self.boundary["u"].size, self.boundary["theta"].size
-        return Layout(nb + n_uv // 2, nb + (n_uv + 1) // 2, ntb + n_theta)
+        nb = self.boundary["u"].size
+        return Layout(nb + n_uv // 2, nb + (n_uv + 1) // 2, self.n_theta_b + n_theta)
 
     def _assemble(self, psi, u_shapes, v_shapes, chi, chi_u) -> np.ndarray:
         """A basis in the full state order with the reduced column order of the layout."""
@@ -182,7 +212,7 @@ class ThermoelasticCraigBampton:
             V[self._int[:, None], cols[None, :]] = psi[:, first : first + cols.size]
         V[mi[:, None], np.arange(nb, nb + self.n_qu)[None, :]] = u_shapes
         V[(nu + mi)[:, None], (Lr.v.start + nb + np.arange(self.n_qv))[None, :]] = v_shapes
-        cq_t = Lr.t.start + tb.size + np.arange(self.n_theta)
+        cq_t = Lr.t.start + tb.size + np.arange(chi.shape[1])
         V[(2 * nu + ti)[:, None], cq_t[None, :]] = chi
         V[mi[:, None], cq_t[None, :]] = chi_u
         return V
@@ -242,7 +272,8 @@ class ThermoelasticCraigBampton:
             "n_qu": n_uv // 2,
             "n_qv": (n_uv + 1) // 2,
             "n_boundary_u": int(self.boundary["u"].size),
-            "n_boundary_theta": int(self.boundary["theta"].size),
+            "n_boundary_theta": int(self.n_theta_b),
+            "thermal": self.thermal,
             "n_full": m.n_dofs,
             "n_reduced": layout.n,
             "timings": dict(self.timings, projection=time.perf_counter() - t0),
@@ -262,12 +293,15 @@ class ThermoelasticCraigBampton:
         )
 
     def _energy(self, R, Ar, Br):
-        """Energy forms projected on ``R``; the thermal-stress power uses ``u̇``, not ``v``.
+        """Energy forms projected on ``R``; the thermal-stress work uses ``u̇``, not ``v``.
 
         The full model's thermal power ``vᵀ(−K^uθ θ)`` equals ``u̇ᵀ(−K^uθ θ)`` because
         ``u̇ = v``; a reduced model only keeps ``u̇_b = v_b`` (its interior ``u̇`` is the rate of
         ``R_u X̄``, which holds thermal-expansion shapes that ``v`` lacks), so the power of the
-        thermal stresses on the reduced displacement is ``(R_u Ā⁻¹ B̄ X̄)ᵀ(−K^uθ)(R_θ X̄)``.
+        thermal stresses on the reduced displacement is ``(R_u Ā⁻¹ B̄ X̄)ᵀ(−K^uθ)(R_θ X̄)``
+        (``Pth``), and the work over a step, impulses included, is
+        ``ΔW_th = (R_u ΔX̄)ᵀ(−K^uθ)(R_θ X̄_m)`` (``Wth``: a heat impulse moves the expansion
+        shapes at once; docs/reduction.md section 8).
         """
         m = self.fom
         forms = m.energy.project(R)
@@ -275,8 +309,10 @@ class ThermoelasticCraigBampton:
         if L.n_t:
             P = sp.csr_matrix(m.energy.Pth)
             P_u = sp.vstack([P[L.v], P[L.u], P[L.t]], format="csr")  # v-rows moved to u-rows
+            W = R.T @ np.asarray(P_u @ R)
             rate = np.linalg.solve(Ar, Br)  # Ẋ̄ = Ā⁻¹ B̄ X̄ without loads and impulses
-            forms.Pth = sp.csr_matrix(rate.T @ (R.T @ np.asarray(P_u @ R)))
+            forms.Pth = sp.csr_matrix(rate.T @ W)
+            forms.Wth = sp.csr_matrix(W)
         return forms
 
     def reconstruct(self, Xr: np.ndarray, n_uv=None, n_theta=None) -> np.ndarray:

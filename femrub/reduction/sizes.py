@@ -15,11 +15,22 @@ its bases that meets ``target``:
   capacity) and the simulated temperature error is mostly set by the mechanical shapes, so
   the thermal target is often missed at ``max_n_theta``: the report says so.
 
+These a-priori indicators are reported. When the caller gives the scene's stepper
+(``make_stepper``), the sizes are then picked a posteriori: the sub-basis models of
+:data:`LADDER` (``n_uv = n_θ = n``) are stepped in increasing order and the first whose
+estimated error (:mod:`femrub.reduction.estimate`, against the reductor's largest model)
+is within ``SAFETY × reduction.tolerance`` is kept. With given sizes
+(``"craig-bampton"``) the reductor is built at
+:func:`~femrub.reduction.estimate.reference_sizes` and the run's model is one of its
+sub-bases, so its error is estimated too (``report["error"]``).
+
 The chosen model is then projected on the leading columns of that reductor's bases
 (``reductor.reduce(n_uv, n_theta)``): nothing is factorised or solved twice.
 """
 
 from __future__ import annotations
+
+import time
 
 import numpy as np
 import scipy.linalg as sla
@@ -29,10 +40,15 @@ import scipy.sparse.linalg as spla
 from ..fem import eigen
 from ..scene.spec import SceneError, fail
 from .craig_bampton import ThermoelasticCraigBampton
+from .estimate import estimate, reference_sizes, simulate
 from .interior import condensed_solve
 
 __all__ = ["natural_frequencies", "reduce_model"]
 
+#: Sizes ``n`` tried by ``"auto"`` (``n_uv = n_θ = n``, within the largest).
+LADDER = (2, 4, 8, 12, 16, 24, 32, 48, 64, 96, 128, 192, 256)
+#: ``"auto"`` keeps the first size whose estimate is within this share of the tolerance.
+SAFETY = 0.5
 #: Accuracy of the reference frequencies relative to the target: far below what is judged.
 REFERENCE_TOL_PER_TARGET = 1e-4
 
@@ -84,7 +100,7 @@ def _thermal_errors(C, K, Q, T, ntb, svals) -> list[float]:
 def _auto_sizes(red, model, opts: dict, t_end: float, report: dict) -> tuple[int, int]:
     """Smallest sizes whose sub-bases of ``red`` (built at the largest sizes) meet the target."""
     L, b = model.layout, model.blocks
-    nb, ntb = red.boundary["u"].size, red.boundary["theta"].size
+    nb, ntb = red.boundary["u"].size, red.n_theta_b
     target, modes = opts["target"], min(opts["modes"], L.n_u)
     solve = condensed_solve(b.K, red.boundary["u"], red.solver)  # no factorisation of K
     tol = REFERENCE_TOL_PER_TARGET * opts["target"]
@@ -113,11 +129,69 @@ def _max_sizes(model, opts: dict) -> tuple[int, int]:
     return min(opts["max_n_uv"], 2 * n_i) // 2 * 2, min(opts["max_n_theta"], n_ti)
 
 
-def reduce_model(model, scene, log=None):
+def _ladder(most: tuple[int, int]) -> list[tuple[int, int]]:
+    """Candidate sizes of ``"auto"``, increasing, ending at the reductor's largest."""
+    out = []
+    for n in LADDER:
+        c = (min(n, most[0]) // 2 * 2, min(n, most[1]))
+        if c not in out and c != most:
+            out.append(c)
+    return out + [most]
+
+
+def _checked(red, model, want, make_stepper, scene, report, log) -> tuple[int, int]:
+    """Sizes to run and their a-posteriori estimate (``report["error"]``).
+
+    ``want``: the sizes asked for (``None`` for ``"auto"``: the smallest of :func:`_ladder`
+    whose estimate is within ``SAFETY × tolerance``). The reference is the reductor's largest
+    model; the largest model itself is judged by its difference to the next smaller one.
+    """
+    t0 = time.perf_counter()
+    tol, t_end = scene["reduction"]["tolerance"], scene["scheme"]["t_end"]
+    window = lobe_passage(scene)
+    most = (red.n_uv, red.n_theta)
+    ref = simulate(red, most, make_stepper, t_end)
+    cands = [want] if want is not None else _ladder(most)
+    chosen, err, tried = None, None, []
+    for c in cands:
+        if c == most:
+            break
+        run = simulate(red, c, make_stepper, t_end)
+        err = estimate((c, *run), (most, *ref), model, window=window)
+        tried.append({"sizes": list(c), "estimate": err["estimate"]})
+        if want is not None or err["estimate"] <= SAFETY * tol:
+            chosen = c
+            break
+    if chosen is None:  # the largest: judged against the next smaller candidate
+        chosen = most
+        if tried:
+            err = dict(err, estimate=err["estimate"], judged="largest model: difference to "
+                       f"the next smaller one {tried[-1]['sizes']} (pessimistic)")  # fmt: skip
+        else:
+            err = {"estimate": 0.0, "note": "the run's model is the reference (no estimate)"}
+    err.update(tolerance=tol, tried=tried, seconds=time.perf_counter() - t0)
+    report["error"] = err
+    if log:
+        log(f"reduction error estimate {100 * err['estimate']:.2g} % at sizes {list(chosen)}")
+    return chosen
+
+
+def lobe_passage(scene) -> float:
+    """Duration (s) of one lobe passage of the casing (0 without lobes or rotation)."""
+    cas, omega = scene["contact"]["casing"], abs(scene["loads"]["rotation_speed"])
+    lobes = cas.get("lobes", 0) if isinstance(cas, dict) else 0
+    return 2.0 * np.pi / (omega * lobes) if lobes and omega else 0.0
+
+
+def reduce_model(model, scene, log=None, make_stepper=None):
     """Reduce ``model`` as ``scene["reduction"]`` asks; return ``(model, reductor, report)``.
 
-    ``reductor`` is the one reductor built (at the largest sizes for ``"auto"``);
-    ``report["n_uv"]``, ``report["n_theta"]`` are the sizes of the returned model.
+    ``reductor`` is the one reductor built (at the largest sizes for ``"auto"``, at
+    :func:`~femrub.reduction.estimate.reference_sizes` of the sizes asked for otherwise);
+    ``report["n_uv"]``, ``report["n_theta"]`` are the sizes of the returned model. With
+    ``make_stepper`` (``model -> stepper`` of the scene's scheme) the run's error is
+    estimated (``report["error"]``, :mod:`femrub.reduction.estimate`) and ``"auto"`` picks
+    the sizes from that estimate.
     """
     opts = scene["reduction"]
     method = opts["method"]
@@ -133,28 +207,43 @@ def reduce_model(model, scene, log=None):
     report = {"method": method, "projection": opts["projection"], "n_full": model.n_dofs}
     if log:
         log(f"reduction ({method}) of {model.n_dofs} dofs ...")
+    want = None
     if method == "auto":
         n_uv, n_theta = _max_sizes(model, opts)
     else:
-        n_uv, n_theta = opts["n_uv"], opts["n_theta"]
+        want = n_uv, n_theta = opts["n_uv"], opts["n_theta"]
         if model.layout.n_t == 0 and n_theta:
             report["note"] = f"reduction.n_theta = {n_theta} ignored: no temperature dofs"
-            n_theta = 0
+            want = n_uv, n_theta = n_uv, 0
+        if make_stepper is not None:  # a richer reductor: the reference of the estimate
+            L, bnd = model.layout, model.boundary
+            cap = (2 * (L.n_u - len(bnd["u"])), L.n_t)
+            if n_uv <= cap[0] and n_theta <= cap[1]:  # else the reductor names the key
+                n_uv, n_theta = reference_sizes(n_uv, n_theta, cap)
     try:
-        red = ThermoelasticCraigBampton(model, n_uv, n_theta, projection=opts["projection"])
+        red = ThermoelasticCraigBampton(
+            model, n_uv, n_theta, projection=opts["projection"], thermal=opts["thermal"]
+        )
     except ValueError as exc:
         text = str(exc)
         key = next((f"reduction.{k}" for k in ("n_theta", "n_uv") if k in text), None)
         raise SceneError(f"{key or f'reduction.method = {method!r}'}: {text}") from None
+    if want is not None:
+        want = (min(want[0], red.n_uv), min(want[1], red.n_theta))
     if method == "auto":
         n_uv, n_theta = _auto_sizes(red, model, opts, scene["scheme"]["t_end"], report)
         report["target"] = opts["target"]
+    else:
+        n_uv, n_theta = want
+    if make_stepper is not None:
+        n_uv, n_theta = _checked(red, model, want, make_stepper, scene, report, log)
     reduced = red.reduce(n_uv, n_theta)
     report.update(
         n_uv=n_uv,
         n_theta=n_theta,
         n_reduced=reduced.n_dofs,
         n_boundary_u=int(red.boundary["u"].size),
-        n_boundary_theta=int(red.boundary["theta"].size),
+        n_boundary_theta=int(red.n_theta_b),
+        thermal=red.thermal,
     )
     return reduced, red, report

@@ -291,6 +291,20 @@ REDUCTION = Variant(
             choices=("petrov-galerkin", "galerkin", "adjoint"),
             doc="left basis",
         ),
+        "thermal": Spec(
+            C,
+            "inputs",
+            choices=("inputs", "boundary"),
+            doc="thermal reduction: one shape pair per heat input, or the heated dofs kept",
+        ),
+        "tolerance": _f(
+            0.05,
+            "none",
+            "estimated relative error above which a run is inaccurate",
+            lo=0.0,
+            hi=1.0,
+            lo_open=True,
+        ),
     },
     variants={
         "none": {},
