@@ -9,7 +9,7 @@ from .fem.material import Material
 from .model.build import ContactSpec, Load, first_order_model
 from .model.first_order import Contact, EnergyForms, FirstOrderModel, Layout, LoadTerm
 from .output.results import Results
-from .steppers import Carpenter, Penalty, ThetaMethod, make_stepper
+from .steppers import Carpenter, ExponentialMoreau, Penalty, ThetaMethod, make_stepper
 
 __version__ = "0.1.0"
 
@@ -17,6 +17,7 @@ __all__ = [
     "PAPER",
     "BarCase",
     "Carpenter",
+    "ExponentialMoreau",
     "Contact",
     "ContactSpec",
     "EnergyForms",

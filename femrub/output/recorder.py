@@ -111,12 +111,17 @@ class Recorder:
             self.message = (
                 f"h = {h:.3g} s exceeds the stability limit {stability_limit:.3g} s of {scheme}"
             )
+        self._work = None
         self.chunk = int(max(1, min(CHUNK_STEPS, CHUNK_VALUES // max(N, 1))))
         self.buf = np.empty((self.chunk + 1, N))
 
     # -- the run ---------------------------------------------------------------------------
     def record(self, start: State, advance: Callable, *, progress: bool = False) -> Results:
-        """Record ``start`` and ``n_steps`` calls of ``advance() -> (t, X, impulse)``."""
+        """Record ``start`` and ``n_steps`` calls of ``advance() -> (t, X, impulse)``.
+
+        ``advance`` may return a fourth value, the contact work of the step (J) as the scheme
+        computed it (impulses inside the step); the energy balance then uses it.
+        """
         n, buf, t, imp = self.n, self.buf, self.t, self.imp
         nc = self.model.n_contacts
         cpu0 = time.process_time()
@@ -135,7 +140,7 @@ class Recorder:
                 self._start(start)
                 for i in range(1, n + 1):
                     try:
-                        ti, X, P = advance()
+                        ti, X, P, *work = advance()
                     except (FloatingPointError, ArithmeticError) as exc:
                         i_end = self._flush(i0, j)
                         raise _Stop("unstable", f"{type(exc).__name__}: {exc}", i_end) from None
@@ -143,6 +148,8 @@ class Recorder:
                     buf[j], t[i] = X, ti
                     if nc:
                         imp[i] = P
+                    if work:  # the scheme's own contact work of the step
+                        self._work_rows()[i] = work[0]
                     if j == self.chunk or i == n:
                         i_end = self._flush(i0, j)
                         self._deliver(i0, i_end)
@@ -164,6 +171,12 @@ class Recorder:
             finally:
                 bar.close()
         return self._results(i_end, time.process_time() - cpu0)
+
+    def _work_rows(self) -> np.ndarray:
+        """Per-step contact work reported by the scheme (allocated on first use)."""
+        if self._work is None:
+            self._work = np.zeros(self.n + 1)
+        return self._work
 
     def _start(self, s: State) -> None:
         """Row 0: the initial state."""
@@ -205,7 +218,8 @@ class Recorder:
             self.gap[rows] = c.gap(t[rows], X[1:])
         if self.meter is not None and m:
             with np.errstate(all="ignore"):
-                self.meter.update(i0, X, self.imp[rows], t[i0 : rows.stop], h)
+                work = None if self._work is None else self._work[rows]
+                self.meter.update(i0, X, self.imp[rows], t[i0 : rows.stop], h, work)
             bad = self.meter.blown_up(rows)
             if bad is not None:
                 raise _Stop("unstable", f"energy created from nothing at t = {t[bad]:.6g} s", bad)
