@@ -54,7 +54,7 @@ __all__ = ["ExponentialMoreau", "MAX_COORDINATES"]
 #: Largest model (coordinates) the dense exponential stepper accepts.
 MAX_COORDINATES = 3000
 #: Events located per step; later closings of the step get end-of-step impulses.
-MAX_EVENTS = 8
+MAX_EVENTS = 64
 #: Most sign checks per step (see ``probes``).
 MAX_PROBES = 512
 _XTOL = 1e-11  # relative tolerance (of h) on an event time
@@ -249,32 +249,34 @@ class ExponentialMoreau(Stepper):
         gv, lv = np.array(gv), np.array(lv).reshape(len(grid), n_s)
         held = np.zeros(c.n, dtype=bool)
         held[list(S)] = True
-        cand = []  # (bracket index j, kind, contact, f, f(grid[j-1]), f(grid[j]))
+        cand = []  # (bracket lo, hi, kind, contact, f, f(lo) > 0, f(hi) < 0)
         # closing: the gap falls below min(g(a), 0) after having been above it
         f_cl = gv - np.minimum(gv[0], 0.0)
         for i in np.flatnonzero(~held & np.any(f_cl[1:] < 0.0, axis=0)):
             j = 1 + int(np.argmax(f_cl[1:, i] < 0.0))
-            if f_cl[j - 1, i] <= 0.0:
-                continue  # no sign change to bracket: end-of-step impulse
             ref = min(gv[0, i], 0.0)
             f = lambda tau, i=i, ref=ref: c.gap(t + tau, state(tau)[0])[i] - ref  # noqa: E731
-            cand.append((j, "closing", int(i), f, f_cl[j - 1, i], f_cl[j, i]))
+            br = (grid[j - 1], grid[j], f_cl[j - 1, i], f_cl[j, i])
+            if br[2] <= 0.0:  # at the surface at a (just released): find where it is open
+                br = _open_side(f, a, grid[j], f_cl[j, i])
+                if br is None:
+                    continue  # back in within round-off: end-of-step impulse
+            cand.append((*br, "closing", int(i), f))
         for k in np.flatnonzero(np.any(lv < 0.0, axis=0)):
             j = int(np.argmax(lv[:, k] < 0.0))
             if j == 0:  # pulled away already: release now
                 return a, "release", S[k], Xa, np.zeros(n_s)
             f = lambda tau, k=k: flows.multiplier(S, *state(tau)[::2])[k]  # noqa: E731
-            cand.append((j, "release", S[k], f, lv[j - 1, k], lv[j, k]))
+            cand.append((grid[j - 1], grid[j], lv[j - 1, k], lv[j, k], "release", S[k], f))
         best, hi = None, h
-        for j, kind, i, f, f_lo, f_hi in sorted(cand, key=lambda x: x[0]):
-            lo = grid[j - 1]
+        for lo, b, f_lo, f_hi, kind, i, f in sorted(cand, key=lambda x: x[1]):
             if lo >= hi:
-                break
-            if grid[j] > hi:
-                f_hi = f(hi)
+                continue
+            if b > hi:
+                b, f_hi = hi, f(hi)
                 if f_hi >= 0.0:
                     continue  # happens after the earliest event found so far
-            hi = _locate(f, lo, min(hi, grid[j]), f_lo, f_hi)
+            hi = _locate(f, lo, b, f_lo, f_hi)
             best = (kind, i)
         if best is None:
             return None
@@ -306,3 +308,14 @@ def _locate(f, lo, hi, f_lo, f_hi):
                 f_lo *= 0.5
             side = 1
     return hi
+
+
+def _open_side(f, a, b, f_b, halvings=30):
+    """Bracket ``(lo, b', f(lo) > 0, f(b') < 0)`` between ``a`` (``f(a) = 0``) and ``b``."""
+    for _ in range(halvings):
+        x = a + 0.5 * (b - a)
+        fx = f(x)
+        if fx > 0.0:
+            return x, b, fx, f_b
+        b, f_b = x, fx
+    return None

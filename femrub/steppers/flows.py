@@ -117,7 +117,7 @@ class FlowFamily:
         """
         if S not in self._probe:
             K, E, lam = self.generator(S)
-            n, m, h = self.L.shape[0], self.G.shape[1], self.h
+            n, h = self.L.shape[0], self.h
             rx, r0, r1 = [], [], []
             for j in range(1, q):
                 w = j / q
