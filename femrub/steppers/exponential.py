@@ -47,7 +47,7 @@ import numpy as np
 from ..contact.impulses import solve_impulses
 from ..fem.linalg import Factorised
 from .base import Stepper
-from .flows import FlowFamily
+from .flows import FlowFamily, shift
 
 __all__ = ["ExponentialMoreau", "MAX_COORDINATES"]
 
@@ -70,6 +70,8 @@ class ExponentialMoreau(Stepper):
     h : time step (s).
     events : locate contact closings and releases inside the step (default) or give
         impulses at step ends only.
+    load_degree : degree of the polynomial interpolating the load signals over a step (at
+        Chebyshev–Lobatto points; 1: linear interpolant), integrated exactly.
     probes : points per step (``j h / probes``) where the exact gaps and held multipliers
         are checked for a sign change before an event is located (1: step ends only;
         default: four per shortest period ``2π / max |Im eig(A⁻¹B)|``, at most
@@ -78,7 +80,16 @@ class ExponentialMoreau(Stepper):
 
     name = "exponential"
 
-    def __init__(self, model, h, *, events: bool = True, probes: int | None = None, t0=0.0):
+    def __init__(
+        self,
+        model,
+        h,
+        *,
+        events: bool = True,
+        probes: int | None = None,
+        load_degree: int = 4,
+        t0=0.0,
+    ):
         n = getattr(model, "n_dofs", 0)
         if n > MAX_COORDINATES:
             raise ValueError(
@@ -90,7 +101,9 @@ class ExponentialMoreau(Stepper):
             raise ValueError(f"events must be true or false, got {events!r}")
         if probes is not None and not (isinstance(probes, int) and 1 <= probes <= MAX_PROBES):
             raise ValueError(f"probes must be an integer in [1, {MAX_PROBES}], got {probes!r}")
-        self.events, self.probes = events, probes
+        if not (isinstance(load_degree, int) and 1 <= load_degree <= 8):
+            raise ValueError(f"load_degree must be an integer in [1, 8], got {load_degree!r}")
+        self.events, self.probes, self.load_degree = events, probes, load_degree
         super().__init__(model, h, t0=t0)
 
     # -- set-up ------------------------------------------------------------------------------
@@ -107,6 +120,10 @@ class ExponentialMoreau(Stepper):
         if not (np.all(np.isfinite(L)) and np.all(np.isfinite(G))):
             raise ValueError("A⁻¹B or A⁻¹F is not finite: check the model's matrices")
         self._signals = [term.signal for term in m.loads]
+        p = self.load_degree if m.loads else 0
+        self._nodes = 0.5 * (1.0 - np.cos(np.pi * np.arange(p + 1) / max(p, 1)))  # Lobatto
+        self._Vinv = np.linalg.inv(self._nodes[:, None] ** np.arange(p + 1))
+        self._T01 = np.diag([float(math.factorial(i)) for i in range(p + 1)])
         self._sk = self._signal_values(self.t)
         c = m.contact
         self._hold = False
@@ -122,7 +139,7 @@ class ExponentialMoreau(Stepper):
             )
             if self._hold:
                 AinvH = self._Zm + self._Zt * c.heat_coefficient
-        self._flows = FlowFamily(L, G, AinvH, GvT, h)
+        self._flows = FlowFamily(L, G, AinvH, GvT, h, p)
         self._flows.flow((), h)  # the free step: one augmented exponential
         if self.probes is None:  # four checks per shortest period of the model
             w_max = float(np.max(np.abs(np.linalg.eigvals(L).imag), initial=0.0))
@@ -135,6 +152,20 @@ class ExponentialMoreau(Stepper):
     def _signal_values(self, t):
         return np.array([float(sig(t)) for sig in self._signals])
 
+    def _load_poly(self, t):
+        """Monomial coefficients ``b`` (p+1, m) of the step's load, ``s = Σ b_i σ^i``."""
+        h, nodes = self.h, self._nodes
+        S = np.empty((nodes.size, len(self._signals)))
+        S[0] = self._sk
+        for j in range(1, nodes.size):
+            S[j] = self._signal_values(t + nodes[j] * h)
+        self._sk = S[-1]
+        return self._Vinv @ S
+
+    def _u(self, b, sigma):
+        """Load signals at the fraction ``sigma`` of the step."""
+        return (sigma ** np.arange(b.shape[0])) @ b
+
     # -- one step ------------------------------------------------------------------------------
     def _advance(self):
         t, X, P = super()._advance()
@@ -142,19 +173,18 @@ class ExponentialMoreau(Stepper):
 
     def _step(self):
         h, t, c = self.h, self.t, self.model.contact
-        s0, s1 = self._sk, self._signal_values(t + h)
-        self._sk = s1
+        b = self._load_poly(t)
         X, S, a = self.X, self._S, 0.0
         P = np.zeros(self.model.n_contacts)
         self._work = 0.0
         for n_events in range(MAX_EVENTS + 1):
-            u0 = s0 + (s1 - s0) * (a / h)
-            Xe, PS = self._flows.flow(S, h - a)(X, u0, s1)
+            w = self._T01 @ b if a == 0.0 else shift(b, a / h, 1.0 - a / h)
+            Xe, PS = self._flows.flow(S, h - a)(X, w)
             if c is None:
                 return Xe, P
             ev = None
             if self.events and n_events < MAX_EVENTS:
-                ev = self._event(S, X, a, Xe, s0, s1)
+                ev = self._event(S, X, a, Xe, b)
             if ev is None:
                 break
             a, kind, i, X, PSa = ev
@@ -166,7 +196,7 @@ class ExponentialMoreau(Stepper):
         X = Xe
         P[list(S)] += PS
         if S and not self.events:  # releases at step ends
-            lam = self._flows.multiplier(S, X, s1)
+            lam = self._flows.multiplier(S, X, self._u(b, 1.0))
             S = tuple(j for j, lj in zip(S, lam) if lj > 0.0)
         X, S = self._impact(t + h, X, S, P)
         self._S = S
@@ -201,121 +231,112 @@ class ExponentialMoreau(Stepper):
         return Xn, tuple(np.flatnonzero(keep))
 
     # -- events --------------------------------------------------------------------------------
-    def _event(self, S, Xa, a, Xe, s0, s1):
+    def _event(self, S, Xa, a, Xe, b):
         """Earliest closing or release in ``(a, h]``: ``(τ, kind, i, X(τ), P_S(a..τ))``.
 
-        Signs are checked at ``q`` points of a full step (probe rows, one small product) or
-        at both ends of a part step; the first sign change is then located exactly.
+        The exact gaps and held multipliers are checked on a grid of spacing ``h / probes``
+        (probe rows on a full step, the cached flow marched on a part step); the first sign
+        change is then bisected on the exact flow (cached dyadic sub-steps).
         """
-        c, h, t, flows = self.model.contact, self.h, self.t, self._flows
-        n_s = len(S)
+        c, h, t, flows, q = self.model.contact, self.h, self.t, self._flows, self.probes
+        n_s, d = len(S), h / self.probes
 
-        def state(tau):
-            u0, ut = s0 + (s1 - s0) * (a / h), s0 + (s1 - s0) * (tau / h)
-            Xt, Pt = flows.flow(S, tau - a)(Xa, u0, ut)
-            return Xt, Pt, ut
+        def values(tau, X):
+            lam = flows.multiplier(S, X, self._u(b, tau / h)) if S else np.zeros(0)
+            return np.r_[c.gap(t + tau, X), lam]
 
-        grid = [a, h]
-        gv = [c.gap(t + a, Xa), c.gap(t + h, Xe)]
-        lv = [np.zeros(0), np.zeros(0)]
-        if S:
-            lv = [flows.multiplier(S, Xa, s0 + (s1 - s0) * (a / h)), flows.multiplier(S, Xe, s1)]
-        q = self.probes
-        if q > 1:
-            taus = a + (h - a) * np.arange(1, q) / q
-            if a == 0.0:  # full step: cached probe rows, one small product
-                Rx, R0, R1 = flows.probe(S, c.GT, q)
-                V = (Rx @ Xa + R0 @ s0 + R1 @ s1).reshape(q - 1, c.n + n_s)
+        if a == 0.0:
+            grid = list(np.arange(q + 1) * d)
+            grid[-1] = h
+            rows = [values(0.0, Xa)]
+            if q > 1:
+                Rx, Rb = flows.probe(S, c.GT, q)
+                V = (Rx @ Xa + Rb @ b.ravel()).reshape(q - 1, c.n + n_s)
                 if callable(c.gap0):
-                    V[:, : c.n] += np.array([c.gap_at(t + tau) for tau in taus])
+                    V[:, : c.n] += np.array([c.gap_at(t + tau) for tau in grid[1:-1]])
                 else:
                     V[:, : c.n] += c.gap0
-            else:  # part step after an event: march the cached flow over h / q
-                taus = np.arange(1, q) * (h / q)
-                taus = taus[taus > a + 1e-9 * h]
-                f, rows, Xt = flows.flow(S, h / q, cache=True), [], Xa
-                for lo, tau in zip([a, *taus[:-1]], taus):
-                    if lo == a and tau - a != h / q:
-                        f_lo = flows.flow(S, tau - a)
-                    else:
-                        f_lo = f
-                    Xt, _ = f_lo(Xt, s0 + (s1 - s0) * (lo / h), ut := s0 + (s1 - s0) * (tau / h))
-                    lam = flows.multiplier(S, Xt, ut) if S else np.zeros(0)
-                    rows.append(np.r_[c.gap(t + tau, Xt), lam])
-                V = np.array(rows).reshape(len(taus), c.n + n_s)
-            grid = [a, *taus, h]
-            gv = [gv[0], *V[:, : c.n], gv[1]]
-            lv = [lv[0], *V[:, c.n :], lv[1]]
-        gv, lv = np.array(gv), np.array(lv).reshape(len(grid), n_s)
+                rows.extend(V)
+            rows.append(values(h, Xe))
+            states = {0: (Xa, np.zeros(n_s))}
+        else:  # part step: march the flow, keep the states
+            grid, rows, states = [a], [values(a, Xa)], {0: (Xa, np.zeros(n_s))}
+            X, Pc = Xa, np.zeros(n_s)
+            while grid[-1] < h:
+                tau = min(grid[-1] + d, h)
+                dt = tau - grid[-1]
+                if h - tau < 1e-9 * d:
+                    tau, dt = h, h - grid[-1]
+                Xn, Pn = flows.flow(S, dt, cache=dt == d)(X, shift(b, grid[-1] / h, dt / h))
+                X, Pc = Xn, Pc + Pn
+                grid.append(tau)
+                rows.append(values(tau, X))
+                states[len(grid) - 1] = (X, Pc)
+        V = np.array(rows)
+        gv, lv = V[:, : c.n], V[:, c.n :]
         held = np.zeros(c.n, dtype=bool)
         held[list(S)] = True
-        cand = []  # (bracket lo, hi, kind, contact, f, f(lo) > 0, f(hi) < 0)
+        cand = []  # (bracket j, kind, contact, f(τ, X))
         # closing: the gap falls below min(g(a), 0) after having been above it
         f_cl = gv - np.minimum(gv[0], 0.0)
         for i in np.flatnonzero(~held & np.any(f_cl[1:] < 0.0, axis=0)):
-            j = 1 + int(np.argmax(f_cl[1:, i] < 0.0))
             ref = min(gv[0, i], 0.0)
-            f = lambda tau, i=i, ref=ref: c.gap(t + tau, state(tau)[0])[i] - ref  # noqa: E731
-            br = (grid[j - 1], grid[j], f_cl[j - 1, i], f_cl[j, i])
-            if br[2] <= 0.0:  # at the surface at a (just released): find where it is open
-                br = _open_side(f, a, grid[j], f_cl[j, i])
-                if br is None:
-                    continue  # back in within round-off: end-of-step impulse
-            cand.append((*br, "closing", int(i), f))
+            f = lambda tau, X, i=i, ref=ref: c.gap(t + tau, X)[i] - ref  # noqa: E731
+            cand.append((1 + int(np.argmax(f_cl[1:, i] < 0.0)), "closing", int(i), f))
         for k in np.flatnonzero(np.any(lv < 0.0, axis=0)):
             j = int(np.argmax(lv[:, k] < 0.0))
             if j == 0:  # pulled away already: release now
                 return a, "release", S[k], Xa, np.zeros(n_s)
-            f = lambda tau, k=k: flows.multiplier(S, *state(tau)[::2])[k]  # noqa: E731
-            cand.append((grid[j - 1], grid[j], lv[j - 1, k], lv[j, k], "release", S[k], f))
-        best, hi = None, h
-        for lo, b, f_lo, f_hi, kind, i, f in sorted(cand, key=lambda x: x[1]):
-            if lo >= hi:
+            f = lambda tau, X, k=k: flows.multiplier(S, X, self._u(b, tau / h))[k]  # noqa: E731
+            cand.append((j, "release", S[k], f))
+        if not cand:
+            return None
+        j = min(x[0] for x in cand)
+        lo = grid[j - 1]
+        if j - 1 not in states:  # full step: march the cached flow to the bracket
+            X, Pc = Xa, np.zeros(n_s)
+            for r in range(j - 1):
+                Xn, Pn = flows.flow(S, d, cache=True)(X, shift(b, grid[r] / h, d / h))
+                X, Pc = Xn, Pc + Pn
+            states[j - 1] = (X, Pc)
+        X0, P0 = states[j - 1]
+        best = None
+        for jj, kind, i, f in cand:
+            if jj != j:
                 continue
-            if b > hi:
-                b, f_hi = hi, f(hi)
-                if f_hi >= 0.0:
-                    continue  # happens after the earliest event found so far
-            hi = _locate(f, lo, b, f_lo, f_hi)
-            best = (kind, i)
+            found = self._bisect(S, f, lo, grid[j] - lo, X0, b)
+            if found is not None and (best is None or found[0] < best[0]):
+                best = (*found, kind, i)
         if best is None:
             return None
-        Xt, Pt, _ = state(hi)
-        return hi, best[0], best[1], Xt, Pt
+        tau, X, Pl, kind, i = best
+        return tau, kind, i, X, P0 + Pl
+
+    def _bisect(self, S, f, lo, length, X_lo, b):
+        """First zero of ``f`` in ``(lo, lo + length]`` (``f(lo + length) < 0``), bisected on
+        the exact flow; ``(τ, X(τ), P_S(lo..τ))`` just after it, or ``None``."""
+        h, flows, d = self.h, self._flows, self.h / self.probes
+        cache = abs(length - d) <= 1e-12 * d
+        P_lo = np.zeros(len(S))
+
+        def go(X, tau, dt):
+            return flows.flow(S, dt, cache=cache)(X, shift(b, tau / h, dt / h))
+
+        if f(lo, X_lo) <= 0.0:  # at the surface at lo (just released): find it open
+            for _ in range(40):
+                length *= 0.5
+                Xm, Pm = go(X_lo, lo, length)
+                if f(lo + length, Xm) > 0.0:
+                    X_lo, P_lo, lo = Xm, Pm, lo + length
+                    break
+            else:
+                return None
+        while length > _XTOL * h:
+            length *= 0.5
+            Xm, Pm = go(X_lo, lo, length)
+            if f(lo + length, Xm) > 0.0:
+                X_lo, P_lo, lo = Xm, P_lo + Pm, lo + length
+        Xe, Pe = go(X_lo, lo, length)
+        return lo + length, Xe, P_lo + Pe
 
 
-def _locate(f, lo, hi, f_lo, f_hi):
-    """Root of ``f`` with ``f(lo) > 0 > f(hi)`` by Illinois regula falsi; returns the bracket
-    end with ``f <= 0`` (the event has just happened)."""
-    span, side = hi - lo, 0
-    if f_lo <= 0.0:
-        return lo
-    for _ in range(200):
-        if hi - lo <= _XTOL * span:
-            break
-        x = hi - f_hi * (hi - lo) / (f_hi - f_lo)
-        if not (lo < x < hi):
-            x = 0.5 * (lo + hi)
-        fx = f(x)
-        if fx > 0.0:
-            lo, f_lo = x, fx
-            if side == -1:
-                f_hi *= 0.5
-            side = -1
-        else:
-            hi, f_hi = x, fx
-            if side == 1:
-                f_lo *= 0.5
-            side = 1
-    return hi
-
-
-def _open_side(f, a, b, f_b, halvings=30):
-    """Bracket ``(lo, b', f(lo) > 0, f(b') < 0)`` between ``a`` (``f(a) = 0``) and ``b``."""
-    for _ in range(halvings):
-        x = a + 0.5 * (b - a)
-        fx = f(x)
-        if fx > 0.0:
-            return x, b, fx, f_b
-        b, f_b = x, fx
-    return None

@@ -1,16 +1,17 @@
 """Exact flows of a first-order model between contact events (matrix exponentials).
 
 Between events a model ``A Ẋ = B X + F(t) + H λ`` is linear. With ``L = A⁻¹ B``, the load
-columns ``G = A⁻¹ [F_1 … F_m]`` and the load signals ``s(t)`` interpolated linearly over an
-interval of length ``τ`` (``s(a + σ τ) = u0 + σ (u1 − u0)``, σ ∈ [0, 1]), the *free* flow is
-exact::
+columns ``G = A⁻¹ [F_1 … F_m]`` and the load signals written over an interval of length
+``τ`` as a polynomial in the normalised time σ ∈ [0, 1],
+``s(a + σ τ) = Σ_i w_i σ^i / i!`` (degree ``p``), the *free* flow is exact::
 
-    X(a + τ) = e^{τL} X(a) + τ φ1(τL) G u0 + τ φ2(τL) G (u1 − u0)
+    X(a + τ) = e^{τL} X(a) + Σ_i τ φ_{i+1}(τL) G w_i,      φ_1(z) = (e^z − 1)/z, …
 
-with ``φ1(z) = (e^z − 1)/z`` and ``φ2(z) = (e^z − 1 − z)/z²``. All three blocks are read
-off one exponential of an augmented matrix (Al-Mohy & Higham's ``scipy.linalg.expm``)::
+(``p = 1`` is the linear interpolant: ``τ φ1 G s_a + τ φ2 G (s_b − s_a)``). All blocks are
+read off one exponential of an augmented matrix (``scipy.linalg.expm``, Al-Mohy & Higham),
+a chain of ``p + 1`` integrators driving the load::
 
-    expm([[τK, τE, 0], [0, 0, I], [0, 0, 0]]) = [[e^{τK}, τφ1(τK) E, τφ2(τK) E], …]
+    expm([[τK, τE, 0, …], [0, 0, I, …], …, [0, …, 0]]) = [[e^{τK}, Ψ_0, …, Ψ_p], …]
 
 A set ``S`` of *held* contacts (closed, gap velocity zero, obstacle fixed) is kept closed by
 the multiplier that holds their gap acceleration at zero, ``Gv_Sᵀ Ẋ = 0``::
@@ -24,31 +25,48 @@ and its impulse ``P_S = ∫ λ_S dt`` is integrated exactly by appending ``P_S``
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import scipy.linalg as sla
 
-__all__ = ["Flow", "FlowFamily"]
+__all__ = ["Flow", "FlowFamily", "shift"]
+
+
+def shift(b: np.ndarray, alpha: float, delta: float) -> np.ndarray:
+    """Chain inputs ``w`` (p+1, m) of ``u(σ) = Σ b_i σ^i`` on ``[α, α + δ]`` (σ' ∈ [0, 1]).
+
+    ``u(α + δ σ') = Σ_l σ'^l Σ_{i>=l} C(i, l) α^{i−l} δ^l b_i``, and ``w_l = l! ×`` that.
+    """
+    p = b.shape[0] - 1
+    T = np.zeros((p + 1, p + 1))
+    for i in range(p + 1):
+        for j in range(i + 1):
+            T[j, i] = math.comb(i, j) * alpha ** (i - j) * delta**j * math.factorial(j)
+    return T @ b
 
 
 class Flow:
-    """Exact flow of one held set over one duration: ``(X, u0, u1) -> (X_end, P_S)``."""
+    """Exact flow of one held set over one duration: ``(X, w) -> (X_end, P_S)``."""
 
-    def __init__(self, K: np.ndarray, E: np.ndarray, n: int, tau: float):
+    def __init__(self, K: np.ndarray, E: np.ndarray, n: int, tau: float, degree: int):
         nz, m = K.shape[0], E.shape[1]
-        M = np.zeros((nz + 2 * m, nz + 2 * m))
+        k = (degree + 1) * m
+        M = np.zeros((nz + k, nz + k))
         M[:nz, :nz] = tau * K
         M[:nz, nz : nz + m] = tau * E
-        M[nz : nz + m, nz + m :] = np.eye(m)
+        for i in range(degree):
+            r = nz + i * m
+            M[r : r + m, r + m : r + 2 * m] = np.eye(m)
         ex = sla.expm(M)
         self.n, self.tau = n, tau
-        self.Phi = np.ascontiguousarray(ex[:nz, :n])  # e^{τK} restricted to X inputs
-        Y0, Y1 = ex[:nz, nz : nz + m], ex[:nz, nz + m :]
-        self.Ya, self.Yb = np.ascontiguousarray(Y0 - Y1), np.ascontiguousarray(Y1)
+        self.Phi = np.ascontiguousarray(ex[:nz, :n])
+        self.Psi = np.ascontiguousarray(ex[:nz, nz:])  # [Ψ_0 … Ψ_p]
 
-    def __call__(self, X, u0, u1):
+    def __call__(self, X, w):
         z = self.Phi @ X
-        if self.Ya.shape[1]:
-            z += self.Ya @ u0 + self.Yb @ u1
+        if self.Psi.shape[1]:
+            z += self.Psi @ w.ravel()
         return z[: self.n], z[self.n :]
 
 
@@ -61,13 +79,15 @@ class FlowFamily:
     G : (N, m) dense ``A⁻¹ F`` (load columns).
     AinvH : (N, n_c) ``A⁻¹ (Hm + Ht diag α)`` (constant α), or ``None`` without contact.
     GvT : (n_c, N) gap-velocity rows.
-    h : the constant step (s): its flows are cached per held set.
+    h : the constant step (s).
+    degree : polynomial degree of the load signals over a step.
     """
 
-    def __init__(self, L, G, AinvH, GvT, h):
-        self.L, self.G, self.AinvH, self.GvT, self.h = L, G, AinvH, GvT, h
+    def __init__(self, L, G, AinvH, GvT, h, degree):
+        self.L, self.G, self.AinvH, self.GvT = L, G, AinvH, GvT
+        self.h, self.degree = h, degree
         self._gen: dict[tuple, tuple] = {}
-        self._step: dict[tuple, Flow] = {}  # (S, τ) -> Flow
+        self._flows: dict[tuple, Flow] = {}  # (S, τ) -> Flow
         self._probe: dict[tuple, tuple] = {}
 
     def generator(self, S: tuple) -> tuple[np.ndarray, np.ndarray, np.ndarray | None]:
@@ -79,8 +99,7 @@ class FlowFamily:
             else:
                 idx = list(S)
                 AH, Gv = self.AinvH[:, idx], self.GvT[idx]
-                W = Gv @ AH
-                lam = -np.linalg.solve(W, Gv @ np.hstack([L, G]))  # λ_S = Λx X + Λs s
+                lam = -np.linalg.solve(Gv @ AH, Gv @ np.hstack([L, G]))
                 s = len(idx)
                 K = np.zeros((n + s, n + s))
                 K[:n, :n] = L + AH @ lam[:, :n]
@@ -92,16 +111,16 @@ class FlowFamily:
     def flow(self, S: tuple, tau: float, cache: bool = False) -> Flow:
         """Exact flow of held set ``S`` over ``tau`` (cached for ``h`` and when ``cache``)."""
         key = (S, tau)
-        if key in self._step:
-            return self._step[key]
+        if key in self._flows:
+            return self._flows[key]
         K, E, _ = self.generator(S)
-        f = Flow(K, E, self.L.shape[0], tau)
+        f = Flow(K, E, self.L.shape[0], tau, self.degree)
         if cache or tau == self.h:
-            self._step[key] = f
+            self._flows[key] = f
         return f
 
     def multiplier(self, S: tuple, X, u) -> np.ndarray:
-        """``λ_S`` (N) holding the set ``S`` at state ``X`` and load signals ``u``."""
+        """``λ_S`` holding the set ``S`` at state ``X`` and load signals ``u`` (m,)."""
         _, _, lam = self.generator(S)
         n = self.L.shape[0]
         out = lam[:, :n] @ X
@@ -109,29 +128,28 @@ class FlowFamily:
             out += lam[:, n:] @ u
         return out
 
-    def probe(self, S: tuple, GT: np.ndarray, q: int) -> tuple[np.ndarray, ...]:
+    def probe(self, S: tuple, GT: np.ndarray, q: int) -> tuple[np.ndarray, np.ndarray]:
         """Gaps ``Gᵀ X`` and held multipliers ``λ_S`` at ``τ_j = j h / q``, j = 1 .. q − 1.
 
-        Returns ``(Rx, R0, R1)`` with rows ``[Gᵀ X(τ_j); λ_S(τ_j)]`` stacked over ``j``
-        (``n_c + |S|`` rows each) ``= Rx X + R0 s_k + R1 s_{k+1}`` over a full step (cached).
+        Returns ``(Rx, Rb)``: rows ``[Gᵀ X(τ_j); λ_S(τ_j)]`` stacked over ``j`` equal
+        ``Rx X_k + Rb b`` for the step's load polynomial ``s = Σ b_i σ^i`` (cached).
         """
         if S not in self._probe:
             K, E, lam = self.generator(S)
-            n, h = self.L.shape[0], self.h
-            rx, r0, r1 = [], [], []
+            n, h, p, m = self.L.shape[0], self.h, self.degree, self.G.shape[1]
+            rx, rb = [], []
             for j in range(1, q):
                 w = j / q
-                f = Flow(K, E, n, w * h)
-                Px, Pa, Pb = f.Phi[:n], f.Ya[:n], f.Yb[:n]
-                A0, A1 = Pa + Pb * (1.0 - w), Pb * w  # u(τ_j) = (1 − w) s_k + w s_{k+1}
-                rows_x, rows_0, rows_1 = [GT @ Px], [GT @ A0], [GT @ A1]
+                f = Flow(K, E, n, w * h, p)
+                # Ψ acting on b: chain inputs of [0, w] are shift(b, 0, w)
+                Tb = np.kron(shift(np.eye(p + 1), 0.0, w), np.eye(m))
+                Px, Pb = f.Phi[:n], f.Psi[:n] @ Tb if m else np.zeros((n, 0))
+                rx.append(GT @ Px)
+                rb.append(GT @ Pb)
                 if lam is not None:
                     lx, ls = lam[:, :n], lam[:, n:]
-                    rows_x.append(lx @ Px)
-                    rows_0.append(lx @ A0 + ls * (1.0 - w))
-                    rows_1.append(lx @ A1 + ls * w)
-                rx += rows_x
-                r0 += rows_0
-                r1 += rows_1
-            self._probe[S] = tuple(np.ascontiguousarray(np.vstack(r)) for r in (rx, r0, r1))
+                    pw = np.kron(w ** np.arange(p + 1), np.eye(m)) if m else np.zeros((m, 0))
+                    rx.append(lx @ Px)
+                    rb.append(lx @ Pb + (ls @ pw if m else np.zeros((len(S), 0))))
+            self._probe[S] = (np.ascontiguousarray(np.vstack(rx)), np.vstack(rb))
         return self._probe[S]
