@@ -42,6 +42,8 @@ class Stepper:
     """Base class; see the module docstring. ``h`` is the time step (s)."""
 
     name = "stepper"
+    #: the recorder stops a run whose energy balance opens (numerical blow-up)
+    blowup_check = True
 
     def __init__(self, model: FirstOrderModel, h: float, *, t0: float = 0.0):
         if not isinstance(model, FirstOrderModel):
@@ -144,5 +146,6 @@ class Stepper:
             store_every=store_every,
             on_state=on_state,
             label=label,
+            blowup_check=self.blowup_check,
         )
         return recorder.record(self.state, self._advance, progress=progress)

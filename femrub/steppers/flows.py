@@ -39,11 +39,28 @@ def shift(b: np.ndarray, alpha: float, delta: float) -> np.ndarray:
     ``u(α + δ σ') = Σ_l σ'^l Σ_{i>=l} C(i, l) α^{i−l} δ^l b_i``, and ``w_l = l! ×`` that.
     """
     p = b.shape[0] - 1
-    T = np.zeros((p + 1, p + 1))
-    for i in range(p + 1):
-        for j in range(i + 1):
-            T[j, i] = math.comb(i, j) * alpha ** (i - j) * delta**j * math.factorial(j)
+    C, E = _binomials(p)
+    T = C * np.where(E >= 0, float(alpha) ** np.maximum(E, 0), 0.0)
+    T *= (float(delta) ** np.arange(p + 1))[:, None]
     return T @ b
+
+
+_BINOMIALS: dict[int, tuple] = {}
+
+
+def _binomials(p: int) -> tuple[np.ndarray, np.ndarray]:
+    """``C[l, i] = C(i, l) l!`` and the exponents ``E[l, i] = i − l``."""
+    if p not in _BINOMIALS:
+        i, j = np.meshgrid(np.arange(p + 1), np.arange(p + 1))
+        C = np.array(
+            [
+                [math.comb(c, r) * math.factorial(r) if c >= r else 0 for c in range(p + 1)]
+                for r in range(p + 1)
+            ],
+            dtype=float,
+        )
+        _BINOMIALS[p] = (C, i - j)
+    return _BINOMIALS[p]
 
 
 class Flow:
@@ -119,6 +136,20 @@ class FlowFamily:
             self._flows[key] = f
         return f
 
+    def advance(self, S: tuple, X, tau0: float, tau1: float, b, unit: float):
+        """Flow of ``S`` from ``tau0`` to ``tau1`` in the step, composed of cached flows over
+        ``unit 2^j`` and ``unit / 2^k`` (k <= 45: the remainder, below ``unit 2^-45``, is
+        dropped); ``b``: the step's load polynomial. Returns ``(X, P_S)``."""
+        h, P = self.h, np.zeros(len(S))
+        rest, tau = tau1 - tau0, tau0
+        j = max(int(math.floor(math.log2(max(rest / unit, 1.0)))), 0)
+        pieces = [unit * 2.0**e for e in range(j, -46, -1)]
+        for u in pieces:
+            while rest >= u * (1.0 - 1e-12):
+                X, dP = self.flow(S, u, cache=True)(X, shift(b, tau / h, u / h))
+                P, tau, rest = P + dP, tau + u, rest - u
+        return X, P
+
     def multiplier(self, S: tuple, X, u) -> np.ndarray:
         """``λ_S`` holding the set ``S`` at state ``X`` and load signals ``u`` (m,)."""
         _, _, lam = self.generator(S)
@@ -132,24 +163,29 @@ class FlowFamily:
         """Gaps ``Gᵀ X`` and held multipliers ``λ_S`` at ``τ_j = j h / q``, j = 1 .. q − 1.
 
         Returns ``(Rx, Rb)``: rows ``[Gᵀ X(τ_j); λ_S(τ_j)]`` stacked over ``j`` equal
-        ``Rx X_k + Rb b`` for the step's load polynomial ``s = Σ b_i σ^i`` (cached).
+        ``Rx X(0) + Rb b`` for the load polynomial ``s(σ) = Σ b_i σ^i`` (σ in units of h)
+        from time 0. Built by recursion on the cached flow over ``h / q`` (cached).
         """
         if S not in self._probe:
-            K, E, lam = self.generator(S)
+            _, _, lam = self.generator(S)
             n, h, p, m = self.L.shape[0], self.h, self.degree, self.G.shape[1]
-            rx, rb = [], []
+            f = self.flow(S, h / q, cache=True)
+            Phi, Psi = f.Phi[:n], f.Psi[:n]
+            rows = GT if lam is None else np.vstack([GT, lam[:, :n]])
+            nl = 0 if lam is None else lam.shape[0]
+            Rx, Cb, rx, rb = rows, np.zeros((n, (p + 1) * m)), [], []
             for j in range(1, q):
-                w = j / q
-                f = Flow(K, E, n, w * h, p)
-                # Ψ acting on b: chain inputs of [0, w] are shift(b, 0, w)
-                Tb = np.kron(shift(np.eye(p + 1), 0.0, w), np.eye(m))
-                Px, Pb = f.Phi[:n], f.Psi[:n] @ Tb if m else np.zeros((n, 0))
-                rx.append(GT @ Px)
-                rb.append(GT @ Pb)
-                if lam is not None:
-                    lx, ls = lam[:, :n], lam[:, n:]
-                    pw = np.kron(w ** np.arange(p + 1), np.eye(m)) if m else np.zeros((m, 0))
-                    rx.append(lx @ Px)
-                    rb.append(lx @ Pb + (ls @ pw if m else np.zeros((len(S), 0))))
-            self._probe[S] = (np.ascontiguousarray(np.vstack(rx)), np.vstack(rb))
+                Rx = Rx @ Phi
+                if m:
+                    K = np.kron(shift(np.eye(p + 1), (j - 1) / q, 1.0 / q), np.eye(m))
+                    Cb = Phi @ Cb + Psi @ K
+                Rb = rows @ Cb
+                if nl and m:
+                    Rb[-nl:] += lam[:, n:] @ np.kron((j / q) ** np.arange(p + 1), np.eye(m))
+                rx.append(Rx)
+                rb.append(Rb)
+            self._probe[S] = (
+                np.ascontiguousarray(np.vstack(rx)),
+                np.ascontiguousarray(np.vstack(rb)),
+            )
         return self._probe[S]
