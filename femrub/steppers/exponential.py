@@ -170,6 +170,11 @@ class ExponentialMoreau(Stepper):
         """Load signals at the fraction ``sigma`` of the step."""
         return (sigma ** np.arange(b.shape[0])) @ b
 
+    def _du(self, b, sigma):
+        """Their time derivative (1/s) at the fraction ``sigma`` of the step."""
+        i = np.arange(1, b.shape[0])
+        return ((i * sigma ** (i - 1)) @ b[1:]) / self.h
+
     # -- one step ------------------------------------------------------------------------------
     def _advance(self):
         t, X, P = super()._advance()
@@ -284,18 +289,28 @@ class ExponentialMoreau(Stepper):
         gv, lv = V[:, : c.n], V[:, c.n :]
         held = np.zeros(c.n, dtype=bool)
         held[list(S)] = True
-        cand = []  # (bracket j, kind, contact, f(τ, X))
+        cand = []  # (bracket j, kind, contact, f(τ, X) -> (value, d/dτ))
+        lam, c_n = (flows.generator(S)[2], self.model.n_dofs) if S else (None, 0)
         # closing: the gap falls below min(g(a), 0) after having been above it
         f_cl = gv - np.minimum(gv[0], 0.0)
         for i in np.flatnonzero(~held & np.any(f_cl[1:] < 0.0, axis=0)):
             ref = min(gv[0, i], 0.0)
-            f = lambda tau, X, i=i, ref=ref: c.gap(t + tau, X)[i] - ref  # noqa: E731
+            def f(tau, X, i=i, ref=ref):
+                rate = c.rate_at(t + tau)[i] if callable(c.gap_rate) else 0.0
+                dX = flows.rate(S, X, self._u(b, tau / h))
+                return c.gap(t + tau, X)[i] - ref, rate + c.GT[i] @ dX
+
             cand.append((1 + int(np.argmax(f_cl[1:, i] < 0.0)), "closing", int(i), f))
         for k in np.flatnonzero(np.any(lv < 0.0, axis=0)):
             j = int(np.argmax(lv[:, k] < 0.0))
             if j == 0:  # pulled away already: release now
                 return a, "release", S[k], Xa, np.zeros(n_s)
-            f = lambda tau, X, k=k: flows.multiplier(S, X, self._u(b, tau / h))[k]  # noqa: E731
+            def f(tau, X, k=k):
+                u, du = self._u(b, tau / h), self._du(b, tau / h)
+                lx, lu = lam[k, : c_n], lam[k, c_n:]
+                val = lx @ X + (lu @ u if lu.size else 0.0)
+                return val, lx @ flows.rate(S, X, u) + (lu @ du if lu.size else 0.0)
+
             cand.append((j, "release", S[k], f))
         if not cand:
             return None
@@ -311,7 +326,7 @@ class ExponentialMoreau(Stepper):
         for jj, kind, i, f in cand:
             if jj != j:
                 continue
-            found = self._bisect(S, f, lo, grid[j] - lo, X0, b)
+            found = self._root(S, f, lo, grid[j], X0, b)
             if found is not None and (best is None or found[0] < best[0]):
                 best = (*found, kind, i)
         if best is None:
@@ -319,28 +334,52 @@ class ExponentialMoreau(Stepper):
         tau, X, Pl, kind, i = best
         return tau, kind, i, X, P0 + Pl
 
-    def _bisect(self, S, f, lo, length, X_lo, b):
-        """First zero of ``f`` in ``(lo, lo + length]`` (``f(lo + length) < 0``), bisected on
-        the exact flow; ``(τ, X(τ), P_S(lo..τ))`` just after it, or ``None``."""
-        h, flows, d = self.h, self._flows, self.h / self.probes
-        P_lo = np.zeros(len(S))
+    def _root(self, S, f, lo, hi, X_lo, b):
+        """First zero of ``f`` in ``(lo, hi]`` (``f(hi) < 0``) on the exact flow from
+        ``(lo, X_lo)``: safeguarded Newton (``f`` returns value and rate), one matrix
+        exponential per evaluation. Returns ``(τ, X(τ), P_S(lo..τ))`` with ``f(τ) <= 0``."""
+        h, flows = self.h, self._flows
+        w0 = lo / h
 
-        def go(X, tau, dt):
-            return flows.advance(S, X, tau, tau + dt, b, d)
+        def at(tau):
+            X, P = flows.flow(S, tau - lo)(X_lo, shift(b, w0, (tau - lo) / h))
+            return X, P, *f(tau, X)
 
-        if f(lo, X_lo) <= 0.0:  # at the surface at lo (just released): find it open
+        f_lo = f(lo, X_lo)[0]
+        if f_lo <= 0.0:  # at the surface at lo (just released): find it open
+            x = hi
             for _ in range(40):
-                length *= 0.5
-                Xm, Pm = go(X_lo, lo, length)
-                if f(lo + length, Xm) > 0.0:
-                    X_lo, P_lo, lo = Xm, Pm, lo + length
+                x = lo + 0.5 * (x - lo)
+                X, P, fx, _ = at(x)
+                if fx > 0.0:
                     break
             else:
                 return None
-        while length > _XTOL * h:
-            length *= 0.5
-            Xm, Pm = go(X_lo, lo, length)
-            if f(lo + length, Xm) > 0.0:
-                X_lo, P_lo, lo = Xm, P_lo + Pm, lo + length
-        Xe, Pe = go(X_lo, lo, length)
-        return lo + length, Xe, P_lo + Pe
+            a, f_a = x, fx
+        else:
+            a, f_a = lo, f_lo
+        x = hi
+        X, P, fx, dfx = at(x)
+        best, bh, f_bh = (x, X, P), hi, fx
+        for _ in range(60):
+            x_new = x - fx / dfx if dfx != 0.0 else np.nan
+            if not (a < x_new < bh):  # outside the bracket: regula falsi, else bisection
+                x_new = a - f_a * (bh - a) / (f_bh - f_a)
+                if not (a < x_new < bh):
+                    x_new = 0.5 * (a + bh)
+            if abs(x_new - x) <= _XTOL * h:  # converged
+                if fx > 0.0 and bh - x > _XTOL * h:  # converged from the open side
+                    x = min(x + 2.0 * _XTOL * h, bh)
+                    X, P, fx, dfx = at(x)
+                    if fx <= 0.0:
+                        best = (x, X, P)
+                break
+            x = x_new
+            X, P, fx, dfx = at(x)
+            if fx > 0.0:
+                a, f_a = x, fx
+            else:
+                bh, f_bh, best = x, fx, (x, X, P)
+            if bh - a <= _XTOL * h:
+                break
+        return best

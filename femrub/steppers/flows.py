@@ -150,6 +150,15 @@ class FlowFamily:
                 P, tau, rest = P + dP, tau + u, rest - u
         return X, P
 
+    def rate(self, S: tuple, X, u) -> np.ndarray:
+        """``Ẋ`` (N) of the held-set-``S`` flow at state ``X`` and load signals ``u``."""
+        K, E, _ = self.generator(S)
+        n = self.L.shape[0]
+        out = K[:n, :n] @ X
+        if E.shape[1]:
+            out += E[:n] @ u
+        return out
+
     def multiplier(self, S: tuple, X, u) -> np.ndarray:
         """``λ_S`` holding the set ``S`` at state ``X`` and load signals ``u`` (m,)."""
         _, _, lam = self.generator(S)
