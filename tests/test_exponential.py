@@ -4,12 +4,12 @@ import numpy as np
 import pytest
 import scipy.linalg as sla
 import scipy.sparse as sp
+from test_energy import _free_vibration
+from test_multicontact import _two_contact_bar
 
 import femrub as fr
 from femrub.model.first_order import Layout, LoadTerm
 from femrub.steppers.exponential import MAX_COORDINATES
-from test_energy import _free_vibration
-from test_multicontact import _two_contact_bar
 
 
 def _free_model():
