@@ -57,6 +57,8 @@ MAX_COORDINATES = 3000
 MAX_EVENTS = 64
 #: Most sign checks per step (see ``probes``).
 MAX_PROBES = 512
+#: Impacts of one contact in one step after which it is held (e = 0): a Zeno sequence
+ZENO_HITS = 3
 _XTOL = 1e-10  # relative tolerance (of h) on an event time
 
 
@@ -185,6 +187,7 @@ class ExponentialMoreau(Stepper):
         b = self._load_poly(t)
         X, S, a = self.X, self._S, 0.0
         P = np.zeros(self.model.n_contacts)
+        hits = np.zeros(self.model.n_contacts, dtype=int)
         self._work = 0.0
         for n_events in range(MAX_EVENTS + 1):
             if a == 0.0:
@@ -202,8 +205,9 @@ class ExponentialMoreau(Stepper):
             P[list(S)] += PSa
             if kind == "release":
                 S = tuple(j for j in S if j != i)
-            else:
-                X, S = self._impact(t + a, X, S, P, forced=i)
+            else:  # a third bounce of one contact in a step: Zeno, end it plastically
+                hits[i] += 1
+                X, S = self._impact(t + a, X, S, P, forced=i, plastic=hits >= ZENO_HITS)
         X = Xe
         P[list(S)] += PS
         if S and not self.events:  # releases at step ends
@@ -214,7 +218,7 @@ class ExponentialMoreau(Stepper):
         return X, P
 
     # -- impulses ------------------------------------------------------------------------------
-    def _impact(self, te, X, S, P, forced=None):
+    def _impact(self, te, X, S, P, forced=None, plastic=None):
         """Newton impulses at time ``te`` (shared LCP); update ``P`` in place; new held set."""
         c = self.model.contact
         g, gd = c.gap(te, X), c.gap_velocity(te, X)
@@ -228,6 +232,8 @@ class ExponentialMoreau(Stepper):
         active = trigger | held
         alpha = c.alpha_at(te)
         e = np.where(held, 0.0, c.restitution)
+        if plastic is not None and c.restitution < 1.0:  # e = 1 has no Zeno sequence
+            e[plastic] = 0.0
         W = self._Wm + self._Wt * alpha
         Pi = solve_impulses(W / (1.0 + e)[:, None], gd, active, self._warm)
         self._warm = Pi > 0.0
