@@ -125,27 +125,33 @@ class ExponentialMoreau(Stepper):
         if not (np.all(np.isfinite(L)) and np.all(np.isfinite(G))):
             raise ValueError("A⁻¹B or A⁻¹F is not finite: check the model's matrices")
         self._signals = [term.signal for term in m.loads]
-        p = self.load_degree if m.loads else 0
-        self._nodes = 0.5 * (1.0 - np.cos(np.pi * np.arange(p + 1) / max(p, 1)))  # Lobatto
-        self._Vinv = np.linalg.inv(self._nodes[:, None] ** np.arange(p + 1))
-        self._T01 = np.diag([float(math.factorial(i)) for i in range(p + 1)])
-        self._Dinv = np.linalg.inv(self._T01)
-        self._sk = self._signal_values(self.t)
         c = m.contact
         self._hold = False
         AinvH = GvT = None
+        # a moving casing enters the held flow through g̈0: extra inputs, one per contact
+        self._n_a = 0
         if c is not None:
             self._Zm = np.asarray(lu.solve(c.Hm))
             self._Zt = np.asarray(lu.solve(c.Ht))
             self._Wm, self._Wt = c.GvT @ self._Zm, c.GvT @ self._Zt
             GvT = c.GvT
-            # held contacts need a fixed obstacle and a constant α (a time-invariant flow)
-            self._hold = (
-                not callable(c.gap0) and c.gap_rate is None and not callable(c.heat_coefficient)
+            # held contacts need a constant α and the casing's motion (fixed, or ġ0 known)
+            moving = callable(c.gap0) or c.gap_rate is not None
+            self._hold = not callable(c.heat_coefficient) and (
+                not moving or c.gap_rate is not None
             )
             if self._hold:
                 AinvH = self._Zm + self._Zt * c.heat_coefficient
-        self._flows = FlowFamily(L, G, AinvH, GvT, h, p)
+                self._n_a = c.n if moving else 0
+        self._m0 = len(self._signals)
+        G = np.hstack([G, np.zeros((m.n_dofs, self._n_a))])
+        p = self.load_degree if G.shape[1] else 0
+        self._nodes = 0.5 * (1.0 - np.cos(np.pi * np.arange(p + 1) / max(p, 1)))  # Lobatto
+        self._Vinv = np.linalg.inv(self._nodes[:, None] ** np.arange(p + 1))
+        self._T01 = np.diag([float(math.factorial(i)) for i in range(p + 1)])
+        self._Dinv = np.linalg.inv(self._T01)
+        self._sk = self._signal_values(self.t)
+        self._flows = FlowFamily(L, G, AinvH, GvT, h, p, n_acc=self._n_a)
         self._flows.flow((), h)  # the free step: one augmented exponential
         if self.probes is None:  # four checks per shortest period of the model
             w_max = float(np.max(np.abs(np.linalg.eigvals(L).imag), initial=0.0))
@@ -156,17 +162,27 @@ class ExponentialMoreau(Stepper):
         self._work = 0.0
 
     def _signal_values(self, t):
-        return np.array([float(sig(t)) for sig in self._signals])
+        """Load signals, then the casing's gap rates ``ġ0`` (moving casing, held contacts)."""
+        s = [float(sig(t)) for sig in self._signals]
+        if self._n_a:
+            return np.r_[s, self.model.contact.rate_at(t)]
+        return np.array(s)
 
     def _load_poly(self, t):
         """Monomial coefficients ``b`` (p+1, m) of the step's load, ``s = Σ b_i σ^i``."""
         h, nodes = self.h, self._nodes
-        S = np.empty((nodes.size, len(self._signals)))
+        S = np.empty((nodes.size, self._m0 + self._n_a))
         S[0] = self._sk
         for j in range(1, nodes.size):
             S[j] = self._signal_values(t + nodes[j] * h)
         self._sk = S[-1]
-        return self._Vinv @ S
+        b = self._Vinv @ S
+        if self._n_a:  # g̈0 = dġ0/dt: the derivative of the rates' interpolant
+            i = np.arange(1, b.shape[0])[:, None]
+            rates = b[:, self._m0 :].copy()
+            b[:, self._m0 :] = 0.0
+            b[:-1, self._m0 :] = i * rates[1:] / h
+        return b
 
     def _u(self, b, sigma):
         """Load signals at the fraction ``sigma`` of the step."""
@@ -201,13 +217,16 @@ class ExponentialMoreau(Stepper):
                 ev = self._event(S, X, a, Xe, b)
             if ev is None:
                 break
-            a, kind, i, X, PSa = ev
+            a, kind, i, Xn, PSa = ev
+            self._held_work(S, PSa, X, Xn)
+            X = Xn
             P[list(S)] += PSa
             if kind == "release":
                 S = tuple(j for j in S if j != i)
             else:  # a third bounce of one contact in a step: Zeno, end it plastically
                 hits[i] += 1
                 X, S = self._impact(t + a, X, S, P, forced=i, plastic=hits >= ZENO_HITS)
+        self._held_work(S, PS, X, Xe)
         X = Xe
         P[list(S)] += PS
         if S and not self.events:  # releases at step ends
@@ -216,6 +235,14 @@ class ExponentialMoreau(Stepper):
         X, S = self._impact(t + h, X, S, P)
         self._S = S
         return X, P
+
+    def _held_work(self, S, PS, X0, X1):
+        """Work of the held contacts' impulse on the structure (moving casing: not zero),
+        with their mean structure velocity over the segment."""
+        if S:
+            c, idx = self.model.contact, list(S)
+            v = c.structure_velocity(X0)[idx] + c.structure_velocity(X1)[idx]
+            self._work += float(PS @ v) / 2
 
     # -- impulses ------------------------------------------------------------------------------
     def _impact(self, te, X, S, P, forced=None, plastic=None):

@@ -97,11 +97,14 @@ class FlowFamily:
     AinvH : (N, n_c) ``A⁻¹ (Hm + Ht diag α)`` (constant α), or ``None`` without contact.
     GvT : (n_c, N) gap-velocity rows.
     h : the constant step (s).
+    n_acc : the last ``n_acc`` columns of ``G`` are zero and their inputs are the casing's
+        gap accelerations ``g̈0`` (one per contact): a held contact on a moving casing keeps
+        ``ġ = ġ0 + Gvᵀ X = 0`` with ``λ_S = −W_S⁻¹ (Gv_Sᵀ (L X + G s) + g̈0_S)``.
     degree : polynomial degree of the load signals over a step.
     """
 
-    def __init__(self, L, G, AinvH, GvT, h, degree):
-        self.L, self.G, self.AinvH, self.GvT = L, G, AinvH, GvT
+    def __init__(self, L, G, AinvH, GvT, h, degree, n_acc=0):
+        self.L, self.G, self.AinvH, self.GvT, self.n_acc = L, G, AinvH, GvT, n_acc
         self.h, self.degree = h, degree
         self._gen: dict[tuple, tuple] = {}
         self._flows: dict[tuple, Flow] = {}  # (S, τ) -> Flow
@@ -116,7 +119,11 @@ class FlowFamily:
             else:
                 idx = list(S)
                 AH, Gv = self.AinvH[:, idx], self.GvT[idx]
-                lam = -np.linalg.solve(Gv @ AH, Gv @ np.hstack([L, G]))
+                W = Gv @ AH
+                lam = -np.linalg.solve(W, Gv @ np.hstack([L, G]))
+                if self.n_acc:  # the casing's acceleration g̈0 (last n_acc inputs)
+                    cols = L.shape[1] + G.shape[1] - self.n_acc + np.array(idx)
+                    lam[:, cols] -= np.linalg.inv(W)
                 s = len(idx)
                 K = np.zeros((n + s, n + s))
                 K[:n, :n] = L + AH @ lam[:, :n]
