@@ -43,10 +43,10 @@ FULL = {
     "exp_h": (5e-3, 2e-3, 1e-3, 5e-4, 2e-4, 1e-4),
     "impact_n": 100,
     "impact_nu": (0.5, 1.0, 2.0, 4.0, 8.0),
-    "blade_t": 0.002,
+    "blade_t": 0.004,
     "blade_ref_h": 2e-7,
     "blade_theta_h": (2e-5, 1e-5, 5e-6, 2e-6),
-    "blade_exp_h": (2e-5, 1e-5),
+    "blade_exp_h": (1e-4, 5e-5, 2e-5, 1e-5),
 }
 QUICK = {
     "t_acc": 0.1,
@@ -269,6 +269,12 @@ def main(argv=None) -> dict:
         "machine": C.machine(),
         "config": {k: list(v) if isinstance(v, tuple) else v for k, v in cfg.items()},
     }
+    out = C.OUT / ("exponential_quick" if args.quick else "exponential")
+    if args.skip and out.with_suffix(".json").exists():  # keep the studies not rerun
+        import json
+
+        old = json.loads(out.with_suffix(".json").read_text())
+        doc = {**{k: v for k, v in old.items() if k in args.skip}, **doc}
     for name, fn in (
         ("accuracy", accuracy),
         ("work_precision", work_precision),
@@ -277,7 +283,6 @@ def main(argv=None) -> dict:
     ):
         if name not in args.skip:
             doc[name] = fn(cfg, log)
-    out = C.OUT / ("exponential_quick" if args.quick else "exponential")
     C.OUT.mkdir(parents=True, exist_ok=True)
     C.write_json(out.with_suffix(".json"), doc)
     if "work_precision" in doc:
