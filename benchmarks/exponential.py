@@ -47,6 +47,7 @@ FULL = {
     "blade_ref_h": 2e-7,
     "blade_theta_h": (2e-5, 1e-5, 5e-6, 2e-6),
     "blade_exp_h": (1e-4, 5e-5, 2e-5, 1e-5),
+    "blade_carpenter_f": (0.9, 0.5, 0.2),
 }
 QUICK = {
     "t_acc": 0.1,
@@ -63,6 +64,7 @@ QUICK = {
     "blade_ref_h": 2e-6,
     "blade_theta_h": (),
     "blade_exp_h": (),
+    "blade_carpenter_f": (),
 }
 
 
@@ -202,9 +204,13 @@ def blade(cfg, log) -> dict:
         f"blade: {model.n_dofs} reduced dofs, reference θ h={cfg['blade_ref_h']:g} "
         f"({ref_cpu:.1f} s)"
     )
+    h_lim = fr.Carpenter(model, 1e-9).stability_limit()
+    carpenter_h = tuple(f * h_lim for f in cfg["blade_carpenter_f"])
+    log(f"blade: Carpenter stability limit {h_lim:.3g} s")
     rows = []
     for name, hs, make in (
         ("θ paper", cfg["blade_theta_h"], lambda h: fr.ThetaMethod(model, h)),
+        ("Carpenter", carpenter_h, lambda h: fr.Carpenter(model, h)),
         ("exponential", cfg["blade_exp_h"], lambda h: fr.ExponentialMoreau(model, h)),
     ):
         for h in hs:
@@ -230,7 +236,13 @@ def blade(cfg, log) -> dict:
             log(
                 f"blade {name} h={h:g}: u_L2 {row['u_L2']:.3g} T_end {row['T_end']:.3g} {cpu:.2f} s"
             )
-    return {"n_dofs": model.n_dofs, "t_end": T, "ref_cpu": ref_cpu, "rows": rows}
+    return {
+        "n_dofs": model.n_dofs,
+        "t_end": T,
+        "ref_cpu": ref_cpu,
+        "carpenter_limit": h_lim,
+        "rows": rows,
+    }
 
 
 def _plot(wp, path):
@@ -253,6 +265,92 @@ def _plot(wp, path):
     fig.tight_layout()
     fig.savefig(path, dpi=110)
     plt.close(fig)
+
+
+def markdown(doc) -> str:
+    """Every table of the study (docs/performance/exponential.md)."""
+    out = [f"# Exponential stepper study\n\nMachine: {doc['machine']}\n"]
+    if "accuracy" in doc:
+        a = doc["accuracy"]
+        out += [
+            f"## Paper case, tip temperature at {a['t_end']} s\n",
+            C.md_table(
+                a["reference"],
+                [
+                    ("h", "θ reference h (s)"),
+                    ("T_end", "T (K)"),
+                    ("t1", "first contact (s)"),
+                    ("cpu", "CPU (s)"),
+                ],
+            ),
+            f"\nReference spread (two finest θ steps): {a['reference_spread']:.3g}\n",
+            C.md_table(
+                a["rows"],
+                [
+                    ("method", "method"),
+                    ("h", "h (s)"),
+                    ("status", "status"),
+                    ("T_end", "T (K)"),
+                    ("T_err", "T error"),
+                    ("t1", "first contact (s)"),
+                    ("t1_err_steps", "t1 error (steps)"),
+                    ("cpu", "CPU (s)"),
+                ],
+            ),
+        ]
+    if "work_precision" in doc:
+        w = doc["work_precision"]
+        out += [
+            f"\n## Work–precision, paper case over {w['t_end']} s (θ reference h = "
+            f"{w['h_ref']:g} s)\n",
+            C.md_table(
+                w["rows"],
+                [
+                    ("method", "method"),
+                    ("h", "h (s)"),
+                    ("u_L2", "u L2"),
+                    ("u_L2_nodes", "u L2 nodes"),
+                    ("T_end", "T end"),
+                    ("P_phase", "P phase"),
+                    ("t1", "t1 (s)"),
+                    ("cpu", "CPU (s)"),
+                ],
+            ),
+        ]
+    if "impact" in doc:
+        out += [
+            "\n## Free bar impact, fixed mesh, against the exact solution\n",
+            C.md_table(
+                doc["impact"],
+                [
+                    ("method", "method"),
+                    ("nu", "Courant ν"),
+                    ("h", "h (s)"),
+                    ("u_L2_nodes", "u L2 nodes"),
+                    ("impulse_err", "impulse error"),
+                    ("cpu", "CPU (s)"),
+                ],
+            ),
+        ]
+    if doc.get("blade"):
+        b = doc["blade"]
+        out += [
+            f"\n## Reduced twisted NACA blade ({b['n_dofs']} coordinates), {b['t_end']} s; "
+            f"Carpenter limit {b['carpenter_limit']:.3g} s\n",
+            C.md_table(
+                b["rows"],
+                [
+                    ("method", "method"),
+                    ("h", "h (s)"),
+                    ("u_L2", "u L2"),
+                    ("u_L2_nodes", "u L2 nodes"),
+                    ("T_end", "T end"),
+                    ("min_gap", "min gap (m)"),
+                    ("cpu", "CPU (s)"),
+                ],
+            ),
+        ]
+    return "\n".join(out) + "\n"
 
 
 def main(argv=None) -> dict:
@@ -285,6 +383,7 @@ def main(argv=None) -> dict:
             doc[name] = fn(cfg, log)
     C.OUT.mkdir(parents=True, exist_ok=True)
     C.write_json(out.with_suffix(".json"), doc)
+    out.with_suffix(".md").write_text(markdown(doc))
     if "work_precision" in doc:
         _plot(doc["work_precision"], out.with_suffix(".png"))
         for level in (0.1, 0.01, 0.001):
