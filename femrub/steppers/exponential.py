@@ -372,10 +372,9 @@ class ExponentialMoreau(Stepper):
         ``(lo, X_lo)``: safeguarded Newton (``f`` returns value and rate), one matrix
         exponential per evaluation. Returns ``(τ, X(τ), P_S(lo..τ))`` with ``f(τ) <= 0``."""
         h, flows = self.h, self._flows
-        w0 = lo / h
 
         def at(tau):
-            X, P = flows.flow(S, tau - lo)(X_lo, shift(b, w0, (tau - lo) / h))
+            X, P = flows.advance(S, X_lo, lo, tau, b, h / self.probes)
             return X, P, *f(tau, X)
 
         f_lo = f(lo, X_lo)[0]

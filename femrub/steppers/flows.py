@@ -145,12 +145,12 @@ class FlowFamily:
 
     def advance(self, S: tuple, X, tau0: float, tau1: float, b, unit: float):
         """Flow of ``S`` from ``tau0`` to ``tau1`` in the step, composed of cached flows over
-        ``unit 2^j`` and ``unit / 2^k`` (k <= 45: the remainder, below ``unit 2^-45``, is
+        ``unit 2^j`` and ``unit / 2^k`` (k <= 36: the remainder, below ``unit 2^-36``, is
         dropped); ``b``: the step's load polynomial. Returns ``(X, P_S)``."""
         h, P = self.h, np.zeros(len(S))
         rest, tau = tau1 - tau0, tau0
         j = max(int(math.floor(math.log2(max(rest / unit, 1.0)))), 0)
-        pieces = [unit * 2.0**e for e in range(j, -46, -1)]
+        pieces = [unit * 2.0**e for e in range(j, -37, -1)]
         for u in pieces:
             while rest >= u * (1.0 - 1e-12):
                 X, dP = self.flow(S, u, cache=True)(X, shift(b, tau / h, u / h))
