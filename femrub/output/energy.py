@@ -95,9 +95,7 @@ class EnergyMeter:
         inc["damping_work"] = h * self._quad(f.Pd, Xm)
         c = self.contact
         if c is not None:
-            dwc = (
-                np.einsum("ij,ij->i", impulse, c.structure_velocity(Xm)) if work is None else work
-            )
+            dwc = np.einsum("ij,ij->i", impulse, c.structure_velocity(Xm)) if work is None else work
             inc["contact_work"] = dwc
             inc["impact_dissipation"] = -dwc
             alpha = np.broadcast_to(c.alpha_at(t[1:]), impulse.shape)

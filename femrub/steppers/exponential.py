@@ -137,9 +137,7 @@ class ExponentialMoreau(Stepper):
             GvT = c.GvT
             # held contacts need a constant α and the casing's motion (fixed, or ġ0 known)
             moving = callable(c.gap0) or c.gap_rate is not None
-            self._hold = not callable(c.heat_coefficient) and (
-                not moving or c.gap_rate is not None
-            )
+            self._hold = not callable(c.heat_coefficient) and (not moving or c.gap_rate is not None)
             if self._hold:
                 AinvH = self._Zm + self._Zt * c.heat_coefficient
                 self._n_a = c.n if moving else 0
@@ -328,6 +326,7 @@ class ExponentialMoreau(Stepper):
         f_cl = gv - np.minimum(gv[0], 0.0)
         for i in np.flatnonzero(~held & np.any(f_cl[1:] < 0.0, axis=0)):
             ref = min(gv[0, i], 0.0)
+
             def f(tau, X, i=i, ref=ref):
                 rate = c.rate_at(t + tau)[i] if callable(c.gap_rate) else 0.0
                 dX = flows.rate(S, X, self._u(b, tau / h))
@@ -338,9 +337,10 @@ class ExponentialMoreau(Stepper):
             j = int(np.argmax(lv[:, k] < 0.0))
             if j == 0:  # pulled away already: release now
                 return a, "release", S[k], Xa, np.zeros(n_s)
+
             def f(tau, X, k=k):
                 u, du = self._u(b, tau / h), self._du(b, tau / h)
-                lx, lu = lam[k, : c_n], lam[k, c_n:]
+                lx, lu = lam[k, :c_n], lam[k, c_n:]
                 val = lx @ X + (lu @ u if lu.size else 0.0)
                 return val, lx @ flows.rate(S, X, u) + (lu @ du if lu.size else 0.0)
 
