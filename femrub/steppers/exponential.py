@@ -1,41 +1,33 @@
 """Exponential Moreau-type stepper: exact flight between contact events, Newton impulses.
 
-Between events the model is linear and every step is integrated exactly
-(:mod:`femrub.steppers.flows`: ``e^{hL}`` and the φ-functions of the linearly interpolated
-load, one augmented matrix exponential per step size, precomputed for the constant ``h``)::
+Between events the model is linear and is integrated exactly (:mod:`~.flows`: ``e^{hL}``,
+``L = A⁻¹B``, and the φ-functions of the load signals interpolated over the step by a
+polynomial, one augmented matrix exponential precomputed for the constant ``h``)::
 
-    X_{k+1} = e^{hL} X_k + h φ1(hL) G s_k + h φ2(hL) G (s_{k+1} − s_k),     L = A⁻¹ B
+    X_{k+1} = e^{hL} X_k + Σ_i h φ_{i+1}(hL) A⁻¹F w_i          (s(t_k + σh) = Σ w_i σ^i / i!)
 
-Contact enters at instants: an impulse ``P`` at time ``t_e`` changes the state by
+Contact enters at instants: an impulse ``P`` at ``t_e`` changes the state by
 ``ΔX = A⁻¹ (Hm + Ht diag α) P`` (velocity jump and frictional heat ``α P`` at once). The
-impulses solve the same LCP as the θ-method, with the same shared solve
-(:func:`femrub.contact.impulses.solve_impulses`): with the pre-impact gap velocity ``ġ⁻``
-(the *free velocity*) and the Delassus operator ``W = Gvᵀ A⁻¹ (Hm + Ht diag α)``, Newton's
-law ``ġ⁺ = ġ⁻ + W P``::
+impulses solve the θ-method's LCP with the same shared solve
+(:func:`femrub.contact.impulses.solve_impulses`): free velocity = the pre-impact gap velocity
+``ġ⁻``, Delassus operator ``W = Gvᵀ A⁻¹ (Hm + Ht diag α)``, ``ġ⁺ = ġ⁻ + W P``::
 
     0 <= P  ⊥  (ġ⁺ + e ġ⁻) / (1 + e) >= 0
 
-Energy: the impulse changes the kinetic energy by ``Pᵀ (ġ⁻ + ġ⁺) / 2 = −(1 − e) / (2 (1 + e))
-Pᵀ W P <= 0`` (fixed obstacle), and the exact free flight neither creates nor dissipates
-energy, so no step creates energy for e <= 1. The stepper reports this contact work to the
-energy meter (the meter's midpoint formula is the θ-method's).
+The kinetic energy changes by ``Pᵀ (ġ⁻ + ġ⁺) / 2 = −(1 − e) / (2 (1 + e)) Pᵀ W P <= 0``
+(fixed obstacle) and the exact flight neither creates nor dissipates energy: no step creates
+energy for e <= 1. This contact work is handed to the energy meter.
 
-Events (``events=True``): a contact open at the start of a (sub)step whose exact free-flight
-gap is negative at its end closes inside it; its closing time is located on the exact flow
-(Illinois regula falsi on ``g(τ)``, one matrix exponential per evaluation), the flow is
-stopped there and the impulse is given at contact (no penetration, exact contact time). With
-e = 0 on a fixed obstacle and constant α, an impacted contact is then *held* closed by the
-exact multiplier flow (``flows``: ``λ = −W⁻¹ Gvᵀ A⁻¹ (B X + F)``, its impulse ``∫ λ dt`` and
-heat integrated exactly) until ``λ`` vanishes; that release time is located the same way.
-So persistent contact phases (a blade pressed on the casing) are integrated exactly too.
-Without events (``events=False``), or for contacts that close again after the event budget
-of a step, the impulse is given at the end of the step on penetrating, approaching
-contacts (velocity-level Moreau, penetration below ``h |ġ|``) and releases happen at step
-ends. A moving obstacle or a time-varying α leaves only impulses (nothing is held).
+Events (``events=True``): exact gaps and held multipliers are checked at ``probes`` points
+per step; at the first sign change the time is found on the exact flow
+(:func:`~.flows.first_zero`) and the impulse is given at contact (no penetration). With
+e = 0 (or a Zeno sequence) and a constant α, an impacted contact is then *held* by its exact
+multiplier (fixed or moving casing, :class:`~.flows.FlowFamily`), its impulse ``∫λ dt`` and
+heat integrated exactly, until ``λ`` vanishes (located the same way). Without events, or
+after :data:`MAX_EVENTS` in a step, impulses are given at the step end on penetrating,
+approaching contacts (velocity-level Moreau) and releases happen at step ends.
 
-Cost: one dense product per step (as the θ-method's dense path) plus one matrix exponential
-per event-location evaluation, so the model must be small (dense, reduced): at most
-:data:`MAX_COORDINATES` coordinates.
+Dense: at most :data:`MAX_COORDINATES` coordinates (reduce larger models first).
 """
 
 from __future__ import annotations
@@ -47,7 +39,7 @@ import numpy as np
 from ..contact.impulses import solve_impulses
 from ..fem.linalg import Factorised
 from .base import Stepper
-from .flows import FlowFamily, shift
+from .flows import FlowFamily, first_zero, shift
 
 __all__ = ["ExponentialMoreau", "MAX_COORDINATES"]
 
@@ -368,50 +360,12 @@ class ExponentialMoreau(Stepper):
         return tau, kind, i, X, P0 + Pl
 
     def _root(self, S, f, lo, hi, X_lo, b):
-        """First zero of ``f`` in ``(lo, hi]`` (``f(hi) < 0``) on the exact flow from
-        ``(lo, X_lo)``: safeguarded Newton (``f`` returns value and rate), one matrix
-        exponential per evaluation. Returns ``(τ, X(τ), P_S(lo..τ))`` with ``f(τ) <= 0``."""
-        h, flows = self.h, self._flows
+        """First zero of ``f`` in ``(lo, hi]`` on the exact flow from ``(lo, X_lo)``
+        (:func:`~femrub.steppers.flows.first_zero`): ``(τ, X(τ), P_S(lo..τ))`` or ``None``."""
+        h, flows, d = self.h, self._flows, self.h / self.probes
 
         def at(tau):
-            X, P = flows.advance(S, X_lo, lo, tau, b, h / self.probes)
+            X, P = flows.advance(S, X_lo, lo, tau, b, d)
             return X, P, *f(tau, X)
 
-        f_lo = f(lo, X_lo)[0]
-        if f_lo <= 0.0:  # at the surface at lo (just released): find it open
-            x = hi
-            for _ in range(40):
-                x = lo + 0.5 * (x - lo)
-                X, P, fx, _ = at(x)
-                if fx > 0.0:
-                    break
-            else:
-                return None
-            a, f_a = x, fx
-        else:
-            a, f_a = lo, f_lo
-        x = hi
-        X, P, fx, dfx = at(x)
-        best, bh, f_bh = (x, X, P), hi, fx
-        for _ in range(60):
-            x_new = x - fx / dfx if dfx != 0.0 else np.nan
-            if not (a < x_new < bh):  # outside the bracket: regula falsi, else bisection
-                x_new = a - f_a * (bh - a) / (f_bh - f_a)
-                if not (a < x_new < bh):
-                    x_new = 0.5 * (a + bh)
-            if abs(x_new - x) <= _XTOL * h:  # converged
-                if fx > 0.0 and bh - x > _XTOL * h:  # converged from the open side
-                    x = min(x + 2.0 * _XTOL * h, bh)
-                    X, P, fx, dfx = at(x)
-                    if fx <= 0.0:
-                        best = (x, X, P)
-                break
-            x = x_new
-            X, P, fx, dfx = at(x)
-            if fx > 0.0:
-                a, f_a = x, fx
-            else:
-                bh, f_bh, best = x, fx, (x, X, P)
-            if bh - a <= _XTOL * h:
-                break
-        return best
+        return first_zero(at, f(lo, X_lo)[0], lo, hi, _XTOL * h)

@@ -20,7 +20,12 @@ the multiplier that holds their gap acceleration at zero, ``Gv_Sᵀ Ẋ = 0``::
 
 so the held flow is again linear, ``Ẋ = Π (L X + G s)`` with ``Π = I − A⁻¹ H_S W_S⁻¹ Gv_Sᵀ``,
 and its impulse ``P_S = ∫ λ_S dt`` is integrated exactly by appending ``P_S`` to the state
-(``K = [[ΠL, 0], [Λx, 0]]``, ``E = [[ΠG], [Λs]]``). ``S = ()`` is the free flow.
+(``K = [[ΠL, 0], [Λx, 0]]``, ``E = [[ΠG], [Λs]]``). ``S = ()`` is the free flow. On a
+moving casing the held contacts keep ``ġ = ġ0(t) + Gvᵀ X = 0`` and ``λ_S`` gets
+``−W_S⁻¹ g̈0_S(t)``: the casing's accelerations are extra inputs (``n_acc``).
+
+Event times are found on these flows by :func:`first_zero` (safeguarded Newton), the states
+at arbitrary times by :meth:`FlowFamily.advance` (cached dyadic sub-step flows).
 """
 
 from __future__ import annotations
@@ -30,7 +35,7 @@ import math
 import numpy as np
 import scipy.linalg as sla
 
-__all__ = ["Flow", "FlowFamily", "shift"]
+__all__ = ["Flow", "FlowFamily", "first_zero", "shift"]
 
 
 def shift(b: np.ndarray, alpha: float, delta: float) -> np.ndarray:
@@ -205,3 +210,50 @@ class FlowFamily:
                 np.ascontiguousarray(np.vstack(rb)),
             )
         return self._probe[S]
+
+
+def first_zero(at, f_lo: float, lo: float, hi: float, tol: float):
+    """First zero of ``f`` in ``(lo, hi]`` with ``f(hi) < 0``, by safeguarded Newton.
+
+    ``at(τ) -> (X, P, f, df/dτ)`` evaluates the exact flow. Newton steps leaving the bracket
+    fall back to regula falsi, then bisection. When ``f(lo) <= 0`` (a contact at the surface
+    at ``lo``, just released) the bracket is first halved towards ``lo`` until ``f > 0``.
+    Returns ``(τ, X(τ), P(τ))`` with ``f(τ) <= 0`` within ``tol`` of the zero, or ``None``.
+    """
+    if f_lo <= 0.0:
+        x = hi
+        for _ in range(40):
+            x = lo + 0.5 * (x - lo)
+            _, _, fx, _ = at(x)
+            if fx > 0.0:
+                break
+        else:
+            return None
+        a, f_a = x, fx
+    else:
+        a, f_a = lo, f_lo
+    x = hi
+    X, P, fx, dfx = at(x)
+    best, bh, f_bh = (x, X, P), hi, fx
+    for _ in range(60):
+        x_new = x - fx / dfx if dfx != 0.0 else np.nan
+        if not (a < x_new < bh):  # outside the bracket: regula falsi, else bisection
+            x_new = a - f_a * (bh - a) / (f_bh - f_a)
+            if not (a < x_new < bh):
+                x_new = 0.5 * (a + bh)
+        if abs(x_new - x) <= tol:  # converged
+            if fx > 0.0 and bh - x > tol:  # from the open side: step just past the zero
+                x = min(x + 2.0 * tol, bh)
+                X, P, fx, dfx = at(x)
+                if fx <= 0.0:
+                    best = (x, X, P)
+            break
+        x = x_new
+        X, P, fx, dfx = at(x)
+        if fx > 0.0:
+            a, f_a = x, fx
+        else:
+            bh, f_bh, best = x, fx, (x, X, P)
+        if bh - a <= tol:
+            break
+    return best
