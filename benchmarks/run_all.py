@@ -332,6 +332,11 @@ def _hard_section(hc) -> str:
     return "\n\n".join([C.md_table(hc["rows"], cols), HARD_NOTES, C.md_table(table, tcols)])
 
 
+def _read(path: Path, script: str) -> str:
+    """A study's Markdown section, or a note that it was not run."""
+    return path.read_text().strip() if path.exists() else f"Not run (`{script}`)."
+
+
 def render(out: Path, doc: Path) -> Path:
     """Rebuild ``doc`` (performance.md) from the JSON files in ``out``."""
     wp, sc, hc = (_load(out, s) for s in STUDIES[:3])
@@ -357,6 +362,8 @@ def render(out: Path, doc: Path) -> Path:
             + cost_text
             + "\n\n"
             + COST_3D_NOTES,
+            '## 6. Exponential Moreau stepper (`scheme.name = "exponential"`)\n\n'
+            + _read(out / "exponential_section.md", "benchmarks/exponential.py"),
         ]
     ).replace("performance/", f"{rel.as_posix()}/")
     doc.write_text(text.rstrip() + "\n")
