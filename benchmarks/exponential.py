@@ -490,7 +490,8 @@ def main(argv=None) -> dict:
         "machine": C.machine(),
         "config": {k: list(v) if isinstance(v, tuple) else v for k, v in cfg.items()},
     }
-    out = (args.out or C.OUT) / ("exponential_quick" if args.quick else "exponential")
+    name = "exponential_quick" if args.quick and args.out is None else "exponential"
+    out = (args.out or C.OUT) / name
     if args.skip and out.with_suffix(".json").exists():  # keep the studies not rerun
         import json
 
