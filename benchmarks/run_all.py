@@ -1,7 +1,8 @@
 """Run every speed/accuracy benchmark and regenerate ``docs/performance.md``.
 
-``python benchmarks/run_all.py`` runs ``work_precision.py``, ``siconos_compare.py`` and
-``hard_cases.py`` (each in a fresh process, so timings and peak memory do not mix), writes
+``python benchmarks/run_all.py`` runs ``work_precision.py``, ``siconos_compare.py``,
+``hard_cases.py``, ``cost_3d.py`` and ``exponential.py`` (each in a fresh process, so timings
+and peak memory do not mix), writes
 their tables, JSON and plots into ``docs/performance/`` and rebuilds ``docs/performance.md``
 from the JSON files (about 20 min on the 2-core reference machine). ``--quick`` is a fast
 pass (about 2 min) that writes into ``build/performance-quick/`` unless ``--out`` is given,
@@ -24,12 +25,13 @@ try:
 except ImportError:  # run as a script
     import _common as C
 
-STUDIES = ("work_precision", "siconos_compare", "hard_cases", "cost_3d")
+STUDIES = ("work_precision", "siconos_compare", "hard_cases", "cost_3d", "exponential")
 JSON = {
     "work_precision": "work_precision",
     "siconos_compare": "siconos",
     "hard_cases": "hard_cases",
     "cost_3d": "cost_3d",
+    "exponential": "exponential",
 }
 
 COST_3D_NOTES = """\
@@ -332,6 +334,11 @@ def _hard_section(hc) -> str:
     return "\n\n".join([C.md_table(hc["rows"], cols), HARD_NOTES, C.md_table(table, tcols)])
 
 
+def _read(path: Path, script: str) -> str:
+    """A study's Markdown section, or a note that it was not run."""
+    return path.read_text().strip() if path.exists() else f"Not run (`{script}`)."
+
+
 def render(out: Path, doc: Path) -> Path:
     """Rebuild ``doc`` (performance.md) from the JSON files in ``out``."""
     wp, sc, hc = (_load(out, s) for s in STUDIES[:3])
@@ -357,6 +364,8 @@ def render(out: Path, doc: Path) -> Path:
             + cost_text
             + "\n\n"
             + COST_3D_NOTES,
+            '## 6. Exponential Moreau stepper (`scheme.name = "exponential"`)\n\n'
+            + _read(out / "exponential_section.md", "benchmarks/exponential.py"),
         ]
     ).replace("performance/", f"{rel.as_posix()}/")
     doc.write_text(text.rstrip() + "\n")

@@ -28,6 +28,7 @@ _LAZY = {
     "Results": ".output.results",
     "Carpenter": ".steppers",
     "Penalty": ".steppers",
+    "ExponentialMoreau": ".steppers",
     "ThetaMethod": ".steppers",
     "make_stepper": ".steppers",
 }
@@ -35,6 +36,7 @@ _LAZY = {
 __all__ = [
     "BarCase",
     "Carpenter",
+    "ExponentialMoreau",
     "Contact",
     "ContactSpec",
     "EnergyForms",

@@ -154,6 +154,8 @@ def _scheme_options(scene) -> dict:
         }
     if s["name"] == "penalty":
         return {"stiffness": s["stiffness"], "damping": s["damping"], "method": s["method"]}
+    if s["name"] == "exponential":
+        return {"events": s["events"]}
     return {}
 
 

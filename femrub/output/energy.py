@@ -79,8 +79,12 @@ class EnergyMeter:
         self._Q0 = d["heat_content"][0]
         self.scale, self.heat_scale = abs(self._E0), abs(self._Q0)
 
-    def update(self, i0, X, impulse, t, h) -> None:
-        """Fill rows ``i0 + 1 .. i0 + m`` from a block of states (see class docstring)."""
+    def update(self, i0, X, impulse, t, h, work=None) -> None:
+        """Fill rows ``i0 + 1 .. i0 + m`` from a block of states (see class docstring).
+
+        ``work`` (m,): the contact work of each step as the scheme computed it (impulses
+        given inside the step, e.g. the exponential stepper); default ``Pᵀ Gvᵀ X_m``.
+        """
         f, d = self.forms, self.data
         m = X.shape[0] - 1
         rows = slice(i0 + 1, i0 + 1 + m)
@@ -100,7 +104,7 @@ class EnergyMeter:
         inc["damping_work"] = h * self._quad(f.Pd, Xm)
         c = self.contact
         if c is not None:
-            dwc = np.einsum("ij,ij->i", impulse, c.structure_velocity(Xm))
+            dwc = np.einsum("ij,ij->i", impulse, c.structure_velocity(Xm)) if work is None else work
             inc["contact_work"] = dwc
             inc["impact_dissipation"] = -dwc
             alpha = np.broadcast_to(c.alpha_at(t[1:]), impulse.shape)

@@ -277,6 +277,11 @@ SCHEME = Variant(
             "damping": _f(0.0, "damping", "penalty damping", **NONNEG),
             "method": Spec(C, "Radau", choices=("Radau", "BDF"), doc="implicit integrator"),
         },
+        "exponential": {
+            "events": Spec(
+                B, True, doc="locate contact closings and releases inside the step (exact times)"
+            ),
+        },
     },
 )
 

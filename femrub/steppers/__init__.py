@@ -2,14 +2,21 @@
 
 from .base import State, Stepper, check_step
 from .carpenter import Carpenter
+from .exponential import ExponentialMoreau
 from .penalty import Penalty
 from .theta import ACTIVATION_RULES, ThetaMethod
 
-SCHEMES = {"theta": ThetaMethod, "carpenter": Carpenter, "penalty": Penalty}
+SCHEMES = {
+    "theta": ThetaMethod,
+    "carpenter": Carpenter,
+    "penalty": Penalty,
+    "exponential": ExponentialMoreau,
+}
 
 
 def make_stepper(scheme: str, model, h, **options) -> Stepper:
-    """Stepper by name: ``"theta"`` (paper Sec. 3), ``"carpenter"`` or ``"penalty"``."""
+    """Stepper by name: ``"theta"`` (paper Sec. 3), ``"carpenter"``, ``"penalty"`` or
+    ``"exponential"`` (exact flight between contact events)."""
     try:
         cls = SCHEMES[scheme]
     except KeyError:
@@ -20,6 +27,7 @@ def make_stepper(scheme: str, model, h, **options) -> Stepper:
 __all__ = [
     "ACTIVATION_RULES",
     "Carpenter",
+    "ExponentialMoreau",
     "Penalty",
     "SCHEMES",
     "State",

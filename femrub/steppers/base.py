@@ -50,6 +50,8 @@ class Stepper:
     """Base class; see the module docstring. ``h`` is the time step (s)."""
 
     name = "stepper"
+    #: the recorder stops a run whose energy balance opens (numerical blow-up)
+    blowup_check = True
 
     def __init__(self, model: FirstOrderModel, h: float, *, t0: float = 0.0):
         if not isinstance(model, FirstOrderModel):
@@ -191,6 +193,7 @@ class Stepper:
             on_state=on_state,
             on_rows=on_rows,
             label=label,
+            blowup_check=self.blowup_check,
         )
         res = recorder.record(self.state, self._advance, progress=progress)
         return assess(res, tolerances=tolerances, merge_time=merge_time)

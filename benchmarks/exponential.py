@@ -1,0 +1,525 @@
+"""Exponential Moreau stepper against the θ-method and Carpenter (issue 16).
+
+Four studies, one command (``python benchmarks/exponential.py [--quick]``):
+
+* ``accuracy``: paper case (α = 3 m/s, coupled) over 0.4 s: tip temperature at 0.4 s and
+  first-contact time of the exponential stepper at h = 5e-4 and 5e-3 s against a converged
+  θ-method reference (two fine steps, their difference reported);
+* ``work-precision``: paper case over 0.1 s, error against CPU for θ (paper rule), Carpenter
+  and the exponential stepper, reference θ at ``h_ref``; errors as in docs/performance.md
+  (``u_L2`` on the reference grid, piecewise-linear interpolant of the run) plus ``u_L2 nodes``
+  (the run's own output times: the error of the computed states);
+* ``events``: the same with event location off (impulses at step ends only);
+* ``impact``: free bar hitting a rigid obstacle on a fixed mesh, several Courant numbers,
+  error against the exact solution at the run's output times;
+* ``blade``: the reduced twisted NACA blade scene (``twisted-naca``), short window, against a
+  fine θ-method step.
+
+Writes docs/performance/exponential.{md,json,png} and prints the tables.
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import time
+from pathlib import Path
+
+import numpy as np
+
+import femrub as fr
+
+try:
+    from . import _common as C
+except ImportError:  # run as a script
+    import _common as C
+
+FULL = {
+    "t_acc": 0.4,
+    "acc_ref_h": (1e-6, 5e-7),
+    "acc_h": (5e-3, 5e-4),
+    "t_wp": 0.1,
+    "h_ref": 2e-7,
+    "theta_h": (1e-3, 5e-4, 2e-4, 1e-4, 5e-5, 2e-5, 1e-5, 5e-6),
+    "carpenter_h": (2.5e-5, 2e-5, 1e-5, 5e-6),
+    "exp_h": (5e-3, 2e-3, 1e-3, 5e-4, 2e-4, 1e-4),
+    "impact_n": 100,
+    "impact_nu": (0.5, 1.0, 2.0, 4.0, 8.0),
+    "blade_t": 0.004,
+    "blade_ref_h": 2e-7,
+    "blade_theta_h": (2e-5, 1e-5, 5e-6, 2e-6, 1e-6, 5e-7),
+    "blade_exp_h": (1e-4, 5e-5, 2e-5, 1e-5),
+    "blade_carpenter_f": (0.9, 0.5, 0.2),
+}
+QUICK = {
+    "t_acc": 0.1,
+    "acc_ref_h": (1e-5, 5e-6),
+    "acc_h": (5e-3, 5e-4),
+    "t_wp": 0.02,
+    "h_ref": 2e-6,
+    "theta_h": (1e-4, 1e-5),
+    "carpenter_h": (2e-5,),
+    "exp_h": (1e-3, 1e-4),
+    "impact_n": 40,
+    "impact_nu": (0.5, 4.0),
+    "blade_t": 0.0,
+    "blade_ref_h": 2e-6,
+    "blade_theta_h": (),
+    "blade_exp_h": (),
+    "blade_carpenter_f": (),
+}
+
+
+def _run(make, t_end, energy=True):
+    """``(Results, CPU s)`` of building the stepper and running it."""
+    c0 = time.process_time()
+    res = make().run(t_end, energy=energy)
+    return res, time.process_time() - c0
+
+
+def _nodal_l2(t, u, t_ref, u_ref) -> float:
+    """Relative l2 error of ``u`` at its own times against ``u_ref`` interpolated there."""
+    r = np.interp(t, t_ref, u_ref)
+    return float(np.sqrt(np.sum((u - r) ** 2) / np.sum(r**2)))
+
+
+def accuracy(cfg, log) -> dict:
+    """Tip temperature at ``t_acc`` and first contact time, paper case (coupled, α = 3)."""
+    model, T = C.paper_model(), cfg["t_acc"]
+    refs = []
+    for h in cfg["acc_ref_h"]:
+        res, cpu = _run(lambda h=h: fr.ThetaMethod(model, h), T, energy=False)
+        refs.append((h, res.signals["tip_temperature"][-1, 0], res.first_contact_time(), cpu))
+        log(f"accuracy ref θ h={h:g}: T={refs[-1][1]:.6g} K t1={refs[-1][2]:.6g} s ({cpu:.1f} s)")
+    T_ref, t1_ref = refs[-1][1], refs[-1][2]
+    rows = []
+    for name, make in (
+        ("exponential", lambda h: fr.ExponentialMoreau(model, h)),
+        ("θ paper", lambda h: fr.ThetaMethod(model, h)),
+    ):
+        for h in cfg["acc_h"]:
+            res, cpu = _run(lambda h=h, make=make: make(h), T)
+            Th = res.signals["tip_temperature"][-1, 0]
+            rows.append(
+                {
+                    "method": name,
+                    "h": h,
+                    "status": res.status,
+                    "T_end": Th,
+                    "T_err": (Th - T_ref) / T_ref,
+                    "t1": res.first_contact_time(),
+                    "t1_err_steps": (res.first_contact_time() - t1_ref) / h,
+                    "cpu": cpu,
+                }
+            )
+            log(f"accuracy {name} h={h:g}: T={Th:.6g} ({rows[-1]['T_err']:+.2%}) {cpu:.2f} s")
+    return {
+        "t_end": T,
+        "reference": [{"h": h, "T_end": Tr, "t1": t1, "cpu": c} for h, Tr, t1, c in refs],
+        "reference_spread": abs(refs[0][1] - refs[-1][1]) / abs(T_ref),
+        "rows": rows,
+    }
+
+
+def work_precision(cfg, log) -> dict:
+    """Error against CPU on the paper case over ``t_wp``."""
+    model, T = C.paper_model(), cfg["t_wp"]
+    ref_res, ref_cpu = _run(lambda: fr.ThetaMethod(model, cfg["h_ref"]), T, energy=False)
+    ref = C.Measures.of(ref_res, C.PERIOD, T)
+    log(f"work-precision reference θ h={cfg['h_ref']:g} ({ref_cpu:.1f} s)")
+    series = [
+        ("θ paper", cfg["theta_h"], lambda h: fr.ThetaMethod(model, h)),
+        ("Carpenter", cfg["carpenter_h"], lambda h: fr.Carpenter(model, h)),
+        ("exponential", cfg["exp_h"], lambda h: fr.ExponentialMoreau(model, h)),
+        (
+            "exponential, no events",
+            cfg["exp_h"],
+            lambda h: fr.ExponentialMoreau(model, h, events=False),
+        ),
+    ]
+    rows = []
+    for name, hs, make in series:
+        for h in hs:
+            res, cpu = _run(lambda h=h, make=make: make(h), T)
+            m = C.Measures.of(res, C.PERIOD, T)
+            err = C.compare(m, ref)
+            err["u_L2_nodes"] = _nodal_l2(m.t, m.u, ref.t, ref.u)
+            rows.append({"method": name, "h": h, "cpu": cpu, "status": res.status, **err})
+            log(
+                f"wp {name} h={h:g}: u_L2 {err['u_L2']:.3g} nodes {err['u_L2_nodes']:.3g} "
+                f"T_end {err['T_end']:.3g} cpu {cpu:.3f}"
+            )
+    return {"t_end": T, "h_ref": cfg["h_ref"], "ref_cpu": ref_cpu, "rows": rows}
+
+
+def cheapest(rows, key, level):
+    """Per method: the cheapest run with ``key <= level``."""
+    out = {}
+    for r in rows:
+        if r[key] <= level and (r["method"] not in out or r["cpu"] < out[r["method"]]["cpu"]):
+            out[r["method"]] = r
+    return out
+
+
+def impact(cfg, log) -> list[dict]:
+    """Free bar impact, fixed mesh, several Courant numbers, exact reference."""
+    n = cfg["impact_n"]
+    model, dx, T = C.impact_model(n), C.LENGTH / n, C.IMPACT_T_END
+    rows = []
+    for name, make in (
+        ("exponential", lambda h: fr.ExponentialMoreau(model, h)),
+        ("θ paper", lambda h: fr.ThetaMethod(model, h)),
+    ):
+        for nu in cfg["impact_nu"]:
+            h = nu * dx / C.WAVE_SPEED
+            res, cpu = _run(lambda h=h, make=make: make(h), T)
+            u = res.signal("tip_displacement")
+            err = _nodal_l2(res.t, u, res.t, C.impact_exact_displacement(res.t))
+            P = res.impulse.sum()
+            rows.append(
+                {
+                    "method": name,
+                    "nu": nu,
+                    "h": h,
+                    "u_L2_nodes": err,
+                    "impulse_err": abs(P - C.EXACT.impulse) / C.EXACT.impulse,
+                    "cpu": cpu,
+                }
+            )
+            log(f"impact {name} ν={nu}: u_L2 nodes {err:.3g} impulse {rows[-1]['impulse_err']:.3g}")
+    return rows
+
+
+def blade(cfg, log) -> dict:
+    """Reduced twisted NACA blade (scene ``twisted-naca``) against a fine θ step."""
+    if not cfg["blade_t"]:
+        return {}
+    from femrub.app.simulation import Simulation
+    from femrub.scene import load_scene
+
+    sim = Simulation.from_scene(load_scene("twisted-naca", {"outputs.vtk_stride": 0}))
+    model, T = sim.model, cfg["blade_t"]
+    ref_res, ref_cpu = _run(lambda: fr.ThetaMethod(model, cfg["blade_ref_h"]), T, energy=False)
+    t_ref, u_ref = ref_res.t, ref_res.signal("tip_displacement")
+    T_ref = ref_res.signals["tip_temperature"][-1, 0]
+    log(
+        f"blade: {model.n_dofs} reduced dofs, reference θ h={cfg['blade_ref_h']:g} "
+        f"({ref_cpu:.1f} s)"
+    )
+    h_lim = fr.Carpenter(model, 1e-9).stability_limit()
+    carpenter_h = tuple(f * h_lim for f in cfg["blade_carpenter_f"])
+    log(f"blade: Carpenter stability limit {h_lim:.3g} s")
+    rows = []
+    for name, hs, make in (
+        ("θ paper", cfg["blade_theta_h"], lambda h: fr.ThetaMethod(model, h)),
+        ("Carpenter", carpenter_h, lambda h: fr.Carpenter(model, h)),
+        ("exponential", cfg["blade_exp_h"], lambda h: fr.ExponentialMoreau(model, h)),
+    ):
+        for h in hs:
+            res, cpu = _run(lambda h=h, make=make: make(h), T)
+            u = res.signal("tip_displacement")
+            Th = res.signals["tip_temperature"][-1, 0]
+            row = {
+                "method": name,
+                "h": h,
+                "cpu": cpu,
+                "status": res.status,
+                "u_L2": float(
+                    np.sqrt(
+                        np.trapezoid((np.interp(t_ref, res.t, u) - u_ref) ** 2, t_ref)
+                        / np.trapezoid(u_ref**2, t_ref)
+                    )
+                ),
+                "u_L2_nodes": _nodal_l2(res.t, u, t_ref, u_ref),
+                "T_end": abs(Th - T_ref) / abs(T_ref),
+                "min_gap": float(res.gap.min()),
+            }
+            rows.append(row)
+            log(
+                f"blade {name} h={h:g}: u_L2 {row['u_L2']:.3g} T_end {row['T_end']:.3g} {cpu:.2f} s"
+            )
+    return {
+        "n_dofs": model.n_dofs,
+        "t_end": T,
+        "ref_cpu": ref_cpu,
+        "carpenter_limit": h_lim,
+        "rows": rows,
+    }
+
+
+def _plot(wp, path):
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, axes = plt.subplots(1, 3, figsize=(13, 4))
+    for ax, key in zip(axes, ("u_L2", "u_L2_nodes", "T_end")):
+        for method in dict.fromkeys(r["method"] for r in wp["rows"]):
+            rs = [r for r in wp["rows"] if r["method"] == method and r[key] > 0]
+            ax.loglog([r["cpu"] for r in rs], [r[key] for r in rs], "o-", label=method)
+        ax.axhline(0.01, color="k", lw=0.6, ls=":")
+        ax.set_xlabel("CPU (s)")
+        ax.set_ylabel(f"{key} error")
+        ax.grid(True, which="both", alpha=0.3)
+    axes[0].legend(fontsize=8)
+    fig.suptitle(f"paper case, {wp['t_end']} s: error against CPU")
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+def markdown(doc) -> str:
+    """Every table of the study (docs/performance/exponential.md)."""
+    out = [f"# Exponential stepper study\n\nMachine: {doc['machine']}\n"]
+    if "accuracy" in doc:
+        a = doc["accuracy"]
+        out += [
+            f"## Paper case, tip temperature at {a['t_end']} s\n",
+            C.md_table(
+                a["reference"],
+                [
+                    ("h", "θ reference h (s)"),
+                    ("T_end", "T (K)"),
+                    ("t1", "first contact (s)"),
+                    ("cpu", "CPU (s)"),
+                ],
+            ),
+            f"\nReference spread (two finest θ steps): {a['reference_spread']:.3g}\n",
+            C.md_table(
+                a["rows"],
+                [
+                    ("method", "method"),
+                    ("h", "h (s)"),
+                    ("status", "status"),
+                    ("T_end", "T (K)"),
+                    ("T_err", "T error"),
+                    ("t1", "first contact (s)"),
+                    ("t1_err_steps", "t1 error (steps)"),
+                    ("cpu", "CPU (s)"),
+                ],
+            ),
+        ]
+    if "work_precision" in doc:
+        w = doc["work_precision"]
+        out += [
+            f"\n## Work–precision, paper case over {w['t_end']} s (θ reference h = "
+            f"{w['h_ref']:g} s)\n",
+            C.md_table(
+                w["rows"],
+                [
+                    ("method", "method"),
+                    ("h", "h (s)"),
+                    ("u_L2", "u L2"),
+                    ("u_L2_nodes", "u L2 nodes"),
+                    ("T_end", "T end"),
+                    ("P_phase", "P phase"),
+                    ("t1", "t1 (s)"),
+                    ("cpu", "CPU (s)"),
+                ],
+            ),
+        ]
+    if "impact" in doc:
+        out += [
+            "\n## Free bar impact, fixed mesh, against the exact solution\n",
+            C.md_table(
+                doc["impact"],
+                [
+                    ("method", "method"),
+                    ("nu", "Courant ν"),
+                    ("h", "h (s)"),
+                    ("u_L2_nodes", "u L2 nodes"),
+                    ("impulse_err", "impulse error"),
+                    ("cpu", "CPU (s)"),
+                ],
+            ),
+        ]
+    if doc.get("blade"):
+        b = doc["blade"]
+        out += [
+            f"\n## Reduced twisted NACA blade ({b['n_dofs']} coordinates), {b['t_end']} s; "
+            f"Carpenter limit {b['carpenter_limit']:.3g} s\n",
+            C.md_table(
+                b["rows"],
+                [
+                    ("method", "method"),
+                    ("h", "h (s)"),
+                    ("u_L2", "u L2"),
+                    ("u_L2_nodes", "u L2 nodes"),
+                    ("T_end", "T end"),
+                    ("min_gap", "min gap (m)"),
+                    ("cpu", "CPU (s)"),
+                ],
+            ),
+        ]
+    return "\n".join(out) + "\n"
+
+
+NOTES = """\
+Reading. The exponential stepper is exact between contact events (docs/theory.md §4b): its
+error is the same at every step size (the remaining difference on the paper case is the θ
+reference's own error), but its CPU has a floor set by the contact events (closings and
+releases of the tip, most of them the bar's chatter at the start of a contact phase): each
+costs a Newton search on the exact flow driven from Python, while a step costs ~20 µs. So at
+the 1 % level the θ-method, whose cost falls with the accuracy asked for, is as cheap or
+cheaper; below 0.1 % only the exponential stepper gets there at this cost. Without event
+location (`events = false`) the same stepper is cheap but wrong: an end-of-step impulse only
+stops the tip mass while the rest of the bar flies through the casing for a whole step; event
+location and held contacts are therefore kept (the measured benefit of the optional item).
+On the free bar impact the error at fixed mesh does not depend on the Courant number (no
+dispersion). What would lower the floor (not done): a compiled event loop.
+"""
+
+TARGET = 3.0  # the issue's target: 3x cheaper than both θ and Carpenter at 1 %
+
+
+def _level_rows(rows, keys, levels, others=("θ paper", "Carpenter")):
+    """Cheapest run per method at each (key, level) and the exponential's CPU ratio."""
+    out = []
+    for key in keys:
+        for level in levels:
+            best = cheapest(rows, key, level)
+            e = best.get("exponential")
+            row = {"key": key, "level": level}
+            for m in (*others, "exponential"):
+                r = best.get(m)
+                row[m] = "not reached" if r is None else f"{r['cpu']:.3g} s (h {r['h']:.2g})"
+            ratio = [best[m]["cpu"] / e["cpu"] for m in others if e and m in best]
+            row["ratio"] = min(ratio) if ratio else math.nan
+            if e is None:
+                row["verdict"] = "not reached"
+            elif len(ratio) < len(others):
+                row["verdict"] = "others not reached at the steps tried"
+            else:
+                row["verdict"] = "met" if row["ratio"] >= TARGET else "not met"
+            out.append(row)
+    return out
+
+
+def section(doc) -> str:
+    """Section 6 of docs/performance.md (rendered by run_all.py from exponential_section.md)."""
+    lines = [
+        f"Measured by `python benchmarks/exponential.py` (load average "
+        f"{doc['machine']['load_average']} at the start; every run: "
+        "[performance/exponential.md](performance/exponential.md), data "
+        "`performance/exponential.json`).",
+        "![exponential: error vs CPU](performance/exponential.png)",
+    ]
+    if "accuracy" in doc:
+        a = doc["accuracy"]
+        rows = [{**r, "target": {5e-4: 0.02, 5e-3: 0.2}.get(r["h"], math.nan)} for r in a["rows"]]
+        for r in rows:
+            ok = abs(r["T_err"]) <= r["target"] and r["status"] == "ok"
+            r["met"] = ("met" if ok else "not met") if r["method"] == "exponential" else "—"
+        ref = a["reference"]
+        lines += [
+            f"**Paper case (α = 3 m/s, coupled), tip temperature at {a['t_end']} s** against the "
+            f"θ-method at h = {ref[-1]['h']:g} s ({ref[-1]['T_end']:.5g} K; at "
+            f"{ref[0]['h']:g} s: {ref[0]['T_end']:.5g} K, spread {a['reference_spread']:.2%}). "
+            "First contact: end of the step holding it, in steps from the reference time.",
+            C.md_table(
+                rows,
+                [
+                    ("method", "method"),
+                    ("h", "h (s)"),
+                    ("T_end", "T (K)"),
+                    ("T_err", "error"),
+                    ("target", "target"),
+                    ("met", "verdict"),
+                    ("t1_err_steps", "t1 error (steps)"),
+                    ("cpu", "CPU (s)"),
+                ],
+            ),
+        ]
+    cols = [
+        ("key", "error"),
+        ("level", "≤"),
+        ("θ paper", "θ paper"),
+        ("Carpenter", "Carpenter"),
+        ("exponential", "exponential"),
+        ("ratio", "best other / exponential"),
+        ("verdict", f"{TARGET:g}× target"),
+    ]
+    if "work_precision" in doc:
+        w = doc["work_precision"]
+        lines += [
+            f"**Work–precision, paper case over {w['t_end']} s** (θ reference h = "
+            f"{w['h_ref']:g} s; `u_L2` as in §1, `u_L2_nodes` at the run's own output times): "
+            "cheapest run reaching each level.",
+            C.md_table(
+                _level_rows(w["rows"], ("u_L2", "u_L2_nodes", "T_end"), (0.01, 0.001)), cols
+            ),
+        ]
+    if doc.get("blade"):
+        b = doc["blade"]
+        lines += [
+            f"**Reduced twisted NACA blade** (`twisted-naca`, {b['n_dofs']} coordinates, lobed "
+            f"casing, {b['t_end']} s; θ reference h = {doc['config']['blade_ref_h']:g} s; "
+            f"Carpenter's limit {b['carpenter_limit']:.3g} s).",
+            C.md_table(_level_rows(b["rows"], ("u_L2", "u_L2_nodes", "T_end"), (0.01,)), cols),
+        ]
+    if "impact" in doc:
+        lines += [
+            "**Free bar impact** (fixed mesh, exact solution; error at the output times):",
+            C.md_table(
+                doc["impact"],
+                [
+                    ("method", "method"),
+                    ("nu", "Courant ν"),
+                    ("u_L2_nodes", "u error"),
+                    ("impulse_err", "impulse error"),
+                    ("cpu", "CPU (s)"),
+                ],
+            ),
+        ]
+    return "\n\n".join([*lines, NOTES])
+
+
+def main(argv=None) -> dict:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--quick", action="store_true")
+    ap.add_argument("--skip", nargs="*", default=[], help="studies to skip")
+    ap.add_argument("--out", type=Path, help="output folder (default docs/performance)")
+    args = ap.parse_args(argv)
+    cfg = QUICK if args.quick else FULL
+
+    def log(msg):
+        print(msg, flush=True)
+
+    doc = {
+        "machine": C.machine(),
+        "config": {k: list(v) if isinstance(v, tuple) else v for k, v in cfg.items()},
+    }
+    name = "exponential_quick" if args.quick and args.out is None else "exponential"
+    out = (args.out or C.OUT) / name
+    if args.skip and out.with_suffix(".json").exists():  # keep the studies not rerun
+        import json
+
+        old = json.loads(out.with_suffix(".json").read_text())
+        doc = {**{k: v for k, v in old.items() if k in args.skip}, **doc}
+    for name, fn in (
+        ("accuracy", accuracy),
+        ("work_precision", work_precision),
+        ("impact", impact),
+        ("blade", blade),
+    ):
+        if name not in args.skip:
+            doc[name] = fn(cfg, log)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    C.write_json(out.with_suffix(".json"), doc)
+    out.with_suffix(".md").write_text(markdown(doc))
+    out.with_name(out.name + "_section.md").write_text(section(doc) + "\n")
+    if "work_precision" in doc:
+        _plot(doc["work_precision"], out.with_suffix(".png"))
+        for level in (0.1, 0.01, 0.001):
+            for key in ("u_L2", "u_L2_nodes", "T_end"):
+                best = cheapest(doc["work_precision"]["rows"], key, level)
+                log(
+                    f"≤ {level:g} {key}: "
+                    + ", ".join(f"{m} {r['cpu']:.3g} s (h={r['h']:g})" for m, r in best.items())
+                )
+    return doc
+
+
+if __name__ == "__main__":
+    main()

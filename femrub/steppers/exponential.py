@@ -1,0 +1,371 @@
+"""Exponential Moreau-type stepper: exact flight between contact events, Newton impulses.
+
+Between events the model is linear and is integrated exactly (:mod:`~.flows`: ``e^{hL}``,
+``L = A⁻¹B``, and the φ-functions of the load signals interpolated over the step by a
+polynomial, one augmented matrix exponential precomputed for the constant ``h``)::
+
+    X_{k+1} = e^{hL} X_k + Σ_i h φ_{i+1}(hL) A⁻¹F w_i          (s(t_k + σh) = Σ w_i σ^i / i!)
+
+Contact enters at instants: an impulse ``P`` at ``t_e`` changes the state by
+``ΔX = A⁻¹ (Hm + Ht diag α) P`` (velocity jump and frictional heat ``α P`` at once). The
+impulses solve the θ-method's LCP with the same shared solve
+(:func:`femrub.contact.impulses.solve_impulses`): free velocity = the pre-impact gap velocity
+``ġ⁻``, Delassus operator ``W = Gvᵀ A⁻¹ (Hm + Ht diag α)``, ``ġ⁺ = ġ⁻ + W P``::
+
+    0 <= P  ⊥  (ġ⁺ + e ġ⁻) / (1 + e) >= 0
+
+The kinetic energy changes by ``Pᵀ (ġ⁻ + ġ⁺) / 2 = −(1 − e) / (2 (1 + e)) Pᵀ W P <= 0``
+(fixed obstacle) and the exact flight neither creates nor dissipates energy: no step creates
+energy for e <= 1. This contact work is handed to the energy meter.
+
+Events (``events=True``): exact gaps and held multipliers are checked at ``probes`` points
+per step; at the first sign change the time is found on the exact flow
+(:func:`~.flows.first_zero`) and the impulse is given at contact (no penetration). With
+e = 0 (or a Zeno sequence) and a constant α, an impacted contact is then *held* by its exact
+multiplier (fixed or moving casing, :class:`~.flows.FlowFamily`), its impulse ``∫λ dt`` and
+heat integrated exactly, until ``λ`` vanishes (located the same way). Without events, or
+after :data:`MAX_EVENTS` in a step, impulses are given at the step end on penetrating,
+approaching contacts (velocity-level Moreau) and releases happen at step ends.
+
+Dense: at most :data:`MAX_COORDINATES` coordinates (reduce larger models first).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ..contact.impulses import solve_impulses
+from ..fem.linalg import Factorised
+from .base import Stepper
+from .flows import FlowFamily, first_zero, shift
+
+__all__ = ["ExponentialMoreau", "MAX_COORDINATES"]
+
+#: Largest model (coordinates) the dense exponential stepper accepts.
+MAX_COORDINATES = 3000
+#: Events located per step; later closings of the step get end-of-step impulses.
+MAX_EVENTS = 64
+#: Most sign checks per step (see ``probes``).
+MAX_PROBES = 512
+#: Impacts of one contact in one step after which it is held (e = 0): a Zeno sequence
+ZENO_HITS = 3
+_XTOL = 1e-10  # relative tolerance (of h) on an event time
+
+
+class ExponentialMoreau(Stepper):
+    """Exact-in-time Moreau stepper for moderate-size models (see module docstring).
+
+    Parameters
+    ----------
+    model : :class:`~femrub.model.first_order.FirstOrderModel` with at most
+        :data:`MAX_COORDINATES` coordinates (reduce larger ones first).
+    h : time step (s).
+    events : locate contact closings and releases inside the step (default) or give
+        impulses at step ends only.
+    load_degree : degree of the polynomial interpolating the load signals over a step (at
+        Chebyshev–Lobatto points; 1: linear interpolant), integrated exactly.
+    probes : points per step (``j h / probes``) where the exact gaps and held multipliers
+        are checked for a sign change before an event is located (1: step ends only;
+        default: four per shortest period ``2π / max |Im eig(A⁻¹B)|``, at most
+        :data:`MAX_PROBES`).
+    """
+
+    name = "exponential"
+    # exact between events: nothing to blow up; over steps longer than the structure's
+    # periods the meter's trapezoidal work integrals (not the scheme) open the balance
+    blowup_check = False
+
+    def __init__(
+        self,
+        model,
+        h,
+        *,
+        events: bool = True,
+        probes: int | None = None,
+        load_degree: int = 4,
+        t0=0.0,
+    ):
+        n = getattr(model, "n_dofs", 0)
+        if n > MAX_COORDINATES:
+            raise ValueError(
+                f"the exponential stepper is dense: the model has {n} coordinates "
+                f"(> {MAX_COORDINATES}); reduce it first (scene: reduction.method = "
+                "'craig-bampton'; API: ThermoelasticCraigBampton(model, ...).reduce())"
+            )
+        if not isinstance(events, bool):
+            raise ValueError(f"events must be true or false, got {events!r}")
+        if probes is not None and not (isinstance(probes, int) and 1 <= probes <= MAX_PROBES):
+            raise ValueError(f"probes must be an integer in [1, {MAX_PROBES}], got {probes!r}")
+        if not (isinstance(load_degree, int) and 1 <= load_degree <= 8):
+            raise ValueError(f"load_degree must be an integer in [1, 8], got {load_degree!r}")
+        self.events, self.probes, self.load_degree = events, probes, load_degree
+        super().__init__(model, h, t0=t0)
+
+    # -- set-up ------------------------------------------------------------------------------
+    def _setup(self):
+        m, h = self.model, self.h
+        lu = Factorised(m.A, what="matrix A")
+        L = np.asarray(lu.solve(m.B.toarray()))
+        F = (
+            np.column_stack([term.vector for term in m.loads])
+            if m.loads
+            else np.zeros((m.n_dofs, 0))
+        )
+        G = np.asarray(lu.solve(F)) if F.shape[1] else F
+        if not (np.all(np.isfinite(L)) and np.all(np.isfinite(G))):
+            raise ValueError("A⁻¹B or A⁻¹F is not finite: check the model's matrices")
+        self._signals = [term.signal for term in m.loads]
+        c = m.contact
+        self._hold = False
+        AinvH = GvT = None
+        # a moving casing enters the held flow through g̈0: extra inputs, one per contact
+        self._n_a = 0
+        if c is not None:
+            self._Zm = np.asarray(lu.solve(c.Hm))
+            self._Zt = np.asarray(lu.solve(c.Ht))
+            self._Wm, self._Wt = c.GvT @ self._Zm, c.GvT @ self._Zt
+            GvT = c.GvT
+            # held contacts need a constant α and the casing's motion (fixed, or ġ0 known)
+            moving = callable(c.gap0) or c.gap_rate is not None
+            self._hold = not callable(c.heat_coefficient) and (not moving or c.gap_rate is not None)
+            if self._hold:
+                AinvH = self._Zm + self._Zt * c.heat_coefficient
+                self._n_a = c.n if moving else 0
+        self._m0 = len(self._signals)
+        G = np.hstack([G, np.zeros((m.n_dofs, self._n_a))])
+        p = self.load_degree if G.shape[1] else 0
+        self._nodes = 0.5 * (1.0 - np.cos(np.pi * np.arange(p + 1) / max(p, 1)))  # Lobatto
+        self._Vinv = np.linalg.inv(self._nodes[:, None] ** np.arange(p + 1))
+        self._T01 = np.diag([float(math.factorial(i)) for i in range(p + 1)])
+        self._Dinv = np.linalg.inv(self._T01)
+        self._sk = self._signal_values(self.t)
+        self._flows = FlowFamily(L, G, AinvH, GvT, h, p, n_acc=self._n_a)
+        self._flows.flow((), h)  # the free step: one augmented exponential
+        if self.probes is None:  # four checks per shortest period of the model
+            w_max = float(np.max(np.abs(np.linalg.eigvals(L).imag), initial=0.0))
+            q = math.ceil(h * w_max / (0.5 * math.pi)) if w_max > 0 else 1
+            self.probes = int(min(max(q, 1), MAX_PROBES))
+        self._S: tuple = ()  # held contacts
+        self._warm = None
+        self._work = 0.0
+
+    def _signal_values(self, t):
+        """Load signals, then the casing's gap rates ``ġ0`` (moving casing, held contacts)."""
+        s = [float(sig(t)) for sig in self._signals]
+        if self._n_a:
+            return np.r_[s, self.model.contact.rate_at(t)]
+        return np.array(s)
+
+    def _load_poly(self, t):
+        """Monomial coefficients ``b`` (p+1, m) of the step's load, ``s = Σ b_i σ^i``."""
+        h, nodes = self.h, self._nodes
+        S = np.empty((nodes.size, self._m0 + self._n_a))
+        S[0] = self._sk
+        for j in range(1, nodes.size):
+            S[j] = self._signal_values(t + nodes[j] * h)
+        self._sk = S[-1]
+        b = self._Vinv @ S
+        if self._n_a:  # g̈0 = dġ0/dt: the derivative of the rates' interpolant
+            i = np.arange(1, b.shape[0])[:, None]
+            rates = b[:, self._m0 :].copy()
+            b[:, self._m0 :] = 0.0
+            b[:-1, self._m0 :] = i * rates[1:] / h
+        return b
+
+    def _u(self, b, sigma):
+        """Load signals at the fraction ``sigma`` of the step."""
+        return (sigma ** np.arange(b.shape[0])) @ b
+
+    def _du(self, b, sigma):
+        """Their time derivative (1/s) at the fraction ``sigma`` of the step."""
+        i = np.arange(1, b.shape[0])
+        return ((i * sigma ** (i - 1)) @ b[1:]) / self.h
+
+    # -- one step ------------------------------------------------------------------------------
+    def _advance(self):
+        t, X, P = super()._advance()
+        return t, X, P, self._work
+
+    def _step(self):
+        h, t, c = self.h, self.t, self.model.contact
+        b = self._load_poly(t)
+        X, S, a = self.X, self._S, 0.0
+        P = np.zeros(self.model.n_contacts)
+        hits = np.zeros(self.model.n_contacts, dtype=int)
+        self._work = 0.0
+        for n_events in range(MAX_EVENTS + 1):
+            if a == 0.0:
+                Xe, PS = self._flows.flow(S, h)(X, self._T01 @ b)
+            else:  # after an event: cached sub-step flows
+                Xe, PS = self._flows.advance(S, X, a, h, b, h / self.probes)
+            if c is None:
+                return Xe, P
+            ev = None
+            if self.events and n_events < MAX_EVENTS:
+                ev = self._event(S, X, a, Xe, b)
+            if ev is None:
+                break
+            a, kind, i, Xn, PSa = ev
+            self._held_work(S, PSa, X, Xn)
+            X = Xn
+            P[list(S)] += PSa
+            if kind == "release":
+                S = tuple(j for j in S if j != i)
+            else:  # a third bounce of one contact in a step: Zeno, end it plastically
+                hits[i] += 1
+                X, S = self._impact(t + a, X, S, P, forced=i, plastic=hits >= ZENO_HITS)
+        self._held_work(S, PS, X, Xe)
+        X = Xe
+        P[list(S)] += PS
+        if S and not self.events:  # releases at step ends
+            lam = self._flows.multiplier(S, X, self._u(b, 1.0))
+            S = tuple(j for j, lj in zip(S, lam) if lj > 0.0)
+        X, S = self._impact(t + h, X, S, P)
+        self._S = S
+        return X, P
+
+    def _held_work(self, S, PS, X0, X1):
+        """Work of the held contacts' impulse on the structure (moving casing: not zero),
+        with their mean structure velocity over the segment."""
+        if S:
+            c, idx = self.model.contact, list(S)
+            v = c.structure_velocity(X0)[idx] + c.structure_velocity(X1)[idx]
+            self._work += float(PS @ v) / 2
+
+    # -- impulses ------------------------------------------------------------------------------
+    def _impact(self, te, X, S, P, forced=None, plastic=None):
+        """Newton impulses at time ``te`` (shared LCP); update ``P`` in place; new held set."""
+        c = self.model.contact
+        g, gd = c.gap(te, X), c.gap_velocity(te, X)
+        held = np.zeros(c.n, dtype=bool)
+        held[list(S)] = True
+        trigger = ~held & (g <= 0.0) & (gd < 0.0)
+        if forced is not None:
+            trigger[forced] = gd[forced] < 0.0
+        if not trigger.any():
+            return X, S
+        active = trigger | held
+        alpha = c.alpha_at(te)
+        e = np.where(held, 0.0, c.restitution)
+        if plastic is not None and c.restitution < 1.0:  # e = 1 has no Zeno sequence
+            e[plastic] = 0.0
+        W = self._Wm + self._Wt * alpha
+        Pi = solve_impulses(W / (1.0 + e)[:, None], gd, active, self._warm)
+        self._warm = Pi > 0.0
+        Xn = X + (self._Zm + self._Zt * alpha) @ Pi
+        self._work += float(Pi @ (c.structure_velocity(X) + c.structure_velocity(Xn))) / 2
+        P += Pi
+        if not self._hold:
+            return Xn, ()
+        gdn = c.gap_velocity(te, Xn)
+        tol = 1e-9 * max(float(np.max(np.abs(gd[active]))), 1e-300)
+        keep = active & (e == 0.0) & (gdn <= tol)
+        return Xn, tuple(np.flatnonzero(keep))
+
+    # -- events --------------------------------------------------------------------------------
+    def _event(self, S, Xa, a, Xe, b):
+        """Earliest closing or release in ``(a, h]``: ``(τ, kind, i, X(τ), P_S(a..τ))``.
+
+        The exact gaps and held multipliers are checked on a grid of spacing ``h / probes``
+        (probe rows on a full step, the cached flow marched on a part step); the first sign
+        change is then bisected on the exact flow (cached dyadic sub-steps).
+        """
+        c, h, t, flows, q = self.model.contact, self.h, self.t, self._flows, self.probes
+        n_s, d = len(S), h / self.probes
+
+        def values(tau, X):
+            lam = flows.multiplier(S, X, self._u(b, tau / h)) if S else np.zeros(0)
+            return np.r_[c.gap(t + tau, X), lam]
+
+        # grid: a, the next multiples of d, h; rows of gaps and multipliers on it
+        grid, rows, states = [a], [values(a, Xa)], {0: (Xa, np.zeros(n_s))}
+        i1 = math.floor(a / d * (1.0 + 1e-12)) + 1  # first grid index after a
+        if i1 < q:
+            g1 = i1 * d
+            if a > 0.0:  # part step: to the grid with cached sub-step flows
+                X1, P1 = flows.advance(S, Xa, a, g1, b, d)
+                grid.append(g1)
+                rows.append(values(g1, X1))
+                states[1] = (X1, P1)
+            else:
+                X1 = Xa
+            k0 = len(grid) - 1  # index of the grid start the probe rows run from
+            if q - i1 > 1 or a == 0.0:
+                Rx, Rb = flows.probe(S, c.GT, q)
+                nj = q - 1 - (i1 if a > 0.0 else 0)  # probe points before h
+                r = Rx.shape[0] // (q - 1)
+                sig0 = grid[k0] / h  # the load polynomial re-expanded at the grid start
+                b1 = b if sig0 == 0.0 else self._Dinv @ shift(b, sig0, 1.0)
+                V = (Rx[: nj * r] @ X1 + Rb[: nj * r] @ b1.ravel()).reshape(nj, r)
+                taus = grid[k0] + d * np.arange(1, nj + 1)
+                if callable(c.gap0):
+                    V[:, : c.n] += np.array([c.gap_at(t + tau) for tau in taus])
+                else:
+                    V[:, : c.n] += c.gap0
+                grid.extend(taus)
+                rows.extend(V)
+        grid.append(h)
+        rows.append(values(h, Xe))
+        V = np.array(rows)
+        gv, lv = V[:, : c.n], V[:, c.n :]
+        held = np.zeros(c.n, dtype=bool)
+        held[list(S)] = True
+        cand = []  # (bracket j, kind, contact, f(τ, X) -> (value, d/dτ))
+        lam, c_n = (flows.generator(S)[2], self.model.n_dofs) if S else (None, 0)
+        # closing: the gap falls below min(g(a), 0) after having been above it
+        f_cl = gv - np.minimum(gv[0], 0.0)
+        for i in np.flatnonzero(~held & np.any(f_cl[1:] < 0.0, axis=0)):
+            ref = min(gv[0, i], 0.0)
+
+            def f(tau, X, i=i, ref=ref):
+                rate = c.rate_at(t + tau)[i] if callable(c.gap_rate) else 0.0
+                dX = flows.rate(S, X, self._u(b, tau / h))
+                return c.gap(t + tau, X)[i] - ref, rate + c.GT[i] @ dX
+
+            cand.append((1 + int(np.argmax(f_cl[1:, i] < 0.0)), "closing", int(i), f))
+        for k in np.flatnonzero(np.any(lv < 0.0, axis=0)):
+            j = int(np.argmax(lv[:, k] < 0.0))
+            if j == 0:  # pulled away already: release now
+                return a, "release", S[k], Xa, np.zeros(n_s)
+
+            def f(tau, X, k=k):
+                u, du = self._u(b, tau / h), self._du(b, tau / h)
+                lx, lu = lam[k, :c_n], lam[k, c_n:]
+                val = lx @ X + (lu @ u if lu.size else 0.0)
+                return val, lx @ flows.rate(S, X, u) + (lu @ du if lu.size else 0.0)
+
+            cand.append((j, "release", S[k], f))
+        if not cand:
+            return None
+        j = min(x[0] for x in cand)
+        lo = grid[j - 1]
+        if j - 1 not in states:  # march the cached flows to the bracket
+            k = max(states)
+            Xk, Pk = states[k]
+            Xj, Pj = flows.advance(S, Xk, grid[k], grid[j - 1], b, d)
+            states[j - 1] = (Xj, Pk + Pj)
+        X0, P0 = states[j - 1]
+        best = None
+        for jj, kind, i, f in cand:
+            if jj != j:
+                continue
+            found = self._root(S, f, lo, grid[j], X0, b)
+            if found is not None and (best is None or found[0] < best[0]):
+                best = (*found, kind, i)
+        if best is None:
+            return None
+        tau, X, Pl, kind, i = best
+        return tau, kind, i, X, P0 + Pl
+
+    def _root(self, S, f, lo, hi, X_lo, b):
+        """First zero of ``f`` in ``(lo, hi]`` on the exact flow from ``(lo, X_lo)``
+        (:func:`~femrub.steppers.flows.first_zero`): ``(τ, X(τ), P_S(lo..τ))`` or ``None``."""
+        h, flows, d = self.h, self._flows, self.h / self.probes
+
+        def at(tau):
+            X, P = flows.advance(S, X_lo, lo, tau, b, d)
+            return X, P, *f(tau, X)
+
+        return first_zero(at, f(lo, X_lo)[0], lo, hi, _XTOL * h)

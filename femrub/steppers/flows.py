@@ -1,0 +1,259 @@
+"""Exact flows of a first-order model between contact events (matrix exponentials).
+
+Between events a model ``A Ẋ = B X + F(t) + H λ`` is linear. With ``L = A⁻¹ B``, the load
+columns ``G = A⁻¹ [F_1 … F_m]`` and the load signals written over an interval of length
+``τ`` as a polynomial in the normalised time σ ∈ [0, 1],
+``s(a + σ τ) = Σ_i w_i σ^i / i!`` (degree ``p``), the *free* flow is exact::
+
+    X(a + τ) = e^{τL} X(a) + Σ_i τ φ_{i+1}(τL) G w_i,      φ_1(z) = (e^z − 1)/z, …
+
+(``p = 1`` is the linear interpolant: ``τ φ1 G s_a + τ φ2 G (s_b − s_a)``). All blocks are
+read off one exponential of an augmented matrix (``scipy.linalg.expm``, Al-Mohy & Higham),
+a chain of ``p + 1`` integrators driving the load::
+
+    expm([[τK, τE, 0, …], [0, 0, I, …], …, [0, …, 0]]) = [[e^{τK}, Ψ_0, …, Ψ_p], …]
+
+A set ``S`` of *held* contacts (closed, gap velocity zero, obstacle fixed) is kept closed by
+the multiplier that holds their gap acceleration at zero, ``Gv_Sᵀ Ẋ = 0``::
+
+    λ_S = −W_S⁻¹ Gv_Sᵀ (L X + G s),        W_S = Gv_Sᵀ A⁻¹ H_S,  H_S = Hm_S + Ht_S diag α_S
+
+so the held flow is again linear, ``Ẋ = Π (L X + G s)`` with ``Π = I − A⁻¹ H_S W_S⁻¹ Gv_Sᵀ``,
+and its impulse ``P_S = ∫ λ_S dt`` is integrated exactly by appending ``P_S`` to the state
+(``K = [[ΠL, 0], [Λx, 0]]``, ``E = [[ΠG], [Λs]]``). ``S = ()`` is the free flow. On a
+moving casing the held contacts keep ``ġ = ġ0(t) + Gvᵀ X = 0`` and ``λ_S`` gets
+``−W_S⁻¹ g̈0_S(t)``: the casing's accelerations are extra inputs (``n_acc``).
+
+Event times are found on these flows by :func:`first_zero` (safeguarded Newton), the states
+at arbitrary times by :meth:`FlowFamily.advance` (cached dyadic sub-step flows).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import scipy.linalg as sla
+
+__all__ = ["Flow", "FlowFamily", "first_zero", "shift"]
+
+
+def shift(b: np.ndarray, alpha: float, delta: float) -> np.ndarray:
+    """Chain inputs ``w`` (p+1, m) of ``u(σ) = Σ b_i σ^i`` on ``[α, α + δ]`` (σ' ∈ [0, 1]).
+
+    ``u(α + δ σ') = Σ_l σ'^l Σ_{i>=l} C(i, l) α^{i−l} δ^l b_i``, and ``w_l = l! ×`` that.
+    """
+    p = b.shape[0] - 1
+    C, E = _binomials(p)
+    T = C * np.where(E >= 0, float(alpha) ** np.maximum(E, 0), 0.0)
+    T *= (float(delta) ** np.arange(p + 1))[:, None]
+    return T @ b
+
+
+_BINOMIALS: dict[int, tuple] = {}
+
+
+def _binomials(p: int) -> tuple[np.ndarray, np.ndarray]:
+    """``C[l, i] = C(i, l) l!`` and the exponents ``E[l, i] = i − l``."""
+    if p not in _BINOMIALS:
+        i, j = np.meshgrid(np.arange(p + 1), np.arange(p + 1))
+        C = np.array(
+            [
+                [math.comb(c, r) * math.factorial(r) if c >= r else 0 for c in range(p + 1)]
+                for r in range(p + 1)
+            ],
+            dtype=float,
+        )
+        _BINOMIALS[p] = (C, i - j)
+    return _BINOMIALS[p]
+
+
+class Flow:
+    """Exact flow of one held set over one duration: ``(X, w) -> (X_end, P_S)``."""
+
+    def __init__(self, K: np.ndarray, E: np.ndarray, n: int, tau: float, degree: int):
+        nz, m = K.shape[0], E.shape[1]
+        k = (degree + 1) * m
+        M = np.zeros((nz + k, nz + k))
+        M[:nz, :nz] = tau * K
+        M[:nz, nz : nz + m] = tau * E
+        for i in range(degree):
+            r = nz + i * m
+            M[r : r + m, r + m : r + 2 * m] = np.eye(m)
+        ex = sla.expm(M)
+        self.n, self.tau = n, tau
+        self.Phi = np.ascontiguousarray(ex[:nz, :n])
+        self.Psi = np.ascontiguousarray(ex[:nz, nz:])  # [Ψ_0 … Ψ_p]
+
+    def __call__(self, X, w):
+        z = self.Phi @ X
+        if self.Psi.shape[1]:
+            z += self.Psi @ w.ravel()
+        return z[: self.n], z[self.n :]
+
+
+class FlowFamily:
+    """Generators of the free and held flows of a model; exact flows built on demand.
+
+    Parameters
+    ----------
+    L : (N, N) dense ``A⁻¹ B``.
+    G : (N, m) dense ``A⁻¹ F`` (load columns).
+    AinvH : (N, n_c) ``A⁻¹ (Hm + Ht diag α)`` (constant α), or ``None`` without contact.
+    GvT : (n_c, N) gap-velocity rows.
+    h : the constant step (s).
+    n_acc : the last ``n_acc`` columns of ``G`` are zero and their inputs are the casing's
+        gap accelerations ``g̈0`` (one per contact): a held contact on a moving casing keeps
+        ``ġ = ġ0 + Gvᵀ X = 0`` with ``λ_S = −W_S⁻¹ (Gv_Sᵀ (L X + G s) + g̈0_S)``.
+    degree : polynomial degree of the load signals over a step.
+    """
+
+    def __init__(self, L, G, AinvH, GvT, h, degree, n_acc=0):
+        self.L, self.G, self.AinvH, self.GvT, self.n_acc = L, G, AinvH, GvT, n_acc
+        self.h, self.degree = h, degree
+        self._gen: dict[tuple, tuple] = {}
+        self._flows: dict[tuple, Flow] = {}  # (S, τ) -> Flow
+        self._probe: dict[tuple, tuple] = {}
+
+    def generator(self, S: tuple) -> tuple[np.ndarray, np.ndarray, np.ndarray | None]:
+        """``(K, E, Λ)`` of held set ``S``; ``Λ = [Λx, Λs]`` gives ``λ_S = Λx X + Λs s``."""
+        if S not in self._gen:
+            L, G, n = self.L, self.G, self.L.shape[0]
+            if not S:
+                self._gen[S] = (L, G, None)
+            else:
+                idx = list(S)
+                AH, Gv = self.AinvH[:, idx], self.GvT[idx]
+                W = Gv @ AH
+                lam = -np.linalg.solve(W, Gv @ np.hstack([L, G]))
+                if self.n_acc:  # the casing's acceleration g̈0 (last n_acc inputs)
+                    cols = L.shape[1] + G.shape[1] - self.n_acc + np.array(idx)
+                    lam[:, cols] -= np.linalg.inv(W)
+                s = len(idx)
+                K = np.zeros((n + s, n + s))
+                K[:n, :n] = L + AH @ lam[:, :n]
+                K[n:, :n] = lam[:, :n]
+                E = np.vstack([G + AH @ lam[:, n:], lam[:, n:]])
+                self._gen[S] = (K, E, lam)
+        return self._gen[S]
+
+    def flow(self, S: tuple, tau: float, cache: bool = False) -> Flow:
+        """Exact flow of held set ``S`` over ``tau`` (cached for ``h`` and when ``cache``)."""
+        key = (S, tau)
+        if key in self._flows:
+            return self._flows[key]
+        K, E, _ = self.generator(S)
+        f = Flow(K, E, self.L.shape[0], tau, self.degree)
+        if cache or tau == self.h:
+            self._flows[key] = f
+        return f
+
+    def advance(self, S: tuple, X, tau0: float, tau1: float, b, unit: float):
+        """Flow of ``S`` from ``tau0`` to ``tau1`` in the step, composed of cached flows over
+        ``unit 2^j`` and ``unit / 2^k`` (k <= 36: the remainder, below ``unit 2^-36``, is
+        dropped); ``b``: the step's load polynomial. Returns ``(X, P_S)``."""
+        h, P = self.h, np.zeros(len(S))
+        rest, tau = tau1 - tau0, tau0
+        j = max(int(math.floor(math.log2(max(rest / unit, 1.0)))), 0)
+        pieces = [unit * 2.0**e for e in range(j, -37, -1)]
+        for u in pieces:
+            while rest >= u * (1.0 - 1e-12):
+                X, dP = self.flow(S, u, cache=True)(X, shift(b, tau / h, u / h))
+                P, tau, rest = P + dP, tau + u, rest - u
+        return X, P
+
+    def rate(self, S: tuple, X, u) -> np.ndarray:
+        """``Ẋ`` (N) of the held-set-``S`` flow at state ``X`` and load signals ``u``."""
+        K, E, _ = self.generator(S)
+        n = self.L.shape[0]
+        out = K[:n, :n] @ X
+        if E.shape[1]:
+            out += E[:n] @ u
+        return out
+
+    def multiplier(self, S: tuple, X, u) -> np.ndarray:
+        """``λ_S`` holding the set ``S`` at state ``X`` and load signals ``u`` (m,)."""
+        _, _, lam = self.generator(S)
+        n = self.L.shape[0]
+        out = lam[:, :n] @ X
+        if lam.shape[1] > n:
+            out += lam[:, n:] @ u
+        return out
+
+    def probe(self, S: tuple, GT: np.ndarray, q: int) -> tuple[np.ndarray, np.ndarray]:
+        """Gaps ``Gᵀ X`` and held multipliers ``λ_S`` at ``τ_j = j h / q``, j = 1 .. q − 1.
+
+        Returns ``(Rx, Rb)``: rows ``[Gᵀ X(τ_j); λ_S(τ_j)]`` stacked over ``j`` equal
+        ``Rx X(0) + Rb b`` for the load polynomial ``s(σ) = Σ b_i σ^i`` (σ in units of h)
+        from time 0. Built by recursion on the cached flow over ``h / q`` (cached).
+        """
+        if S not in self._probe:
+            _, _, lam = self.generator(S)
+            n, h, p, m = self.L.shape[0], self.h, self.degree, self.G.shape[1]
+            f = self.flow(S, h / q, cache=True)
+            Phi, Psi = f.Phi[:n], f.Psi[:n]
+            rows = GT if lam is None else np.vstack([GT, lam[:, :n]])
+            nl = 0 if lam is None else lam.shape[0]
+            Rx, Cb, rx, rb = rows, np.zeros((n, (p + 1) * m)), [], []
+            for j in range(1, q):
+                Rx = Rx @ Phi
+                if m:
+                    K = np.kron(shift(np.eye(p + 1), (j - 1) / q, 1.0 / q), np.eye(m))
+                    Cb = Phi @ Cb + Psi @ K
+                Rb = rows @ Cb
+                if nl and m:
+                    Rb[-nl:] += lam[:, n:] @ np.kron((j / q) ** np.arange(p + 1), np.eye(m))
+                rx.append(Rx)
+                rb.append(Rb)
+            self._probe[S] = (
+                np.ascontiguousarray(np.vstack(rx)),
+                np.ascontiguousarray(np.vstack(rb)),
+            )
+        return self._probe[S]
+
+
+def first_zero(at, f_lo: float, lo: float, hi: float, tol: float):
+    """First zero of ``f`` in ``(lo, hi]`` with ``f(hi) < 0``, by safeguarded Newton.
+
+    ``at(τ) -> (X, P, f, df/dτ)`` evaluates the exact flow. Newton steps leaving the bracket
+    fall back to regula falsi, then bisection. When ``f(lo) <= 0`` (a contact at the surface
+    at ``lo``, just released) the bracket is first halved towards ``lo`` until ``f > 0``.
+    Returns ``(τ, X(τ), P(τ))`` with ``f(τ) <= 0`` within ``tol`` of the zero, or ``None``.
+    """
+    if f_lo <= 0.0:
+        x = hi
+        for _ in range(40):
+            x = lo + 0.5 * (x - lo)
+            _, _, fx, _ = at(x)
+            if fx > 0.0:
+                break
+        else:
+            return None
+        a, f_a = x, fx
+    else:
+        a, f_a = lo, f_lo
+    x = hi
+    X, P, fx, dfx = at(x)
+    best, bh, f_bh = (x, X, P), hi, fx
+    for _ in range(60):
+        x_new = x - fx / dfx if dfx != 0.0 else np.nan
+        if not (a < x_new < bh):  # outside the bracket: regula falsi, else bisection
+            x_new = a - f_a * (bh - a) / (f_bh - f_a)
+            if not (a < x_new < bh):
+                x_new = 0.5 * (a + bh)
+        if abs(x_new - x) <= tol:  # converged
+            if fx > 0.0 and bh - x > tol:  # from the open side: step just past the zero
+                x = min(x + 2.0 * tol, bh)
+                X, P, fx, dfx = at(x)
+                if fx <= 0.0:
+                    best = (x, X, P)
+            break
+        x = x_new
+        X, P, fx, dfx = at(x)
+        if fx > 0.0:
+            a, f_a = x, fx
+        else:
+            bh, f_bh, best = x, fx, (x, X, P)
+        if bh - a <= tol:
+            break
+    return best
