@@ -72,11 +72,11 @@ def test_physical_limits_are_on_without_a_limits_table(tmp_path):
 
 
 def test_coarse_steps_on_the_paper_scene_are_not_silently_ok(tmp_path):
-    """h = 5e-3 s runs away (stopped by the default limit); h = 1e-3 s warns."""
+    """h = 5e-3 s: 2 steps per contact episode, inaccurate; h = 1e-3 s warns."""
     out = tmp_path / "h5e-3"
     assert main(["run", "paper", "--set", "scheme.h=5e-3", "-o", str(out), "-q"]) == 0
     s = json.loads((out / "summary.json").read_text())
-    assert s["status"] == "diverged-physically" and "tip_temperature" in s["message"]
+    assert s["status"] == "inaccurate" and "use scheme.h <= 0.0005 s" in s["message"]
     out = tmp_path / "h1e-3"
     assert main(["run", "paper", "--set", "scheme.h=1e-3", "-o", str(out), "-q"]) == 0
     s = json.loads((out / "summary.json").read_text())

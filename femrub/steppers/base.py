@@ -52,6 +52,8 @@ class Stepper:
     name = "stepper"
     #: the recorder stops a run whose energy balance opens (numerical blow-up)
     blowup_check = True
+    #: the step locates contact events inside itself (no contact-resolution check needed)
+    locates_events = False
 
     def __init__(self, model: FirstOrderModel, h: float, *, t0: float = 0.0):
         if not isinstance(model, FirstOrderModel):
@@ -196,4 +198,6 @@ class Stepper:
             blowup_check=self.blowup_check,
         )
         res = recorder.record(self.state, self._advance, progress=progress)
+        if self.locates_events:
+            merge_time = None
         return assess(res, tolerances=tolerances, merge_time=merge_time)

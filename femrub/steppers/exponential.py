@@ -76,6 +76,7 @@ class ExponentialMoreau(Stepper):
     # exact between events: nothing to blow up; over steps longer than the structure's
     # periods the meter's trapezoidal work integrals (not the scheme) open the balance
     blowup_check = False
+    locates_events = True
 
     def __init__(
         self,
