@@ -71,8 +71,9 @@ def _resolved(scene: Scene) -> Scene:
 
 
 def run_scene(
-    scene: Scene, out, *, overwrite=False, progress=False, log=None, on_built=None, modes=0
-):
+    scene: Scene, out, *, overwrite=False, progress=False, log=None, on_built=None, modes=0,
+    cache=None,
+):  # fmt: skip
     """Build and run ``scene`` into the folder ``out``; return ``(results, built)``.
 
     Parameters
@@ -85,6 +86,7 @@ def run_scene(
     log : callable for progress messages (``None``: silent).
     on_built : callable ``f(built)`` called after the build, before the first step.
     modes : natural frequencies to compute and report (``build.natural_frequencies_hz``).
+    cache : a :class:`~femrub.app.cache.ModelCache` of assembled and reduced models.
     """
     out = Path(out)
     status = folder_status(out)
@@ -93,7 +95,7 @@ def run_scene(
             f"{out} already holds a finished result (status {status}); "
             "use another folder or --overwrite"
         )
-    built = build(scene, log=log, modes=modes)
+    built = build(scene, log=log, modes=modes, cache=cache)
     if on_built is not None:
         on_built(built)
     out.mkdir(parents=True, exist_ok=True)

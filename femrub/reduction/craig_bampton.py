@@ -51,6 +51,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from ..fem.eigen import lowest_modes, normalise_columns
+from ..fem.linalg import project
 from ..model.first_order import FirstOrderModel, Layout, LoadTerm
 from .interior import InteriorSolver
 
@@ -223,8 +224,8 @@ class ThermoelasticCraigBampton:
         m = self.fom
         R = np.take(self.R, cols, axis=1)  # C-ordered copies: faster sparse products
         Lt = R if self.projection == "galerkin" else np.take(self.left, cols, axis=1)
-        Ar = Lt.T @ np.asarray(m.A @ R)
-        Br = Lt.T @ np.asarray(m.B @ R)
+        Ar = project(Lt, m.A, R)
+        Br = project(Lt, m.B, R)
         loads = [
             LoadTerm(Lt.T @ t.vector, t.signal, power=R.T @ t.power, heat=t.heat, name=t.name)
             for t in m.loads
@@ -276,7 +277,7 @@ class ThermoelasticCraigBampton:
             P = sp.csr_matrix(m.energy.Pth)
             P_u = sp.vstack([P[L.v], P[L.u], P[L.t]], format="csr")  # v-rows moved to u-rows
             rate = np.linalg.solve(Ar, Br)  # Ẋ̄ = Ā⁻¹ B̄ X̄ without loads and impulses
-            forms.Pth = sp.csr_matrix(rate.T @ (R.T @ np.asarray(P_u @ R)))
+            forms.Pth = sp.csr_matrix(rate.T @ project(R, P_u, R))
         return forms
 
     def reconstruct(self, Xr: np.ndarray, n_uv=None, n_theta=None) -> np.ndarray:
