@@ -93,16 +93,19 @@ class Stages:
     def reduce(self, model, scene, log=None):
         """:func:`~femrub.reduction.sizes.reduce_model`: ``(reduced, reductor, report)``."""
         if self.cache is None or self._mats_key is None:
-            return reduce_model(model, scene, log)
+            out = reduce_model(model, scene, log)
+            _say_phases(self._say, out[0].info.get("timings", {}))
+            return out
         opts = dict(scene["reduction"])
         if opts["method"] == "none":
-            return reduce_model(model, scene, log)
+            return reduce_model(model, scene, log)  # nothing to store
         t_end = scene["scheme"]["t_end"] if opts["method"] == "auto" else None
         key = self._model_key(model, "reduction", opts, t_end)
         hit = self._fetch("reduction", key)
         if hit is not None:
             return _attach(hit, model), None, dict(hit["report"], cache="hit")
         reduced, reductor, report = reduce_model(model, scene, log)
+        _say_phases(self._say, reduced.info.get("timings", {}))
         self._keep("reduction", key, _detach(reduced, report), f"{reduced.n_dofs} dofs")
         return reduced, reductor, report
 
@@ -116,6 +119,13 @@ class Stages:
             f = natural_frequencies(model, k)
             self._keep("frequencies", key, np.asarray(f), f"{k} frequencies")
         return f
+
+
+def _say_phases(say, timings: dict) -> None:
+    """One line with the seconds of each phase of a reduction (static shapes, modes, ...)."""
+    if timings:
+        parts = ", ".join(f"{k.replace('_', ' ')} {v:.2f} s" for k, v in timings.items())
+        say(f"reduction phases: {parts}")
 
 
 def _state_arrays(obj, n: int) -> dict:

@@ -121,4 +121,11 @@ def run_scene(
         n_full=built.full.n_dofs,
         rotation_speed=scene["loads"]["rotation_speed"],
     )
+    if log:
+        t = res.info.get("timings", {})
+        per_step = 1e6 * t.get("stepping", 0.0) / max(res.steps, 1)
+        log(
+            f"stepping done in {t.get('stepping', 0.0):.2f} s ({res.steps} steps, "
+            f"{per_step:.0f} µs/step wall), output {t.get('output', 0.0):.2f} s"
+        )
     return res, built

@@ -21,6 +21,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .. import progress
 from ..contact.heat import heat_coefficients
 from ..contact.points import locate_contacts
 from ..contact.reach import contact_reach, normal_deflection
@@ -66,7 +67,8 @@ class Simulation:
             A one-line message naming the key at fault (missing file or group, step above
             the stability limit, ...).
         """
-        return _build(scene, log, modes, Stages(cache, log))
+        with progress.reporting(log):  # factorisations, eigen-solves, reduction phases
+            return _build(scene, log, modes, Stages(cache, log))
 
 
 def build(scene, *, log=None, modes: int = 0, cache=None) -> Simulation:

@@ -7,10 +7,16 @@ order of magnitude faster per step. Large finite-element operators stay sparse.
 
 from __future__ import annotations
 
+import functools
+import importlib.util
+import time
+
 import numpy as np
 import scipy.linalg as sla
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
+
+from .. import progress
 
 __all__ = [
     "DENSE_BELOW",
@@ -29,6 +35,11 @@ PARDISO_ABOVE = 20_000
 
 #: Pardiso matrix types: real symmetric positive definite, symmetric indefinite, general.
 _SPD, _SYM, _GENERAL = 2, -2, 11
+
+
+@functools.cache
+def _has_pypardiso() -> bool:
+    return importlib.util.find_spec("pypardiso") is not None and pardiso_available()
 
 
 def pardiso_available() -> bool:
@@ -69,6 +80,10 @@ class _Pardiso:
             if self._s.get_iparm(14):  # perturbed pivots: numerically singular
                 raise RuntimeError("zero pivot in the symmetric factorisation") from None
 
+    @property
+    def method(self) -> str:
+        return {_SPD: "Cholesky", _SYM: "LDLt", _GENERAL: "LU"}[self.mtype] + " (MKL Pardiso)"
+
     def _factor(self, pypardiso, A, mtype: int) -> None:
         A.sort_indices()
         s = pypardiso.PyPardisoSolver(mtype=mtype)
@@ -87,11 +102,18 @@ class _Pardiso:
             return self._AT.solve(rhs)
         b = np.asfortranarray(rhs, dtype=float)
         s = self._s
+        many = b.ndim == 2 and b.shape[1] > 1
+        t0 = time.perf_counter() if many else 0.0
         if hasattr(s, "_call_pardiso"):  # solve phase only (pypardiso 0.4)
             s.set_phase(33)
             out = s._call_pardiso(self.A, b)
         else:  # pragma: no cover - other pypardiso versions
             out = s.solve(self.A, b)
+        if many:
+            progress.note(
+                f"solved {b.shape[1]} right-hand sides of {b.shape[0]} unknowns in "
+                f"{time.perf_counter() - t0:.2f} s"
+            )
         return out.reshape(np.shape(rhs))
 
 
@@ -109,17 +131,21 @@ def sparse_lu(M, *, symmetric: bool = False, what: str = "matrix", pardiso: bool
     """
     n = M.shape[0]
     try:
-        if pardiso and n >= PARDISO_ABOVE:
+        if pardiso and n >= PARDISO_ABOVE and _has_pypardiso():
             try:
-                return _Pardiso(M, symmetric)
-            except (ImportError, OSError):
-                pass
+                with progress.phase(f"factorising the {what} ({n} unknowns)") as p:
+                    lu = _Pardiso(M, symmetric)
+                    p["detail"] = lu.method
             except Exception as exc:  # a Pardiso error: singular, or out of memory
                 if type(exc).__name__ != "PyPardisoError":
                     raise
                 raise RuntimeError(str(exc)) from None
+            return lu
         spec = "MMD_AT_PLUS_A" if symmetric else "COLAMD"
-        return spla.splu(sp.csc_matrix(M), permc_spec=spec)
+        if n < PARDISO_ABOVE:
+            return spla.splu(sp.csc_matrix(M), permc_spec=spec)
+        with progress.phase(f"factorising the {what} ({n} unknowns, SuperLU)"):
+            return spla.splu(sp.csc_matrix(M), permc_spec=spec)
     except RuntimeError as exc:
         raise ValueError(f"the {what} is singular ({exc})") from None
 
