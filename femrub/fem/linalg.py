@@ -33,6 +33,8 @@ DENSE_BELOW = 600
 #: right-hand sides (reduction, eigen-solvers); docs/performance.md has the measurements.
 PARDISO_ABOVE = 20_000
 
+#: Condition number estimate above which a symmetric matrix is called singular.
+SINGULAR_CONDITION = 1e14
 #: Pardiso matrix types: real symmetric positive definite, symmetric indefinite, general.
 _SPD, _SYM, _GENERAL = 2, -2, 11
 
@@ -72,13 +74,17 @@ class _Pardiso:
         if not symmetric:
             self._factor(pypardiso, A, _GENERAL)
             return
-        A = sp.triu(A, format="csr")
+        full, A = A, sp.triu(A, format="csr")
         try:
             self._factor(pypardiso, A, _SPD)
         except pypardiso.pardiso_wrapper.PyPardisoError:  # not positive definite
             self._factor(pypardiso, A, _SYM)
-            if self._s.get_iparm(14):  # perturbed pivots: numerically singular
-                raise RuntimeError("zero pivot in the symmetric factorisation") from None
+        # a singular matrix may factorise with a round-off pivot: estimate the condition
+        # number from one solve, ‖x‖ ‖A‖ / ‖b‖ with b = 1, as SuperLU's exact zero pivot
+        x = self.solve(np.ones(A.shape[0]))
+        est = np.abs(x).max() * abs(full).sum(axis=1).max()
+        if not np.isfinite(est) or est > SINGULAR_CONDITION:
+            raise RuntimeError(f"condition number estimate {est:.1e}: numerically singular")
 
     @property
     def method(self) -> str:
@@ -150,30 +156,31 @@ def sparse_lu(M, *, symmetric: bool = False, what: str = "matrix", pardiso: bool
         raise ValueError(f"the {what} is singular ({exc})") from None
 
 
-def project(left: np.ndarray, Q, right: np.ndarray) -> np.ndarray:
+def project(left: np.ndarray, Q, right: np.ndarray, chunk: int = 8192) -> np.ndarray:
     """``leftᵀ Q right`` (dense) for a sparse ``Q`` and dense bases ``left``, ``right``.
 
-    Only the rows and columns of ``Q`` that hold entries, and the columns of the bases that
-    are not zero on them, enter the products: the operators of a first-order model are
-    block-sparse (``A = diag(I, M, C^θθ)``, energy forms on one block) and a reduction basis
-    is block-structured, so this skips most of the dense work of ``leftᵀ (Q right)``.
+    Row blocks of ``chunk`` rows are projected one at a time on the columns of the bases
+    that are not zero there: the operators of a first-order model are block-sparse
+    (``A = diag(I, M, C^θθ)``; ``B`` couples ``u``, ``v``, ``θ`` by blocks; energy forms
+    act on one block) and a reduction basis is block-structured (a ``v`` row only has ``v``
+    shapes), so this skips most of the dense work of ``leftᵀ (Q right)``.
     """
     if not sp.issparse(Q):
         return left.T @ (np.asarray(Q) @ right)
     Q = sp.csr_matrix(Q)
     out = np.zeros((left.shape[1], right.shape[1]))
-    rows = np.flatnonzero(np.diff(Q.indptr))
-    if rows.size == 0:
-        return out
-    Q = Q[rows]
-    cols = np.unique(Q.indices)
-    Rq = right[cols]
-    rc = np.flatnonzero(np.any(Rq != 0.0, axis=0))
-    Lq = left[rows]
-    lc = np.flatnonzero(np.any(Lq != 0.0, axis=0))
-    if rc.size and lc.size:
-        QR = Q[:, cols] @ np.ascontiguousarray(Rq[:, rc])
-        out[np.ix_(lc, rc)] = Lq[:, lc].T @ QR
+    for s in range(0, Q.shape[0], chunk):
+        Qs = Q[s : s + chunk]
+        if Qs.nnz == 0:
+            continue
+        Ls = left[s : s + chunk]
+        lc = np.flatnonzero(np.any(Ls != 0.0, axis=0))
+        cols = np.unique(Qs.indices)
+        Rq = right[cols]
+        rc = np.flatnonzero(np.any(Rq != 0.0, axis=0))
+        if lc.size and rc.size:
+            QR = Qs[:, cols] @ np.ascontiguousarray(Rq[:, rc])
+            out[np.ix_(lc, rc)] += Ls[:, lc].T @ QR
     return out
 
 

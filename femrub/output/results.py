@@ -22,7 +22,7 @@ from pathlib import Path
 
 import numpy as np
 
-__all__ = ["Results", "ENERGY_KEYS"]
+__all__ = ["Results", "ENERGY_KEYS", "decimate_columns"]
 
 ENERGY_KEYS = (
     "kinetic",
@@ -132,9 +132,19 @@ class Results:
         cols.update(self.energy)
         return cols
 
-    def save_csv(self, path) -> Path:
+    def save_csv(self, path, every: int = 1) -> Path:
+        """Write :meth:`columns` as CSV, every step or one row in ``every``.
+
+        With ``every > 1`` the rows are the first step and every ``every``-th one (and the
+        last); ``contact_impulse*`` is summed over the steps since the previous row and
+        ``contact_force*`` is that impulse over the time since the previous row (the mean
+        force), so the CSV keeps the total impulse; other columns are the values at the
+        row's time. :meth:`save_npz` keeps every step.
+        """
         path = Path(path)
         cols = self.columns()
+        if every > 1:
+            cols = decimate_columns(cols, int(every))
         with path.open("w", newline="") as fh:
             w = csv.writer(fh)
             w.writerow(list(cols))
@@ -142,6 +152,7 @@ class Results:
         return path
 
     def save_npz(self, path) -> Path:
+        """Every step, compressed (``numpy.savez_compressed``); :meth:`load_npz` reads it."""
         path = Path(path)
         meta = {
             "scheme": self.scheme,
@@ -191,3 +202,21 @@ class Results:
                 state_times=stimes,
                 info=meta.get("info", {}),
             )
+
+
+def decimate_columns(cols: dict, every: int) -> dict:
+    """Rows ``0, every, 2 every, …, last`` of ``cols`` (see :meth:`Results.save_csv`)."""
+    t = cols["t"]
+    idx = np.unique(np.r_[np.arange(0, t.size, every), t.size - 1]) if t.size else t.astype(int)
+    out = {k: np.asarray(v)[idx].copy() for k, v in cols.items()}
+    if idx.size < 2:
+        return out
+    dt = np.diff(t[idx])
+    for k in cols:
+        if k.startswith("contact_impulse"):
+            total = np.add.reduceat(np.asarray(cols[k]), idx[:-1] + 1)  # (idx[j-1], idx[j]]
+            out[k][1:] = total
+            force = "contact_force" + k[len("contact_impulse") :]
+            if force in out:
+                out[force][1:] = total / np.where(dt > 0, dt, np.inf)
+    return out
