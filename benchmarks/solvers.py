@@ -59,6 +59,14 @@ EIGEN = {
 
 
 def _rss_mb() -> float:
+    """Peak resident memory of this process (MB): ``VmHWM``, which an ``exec`` resets (the
+    ``ru_maxrss`` of a child keeps its parent's peak on Linux)."""
+    try:
+        for line in Path("/proc/self/status").read_text().splitlines():
+            if line.startswith("VmHWM:"):
+                return int(line.split()[1]) / 1024
+    except OSError:
+        pass
     return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
 
 

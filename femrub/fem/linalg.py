@@ -167,6 +167,8 @@ def project(left: np.ndarray, Q, right: np.ndarray, chunk: int = 8192) -> np.nda
     """
     if not sp.issparse(Q):
         return left.T @ (np.asarray(Q) @ right)
+    if Q.shape[0] < DENSE_BELOW:  # small: the plain products (no gain from the blocks)
+        return left.T @ np.asarray(Q @ right)
     Q = sp.csr_matrix(Q)
     out = np.zeros((left.shape[1], right.shape[1]))
     for s in range(0, Q.shape[0], chunk):

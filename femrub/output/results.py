@@ -132,8 +132,9 @@ class Results:
         cols.update(self.energy)
         return cols
 
-    def save_csv(self, path, every: int = 1) -> Path:
-        """Write :meth:`columns` as CSV, every step or one row in ``every``.
+    def save_csv(self, path, every: int = 1, digits: int | None = None) -> Path:
+        """Write :meth:`columns` as CSV, every step or one row in ``every``; ``digits``:
+        significant digits of the numbers (``None``: every digit, ``repr``).
 
         With ``every > 1`` the rows are the first step and every ``every``-th one (and the
         last); ``contact_impulse*`` is summed over the steps since the previous row and
@@ -145,10 +146,15 @@ class Results:
         cols = self.columns()
         if every > 1:
             cols = decimate_columns(cols, int(every))
+        table = np.column_stack(list(cols.values()))
         with path.open("w", newline="") as fh:
             w = csv.writer(fh)
             w.writerow(list(cols))
-            w.writerows(np.column_stack(list(cols.values())).tolist())
+            if digits is None:
+                w.writerows(table.tolist())
+            else:
+                fmt = ",".join([f"%.{int(digits)}g"] * table.shape[1])
+                np.savetxt(fh, table, fmt=fmt, delimiter=",")
         return path
 
     def save_npz(self, path) -> Path:
