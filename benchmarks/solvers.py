@@ -243,8 +243,8 @@ def run_e2e(kind: str, cache_dir: str) -> dict:
 def _child(args: list[str], timeout: float) -> dict:
     env = dict(os.environ, PYTHONPATH=str(ROOT) + os.pathsep + os.environ.get("PYTHONPATH", ""))
     try:
-        p = subprocess.run([sys.executable, __file__, "--child", *args], capture_output=True, text=True,
-                           timeout=timeout, env=env)  # fmt: skip
+        cmd = [sys.executable, __file__, "--child", *args]
+        p = subprocess.run(cmd, capture_output=True, text=True, timeout=timeout, env=env)
     except subprocess.TimeoutExpired:
         return {"error": f"over {timeout:.0f} s"}
     for line in reversed(p.stdout.splitlines()):
