@@ -326,6 +326,8 @@ def _tables(doc: dict) -> str:
                 continue
             ph = ", ".join(f"{k.replace('_', ' ')} {v:.1f}" for k, v in
                            r["reduction_phases"].items())  # fmt: skip
+            if kind == "hit":
+                ph = "loaded from the cache"
             lines.append(
                 f"| {what[kind]} | {_fmt(r['cpu'])} | {_fmt(r['wall'])} | "
                 f"{r['peak_mb']:.0f} | {_fmt(r['timings'].get('assembly'))} | "
@@ -369,9 +371,6 @@ def main(argv=None) -> int:
         return 0
     only = set(args.only.split(",")) if args.only else None
     doc = {"python": sys.version.split()[0], "factor": {}, "eigen": {}, "e2e": {}}
-    if (OUT / "solvers.json").exists() and (only or args.no_e2e or args.e2e_only):
-        old = json.loads((OUT / "solvers.json").read_text())  # keep the rows not rerun
-        doc.update({k: old.get(k, {}) for k in ("factor", "eigen", "e2e", "data")})
     with tempfile.TemporaryDirectory(prefix="femrub-solvers-") as tmp:
         folder = Path(tmp)
         if not args.e2e_only:
@@ -390,6 +389,12 @@ def main(argv=None) -> int:
                 print(f"rotor37 end to end: {kind} ...", flush=True)
                 doc["e2e"][kind] = r = _child(["e2e", kind, str(cache_dir)], args.timeout)
                 print(f"  { {k: v for k, v in r.items() if k != 'log'} }", flush=True)
+    if (OUT / "solvers.json").exists() and (only or args.no_e2e or args.e2e_only):
+        old = json.loads((OUT / "solvers.json").read_text())  # keep the rows not rerun
+        for k in ("factor", "eigen", "e2e"):
+            old.setdefault(k, {}).update(doc[k])
+        old["data"] = doc.get("data") or old.get("data")
+        doc = dict(old, python=doc["python"])
     _write(doc)
     print(_tables(doc))
     return 0
