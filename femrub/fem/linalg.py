@@ -136,10 +136,11 @@ def sparse_lu(M, *, symmetric: bool = False, what: str = "matrix", pardiso: bool
     steppers pass ``pardiso=False``.
     """
     n = M.shape[0]
+    name = what.split(" (")[0]  # without the hint of the error message
     try:
         if pardiso and n >= PARDISO_ABOVE and _has_pypardiso():
             try:
-                with progress.phase(f"factorising the {what} ({n} unknowns)") as p:
+                with progress.phase(f"factorising the {name} ({n} unknowns)") as p:
                     lu = _Pardiso(M, symmetric)
                     p["detail"] = lu.method
             except Exception as exc:  # a Pardiso error: singular, or out of memory
@@ -150,7 +151,7 @@ def sparse_lu(M, *, symmetric: bool = False, what: str = "matrix", pardiso: bool
         spec = "MMD_AT_PLUS_A" if symmetric else "COLAMD"
         if n < PARDISO_ABOVE:
             return spla.splu(sp.csc_matrix(M), permc_spec=spec)
-        with progress.phase(f"factorising the {what} ({n} unknowns, SuperLU)"):
+        with progress.phase(f"factorising the {name} ({n} unknowns, SuperLU)"):
             return spla.splu(sp.csc_matrix(M), permc_spec=spec)
     except RuntimeError as exc:
         raise ValueError(f"the {what} is singular ({exc})") from None
