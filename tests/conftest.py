@@ -17,6 +17,19 @@ sys.path.insert(0, str(ROOT / "examples"))
 os.environ.setdefault("MPLBACKEND", "Agg")
 
 
+@pytest.fixture(scope="session", autouse=True)
+def _model_cache_folder(tmp_path_factory):
+    """Command-line runs in the tests cache their models in a temporary folder, not in the
+    user's cache folder (``femrub.app.cache``)."""
+    old = os.environ.get("FEMRUB_CACHE_DIR")
+    os.environ["FEMRUB_CACHE_DIR"] = str(tmp_path_factory.mktemp("femrub-cache"))
+    yield
+    if old is None:
+        os.environ.pop("FEMRUB_CACHE_DIR", None)
+    else:
+        os.environ["FEMRUB_CACHE_DIR"] = old
+
+
 @pytest.fixture(scope="session")
 def shared_data() -> Path:
     """The read-only reference data folder; tests using it skip when it is absent."""

@@ -1,4 +1,9 @@
-"""Command line: ``femrub run | check | sweep | scenes | scene show | paper | mesh``.
+"""Command line: ``femrub run | check | sweep | scenes | scene show | paper | mesh | cache``.
+
+``run``, ``check`` and ``sweep`` keep the assembled and reduced models in a cache folder
+(:mod:`femrub.app.cache`): ``--cache-dir`` or ``$FEMRUB_CACHE_DIR`` (default: the user's
+cache folder), size limit ``$FEMRUB_CACHE_SIZE`` (default 8 GiB), ``--no-cache`` to build
+everything; ``femrub cache info`` and ``femrub cache clear`` inspect and empty it.
 
 Errors in the input or the output folder are reported on one line (``femrub: error: ...``)
 with exit status 2, never as a traceback (set ``FEMRUB_DEBUG=1`` to see one); an
@@ -63,6 +68,33 @@ def _changes(args) -> dict:
     return out
 
 
+def _cache(args, log=None):
+    """The model cache the command line asks for (``None`` with ``--no-cache``)."""
+    from .cache import DEFAULT_LIMIT, ModelCache, parse_size
+
+    if getattr(args, "no_cache", False):
+        return None
+    root = getattr(args, "cache_dir", None) or os.environ.get("FEMRUB_CACHE_DIR") or None
+    size = os.environ.get("FEMRUB_CACHE_SIZE")
+    return ModelCache(root, parse_size(size) if size else DEFAULT_LIMIT, log=log)
+
+
+def _cache_command(args) -> int:
+    cache = _cache(args)
+    if args.cache_command == "clear":
+        n, freed = cache.clear()
+        print(f"femrub cache: removed {n} entries ({freed / 1e6:.1f} MB) from {cache.root}")
+        return 0
+    info = cache.info()
+    print(f"cache folder  {info['root']}")
+    print(f"entries       {info['entries']} ({info['bytes'] / 1e6:.1f} MB of "
+          f"{info['limit'] / 1e6:.0f} MB)")  # fmt: skip
+    for stage, s in sorted(info["stages"].items()):
+        print(f"  {stage:<12}{s['entries']} ({s['bytes'] / 1e6:.1f} MB)")
+    print(f"code version  {info['code']}")
+    return 0
+
+
 def _load(args):
     from ..scene import load_scene
 
@@ -89,7 +121,7 @@ def _run(args) -> int:
     t0 = time.perf_counter()
     res, built = run_scene(
         scene, out, overwrite=args.overwrite, progress=not args.quiet, log=_log(args),
-        on_built=on_built,
+        on_built=on_built, cache=_cache(args, _log(args)),
     )  # fmt: skip
     where = f"{out}/ (summary.json, history.csv, history.npz)"
     if res.status == "interrupted":
@@ -138,7 +170,7 @@ def _check(args) -> int:
         if not args.quiet:
             print(f"ok: {scene.source} is a valid scene (model not built)")
         return 0
-    built = build(scene, log=_log(args))
+    built = build(scene, log=_log(args), cache=_cache(args, _log(args)))
     if args.explain:
         print(built.explain())
     if not args.quiet:
@@ -181,6 +213,7 @@ def _sweep(args) -> int:
     rows = run_sweep(
         scene, params, out, scheduler=args.scheduler, workers=args.workers,
         overwrite=args.overwrite, progress=not args.quiet, log=None if args.quiet else print,
+        cache=_cache(args),
     )  # fmt: skip
     failed = [r for r in rows if r.get("status") not in FINISHED]
     for r in failed:
@@ -210,6 +243,16 @@ def _scene_args(p: argparse.ArgumentParser, out: bool = True) -> None:
         p.add_argument("-o", "--out", help="results folder (default NAME-out)")
         p.add_argument("--overwrite", action="store_true", help="replace a finished result")
     p.add_argument("--quiet", "-q", action="store_true", help="no progress output")
+    _cache_args(p)
+
+
+def _cache_args(p: argparse.ArgumentParser, switch: bool = True) -> None:
+    p.add_argument(
+        "--cache-dir", help="cache folder of built models (default $FEMRUB_CACHE_DIR, else "
+        "the user's cache folder)",
+    )  # fmt: skip
+    if switch:
+        p.add_argument("--no-cache", action="store_true", help="build every model anew")
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -256,6 +299,12 @@ def build_parser() -> argparse.ArgumentParser:
     pp.add_argument("--quiet", "-q", action="store_true", help="no progress output")
     pp.add_argument("--overwrite", action="store_true", help="replace a finished reproduction")
     pp.set_defaults(func=_paper)
+    cap = sub.add_parser("cache", help="the cache of assembled and reduced models")
+    csub = cap.add_subparsers(dest="cache_command", required=True)
+    for name, text in (("info", "where it is, entries and size"), ("clear", "remove all")):
+        c = csub.add_parser(name, help=text)
+        _cache_args(c, switch=False)
+        c.set_defaults(func=_cache_command)
     try:
         from ..geometry.cli import add_mesh_parser, run_mesh
     except ImportError:  # geometry extras not installed

@@ -89,8 +89,9 @@ def _resolved(scene: Scene) -> Scene:
 
 
 def run_scene(
-    scene: Scene, out, *, overwrite=False, progress=False, log=None, on_built=None, modes=0
-):
+    scene: Scene, out, *, overwrite=False, progress=False, log=None, on_built=None, modes=0,
+    cache=None,
+):  # fmt: skip
     """Build and run ``scene`` into the folder ``out``; return ``(results, built)``.
 
     Parameters
@@ -103,14 +104,15 @@ def run_scene(
     log : callable for progress messages (``None``: silent).
     on_built : callable ``f(built)`` called after the build, before the first step.
     modes : natural frequencies to compute and report (``build.natural_frequencies_hz``).
+    cache : a :class:`~femrub.app.cache.ModelCache` of assembled and reduced models.
     """
     out = Path(out)
     with claim(out, "run", overwrite=overwrite):
-        return _run_claimed(scene, out, progress, log, on_built, modes)
+        return _run_claimed(scene, out, progress, log, on_built, modes, cache)
 
 
-def _run_claimed(scene, out, progress, log, on_built, modes):
-    built = build(scene, log=log, modes=modes)
+def _run_claimed(scene, out, progress, log, on_built, modes, cache):
+    built = build(scene, log=log, modes=modes, cache=cache)
     if on_built is not None:
         on_built(built)
     (out / "scene.toml").write_text(_resolved(scene).dumps())
@@ -143,4 +145,11 @@ def _run_claimed(scene, out, progress, log, on_built, modes):
         claimed=True,
         reduction_error=built.report["reduction"].get("error"),
     )
+    if log:
+        t = res.info.get("timings", {})
+        per_step = 1e6 * t.get("stepping", 0.0) / max(res.steps, 1)
+        log(
+            f"stepping done in {t.get('stepping', 0.0):.2f} s ({res.steps} steps, "
+            f"{per_step:.0f} µs/step wall), output {t.get('output', 0.0):.2f} s"
+        )
     return res, built

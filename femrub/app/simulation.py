@@ -26,16 +26,17 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .. import progress
 from ..contact.heat import heat_coefficients
 from ..contact.points import locate_contacts
 from ..contact.reach import contact_reach, normal_deflection
-from ..fem.discretisation import assemble, discretise
+from ..fem.discretisation import discretise
 from ..model.rub import rub_model, tip_load
-from ..reduction.sizes import natural_frequencies, reduce_model
 from ..scene.spec import SceneError, fail
 from ..steppers import make_stepper
 from . import translate as tr
 from .blade import load_blade
+from .cached import Stages
 from .explain import explain
 
 __all__ = [
@@ -113,8 +114,10 @@ class Simulation:
         return explain(self.report)
 
     @classmethod
-    def from_scene(cls, scene, *, log=None, modes: int = 0) -> Simulation:
-        """Build ``scene``; ``modes``: natural frequencies to report.
+    def from_scene(cls, scene, *, log=None, modes: int = 0, cache=None) -> Simulation:
+        """Build ``scene``; ``modes``: natural frequencies to report; ``cache``: a
+        :class:`~femrub.app.cache.ModelCache` for the assembled and reduced models
+        (:mod:`femrub.app.cached`), ``None`` to build everything.
 
         Raises
         ------
@@ -122,12 +125,13 @@ class Simulation:
             A one-line message naming the key at fault (missing file or group, step above
             the stability limit, ...).
         """
-        return _build(scene, log, modes)
+        with progress.reporting(log):  # factorisations, eigen-solves, reduction phases
+            return _build(scene, log, modes, Stages(cache, log))
 
 
-def build(scene, *, log=None, modes: int = 0) -> Simulation:
+def build(scene, *, log=None, modes: int = 0, cache=None) -> Simulation:
     """:meth:`Simulation.from_scene`."""
-    return Simulation.from_scene(scene, log=log, modes=modes)
+    return Simulation.from_scene(scene, log=log, modes=modes, cache=cache)
 
 
 class _Clock:
@@ -159,7 +163,7 @@ def _scheme_options(scene) -> dict:
     return {}
 
 
-def _build(scene, log, modes) -> Simulation:
+def _build(scene, log, modes, stages) -> Simulation:
     scene.check_files()
     clock = _Clock(log)
     c, p = scene["contact"], scene["physics"]
@@ -187,7 +191,7 @@ def _build(scene, log, modes) -> Simulation:
     try:
         disc = discretise(blade, p["order"] if blade.dim == 3 else 1,
                           clamped=scene["boundary"]["clamped"])  # fmt: skip
-        mats = assemble(
+        mats = stages.assemble(
             disc, material, area=tr.area_of(scene), lumping=p["lumping"],
             coupling=tr.coupling_of(scene), beta=p["beta"], strain_heating=p["strain_heating"],
             rayleigh=tuple(p["rayleigh"]), damping_ratio=p["damping_ratio"],
@@ -227,9 +231,9 @@ def _build(scene, log, modes) -> Simulation:
     report["contacts"] = _contacts_report(candidates, reach)
     model, limits = _select_signals(scene, full, report, size)
     if modes:
-        report["natural_frequencies_hz"] = natural_frequencies(model, modes).tolist()
+        report["natural_frequencies_hz"] = stages.frequencies(model, modes).tolist()
     make = lambda m: _bare_stepper(scene, m)  # noqa: E731  (the reduction error estimate)
-    reduced, reductor, report["reduction"] = reduce_model(model, scene, log, make)
+    reduced, reductor, report["reduction"] = stages.reduce(model, scene, log, make)
     clock.done("reduction", f"{reduced.n_dofs} dofs")
     report["model"] = {"n_dofs": reduced.n_dofs, **_layout(reduced)}
     stepper = _stepper(scene, reduced, report)

@@ -101,11 +101,15 @@ def point_metrics(folder) -> dict:
     }
 
 
-def run_point(scene_data: dict, source: str, base_dir: str, changes: dict, out: str) -> dict:
-    """Run one point (in a worker); never raises: failures come back as a row."""
+def run_point(
+    scene_data: dict, source: str, base_dir: str, changes: dict, out: str, cache=None
+) -> dict:
+    """Run one point (in a worker); never raises: failures come back as a row.
+
+    ``cache``: a :class:`~femrub.app.cache.ModelCache` shared by the points."""
     try:
         scene = Scene(scene_data, source, Path(base_dir)).with_changes(changes)
-        run_scene(scene, out, overwrite=True, modes=N_MODES)
+        run_scene(scene, out, overwrite=True, modes=N_MODES, cache=cache)
     except Exception as exc:  # a bad point must not stop the sweep
         msg = f"{type(exc).__name__}: {exc}".splitlines()[0]
         try:
@@ -141,7 +145,7 @@ def _client(scheduler, workers):
 
 def run_sweep(
     scene: Scene, params, out, *, scheduler=None, workers=2, overwrite=False, progress=False,
-    log=None,
+    log=None, cache=None,
 ) -> list[dict]:  # fmt: skip
     """Run the sweep; return one row per point (params, metrics, folder, skipped).
 
@@ -152,6 +156,9 @@ def run_sweep(
     out : sweep folder.
     scheduler : address of a dask scheduler; ``None``: a ``LocalCluster`` of ``workers``.
     overwrite : rerun points that already have a finished result.
+    cache : a :class:`~femrub.app.cache.ModelCache` (its folder must be shared with the
+        workers): the first point runs alone and stores its models, the others then load
+        the models they share with it.
     """
     out = Path(out)
     if scheduler is None and (isinstance(workers, bool) or not isinstance(workers, int)
@@ -162,11 +169,11 @@ def run_sweep(
     scenes = [scene.with_changes(p) for p in points]  # every point valid before any work
     with claim(out, "sweep", check_result=False):
         return _sweep(scene, params, points, scenes, keys, out, scheduler, workers, overwrite,
-                      progress, log)  # fmt: skip
+                      progress, log, cache)  # fmt: skip
 
 
 def _sweep(scene, params, points, scenes, keys, out, scheduler, workers, overwrite, progress,
-           log):  # fmt: skip
+           log, cache):  # fmt: skip
     hashes = [scene_hash(s) for s in scenes]
     doc = {
         "scene": scene.data,
@@ -193,7 +200,7 @@ def _sweep(scene, params, points, scenes, keys, out, scheduler, workers, overwri
             f"{len(todo)} to run -> {out}/"
         )
     if todo:
-        _compute(scene, todo, scheduler, workers, progress)
+        _compute(scene, todo, scheduler, workers, progress, cache)
     for r in rows:
         r["x"] = _x(scene.with_changes(r["params"]), keys[0])
     _write_csv(rows, keys, out / "interaction.csv")
@@ -203,32 +210,43 @@ def _sweep(scene, params, points, scenes, keys, out, scheduler, workers, overwri
     return rows
 
 
-def _compute(scene, todo, scheduler, workers, progress) -> None:
-    from dask.distributed import as_completed
+def _compute(scene, todo, scheduler, workers, progress, cache=None) -> None:
     from tqdm.auto import tqdm
 
     client, cluster = _client(scheduler, workers)
-    try:
-        futures = {
+
+    def submit(rows):
+        return {
             client.submit(
                 run_point, scene.data, scene.source, str(scene.base_dir), r["params"],
-                r["folder"], pure=False, key=f"femrub-point-{r['point']}-{id(r)}",
+                r["folder"], cache, pure=False, key=f"femrub-point-{r['point']}-{id(r)}",
             ): r
-            for r in todo
+            for r in rows
         }  # fmt: skip
-        bar = tqdm(total=len(futures), disable=not progress, unit="point", desc="sweep")
-        for fut in as_completed(futures):
-            r = futures[fut]
-            try:
-                r.update(fut.result())
-            except Exception as exc:  # worker lost, etc.
-                r.update(status="failed", message=f"{type(exc).__name__}: {exc}")
-            bar.update(1)
+
+    try:
+        bar = tqdm(total=len(todo), disable=not progress, unit="point", desc="sweep")
+        first = cache is not None and len(todo) > 1
+        batches = [todo[:1], todo[1:]] if first else [todo]  # the first point fills the cache
+        for batch in batches:
+            _collect(submit(batch), bar)
         bar.close()
     finally:
         client.close()
         if cluster is not None:
             cluster.close()
+
+
+def _collect(futures, bar) -> None:
+    from dask.distributed import as_completed
+
+    for fut in as_completed(futures):
+        r = futures[fut]
+        try:
+            r.update(fut.result())
+        except Exception as exc:  # worker lost, etc.
+            r.update(status="failed", message=f"{type(exc).__name__}: {exc}")
+        bar.update(1)
 
 
 def _x(scene, key) -> float:

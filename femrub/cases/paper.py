@@ -33,7 +33,7 @@ from ..output.folder import claim
 from ..output.interrupts import interruptible
 from ..output.jsonfile import write_json
 from ..output.plots import energy_panel, savefig, tip_panels
-from ..output.results import UNITS
+from ..output.results import UNITS, decimate_columns
 from ..steppers import make_stepper
 from ..steppers.base import MAX_STEPS
 from .bar import PAPER, bar_model
@@ -46,6 +46,10 @@ ALPHA_DEFAULT = 3.0
 #: tip displacement of a tenth of the bar's length (m).
 LIMITS = {"tip_temperature": 1500.0, "tip_displacement": 0.1 * PAPER.length}
 T_END = 0.4
+#: Time between two rows of the CSV files (s): runs with smaller steps are written one row
+#: per ``CSV_DT`` (impulses summed, forces averaged in between), with 9 significant digits
+#: as the figure CSVs; every step is in the .npz, to the last bit.
+CSV_DT = 1e-4
 
 
 @dataclass(frozen=True)
@@ -231,18 +235,32 @@ def summarise(figure: str, run: Run, res, model) -> dict:
     }
 
 
-def _figure_csv(path: Path, runs) -> None:
-    """One CSV per figure: time and the three signals of every run (rows = union of times)."""
+def _stride(res) -> int:
+    """Rows of a run's CSV: one per :data:`CSV_DT` (every step when the step is larger)."""
+    return max(1, round(CSV_DT / res.h)) if res.h else 1
+
+
+def _figure_csv(path: Path, runs, tlim=None) -> None:
+    """One CSV per figure: time and the three signals of every run, one row per
+    :data:`CSV_DT` (:meth:`~femrub.output.results.Results.save_csv`), or every step inside
+    the window ``tlim`` of a close-up."""
     cols, names = [], []
     for label, res, _ in runs:
         temp = res.signals.get("tip_temperature")
-        for name, arr in (
-            ("t", res.t),
-            ("tip_displacement", res.signal("tip_displacement")),
-            ("tip_temperature", temp[:, 0] if temp is not None else np.zeros_like(res.t)),
-            ("contact_force", res.force.sum(axis=1)),
-        ):
-            cols.append(arr)
+        table = {
+            "t": res.t,
+            "tip_displacement": res.signal("tip_displacement"),
+            "tip_temperature": temp[:, 0] if temp is not None else np.zeros_like(res.t),
+            "contact_force": res.force.sum(axis=1),
+            "contact_impulse": res.impulse.sum(axis=1),
+        }
+        if tlim is not None:
+            keep = (res.t >= tlim[0]) & (res.t <= tlim[1])
+            table = {k: v[keep] for k, v in table.items()}
+        else:
+            table = decimate_columns(table, _stride(res))
+        for name in ("t", "tip_displacement", "tip_temperature", "contact_force"):
+            cols.append(table[name])
             names.append(f"{label} | {name} [{UNITS[name]}]")
     n = max(len(c) for c in cols)
     with path.open("w", newline="") as fh:
@@ -311,7 +329,7 @@ def _figures(out, names, t_end, progress, log, rows, started) -> None:
                     raise KeyboardInterrupt(f"interrupted during {fig} / {run.label}")
                 cache[run.key()] = (res, model)
                 stem = "_".join(str(k) for k in run.key() if k is not None).replace(" ", "")
-                res.save_csv(out / "runs" / f"{stem}.csv")
+                res.save_csv(out / "runs" / f"{stem}.csv", every=_stride(res), digits=9)
                 res.save_npz(out / "runs" / f"{stem}.npz")
                 log(
                     f"  {fig}: {run.label:<24} {res.status:<20} {res.steps:>7} steps "
@@ -338,7 +356,7 @@ def _figures(out, names, t_end, progress, log, rows, started) -> None:
                 columns=cols and [(t, [drawn[i] for i in idx]) for t, idx in cols],
             )
             savefig(f, out / f"{fig}.png")
-            _figure_csv(out / f"{fig}.csv", named)
+            _figure_csv(out / f"{fig}.csv", named, spec.get("tlim"))
         if fig == "fig5":  # energy balances of the two schemes at the same step
             for run, _ in spec["runs"][:2]:
                 res = cache[run.key()][0]

@@ -15,8 +15,8 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-import scipy.sparse as sp
-import scipy.sparse.linalg as spla
+
+from ..fem.linalg import sparse_lu
 
 __all__ = ["Reach", "contact_reach", "normal_deflection"]
 
@@ -48,8 +48,8 @@ def normal_deflection(mats, normal_rows, force, omega: float | None = None) -> f
     out = 0.0
     for w in [0.0] + ([omega] if omega else []):
         try:
-            u = spla.splu(sp.csc_matrix(mats.K - w * w * mats.M)).solve(force)
-        except RuntimeError:
+            u = sparse_lu(mats.K - w * w * mats.M, symmetric=True).solve(force)
+        except ValueError:
             return math.inf
         out = max(out, float(np.max(np.abs(normal_rows @ u))))
     return out

@@ -18,6 +18,7 @@ import numpy as np
 import scipy.sparse as sp
 from skfem import Basis
 
+from .. import progress
 from . import forms
 from .lumping import lump
 from .material import Material, check_finite_positive
@@ -167,14 +168,17 @@ def assemble_thermoelastic(
     lam, mu = forms.lame_parameters(material.young, material.poisson, dim)
     n_comp = basis_u.elem.dim if hasattr(basis_u.elem, "dim") else 1
 
-    M = lump(forms.mass.assemble(basis_u, rho=material.rho, area=area), lumping, n_comp)
+    with progress.phase(f"mass matrix ({basis_u.N} dofs)", start=False):
+        M = lump(forms.mass.assemble(basis_u, rho=material.rho, area=area), lumping, n_comp)
     # stiffness and coupling integrate gradients: the lowest exact quadrature is enough
     # (order 2 for P2 on straight elements), several times cheaper than the mass's
-    bu_k, bt_k = _stiffness_bases(basis_u, basis_t)
-    K = forms.stiffness.assemble(bu_k, lam=lam, mu=mu, area=area)
-    Ctt = forms.heat_capacity.assemble(basis_t, rho_c=material.rho_c, area=area)
-    Ctt = lump(Ctt, heat_lumping or lumping, 1)
-    Ktt = forms.conductivity.assemble(basis_t, k=material.conductivity, area=area)
+    with progress.phase(f"stiffness matrix ({basis_u.N} dofs)", start=False):
+        bu_k, bt_k = _stiffness_bases(basis_u, basis_t)
+        K = forms.stiffness.assemble(bu_k, lam=lam, mu=mu, area=area)
+    with progress.phase(f"heat matrices ({basis_t.N} dofs)", start=False):
+        Ctt = forms.heat_capacity.assemble(basis_t, rho_c=material.rho_c, area=area)
+        Ctt = lump(Ctt, heat_lumping or lumping, 1)
+        Ktt = forms.conductivity.assemble(basis_t, k=material.conductivity, area=area)
 
     b = (dim * lam + 2.0 * mu) * material.expansion
     if coupling == "physical":

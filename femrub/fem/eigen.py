@@ -3,9 +3,11 @@
 * :func:`lowest_modes`: the ``k`` lowest eigenpairs of ``K x = λ M x`` (``K``, ``M``
   symmetric, ``M`` positive): LAPACK ``eigh`` on dense matrices below
   :data:`DENSE_EIGEN_BELOW` unknowns, else ARPACK ``eigsh`` in shift-invert mode about
-  σ = 0, reusing a given factorisation of ``K`` (``solve``). Shapes are normalised to a unit
-  largest amplitude, with that entry positive (:func:`normalise_columns`), so modal
-  coordinates carry the units of the physical dofs and the basis is deterministic.
+  σ = 0, reusing a given factorisation of ``K`` (``solve``) or factorising ``K`` with
+  :func:`~femrub.fem.linalg.sparse_lu` (Pardiso's Cholesky on large problems). Shapes are
+  normalised to a unit largest amplitude, with that entry positive
+  (:func:`normalise_columns`), so modal coordinates carry the units of the physical dofs and
+  the basis is deterministic.
 * :func:`angular_frequencies`, :func:`natural_frequencies`: ``ω = √λ`` (rad/s) and
   ``f = ω / 2π`` (Hz) of the lowest modes; a free structure (singular ``K``) is shifted.
 * :func:`largest_modulus`: the largest ``|λ|`` of ``A⁻¹ B`` (non-symmetric), which bounds
@@ -19,6 +21,9 @@ import scipy.linalg as sla
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 from threadpoolctl import threadpool_limits
+
+from .. import progress
+from .linalg import sparse_lu
 
 __all__ = [
     "DENSE_EIGEN_BELOW",
@@ -79,22 +84,31 @@ def lowest_modes(K, M, k: int, solve=None, *, tol: float = 1e-12, vectors: bool 
             )
         lam, V = (out, None) if not vectors else out
     else:
-        Kc, Mc = sp.csc_matrix(K), sp.csc_matrix(M)
-        kw = dict(k=k, M=Mc, which="LM", tol=tol, return_eigenvectors=vectors)
-        if solve is not None:
-            opinv = spla.LinearOperator((n, n), matvec=solve, dtype=float)
-            out = spla.eigsh(Kc, sigma=0.0, OPinv=opinv, **kw)
-        else:
-            try:
-                out = spla.eigsh(Kc, sigma=0.0, **kw)
-            except RuntimeError:  # singular stiffness: a free structure
-                out = spla.eigsh(Kc, sigma=FREE_SHIFT, **kw)
-        lam, V = out if vectors else (out, None)
-        order = np.argsort(lam)
-        lam = lam[order]
-        V = None if V is None else V[:, order]
+        with progress.phase(f"eigen-solve: {k} lowest modes of {n} unknowns (ARPACK)"):
+            lam, V = _arpack_lowest(K, M, k, solve, tol, vectors)
     lam = np.asarray(lam)
     return (lam, normalise_columns(V)) if vectors else lam
+
+
+def _arpack_lowest(K, M, k, solve, tol, vectors):
+    """ARPACK in shift-invert mode about σ = 0 (or :data:`FREE_SHIFT`), sorted."""
+    n = K.shape[0]
+    Kc, Mc = sp.csc_matrix(K), sp.csc_matrix(M)
+    kw = dict(k=k, M=Mc, which="LM", tol=tol, return_eigenvectors=vectors)
+    if solve is not None:
+        opinv = spla.LinearOperator((n, n), matvec=solve, dtype=float)
+        out = spla.eigsh(Kc, sigma=0.0, OPinv=opinv, **kw)
+    else:
+        try:
+            sigma, lu = 0.0, sparse_lu(Kc, symmetric=True, what="stiffness")
+        except ValueError:  # singular stiffness: a free structure
+            sigma = FREE_SHIFT
+            lu = sparse_lu(Kc - FREE_SHIFT * Mc, symmetric=True, what="shifted stiffness")
+        opinv = spla.LinearOperator((n, n), matvec=lu.solve, dtype=float)
+        out = spla.eigsh(Kc, sigma=sigma, OPinv=opinv, **kw)
+    lam, V = out if vectors else (out, None)
+    order = np.argsort(lam)
+    return lam[order], None if V is None else V[:, order]
 
 
 def angular_frequencies(K, M, k: int, solve=None, *, tol: float = 1e-12) -> np.ndarray:

@@ -7,61 +7,184 @@ order of magnitude faster per step. Large finite-element operators stay sparse.
 
 from __future__ import annotations
 
+import functools
+import importlib.util
+import time
+
 import numpy as np
 import scipy.linalg as sla
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-__all__ = ["DENSE_BELOW", "PARDISO_ABOVE", "compact", "Factorised", "sparse_lu"]
+from .. import progress
+
+__all__ = [
+    "DENSE_BELOW",
+    "PARDISO_ABOVE",
+    "compact",
+    "Factorised",
+    "pardiso_available",
+    "project",
+    "sparse_lu",
+]
 
 DENSE_BELOW = 600
-#: Size above which MKL Pardiso (optional, ``pip install femrub[fast]``) replaces SuperLU:
-#: on the 96k-dof Rotor 37 stiffness it factorises in 14 s against 107 s for SuperLU.
+#: Size above which MKL Pardiso replaces SuperLU for one-off factorisations with many
+#: right-hand sides (reduction, eigen-solvers); docs/performance.md has the measurements.
 PARDISO_ABOVE = 20_000
+
+#: Condition number estimate above which a symmetric matrix is called singular.
+SINGULAR_CONDITION = 1e14
+#: Pardiso matrix types: real symmetric positive definite, symmetric indefinite, general.
+_SPD, _SYM, _GENERAL = 2, -2, 11
+
+
+@functools.cache
+def _has_pypardiso() -> bool:
+    return importlib.util.find_spec("pypardiso") is not None and pardiso_available()
+
+
+def pardiso_available() -> bool:
+    """Whether MKL Pardiso can be loaded (``pypardiso`` and the MKL runtime installed)."""
+    try:
+        import pypardiso
+
+        pypardiso.PyPardisoSolver()
+    except (ImportError, OSError):
+        return False
+    return True
 
 
 class _Pardiso:
-    """MKL Pardiso factorisation with the ``splu``-like ``solve(rhs, trans)`` interface."""
+    """MKL Pardiso factorisation with the ``splu``-like ``solve(rhs, trans)`` interface.
+
+    Symmetric matrices are factorised as positive definite (Cholesky, ``L Lᵀ``, on the upper
+    triangle) and, when a pivot is not positive, as symmetric indefinite (``L D Lᵀ`` with
+    Bunch-Kaufman pivoting); other matrices by LU with pivot perturbation and iterative
+    refinement. Solves call Pardiso's solve phase directly: the ``pypardiso.solve`` entry
+    point hashes the whole matrix on every call to check it is the factorised one.
+    """
 
     def __init__(self, M, symmetric: bool):
         import pypardiso
 
-        self.A = sp.csr_matrix(M, dtype=float)
-        self.A.sort_indices()
         self.symmetric = symmetric
-        self._s = pypardiso.PyPardisoSolver(mtype=11)
-        self._s.set_iparm(8, 20)  # iterative refinement steps: residuals near round-off
-        self._s.factorize(self.A)
         self._AT = None
+        A = sp.csr_matrix(M, dtype=float)
+        if not symmetric:
+            self._factor(pypardiso, A, _GENERAL)
+            return
+        full, A = A, sp.triu(A, format="csr")
+        try:
+            self._factor(pypardiso, A, _SPD)
+        except pypardiso.pardiso_wrapper.PyPardisoError:  # not positive definite
+            self._factor(pypardiso, A, _SYM)
+        # a singular matrix may factorise with a round-off pivot: estimate the condition
+        # number from one solve, ‖x‖ ‖A‖ / ‖b‖ with b = 1, as SuperLU's exact zero pivot
+        x = self.solve(np.ones(A.shape[0]))
+        est = np.abs(x).max() * abs(full).sum(axis=1).max()
+        if not np.isfinite(est) or est > SINGULAR_CONDITION:
+            raise RuntimeError(f"condition number estimate {est:.1e}: numerically singular")
+
+    @property
+    def method(self) -> str:
+        return {_SPD: "Cholesky", _SYM: "LDLt", _GENERAL: "LU"}[self.mtype] + " (MKL Pardiso)"
+
+    def _factor(self, pypardiso, A, mtype: int) -> None:
+        A.sort_indices()
+        s = pypardiso.PyPardisoSolver(mtype=mtype)
+        if mtype == _GENERAL:
+            s.set_iparm(8, 20)  # iterative refinement steps: residuals near round-off
+        else:  # explicit settings: the defaults add refinement solves that cost 5x here
+            for i, v in ((1, 1), (2, 2), (8, 0), (10, 8), (11, 0), (13, 0), (21, 1), (35, 0)):
+                s.set_iparm(i, v)
+        s.factorize(A)
+        self.A, self.mtype, self._s = A, mtype, s
 
     def solve(self, rhs, trans: str = "N"):
         if trans != "N" and not self.symmetric:
             if self._AT is None:
                 self._AT = _Pardiso(self.A.T, False)
             return self._AT.solve(rhs)
-        out = self._s.solve(self.A, np.asarray(rhs, dtype=float))
+        b = np.asfortranarray(rhs, dtype=float)
+        s = self._s
+        many = b.ndim == 2 and b.shape[1] > 1
+        t0 = time.perf_counter() if many else 0.0
+        if hasattr(s, "_call_pardiso"):  # solve phase only (pypardiso 0.4)
+            s.set_phase(33)
+            out = s._call_pardiso(self.A, b)
+        else:  # pragma: no cover - other pypardiso versions
+            out = s.solve(self.A, b)
+        if many:
+            progress.note(
+                f"solved {b.shape[1]} right-hand sides of {b.shape[0]} unknowns in "
+                f"{time.perf_counter() - t0:.2f} s"
+            )
         return out.reshape(np.shape(rhs))
 
 
 def sparse_lu(M, *, symmetric: bool = False, what: str = "matrix", pardiso: bool = True):
-    """Sparse LU of ``M`` with ``solve(rhs, trans="N")``: Pardiso when large and installed,
-    else SuperLU (minimum-degree ordering on ``A + Aᵀ`` for symmetric patterns).
+    """Sparse factorisation of ``M`` with ``solve(rhs, trans="N")``.
+
+    MKL Pardiso when ``M`` is large (``n >= PARDISO_ABOVE``) and ``pypardiso`` is installed
+    (a default dependency on x86-64): Cholesky for a symmetric positive definite ``M``
+    (``symmetric=True``), else symmetric indefinite or general LU. Otherwise SuperLU
+    (minimum-degree ordering on ``A + Aᵀ`` for symmetric patterns).
 
     Pardiso pays off for one-off factorisations with many right-hand sides (reduction,
-    eigen-solvers); a per-step solve is faster with SuperLU (0.26 ms against 3.7 ms on a
-    20,000-unknown bar), so steppers pass ``pardiso=False``.
+    eigen-solvers); a per-step solve is faster with SuperLU (per-call overhead), so
+    steppers pass ``pardiso=False``.
     """
     n = M.shape[0]
+    name = what.split(" (")[0]  # without the hint of the error message
     try:
-        if pardiso and n >= PARDISO_ABOVE:
+        if pardiso and n >= PARDISO_ABOVE and _has_pypardiso():
             try:
-                return _Pardiso(M, symmetric)
-            except ImportError:
-                pass
+                with progress.phase(f"factorising the {name} ({n} unknowns)") as p:
+                    lu = _Pardiso(M, symmetric)
+                    p["detail"] = lu.method
+            except Exception as exc:  # a Pardiso error: singular, or out of memory
+                if type(exc).__name__ != "PyPardisoError":
+                    raise
+                raise RuntimeError(str(exc)) from None
+            return lu
         spec = "MMD_AT_PLUS_A" if symmetric else "COLAMD"
-        return spla.splu(sp.csc_matrix(M), permc_spec=spec)
+        if n < PARDISO_ABOVE:
+            return spla.splu(sp.csc_matrix(M), permc_spec=spec)
+        with progress.phase(f"factorising the {name} ({n} unknowns, SuperLU)"):
+            return spla.splu(sp.csc_matrix(M), permc_spec=spec)
     except RuntimeError as exc:
         raise ValueError(f"the {what} is singular ({exc})") from None
+
+
+def project(left: np.ndarray, Q, right: np.ndarray, chunk: int = 8192) -> np.ndarray:
+    """``leftᵀ Q right`` (dense) for a sparse ``Q`` and dense bases ``left``, ``right``.
+
+    Row blocks of ``chunk`` rows are projected one at a time on the columns of the bases
+    that are not zero there: the operators of a first-order model are block-sparse
+    (``A = diag(I, M, C^θθ)``; ``B`` couples ``u``, ``v``, ``θ`` by blocks; energy forms
+    act on one block) and a reduction basis is block-structured (a ``v`` row only has ``v``
+    shapes), so this skips most of the dense work of ``leftᵀ (Q right)``.
+    """
+    if not sp.issparse(Q):
+        return left.T @ (np.asarray(Q) @ right)
+    if Q.shape[0] < DENSE_BELOW:  # small: the plain products (no gain from the blocks)
+        return left.T @ np.asarray(Q @ right)
+    Q = sp.csr_matrix(Q)
+    out = np.zeros((left.shape[1], right.shape[1]))
+    for s in range(0, Q.shape[0], chunk):
+        Qs = Q[s : s + chunk]
+        if Qs.nnz == 0:
+            continue
+        Ls = left[s : s + chunk]
+        lc = np.flatnonzero(np.any(Ls != 0.0, axis=0))
+        cols = np.unique(Qs.indices)
+        Rq = right[cols]
+        rc = np.flatnonzero(np.any(Rq != 0.0, axis=0))
+        if lc.size and rc.size:
+            QR = Qs[:, cols] @ np.ascontiguousarray(Rq[:, rc])
+            out[np.ix_(lc, rc)] += Ls[:, lc].T @ QR
+    return out
 
 
 def compact(M, dense_below: int = DENSE_BELOW):

@@ -19,6 +19,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from ..contact.gap import Contact
+from ..fem.linalg import project
 
 __all__ = ["Layout", "LoadTerm", "Contact", "EnergyForms", "FirstOrderModel"]
 
@@ -98,8 +99,9 @@ class EnergyForms:
 
     def project(self, R) -> EnergyForms:
         def pr(Q):
-            out = R.T @ (Q @ R)
-            return sp.csr_matrix(out) if sp.issparse(out) else sp.csr_matrix(np.asarray(out))
+            if sp.issparse(R):
+                return sp.csr_matrix(R.T @ (Q @ R))
+            return sp.csr_matrix(project(R, Q, R))
 
         return EnergyForms(
             Qk=pr(self.Qk),

@@ -29,7 +29,15 @@ import numpy as np
 
 from .jsonfile import jsonable
 
-__all__ = ["ENERGY_KEYS", "UNITS", "Results", "csv_header", "flatten_columns", "unit_of"]
+__all__ = [
+    "ENERGY_KEYS",
+    "UNITS",
+    "Results",
+    "csv_header",
+    "decimate_columns",
+    "flatten_columns",
+    "unit_of",
+]
 
 ENERGY_KEYS = (
     "kinetic",
@@ -204,18 +212,35 @@ class Results:
         names += [f"energy_{k}" for k in self.energy]
         return {k: unit_of(k) for k in names}
 
-    def save_csv(self, path) -> Path:
+    def save_csv(self, path, every: int = 1, digits: int | None = None) -> Path:
+        """Write :meth:`columns` as CSV, every step or one row in ``every``; ``digits``:
+        significant digits of the numbers (``None``: every digit, ``repr``).
+
+        With ``every > 1`` the rows are the first step and every ``every``-th one (and the
+        last); ``contact_impulse*`` is summed over the steps since the previous row and
+        ``contact_force*`` is that impulse over the time since the previous row (the mean
+        force), so the CSV keeps the total impulse; other columns are the values at the
+        row's time. :meth:`save_npz` keeps every step.
+        """
         path = Path(path)
         cols = self.columns()
+        if every > 1:
+            cols = decimate_columns(cols, int(every))
+        table = np.column_stack(list(cols.values()))
         tmp = path.with_name(path.name + ".tmp")
         with tmp.open("w", newline="") as fh:
             w = csv.writer(fh)
             w.writerow(csv_header(cols, UNITS))
-            w.writerows(np.column_stack(list(cols.values())).tolist())
+            if digits is None:
+                w.writerows(table.tolist())
+            else:
+                fmt = ",".join([f"%.{int(digits)}g"] * table.shape[1])
+                np.savetxt(fh, table, fmt=fmt, delimiter=",")
         os.replace(tmp, path)
         return path
 
     def save_npz(self, path) -> Path:
+        """Every step, compressed (``numpy.savez_compressed``); :meth:`load_npz` reads it."""
         path = Path(path)
         meta = {
             "scheme": self.scheme,
@@ -278,3 +303,21 @@ class Results:
                 extra=extra,
                 warnings=meta.get("warnings", []),
             )
+
+
+def decimate_columns(cols: dict, every: int) -> dict:
+    """Rows ``0, every, 2 every, …, last`` of ``cols`` (see :meth:`Results.save_csv`)."""
+    t = cols["t"]
+    idx = np.unique(np.r_[np.arange(0, t.size, every), t.size - 1]) if t.size else t.astype(int)
+    out = {k: np.asarray(v)[idx].copy() for k, v in cols.items()}
+    if idx.size < 2:
+        return out
+    dt = np.diff(t[idx])
+    for k in cols:
+        if k.startswith("contact_impulse"):
+            total = np.add.reduceat(np.asarray(cols[k]), idx[:-1] + 1)  # (idx[j-1], idx[j]]
+            out[k][1:] = total
+            force = "contact_force" + k[len("contact_impulse") :]
+            if force in out:
+                out[force][1:] = total / np.where(dt > 0, dt, np.inf)
+    return out

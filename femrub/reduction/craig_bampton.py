@@ -51,6 +51,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from ..fem.eigen import lowest_modes, normalise_columns
+from ..fem.linalg import project
 from ..model.first_order import FirstOrderModel, Layout, LoadTerm
 from .interior import InteriorSolver
 from .thermal_inputs import input_basis, input_distributions
@@ -253,8 +254,8 @@ class ThermoelasticCraigBampton:
         m = self.fom
         R = np.take(self.R, cols, axis=1)  # C-ordered copies: faster sparse products
         Lt = R if self.projection == "galerkin" else np.take(self.left, cols, axis=1)
-        Ar = Lt.T @ np.asarray(m.A @ R)
-        Br = Lt.T @ np.asarray(m.B @ R)
+        Ar = project(Lt, m.A, R)
+        Br = project(Lt, m.B, R)
         loads = [
             LoadTerm(Lt.T @ t.vector, t.signal, power=R.T @ t.power, heat=t.heat, name=t.name)
             for t in m.loads
@@ -309,7 +310,7 @@ class ThermoelasticCraigBampton:
         if L.n_t:
             P = sp.csr_matrix(m.energy.Pth)
             P_u = sp.vstack([P[L.v], P[L.u], P[L.t]], format="csr")  # v-rows moved to u-rows
-            W = R.T @ np.asarray(P_u @ R)
+            W = np.asarray(project(R, P_u, R))
             rate = np.linalg.solve(Ar, Br)  # Ẋ̄ = Ā⁻¹ B̄ X̄ without loads and impulses
             forms.Pth = sp.csr_matrix(rate.T @ W)
             forms.Wth = sp.csr_matrix(W)

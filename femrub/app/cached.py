@@ -1,0 +1,173 @@
+"""The model-building stages of :mod:`femrub.app.simulation` through a :class:`ModelCache`.
+
+:class:`Stages` wraps the three expensive, deterministic stages of the pipeline; with no
+cache it only calls them:
+
+* ``assemble``: the Eq. (2) blocks (:func:`femrub.fem.discretisation.assemble`, damping
+  eigen-solve included); key: the mesh itself (vertices, cells, element, clamped dofs: the
+  content of the mesh file as read) and every argument of the assembly (material, lumping,
+  coupling, Rayleigh or modal damping, ...);
+* ``reduce``: the reduced model (:func:`femrub.reduction.sizes.reduce_model`) and its
+  report; key: the assembly key, every state-space array of the full model the reduction
+  projects (``A``, ``B``, contact rows, load vectors, observations, energy forms, map to the
+  mesh, boundary dofs, initial state), the ``reduction`` options and, for ``"auto"``, the
+  end time that sets its thermal frequencies;
+* ``frequencies``: the natural frequencies of the full model (sweeps, ``--modes``).
+
+What a rotation speed changes without changing a matrix (the casing gap swept at Ω, the
+heat coefficients, the restitution, the load signals) is not in the assembly key: every
+point of a speed sweep on one blade shares the assembled model. The reduction error
+estimate (``docs/reduction.md``) steps the run itself, so a reduced model is keyed by the
+scene's ``scheme``, ``loads`` and ``contact`` too; a cached reduced model takes the gap
+functions and signals from the full model built in this run. Every key also holds
+:func:`~femrub.app.cache.code_version`.
+On a hit ``Simulation.reductor`` is ``None`` (the bases are not stored: the reduced model
+carries what the run needs, including its map to the mesh).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import time
+
+import numpy as np
+
+from ..fem.discretisation import assemble
+from ..reduction.sizes import natural_frequencies, reduce_model
+from .cache import content_key
+
+__all__ = ["Stages"]
+
+
+class Stages:
+    """The cached stages; ``cache``: a :class:`~femrub.app.cache.ModelCache` or ``None``."""
+
+    def __init__(self, cache=None, log=None):
+        self.cache, self.log = cache, log
+        self.hits: dict[str, bool] = {}
+        self._mats_key = None
+        if cache is not None and log is not None and cache.log is None:
+            cache.log = log
+
+    def _say(self, text: str) -> None:
+        if self.log:
+            self.log(text)
+
+    def _fetch(self, stage: str, key: str):
+        t0 = time.perf_counter()
+        obj = self.cache.load(key)
+        self.hits[stage] = obj is not None
+        if obj is not None:
+            self._say(f"cache: {stage} loaded in {time.perf_counter() - t0:.2f} s ({key[:12]})")
+        return obj
+
+    def _keep(self, stage: str, key: str, obj, describe: str) -> None:
+        t0 = time.perf_counter()
+        if self.cache.store(key, obj, stage=stage, describe=describe):
+            self._say(f"cache: {stage} stored in {time.perf_counter() - t0:.2f} s ({key[:12]})")
+
+    def assemble(self, disc, material, **kw):
+        """:func:`~femrub.fem.discretisation.assemble` of ``disc``, through the cache."""
+        if self.cache is None:
+            return assemble(disc, material, **kw)
+        mesh = disc.mesh
+        key = content_key(
+            "assembly", type(mesh).__name__, mesh.p, mesh.t, disc.order,
+            type(disc.basis_u.elem).__name__, type(disc.basis_t.elem).__name__,
+            disc.fixed_u, disc.fixed_t, material, kw,
+        )  # fmt: skip
+        self._mats_key = key
+        mats = self._fetch("assembly", key)
+        if mats is not None:
+            return dataclasses.replace(mats, basis_u=disc.basis_u, basis_t=disc.basis_t)
+        mats = assemble(disc, material, **kw)
+        bare = dataclasses.replace(mats, basis_u=None, basis_t=None)
+        self._keep("assembly", key, bare, f"{mats.n_u} + {mats.n_t} FE dofs")
+        return mats
+
+    def _model_key(self, model, *extra) -> str:
+        n = model.n_dofs
+        return content_key(
+            self._mats_key, model.layout, model.boundary, model.x0, model.A, model.B,
+            _state_arrays(model.contact, n), [_state_arrays(t, n) for t in model.loads],
+            model.observations, model.energy, model.to_full, *extra,
+        )  # fmt: skip
+
+    def reduce(self, model, scene, log=None, make_stepper=None):
+        """:func:`~femrub.reduction.sizes.reduce_model`: ``(reduced, reductor, report)``.
+
+        ``make_stepper`` (for the reduction error estimate, which steps the run itself)
+        puts the scene's ``scheme``, ``loads`` and ``contact`` into the key.
+        """
+        if self.cache is None or self._mats_key is None:
+            out = reduce_model(model, scene, log, make_stepper)
+            _say_phases(self._say, out[0].info.get("timings", {}))
+            return out
+        opts = dict(scene["reduction"])
+        if opts["method"] == "none":
+            return reduce_model(model, scene, log, make_stepper)  # nothing to store
+        t_end = scene["scheme"]["t_end"] if opts["method"] == "auto" else None
+        run = [dict(scene[k]) for k in ("scheme", "loads", "contact")] if make_stepper else None
+        key = self._model_key(model, "reduction", opts, t_end, run)
+        hit = self._fetch("reduction", key)
+        if hit is not None:
+            return _attach(hit, model), None, dict(hit["report"], cache="hit")
+        reduced, reductor, report = reduce_model(model, scene, log, make_stepper)
+        _say_phases(self._say, reduced.info.get("timings", {}))
+        self._keep("reduction", key, _detach(reduced, report), f"{reduced.n_dofs} dofs")
+        return reduced, reductor, report
+
+    def frequencies(self, model, k: int) -> np.ndarray:
+        """:func:`~femrub.reduction.sizes.natural_frequencies` (Hz), through the cache."""
+        if self.cache is None or self._mats_key is None:
+            return natural_frequencies(model, k)
+        key = content_key(self._mats_key, "frequencies", model.layout.n_u, k)
+        f = self._fetch("frequencies", key)
+        if f is None:
+            f = natural_frequencies(model, k)
+            self._keep("frequencies", key, np.asarray(f), f"{k} frequencies")
+        return f
+
+
+def _say_phases(say, timings: dict) -> None:
+    """One line with the seconds of each phase of a reduction (static shapes, modes, ...)."""
+    if timings:
+        parts = ", ".join(f"{k.replace('_', ' ')} {v:.2f} s" for k, v in timings.items())
+        say(f"reduction phases: {parts}")
+
+
+def _state_arrays(obj, n: int) -> dict:
+    """The fields of a dataclass that are state-space arrays (a first dimension ``n``).
+
+    These are what a reduction projects (``Rᵀ G``, ``R̃ᵀ F``); the other fields (gap
+    functions, heat coefficients, signals, names) pass through it unchanged.
+    """
+    if obj is None:
+        return {}
+    return {
+        f.name: v
+        for f in dataclasses.fields(obj)
+        if isinstance(v := getattr(obj, f.name), np.ndarray) and v.ndim and v.shape[0] == n
+    }
+
+
+def _detach(reduced, report) -> dict:
+    """What to store of a reduced model: its arrays, without the run-specific functions."""
+    n = reduced.n_dofs
+    return {
+        "model": dataclasses.replace(reduced, contact=None, loads=[]),
+        "contact": None if reduced.contact is None else _state_arrays(reduced.contact, n),
+        "loads": [_state_arrays(t, n) for t in reduced.loads],
+        "report": report,
+    }
+
+
+def _attach(hit: dict, full):
+    """The stored reduced model with the gap, heat and load functions of ``full``."""
+    model = hit["model"]
+    contact = (
+        None if hit["contact"] is None else dataclasses.replace(full.contact, **hit["contact"])
+    )
+    loads = [dataclasses.replace(t, **a) for t, a in zip(full.loads, hit["loads"], strict=True)]
+    info = dict(model.info, full_info=dict(full.info))
+    return model.with_(contact=contact, loads=loads, info=info)

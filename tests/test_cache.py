@@ -1,0 +1,181 @@
+"""The content-addressed model cache: hits, misses on changed inputs, corruption, limits."""
+
+from __future__ import annotations
+
+import os
+import time
+
+import numpy as np
+import pytest
+
+from femrub.app.cache import ModelCache, content_key, parse_size
+from femrub.app.cli import main
+from femrub.app.simulation import build
+from femrub.scene import load_scene
+
+# a coarse twisted blade (a few hundred tetrahedra) reduced with fixed sizes; every contact
+# kept whatever the speed, so a speed change keeps the same boundary dofs
+SMALL = {
+    "geometry.h": 0.03,
+    "geometry.n_sections": 2,
+    "contact.reach": "all",
+    "reduction.method": "craig-bampton",
+    "reduction.n_uv": 8,
+    "reduction.n_theta": 4,
+    "scheme.t_end": 2e-5,
+}
+
+
+def _scene(**changes):
+    return load_scene("twisted-naca", {**SMALL, **changes})
+
+
+def _build(cache, notes=None, **changes):
+    log = notes.append if notes is not None else None
+    return build(_scene(**changes), log=log, cache=cache)
+
+
+def _close(a, b, tol=1e-8):
+    """Equal up to the eigen-solver's tolerance (ARPACK's random start vector)."""
+    a, b = np.asarray(a), np.asarray(b)
+    np.testing.assert_allclose(a, b, rtol=tol, atol=tol * max(np.abs(b).max(), 1e-300))
+
+
+def _same_model(a, b):
+    _close(a.A.toarray(), b.A.toarray())
+    _close(a.B.toarray(), b.B.toarray())
+    ca, cb = a.contact, b.contact
+    for name in ("G", "Gv", "Hm", "Ht"):
+        _close(getattr(ca, name), getattr(cb, name))
+    for t in (0.0, 1.3e-4):
+        np.testing.assert_array_equal(ca.gap_at(t), cb.gap_at(t))
+        np.testing.assert_array_equal(ca.alpha_at(t), cb.alpha_at(t))
+    _close(a.to_full, b.to_full)
+    assert sorted(a.observations) == sorted(b.observations)
+
+
+def _states(sim, steps=15):
+    return np.array([s.X for _, s in zip(range(steps), sim.stepper.iterate(1.0))])
+
+
+@pytest.fixture(scope="module")
+def first(tmp_path_factory):
+    cache = ModelCache(tmp_path_factory.mktemp("cache"))
+    notes = []
+    sim = _build(cache, notes)
+    return cache, sim, notes
+
+
+def test_first_build_stores_assembly_and_reduction(first):
+    cache, sim, notes = first
+    info = cache.info()
+    assert info["stages"]["assembly"]["entries"] == 1
+    assert info["stages"]["reduction"]["entries"] == 1
+    assert any("assembly stored" in n for n in notes)
+    assert sim.reductor is not None and "cache" not in sim.report["reduction"]
+
+
+def test_second_build_hits_and_runs_the_same(first):
+    cache, sim, _ = first
+    notes = []
+    again = _build(cache, notes)
+    assert any("assembly loaded" in n for n in notes)
+    assert again.report["reduction"]["cache"] == "hit" and again.reductor is None
+    _same_model(sim.model, again.model)
+    np.testing.assert_array_equal(_states(again), _states(sim))  # the same bits
+
+
+def test_speed_change_reuses_the_matrices_with_the_new_gap_and_heat(first):
+    cache, _, _ = first
+    hit = _build(cache, None, **{"loads.rotation_speed": 1700.0})
+    assert hit.report["reduction"]["cache"] == "hit"
+    fresh = _build(None, None, **{"loads.rotation_speed": 1700.0})
+    _same_model(hit.model, fresh.model)
+    _close(_states(hit), _states(fresh), 1e-6)
+
+
+def test_changed_material_misses(first):
+    cache, sim, _ = first
+    notes = []
+    other = _build(cache, notes, **{"material.young": "120 GPa"})
+    assert any("assembly stored" in n for n in notes)
+    assert "cache" not in other.report["reduction"]
+    assert not np.allclose(other.model.B.toarray(), sim.model.B.toarray())
+
+
+def test_corrupt_entry_is_detected_and_rebuilt(first, tmp_path):
+    cache, sim, _ = first
+    local = ModelCache(tmp_path / "c")
+    _build(local)
+    for e in local.entries():
+        if e["stage"] == "reduction":
+            path = local.root / f"{e['key']}.pkl"
+            data = bytearray(path.read_bytes())
+            data[len(data) // 2] ^= 0xFF
+            path.write_bytes(bytes(data))
+    notes = []
+    rebuilt = _build(local, notes)
+    assert any("corrupt" in n and "rebuilding" in n for n in notes)
+    assert "cache" not in rebuilt.report["reduction"]  # rebuilt, not loaded
+    _same_model(rebuilt.model, sim.model)
+    assert _build(local).report["reduction"]["cache"] == "hit"  # and stored again
+
+
+def test_store_load_clear_and_info(tmp_path):
+    cache = ModelCache(tmp_path)
+    obj = {"a": np.arange(10.0), "b": "text"}
+    key = content_key("x", obj["a"])
+    assert cache.load(key) is None
+    assert cache.store(key, obj, stage="test")
+    back = cache.load(key)
+    np.testing.assert_array_equal(back["a"], obj["a"])
+    assert cache.info()["entries"] == 1
+    assert cache.clear()[0] == 1 and cache.info()["entries"] == 0
+    assert cache.load(key) is None
+
+
+def test_keys_follow_content():
+    a = np.arange(5.0)
+    assert content_key(a, {"k": 1}) == content_key(a.copy(), {"k": 1})
+    assert content_key(a, {"k": 1}) != content_key(a, {"k": 2})
+    b = a.copy()
+    b[3] += 1e-15
+    assert content_key(a) != content_key(b)
+
+
+def test_size_limit_evicts_least_recently_used(tmp_path):
+    blob = np.zeros(100_000)  # 800 kB
+    cache = ModelCache(tmp_path, limit=2_000_000)
+    cache.store("a", blob, stage="t")
+    cache.store("b", blob, stage="t")
+    now = time.time()
+    os.utime(tmp_path / "a.json", (now - 100, now - 100))
+    os.utime(tmp_path / "b.json", (now - 50, now - 50))
+    assert cache.load("a") is not None  # a becomes the most recently used
+    cache.store("c", blob, stage="t")
+    keys = {e["key"] for e in cache.entries()}
+    assert keys == {"a", "c"}
+    assert cache.info()["bytes"] <= cache.limit
+    notes = []
+    small = ModelCache(tmp_path / "small", limit=1000, log=notes.append)
+    assert not small.store("big", blob, stage="t")
+    assert small.entries() == [] and "exceeds the cache size" in notes[0]
+
+
+def test_parse_size():
+    assert parse_size("500MB") == 500_000_000
+    assert parse_size("2GiB") == 2 * 2**30
+    assert parse_size(1e6) == 1_000_000
+    with pytest.raises(ValueError, match="cache size"):
+        parse_size("lots")
+
+
+def test_cli_cache_info_and_clear(tmp_path, capsys):
+    cache = ModelCache(tmp_path)
+    cache.store("k", np.ones(3), stage="assembly")
+    assert main(["cache", "info", "--cache-dir", str(tmp_path)]) == 0
+    out = capsys.readouterr().out
+    assert str(tmp_path) in out and "assembly" in out and "entries       1" in out
+    assert main(["cache", "clear", "--cache-dir", str(tmp_path)]) == 0
+    assert "removed 1 entries" in capsys.readouterr().out
+    assert cache.entries() == []
