@@ -200,7 +200,7 @@ def test_paper_honours_ctrl_c(tmp_path, capsys, monkeypatch):
     assert "--overwrite" in capsys.readouterr().err
 
 
-def _serial(scene, todo, scheduler, workers, progress):
+def _serial(scene, todo, scheduler, workers, progress, cache=None):
     for r in todo:
         r.update(sweep_mod.run_point(scene.data, scene.source, str(scene.base_dir),
                                      r["params"], r["folder"]))  # fmt: skip
