@@ -8,7 +8,10 @@ Energy columns (J), cumulative from ``t = 0``:
 ``thermal_work`` (work of the thermal stresses on the structure), ``damping_work`` (<= 0),
 ``contact_work`` (<= 0 when no energy is created at contacts; ``impact_dissipation`` is its
 opposite), ``heat_content`` (J above ambient), ``friction_heat`` (Σ α × impulse),
-``heat_load``, ``heat_outflow`` (through the boundaries), and the balance residuals
+``heat_load``, ``heat_outflow`` (through the boundaries), with Coulomb friction
+``friction_work`` (friction dissipation, >= 0), ``casing_work`` (work of the moving casing
+through friction; ``contact_work`` = normal work + ``casing_work`` − ``friction_work``) and
+``heat_to_casing`` (the friction power not put into the blade), and the balance residuals
 ``energy_error = E − E0 − (external + thermal + damping + contact work)`` and
 ``heat_error = Q − Q0 − (friction_heat + heat_load − heat_outflow)``.
 """
@@ -36,6 +39,9 @@ ENERGY_KEYS = (
     "friction_heat",
     "heat_load",
     "heat_outflow",
+    "friction_work",
+    "casing_work",
+    "heat_to_casing",
     "energy_error",
     "heat_error",
 )
@@ -63,6 +69,10 @@ class Results:
     cpu_seconds: float = 0.0
     states: np.ndarray | None = None
     state_times: np.ndarray | None = None
+    friction_force: np.ndarray | None = None
+    slip_velocity: np.ndarray | None = None
+    contact_state: np.ndarray | None = None
+    friction_limit: np.ndarray | None = None
     info: dict = field(default_factory=dict)
 
     @property
@@ -156,6 +166,9 @@ class Results:
         arrays.update({f"energy_{k}": v for k, v in self.energy.items()})
         if self.states is not None:
             arrays["states"], arrays["state_times"] = self.states, self.state_times
+        for k in ("friction_force", "slip_velocity", "contact_state", "friction_limit"):
+            if getattr(self, k) is not None:
+                arrays[k] = getattr(self, k)
         np.savez_compressed(
             path,
             t=self.t,
@@ -175,6 +188,11 @@ class Results:
             energy = {k[7:]: d[k] for k in d.files if k.startswith("energy_")}
             states = d["states"] if "states" in d.files else None
             stimes = d["state_times"] if "state_times" in d.files else None
+            extra = {
+                k: d[k]
+                for k in ("friction_force", "slip_velocity", "contact_state", "friction_limit")
+                if k in d.files
+            }
             return cls(
                 scheme=meta["scheme"],
                 h=meta["h"],
@@ -190,4 +208,5 @@ class Results:
                 states=states,
                 state_times=stimes,
                 info=meta.get("info", {}),
+                **extra,
             )

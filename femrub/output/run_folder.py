@@ -52,6 +52,28 @@ def _write_json(path: Path, doc: dict) -> None:
     tmp.replace(path)
 
 
+def _friction_summary(res) -> dict:
+    """``max_friction_force`` (N), ``friction_work``, ``heat_to_blade``, ``heat_to_casing``
+    (J) and the Coulomb check of every recorded step (:func:`~femrub.contact.friction.coulomb_check`)."""
+    e = res.energy
+    ff = res.friction_force
+    out = {
+        "max_friction_force": float(np.linalg.norm(ff, axis=-1).max())
+        if ff is not None and ff.size
+        else 0.0,
+        "friction_work": float(e["friction_work"][-1]) if "friction_work" in e else 0.0,
+        "heat_to_blade": float(e["friction_heat"][-1]) if "friction_heat" in e else 0.0,
+        "heat_to_casing": float(e["heat_to_casing"][-1]) if "heat_to_casing" in e else 0.0,
+    }
+    if ff is not None and ff.size and res.friction_limit is not None:
+        from ..contact.friction import coulomb_check
+
+        out["coulomb_check"] = coulomb_check(
+            res.force, ff, res.slip_velocity, res.contact_state, res.friction_limit
+        )
+    return out
+
+
 def run_to_folder(
     stepper,
     t_end: float,
@@ -156,6 +178,7 @@ def run_to_folder(
         vtk=str(series.pvd_path.relative_to(out)) if series is not None else None,
         vtk_frames=len(series.frames) if series is not None else 0,
     )
+    doc.update(_friction_summary(res))
     for name, arr in res.signals.items():
         doc.setdefault("signals_max_abs", {})[name] = float(np.abs(arr).max()) if arr.size else 0.0
     _write_json(summary_path, doc)

@@ -37,6 +37,17 @@ created. With this choice the contact work of every step is ``<= 0`` (see
 
 The heat input ``α P`` enters the same step as the impulse. Penetration is not prevented at
 the position level; it stays below ``h |ġ|`` (paper Sec. 4.3).
+
+**Coulomb friction** (a contact with tangents and ``μ > 0``): the impulse of a contact is
+``(P_n, P_t1, P_t2)``, ``X_{k+1} = X_p + Z₃ P`` with ``Z₃ = D⁻¹ [Hm, Hmt]``, and the local
+velocities ``(ġ_{k+1}, w_{t,k+1})`` (gap velocity, slip velocity relative to the casing
+surface) are affine in ``P`` through the Delassus operator ``W₃ = [Gv, Gvt]ᵀ Z₃``. Each step
+solves Signorini–Coulomb with Newton's law exactly
+(:func:`femrub.contact.friction.solve_frictional_contact`) inside the same activation rule.
+With the ``"power"`` heat law the blade then receives ``η (−P_t · w_t,m)`` per contact, with
+``w_t,m`` the slip velocity at the mid-step state (the value the energy balance uses), as a
+heat input of the same step; its effect on the step's velocities through the thermal
+coupling is not fed back into the contact solve (one splitting per step).
 """
 
 from __future__ import annotations
@@ -44,6 +55,7 @@ from __future__ import annotations
 import numpy as np
 import scipy.sparse as sp
 
+from ..contact.friction import solve_frictional_contact
 from ..contact.impulses import solve_impulses
 from ..fem.linalg import Factorised, compact
 from .base import Stepper
@@ -130,6 +142,7 @@ class ThetaMethod(Stepper):
                 and not callable(c.gap0)
                 and not callable(c.heat_coefficient)
                 and c.gap_rate is None
+                and not c.has_friction
             ):
                 a = c.heat_coefficient
                 self._fast = True
@@ -140,6 +153,14 @@ class ThetaMethod(Stepper):
                 if self._w <= 0.0:
                     raise ValueError("non-positive Delassus operator at the contact")
         self._warm = None
+        self._friction = c is not None and c.has_friction
+        if self._friction:
+            self._Z3 = self._lu.solve(c.H3)
+            self._W3 = c.V3T @ self._Z3
+            self._W3t = c.V3T @ self._Zt  # heat columns seen by the local velocities
+            self._GZ3 = c.GT @ self._Z3
+            self._GZt = c.GT @ self._Zt
+            self._warm3 = None
 
     def _signal_values(self, t):
         return np.array([float(sig(t)) for sig in self._signals])
@@ -179,6 +200,8 @@ class ThetaMethod(Stepper):
         c = m.contact
         if c is None:
             return Xp, np.zeros(0)
+        if self._friction:
+            return self._step_friction(Xk, Xp, t1)
         alpha = c.alpha_at(t1)
         Z = self._Zm + self._Zt * alpha
         W = self._Wm + self._Wt * alpha
@@ -211,3 +234,52 @@ class ThetaMethod(Stepper):
                 active = new
         self._warm = P > 0.0
         return Xp + Z @ P, P
+
+    def _step_friction(self, Xk, Xp, t1):
+        """Signorini–Coulomb step (module docstring), same activation rules."""
+        c, h = self.model.contact, self.h
+        n = c.n
+        alpha = c.alpha_at(t1) if c.heat_law == "alpha" else np.zeros(n)
+        Z, W, GZ = self._Z3, self._W3, self._GZ3
+        if np.any(alpha):  # α λ heat enters with the normal impulse
+            Z, W, GZ = Z.copy(), W.copy(), GZ.copy()
+            Z[:, ::3] += self._Zt * alpha
+            W[:, ::3] += self._W3t * alpha
+            GZ[:, ::3] += self._GZt * alpha
+        gdot_k = c.gap_velocity(self.t, Xk)
+        q = np.column_stack([c.gap_velocity(t1, Xp), c.slip_velocity(Xp)])
+        e = np.where(gdot_k > 0.0, 1.0, c.restitution)
+        gap_k = c.gap(self.t, Xk)
+
+        def solve(active):
+            return solve_frictional_contact(
+                W, q, c.friction, active, restitution=e, u_before=gdot_k, warm=self._warm3
+            )
+
+        if self.activation == "predicted":
+            res = solve(gap_k + self.gamma * h * gdot_k <= 0.0)
+        else:
+            gap_p = c.gap(t1, Xp)
+            closed = gap_k <= 0.0
+            active = closed | (gap_p <= 0.0)
+            seen = []
+            while True:
+                res = solve(active)
+                new = closed | (gap_p + GZ @ res.P.reshape(-1) <= 0.0)
+                if np.array_equal(new, active):
+                    break
+                if any(np.array_equal(new, a) for a in seen):  # no consistent set: keep impulse
+                    res = solve(new | active)
+                    break
+                seen.append(active)
+                active = new
+        P = res.P
+        self._warm3 = P
+        X = Xp + Z @ P.reshape(-1)
+        heat = alpha * P[:, 0]
+        if c.heat_law == "power" and self.model.layout.n_t:
+            w_mid = 0.5 * (c.slip_velocity(Xk) + c.slip_velocity(X))
+            power = -np.einsum("ij,ij->i", P[:, 1:], w_mid)
+            heat = c.heat_partition * power
+            X = X + self._Zt @ heat
+        return X, P[:, 0].copy(), {"friction_impulse": P[:, 1:], "heat": heat, "state": res.state}
