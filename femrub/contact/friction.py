@@ -17,8 +17,8 @@ by the semi-smooth Newton method of Alart & Curnier (1991) on::
     F_n = P_n − max(0, P_n − ρ u_n) = 0
     F_t = P_t − proj_{B(μ max(0, P_n − ρ u_n))}(P_t − ρ u_t) = 0
 
-with per-contact ``ρ_i = 1 / ‖W_ii‖``, an Armijo line search on ``‖F‖²/2``, and a
-projected-fixed-point fallback. The converged impulses are put on the cone exactly: a
+with per-contact ``ρ_i = 1 / ‖W_ii‖``, an Armijo line search on ``‖F‖²/2``, and projected block Gauss–Seidel sweeps on the
+same map (then Newton again) when Newton stalls. The converged impulses are put on the cone exactly: a
 sliding contact gets ``|P_t| = μ P_n`` and the direction of ``−u_t``. Without friction
 (``μ = 0`` everywhere) the problem is the LCP of :func:`femrub.contact.impulses.solve_impulses`,
 which is used instead (exact pivoting, and the one-contact closed form).
@@ -210,6 +210,52 @@ def _on_cone(P, u, mu, rho):
     return P, slide
 
 
+def _newton(P, W, q, mu, rho, tol, max_iter):
+    """Semi-smooth Newton with Armijo line search on ``‖F‖²/2``; stops when it stalls."""
+    m = q.shape[0]
+    F, aux = _residual(P, W, q, mu, rho)
+    merit = 0.5 * np.sum(F**2)
+    it = 0
+    for it in range(1, max_iter + 1):
+        if np.max(np.abs(F)) <= tol:
+            break
+        J = _jacobian(W, mu, rho, aux)
+        try:
+            d = np.linalg.solve(J, -F.reshape(-1)).reshape(m, 3)
+        except np.linalg.LinAlgError:
+            break
+        t = 1.0
+        while True:
+            Fn, auxn = _residual(P + t * d, W, q, mu, rho)
+            mn = 0.5 * np.sum(Fn**2)
+            if mn <= (1.0 - 1e-4 * t) * merit:
+                break
+            t *= 0.5
+            if t < 1e-8:
+                return P, F, aux, it
+        P, F, aux, merit = P + t * d, Fn, auxn, mn
+    return P, F, aux, it
+
+
+def _gauss_seidel(P, W, q, mu, rho, tol, sweeps=5000):
+    """Projected block Gauss–Seidel on the Alart–Curnier map (robust, linear convergence)."""
+    P = P.copy()
+    m = q.shape[0]
+    Wr = W.reshape(m, 3, 3 * m)
+    for _ in range(sweeps):
+        P0 = P.copy()
+        for i in range(m):
+            u = Wr[i] @ P.reshape(-1) + q[i]
+            pn = max(0.0, P[i, 0] - rho[i] * u[0])
+            x = P[i, 1:] - rho[i] * u[1:]
+            nx = np.linalg.norm(x)
+            r = mu[i] * pn
+            P[i] = (pn, *(x if nx <= r else x * (r / nx)))
+        if np.max(np.abs(P - P0)) <= tol:
+            break
+    return P
+
+
 def _alart_curnier(W, q, mu, warm, tol, max_iter):
     m = q.shape[0]
     Wd = _blocks(W, m)
@@ -224,31 +270,11 @@ def _alart_curnier(W, q, mu, warm, tol, max_iter):
         Fw = _residual(P, W, q, mu, rho)[0]
         if np.sum(Fw**2) > np.sum(F0**2):
             P = np.zeros((m, 3))
-    F, aux = _residual(P, W, q, mu, rho)
-    merit = 0.5 * np.sum(F**2)
-    it = 0
-    for it in range(1, max_iter + 1):
-        if np.max(np.abs(F)) <= tol * scale:
-            break
-        J = _jacobian(W, mu, rho, aux)
-        try:
-            d = np.linalg.solve(J, -F.reshape(-1)).reshape(m, 3)
-        except np.linalg.LinAlgError:
-            d = -F
-        t = 1.0
-        while True:
-            Fn, auxn = _residual(P + t * d, W, q, mu, rho)
-            mn = 0.5 * np.sum(Fn**2)
-            if mn <= (1.0 - 1e-4 * t) * merit or t < 1e-10:
-                break
-            t *= 0.5
-        if t < 1e-10:  # Newton stalls: a projected fixed-point step (Alart–Curnier map)
-            Fn, auxn = _residual(P - F, W, q, mu, rho)
-            mn = 0.5 * np.sum(Fn**2)
-            P = P - F
-        else:
-            P = P + t * d
-        F, aux, merit = Fn, auxn, mn
+    P, F, aux, it = _newton(P, W, q, mu, rho, tol * scale, max_iter)
+    if np.max(np.abs(F)) > tol * scale:  # Newton stalled: Gauss-Seidel sweeps, then Newton
+        P = _gauss_seidel(P, W, q, mu, rho, tol * scale)
+        P, F, aux, it2 = _newton(P, W, q, mu, rho, tol * scale, max_iter)
+        it += it2
     res = float(np.max(np.abs(F)) / scale)
     if not res <= np.sqrt(tol):
         raise FloatingPointError(f"frictional contact not solved: residual {res:.3g}")

@@ -2,8 +2,10 @@
 
 :func:`run_to_folder` integrates a model with a stepper and writes, into ``out``:
 ``history.csv`` and ``history.npz`` (every observed signal, gaps, contact forces and
-impulses, energy balance), ``summary.json`` (inputs, versions, timings, energy balance,
-status), ``signals.png`` and, when a :class:`~femrub.model.rub.FieldMap` is given, ``vtk/``
+impulses, friction forces, slip velocities and contact states, energy balance),
+``summary.json`` (inputs, versions, timings, energy balance, friction, status),
+``signals.png``, on a rotating blade ``response.png``, ``spectrum.png`` and
+``contact_forces.png`` (:mod:`femrub.output.rub_plots`) and, when a :class:`~femrub.model.rub.FieldMap` is given, ``vtk/``
 (``.pvd`` + ``.vtu``, written as the run goes) and ``snapshot.png``. A run that is
 interrupted or fails keeps everything written so far and says so in ``summary.json``.
 A finished result (status ok, unstable or diverged-physically) is not overwritten unless
@@ -147,6 +149,13 @@ def run_to_folder(
             ),
             out / "signals.png",
         )
+    if plots and rotation_speed and res.impulse.shape[1] and res.steps > 1:
+        from .rub_plots import contact_force_panel, response_panels, spectrum_panel
+
+        omega_ = float(rotation_speed)
+        savefig(response_panels(res, omega_), out / "response.png")
+        savefig(spectrum_panel(res, omega_), out / "spectrum.png")
+        savefig(contact_force_panel(res, omega_), out / "contact_forces.png")
     if series is not None and series.frames and snapshot and plots:
         from .vtk import snapshot_png
 
