@@ -17,11 +17,12 @@ by the semi-smooth Newton method of Alart & Curnier (1991) on::
     F_n = P_n − max(0, P_n − ρ u_n) = 0
     F_t = P_t − proj_{B(μ max(0, P_n − ρ u_n))}(P_t − ρ u_t) = 0
 
-with per-contact ``ρ_i = 1 / ‖W_ii‖``, an Armijo line search on ``‖F‖²/2``, and projected block Gauss–Seidel sweeps on the
-same map (then Newton again) when Newton stalls. The converged impulses are put on the cone exactly: a
-sliding contact gets ``|P_t| = μ P_n`` and the direction of ``−u_t``. Without friction
-(``μ = 0`` everywhere) the problem is the LCP of :func:`femrub.contact.impulses.solve_impulses`,
-which is used instead (exact pivoting, and the one-contact closed form).
+with per-contact ``ρ_i = 1 / ‖W_ii‖``, an Armijo line search on ``‖F‖²/2``, and projected
+block Gauss–Seidel sweeps on the same map (then Newton again) when Newton stalls. The
+converged impulses are put on the cone exactly: a sliding contact gets ``|P_t| = μ P_n``
+and the direction of ``−u_t``. Without friction (``μ = 0`` everywhere) the problem is the
+LCP of :func:`femrub.contact.impulses.solve_impulses`, which is used instead (exact
+pivoting, and the one-contact closed form).
 """
 
 from __future__ import annotations

@@ -85,13 +85,13 @@ class ContactPoints:
         cols = np.repeat(mats.u_index(self.u_dofs.T.ravel()).reshape(nc, 1, dim), 2, axis=1)
         rows = np.repeat(np.arange(2 * nc), dim).reshape(nc, 2, dim)
         vals = np.transpose(self.tangents, (2, 1, 0))  # (n_c, 2, dim)
-        return sp.csr_matrix(
-            (vals.ravel(), (rows.ravel(), cols.ravel())), shape=(2 * nc, mats.n_u)
-        )
+        return sp.csr_matrix((vals.ravel(), (rows.ravel(), cols.ravel())), shape=(2 * nc, mats.n_u))
 
     def frames(self) -> np.ndarray:
         """(n_c, 3, dim): unit normal, axial and circumferential tangents of each point."""
-        return np.concatenate([self.normals.T[:, None, :], np.transpose(self.tangents, (2, 1, 0))], 1)
+        return np.concatenate(
+            [self.normals.T[:, None, :], np.transpose(self.tangents, (2, 1, 0))], 1
+        )
 
     def heat_rows(self, mats) -> sp.csr_matrix:
         """(n_c, n_θ) heat weights on the free temperature dofs."""

@@ -5,8 +5,9 @@
 impulses, friction forces, slip velocities and contact states, energy balance),
 ``summary.json`` (inputs, versions, timings, energy balance, friction, status),
 ``signals.png``, on a rotating blade ``response.png``, ``spectrum.png`` and
-``contact_forces.png`` (:mod:`femrub.output.rub_plots`) and, when a :class:`~femrub.model.rub.FieldMap` is given, ``vtk/``
-(``.pvd`` + ``.vtu``, written as the run goes) and ``snapshot.png``. A run that is
+``contact_forces.png`` (:mod:`femrub.output.rub_plots`) and, when a
+:class:`~femrub.model.rub.FieldMap` is given, ``vtk/`` (``.pvd`` + ``.vtu``, written as the
+run goes) and ``snapshot.png``. A run that is
 interrupted or fails keeps everything written so far and says so in ``summary.json``.
 A finished result (status ok, unstable or diverged-physically) is not overwritten unless
 ``overwrite=True``; an interrupted or failed one is simply run again.
@@ -55,8 +56,9 @@ def _write_json(path: Path, doc: dict) -> None:
 
 
 def _friction_summary(res) -> dict:
-    """``max_friction_force`` (N), ``friction_work``, ``heat_to_blade``, ``heat_to_casing``
-    (J) and the Coulomb check of every recorded step (:func:`~femrub.contact.friction.coulomb_check`)."""
+    """``max_friction_force`` (N), ``friction_work``, ``heat_to_blade``, ``heat_to_casing`` (J)
+    and the Coulomb check of every recorded step (:func:`femrub.contact.friction.coulomb_check`).
+    """
     e = res.energy
     ff = res.friction_force
     out = {
