@@ -182,3 +182,26 @@ def test_history_keys(tmp_path):
         assert key in s
     assert s["max_friction_force"] == pytest.approx(3.0)
     assert s["coulomb_check"]["cone"] <= 1e-8
+
+
+def test_energy_and_heat_balance_close_on_a_full_blade_model():
+    """Twisted NACA blade, full model (no reduction), μ = 0.15, frictional heat on."""
+    from femrub.app import build
+    from femrub.scene import load_scene
+
+    scene = load_scene(
+        "twisted-naca",
+        {"reduction.method": "none", "contact.friction": 0.15, "scheme.t_end": 8e-4,
+         "outputs.vtk_stride": 0},
+    )  # fmt: skip
+    res = build(scene).stepper.run(scene["scheme"]["t_end"])
+    assert res.status == "ok" and res.force.max() > 0
+    e = res.energy
+    assert res.energy_error() < 1e-8 and res.heat_error() < 1e-10
+    assert e["friction_work"][-1] > 0
+    # η = 1: the blade takes the friction work (up to the thermal coupling of the step)
+    np.testing.assert_allclose(e["friction_heat"][-1], e["friction_work"][-1], rtol=1e-4)
+    check = coulomb_check(res.force, res.friction_force, res.slip_velocity,
+                          res.contact_state, res.friction_limit)  # fmt: skip
+    assert check["cone"] <= 1e-8 and check["slip_equality"] <= 1e-8
+    assert check["direction"] <= 1e-6
