@@ -78,6 +78,23 @@ def _friction_summary(res) -> dict:
     return out
 
 
+#: relative tolerance of the Coulomb check (|λ_t| <= μ λ, equality and direction when sliding)
+COULOMB_TOL = 1e-8
+
+
+def _coulomb_violated(check) -> str:
+    """A message when the recorded friction forces break Coulomb's law, else ``""``."""
+    if not check:
+        return ""
+    worst = max(check["cone"], check["slip_equality"], check["direction"])
+    if worst <= COULOMB_TOL and check["force_without_normal"] == 0.0:
+        return ""
+    return (
+        f"Coulomb law violated beyond {COULOMB_TOL:g} (cone {check['cone']:.2g}, sliding "
+        f"{check['slip_equality']:.2g}, direction {check['direction']:.2g})"
+    )
+
+
 def run_to_folder(
     stepper,
     t_end: float,
@@ -190,6 +207,9 @@ def run_to_folder(
         vtk_frames=len(series.frames) if series is not None else 0,
     )
     doc.update(_friction_summary(res))
+    bad = _coulomb_violated(doc.get("coulomb_check"))
+    if bad and doc["status"] == "ok":  # not trustworthy: the friction law is not met
+        doc.update(status="inaccurate", message=bad)
     for name, arr in res.signals.items():
         doc.setdefault("signals_max_abs", {})[name] = float(np.abs(arr).max()) if arr.size else 0.0
     _write_json(summary_path, doc)

@@ -47,7 +47,8 @@ solves Signorini–Coulomb with Newton's law exactly
 With the ``"power"`` heat law the blade then receives ``η (−P_t · w_t,m)`` per contact, with
 ``w_t,m`` the slip velocity at the mid-step state (the value the energy balance uses), as a
 heat input of the same step; its effect on the step's velocities through the thermal
-coupling is not fed back into the contact solve (one splitting per step).
+coupling is fed back into the contact solve by a fixed point (contact solve, heat, contact
+solve with the heat's velocity shift ``W_θ Q``, ...) until the heat repeats to 1e-12.
 """
 
 from __future__ import annotations
@@ -63,6 +64,8 @@ from .base import Stepper
 __all__ = ["ThetaMethod", "ACTIVATION_RULES"]
 
 ACTIVATION_RULES = ("paper", "predicted")
+#: fixed-point iterations between the contact solve and the frictional heat of a step
+MAX_HEAT_ITERATIONS = 20
 
 
 class ThetaMethod(Stepper):
@@ -251,13 +254,15 @@ class ThetaMethod(Stepper):
         e = np.where(gdot_k > 0.0, 1.0, c.restitution)
         gap_k = c.gap(self.t, Xk)
 
-        def solve(active):
+        def solve(active, shift=0.0):
             return solve_frictional_contact(
-                W, q, c.friction, active, restitution=e, u_before=gdot_k, warm=self._warm3
-            )
+                W, q + shift, c.friction, active, restitution=e, u_before=gdot_k,
+                warm=self._warm3,
+            )  # fmt: skip
 
         if self.activation == "predicted":
-            res = solve(gap_k + self.gamma * h * gdot_k <= 0.0)
+            active = gap_k + self.gamma * h * gdot_k <= 0.0
+            res = solve(active)
         else:
             gap_p = c.gap(t1, Xp)
             closed = gap_k <= 0.0
@@ -269,17 +274,29 @@ class ThetaMethod(Stepper):
                 if np.array_equal(new, active):
                     break
                 if any(np.array_equal(new, a) for a in seen):  # no consistent set: keep impulse
-                    res = solve(new | active)
+                    active = new | active
+                    res = solve(active)
                     break
                 seen.append(active)
                 active = new
+        heat = alpha * res.P[:, 0]  # the α λ heat is already in Z's normal columns
+        power = c.heat_law == "power" and self.model.layout.n_t > 0
+        if power:
+            # the heat η (−P_t · w_t,mid) moves the step's velocities through the thermal
+            # coupling: fixed point on it, so the final state meets Coulomb's law
+            w_k = c.slip_velocity(Xk)
+            heat = np.zeros(n)
+            for _ in range(MAX_HEAT_ITERATIONS):
+                w_mid = 0.5 * (w_k + res.u[:, 1:])
+                new = c.heat_partition * -np.einsum("ij,ij->i", res.P[:, 1:], w_mid)
+                if np.max(np.abs(new - heat), initial=0.0) <= 1e-12 * np.max(np.abs(new)):
+                    break
+                heat = new
+                res = solve(active, (self._W3t @ heat).reshape(n, 3))
+            heat = new
         P = res.P
         self._warm3 = P
         X = Xp + Z @ P.reshape(-1)
-        heat = alpha * P[:, 0]
-        if c.heat_law == "power" and self.model.layout.n_t:
-            w_mid = 0.5 * (c.slip_velocity(Xk) + c.slip_velocity(X))
-            power = -np.einsum("ij,ij->i", P[:, 1:], w_mid)
-            heat = c.heat_partition * power
+        if power:
             X = X + self._Zt @ heat
         return X, P[:, 0].copy(), {"friction_impulse": P[:, 1:], "heat": heat, "state": res.state}
