@@ -219,3 +219,12 @@ def test_contacts_starting_inside_the_casing_warn_by_how_much():
     model.contact.gap0 = np.array([1e-6])
     _initial_penetration(model, report := {}, None)
     assert "warnings" not in report
+
+
+def test_a_broken_coulomb_check_is_not_ok():
+    from femrub.output.run_folder import _coulomb_violated
+
+    good = {"cone": -0.5, "slip_equality": 1e-15, "direction": 0.0, "force_without_normal": 0.0}
+    assert _coulomb_violated(good) == "" and _coulomb_violated(None) == ""
+    assert "Coulomb law violated" in _coulomb_violated({**good, "cone": 1e-6})
+    assert "Coulomb law violated" in _coulomb_violated({**good, "force_without_normal": 1.0})

@@ -21,7 +21,8 @@ With Coulomb friction the impulses are ``(P_n, P_t1, P_t2)`` per contact and
 :func:`femrub.contact.friction.solve_frictional_contact` solves the same projection with the
 Coulomb cone: the normal rows act on the predicted gap (``W_c``), the tangential rows on the
 slip velocity ``Gvtᵀ X − v_c`` of ``v_{n+1/2}`` (``Gvtᵀ ∂X/∂P``). With the ``"power"`` heat
-law the blade receives ``η (−P_t · w_t,m)`` after the contact solve, as in the θ-method.
+law the blade receives ``η (−P_t · w_t,m)`` after the contact solve (explicitly: unlike the
+θ-method, not iterated with the contact solve).
 
 The scheme is conditionally stable: ``h < 2 / ω_max`` for the mechanical part and
 ``h < 2 / μ_max`` for the explicit heat equation; :meth:`Carpenter.stability_limit` computes
