@@ -114,6 +114,14 @@ def explain(report: dict, reach_key=None) -> str:
         rows.append(("dropped", d))
     reach_key = reach_key or report.get("reach_key", "auto")
     rows += [("contacts", x) for x in _contacts(report["contacts"], reach_key)]
+    f = report.get("friction")
+    if f and f["mu"] > 0:
+        rows.append(
+            ("friction", f"Coulomb μ = {f['mu']:g} (stick/slip, casing frame); heat law "
+             f"{f['heat_law']}, heat_partition {f['heat_partition']:g}")
+        )  # fmt: skip
+    for w in report.get("warnings", []):
+        rows.append(("warning", w))
     rows += [("reduction", x) for x in _reduction(report["reduction"])]
     s = report["scheme"]
     opts = ", ".join(f"{k} {v}" for k, v in s.items() if k not in ("name", "h", "t_end", "steps"))

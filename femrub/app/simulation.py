@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import math
 import time
+import warnings
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -211,16 +212,25 @@ def _build(scene, log, modes, stages) -> Simulation:
                                          loads[0].vector if loads else None, force and force[2]),
         )  # fmt: skip
         points = candidates.restrict(reach.keep)
-        alpha = heat_coefficients(
-            points.radii, tr.heat_law_of(scene), alpha=c["heat_coefficient"],
-            friction=c["friction"], rotation_speed=omega, heat_partition=c["heat_partition"],
-        )  # fmt: skip
-        keep_t, report["thermal"] = tr.thermal_choice(scene, bool(np.any(alpha > 0)), points.n > 0)
+        law = tr.heat_law_of(scene)
+        mu = c["friction"] if blade.dim == 3 else 0.0
+        if law == "power":
+            alpha = np.zeros(points.n)
+            heated = mu > 0.0 and c["heat_partition"] > 0.0
+        else:
+            alpha = heat_coefficients(points.radii, "alpha", alpha=c["heat_coefficient"],
+                                      heat_partition=c["heat_partition"])  # fmt: skip
+            heated = bool(np.any(alpha > 0))
+        keep_t, report["thermal"] = tr.thermal_choice(scene, heated, points.n > 0)
         full, fields = rub_model(
             disc, mats, points, material, casing=casing, rotation_speed=omega, alpha=alpha,
             restitution=c["restitution"], offset=reach.offset[reach.keep], loads=loads,
             thermal=keep_t, observe_at=points if points.n else candidates,
+            friction=mu, heat_law="power" if law == "power" else "alpha",
+            heat_partition=c["heat_partition"],
         )  # fmt: skip
+        report["friction"] = {"mu": mu, "heat_law": law, "heat_partition": c["heat_partition"]}
+        _initial_penetration(full, report, log)
     except ValueError as exc:  # a value the schema cannot see (e.g. a singular clamp)
         if isinstance(exc, SceneError):
             raise
@@ -302,6 +312,26 @@ def _select_signals(scene, model, report, size):
     report["limits"], report["ignored"] = kept_limits, ignored
     report["limits_default"] = sorted(defaults)
     return model.with_(observations=obs), kept_limits
+
+
+def _initial_penetration(model, report, log) -> None:
+    """Warn when contacts start inside the casing (negative gap at t = 0), and by how much."""
+    c = model.contact
+    if c is None:
+        return
+    g = np.asarray(c.gap_at(0.0), dtype=float)
+    inside = np.flatnonzero(g < 0.0)
+    if not inside.size:
+        return
+    msg = (
+        f"{inside.size} of {c.n} contacts start inside the casing at t = 0, by up to "
+        f"{-g.min() * 1e6:.3g} um ({', '.join(c.names[i] for i in inside[:4])}"
+        f"{', ...' if inside.size > 4 else ''}): the first steps push them out"
+    )
+    report.setdefault("warnings", []).append(msg)
+    warnings.warn(msg, stacklevel=3)
+    if log:
+        log(f"warning: {msg}")
 
 
 def _contacts_report(points, reach) -> dict:

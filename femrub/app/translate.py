@@ -75,8 +75,15 @@ def coupling_of(scene) -> str:
 
 
 def heat_law_of(scene) -> str:
-    """``"alpha"`` (α given, the bar) or ``"friction"`` (μ Ω r, blades)."""
-    return "alpha" if is_bar(scene) else "friction"
+    """``"alpha"`` (α given; the bar's default) or ``"power"`` (η × friction power; blades)."""
+    law = scene["contact"].get("heat_law", "auto")
+    if law == "auto":
+        return "alpha" if is_bar(scene) else "power"
+    if law == "power" and is_bar(scene):
+        from ..scene.spec import fail
+
+        fail("contact.heat_law", law, "the bar has no tangential friction; use 'alpha'")
+    return law
 
 
 def area_of(scene) -> float:

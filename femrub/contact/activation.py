@@ -51,7 +51,14 @@ import numpy as np
 
 from .impulses import solve_impulses
 
-__all__ = ["RULES", "DEFAULT_RULE", "check_rule", "impulse_one", "impulses"]
+__all__ = [
+    "RULES",
+    "DEFAULT_RULE",
+    "check_rule",
+    "frictional_fixed_point",
+    "impulse_one",
+    "impulses",
+]
 
 RULES = ("position", "capped", "paper", "plain", "predicted")
 DEFAULT_RULE = "position"
@@ -164,3 +171,32 @@ def _capped(g_k, gd_k, g_p, gd_p, W, GZ, e, h, warm):
 def _target(g_k, e):
     """Highest gap an impulse may lift a contact to: ``g* = min(g_k, 0) + e max(g_k, 0)``."""
     return np.minimum(g_k, 0.0) + e * np.maximum(g_k, 0.0)
+
+
+def frictional_fixed_point(rule, g_k, gd_k, g_p, GZ3, solve, h, gamma):
+    """Active set and solution of a frictional step: ``(active, solve(active))``.
+
+    ``solve(active)`` solves the Signorini–Coulomb problem on ``active``
+    (:func:`femrub.contact.friction.solve_frictional_contact`), returning ``P`` (n_c, 3);
+    ``GZ3 = ∂g_{k+1}/∂P`` (n_c, 3 n_c). ``"predicted"`` is the Moreau–Jean rule
+    ``g_k + γ h ġ_k <= 0``; every other rule uses the ``"paper"`` fixed point (closed at
+    ``t_k`` or closed at ``t_{k+1}`` after the impulse): the position-level rules
+    (``"position"``, ``"capped"``) have no frictional form yet, so with friction the
+    velocity-level Newton law holds on the active contacts.
+    """
+    if rule == "predicted":
+        active = g_k + gamma * h * gd_k <= 0.0
+        return active, solve(active)
+    closed = g_k <= 0.0
+    active = closed | (g_p <= 0.0)
+    seen = []
+    while True:
+        res = solve(active)
+        new = closed | (g_p + GZ3 @ res.P.reshape(-1) <= 0.0)
+        if np.array_equal(new, active):
+            return active, res
+        if any(np.array_equal(new, a) for a in seen):  # no consistent set: keep impulse
+            active = new | active
+            return active, solve(active)
+        seen.append(active)
+        active = new

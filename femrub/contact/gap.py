@@ -4,6 +4,13 @@
     ġ(t, X)  = ġ0(t) + Gvᵀ X         normal gap velocity (m/s); ġ0 = dg0/dt (moving casing)
     force    = Hm λ + Ht (α λ)       reaction λ >= 0 (N) and frictional heat α λ (W)
 
+With Coulomb friction each contact also has two tangents (casing frame: axial and
+circumferential) and a tangential reaction ``λ_t`` (N)::
+
+    w_t(X)   = Gvtᵀ X − v_c           slip velocity: structure minus casing surface (m/s)
+    force   += Hmt λ_t                |λ_t| <= μ λ, λ_t = −μ λ w_t/|w_t| when sliding
+    heat     = η (−λ_t · w_t)          heat law "power": the blade's share η of the friction power
+
 The paper's tip node is the case ``G = −e_u(n)``, ``Gv = Hm = −e_v(n)``, ``Ht = e_θ(n)``:
 the reaction pushes the tip away from the casing and the heat input ``α λ`` is never negative.
 
@@ -34,6 +41,14 @@ class Contact:
     restitution : Newton restitution coefficient e in [0, 1].
     heat_coefficient : α (m/s) per contact, scalar, array or callable ``t -> (n_c,)``.
     names : labels of the contacts.
+    Gvt, Hmt : (N, 2 n_c) tangential velocity rows and force columns (contact-major:
+        columns ``2 i, 2 i + 1`` are the two tangents of contact ``i``); ``None``: no
+        tangential force.
+    friction : Coulomb coefficient μ per contact (scalar or (n_c,)).
+    casing_velocity : (n_c, 2) velocity of the casing surface along the tangents (m/s).
+    frames : (n_c, 3, dim) unit normal and tangents of each contact in global axes (output).
+    heat_law : ``"alpha"`` (heat ``α λ``) or ``"power"`` (heat ``η`` × friction power).
+    heat_partition : η, the blade's share of the friction power (``"power"`` law).
 
     Callables are evaluated at one time per call (their contract is a scalar ``t``); the
     products with the states are vectorised over rows.
@@ -48,6 +63,13 @@ class Contact:
     heat_coefficient: float | np.ndarray | Callable = 0.0
     names: list[str] = field(default_factory=list)
     gap_rate: Callable | None = None
+    Gvt: np.ndarray | None = None
+    Hmt: np.ndarray | None = None
+    friction: float | np.ndarray = 0.0
+    casing_velocity: np.ndarray | None = None
+    frames: np.ndarray | None = None
+    heat_law: str = "alpha"
+    heat_partition: float | np.ndarray = 1.0
 
     def __post_init__(self):
         self.G, self.Gv, self.Hm, self.Ht = (
@@ -68,6 +90,25 @@ class Contact:
             self.heat_coefficient = a
         if not self.names:
             self.names = [f"c{i}" for i in range(self.n)]
+        mu = np.broadcast_to(np.asarray(self.friction, dtype=float), (self.n,)).copy()
+        if not np.all(np.isfinite(mu)) or np.any(mu < 0):
+            raise ValueError(f"friction coefficient must be finite and >= 0, got {mu}")
+        self.friction = mu
+        if self.heat_law not in ("alpha", "power"):
+            raise ValueError(f"heat_law must be 'alpha' or 'power', got {self.heat_law!r}")
+        eta = np.broadcast_to(np.asarray(self.heat_partition, dtype=float), (self.n,)).copy()
+        if np.any(~((eta >= 0) & (eta <= 1))):
+            raise ValueError(f"heat_partition must be in [0, 1], got {eta}")
+        self.heat_partition = eta
+        if self.Gvt is not None:
+            self.Gvt = np.asarray(self.Gvt, dtype=float).reshape(self.G.shape[0], 2 * self.n)
+            self.Hmt = (
+                self.Gvt.copy()
+                if self.Hmt is None
+                else np.asarray(self.Hmt, dtype=float).reshape(self.Gvt.shape)
+            )
+            vc = np.zeros((self.n, 2)) if self.casing_velocity is None else self.casing_velocity
+            self.casing_velocity = np.broadcast_to(np.asarray(vc, dtype=float), (self.n, 2)).copy()
 
     @property
     def n(self) -> int:
@@ -133,16 +174,68 @@ class Contact:
     @property
     def has_heat(self) -> bool:
         a = self.heat_coefficient
+        if self.heat_law == "power":
+            return self.has_friction and bool(np.any(self.heat_partition > 0) and np.any(self.Ht))
         return callable(a) or bool(np.any(np.asarray(a) > 0) and np.any(self.Ht))
+
+    # -- friction --------------------------------------------------------------------------
+    @property
+    def has_friction(self) -> bool:
+        """Tangential forces exist (tangent rows and some μ > 0)."""
+        return self.Gvt is not None and bool(np.any(self.friction > 0.0))
+
+    @cached_property
+    def GvtT(self) -> np.ndarray:
+        """``Gvtᵀ`` (2 n_c, N), C-contiguous: the tangential velocity rows."""
+        return np.ascontiguousarray(self.Gvt.T)
+
+    def local(self, normal: np.ndarray, tangential: np.ndarray) -> np.ndarray:
+        """Interleave (N, n_c) normal and (N, 2 n_c) tangential columns contact-major:
+        (N, 3 n_c) with columns ``3 i + (n, t1, t2)`` (the layout of
+        :func:`~femrub.contact.friction.solve_frictional_contact`)."""
+        N = normal.shape[0]
+        out = np.empty((N, self.n, 3))
+        out[:, :, 0] = normal
+        out[:, :, 1:] = tangential.reshape(N, self.n, 2)
+        return out.reshape(N, 3 * self.n)
+
+    @cached_property
+    def H3(self) -> np.ndarray:
+        """Force columns of the local impulses ``(P_n, P_t1, P_t2)`` (N, 3 n_c)."""
+        return self.local(self.Hm, self.Hmt)
+
+    @cached_property
+    def V3T(self) -> np.ndarray:
+        """Local velocity rows ``(ġ, w_t + v_c)`` of the structure (3 n_c, N)."""
+        return np.ascontiguousarray(self.local(self.Gv, self.Gvt).T)
+
+    def slip_velocity(self, X: np.ndarray) -> np.ndarray:
+        """``w_t = Gvtᵀ X − v_c`` (m/s): (n_c, 2) for X (N,), (m, n_c, 2) for X (m, N)."""
+        if X.ndim == 1:
+            return (self.GvtT @ X).reshape(self.n, 2) - self.casing_velocity
+        return (X @ self.Gvt).reshape(X.shape[0], self.n, 2) - self.casing_velocity
+
+    def to_global(self, local: np.ndarray, part: str = "tangent") -> np.ndarray:
+        """Vectors given on the tangents ((…, n_c, 2)) in global axes ((…, n_c, 3))."""
+        F = self.frames
+        dim = F.shape[2]
+        out = np.einsum("...ij,ijd->...id", local, F[:, 1:3, :])
+        if dim < 3:
+            out = np.concatenate([out, np.zeros((*out.shape[:-1], 3 - dim))], axis=-1)
+        return out
 
     def project(self, left: np.ndarray, right: np.ndarray) -> Contact:
         """Contact of the model reduced by ``X = right X̄`` and left projection ``leftᵀ``."""
+        tang = {}
+        if self.Gvt is not None:
+            tang = {"Gvt": right.T @ self.Gvt, "Hmt": left.T @ self.Hmt}
         return replace(
             self,
             G=right.T @ self.G,
             Gv=right.T @ self.Gv,
             Hm=left.T @ self.Hm,
             Ht=left.T @ self.Ht,
+            **tang,
         )
 
 

@@ -37,6 +37,9 @@ class ContactPoints:
     heat : (n_c, n_t_all) sparse weights on the temperature dofs (rows sum to 1).
     vertices : (n_c,) the mesh vertex nearest to each point (where output draws its force).
     names : labels of the points.
+    tangents : (dim, 2, n_c) casing tangents at each point: the axial direction and the
+        circumferential one ``axis × n`` (the direction of rotation for Ω > 0); ``None`` on
+        the bar.
     """
 
     points: np.ndarray
@@ -47,6 +50,7 @@ class ContactPoints:
     heat: sp.csr_matrix
     vertices: np.ndarray
     names: tuple[str, ...]
+    tangents: np.ndarray | None = None
 
     @property
     def n(self) -> int:
@@ -65,6 +69,7 @@ class ContactPoints:
             heat=self.heat[idx],
             vertices=self.vertices[idx],
             names=tuple(self.names[i] for i in idx),
+            tangents=None if self.tangents is None else self.tangents[:, :, idx],
         )
 
     def normal_rows(self, mats) -> sp.csr_matrix:
@@ -73,6 +78,20 @@ class ContactPoints:
         cols = mats.u_index(self.u_dofs.T.ravel())
         rows = np.repeat(np.arange(nc), dim)
         return sp.csr_matrix((self.normals.T.ravel(), (rows, cols)), shape=(nc, mats.n_u))
+
+    def tangent_rows(self, mats) -> sp.csr_matrix:
+        """(2 n_c, n_u) rows ``t_ij · u(p_i)`` (row ``2 i + j``) on the free dofs."""
+        dim, nc = self.u_dofs.shape
+        cols = np.repeat(mats.u_index(self.u_dofs.T.ravel()).reshape(nc, 1, dim), 2, axis=1)
+        rows = np.repeat(np.arange(2 * nc), dim).reshape(nc, 2, dim)
+        vals = np.transpose(self.tangents, (2, 1, 0))  # (n_c, 2, dim)
+        return sp.csr_matrix((vals.ravel(), (rows.ravel(), cols.ravel())), shape=(2 * nc, mats.n_u))
+
+    def frames(self) -> np.ndarray:
+        """(n_c, 3, dim): unit normal, axial and circumferential tangents of each point."""
+        return np.concatenate(
+            [self.normals.T[:, None, :], np.transpose(self.tangents, (2, 1, 0))], 1
+        )
 
     def heat_rows(self, mats) -> sp.csr_matrix:
         """(n_c, n_θ) heat weights on the free temperature dofs."""
@@ -142,7 +161,13 @@ def locate_contacts(disc, points=None) -> ContactPoints:
         _, e1, e2 = _axis_frame(blade.axis)
         angles = np.arctan2(e2 @ pts, e1 @ pts)
     names = tuple(f"contact{i}" for i in range(pts.shape[1]))
-    return ContactPoints(pts, normals, radii, angles, u_dofs, heat, vertices, names)
+    tangents = None
+    if dim == 3:
+        a = np.asarray(blade.axis, dtype=float) / np.linalg.norm(blade.axis)
+        t1 = a[:, None] - (a @ normals) * normals
+        t1 /= np.linalg.norm(t1, axis=0)
+        tangents = np.stack([t1, np.cross(t1, normals, axis=0)], axis=1)
+    return ContactPoints(pts, normals, radii, angles, u_dofs, heat, vertices, names, tangents)
 
 
 def tributary_heat_weights(blade, pts, tol, vertices) -> sp.csr_matrix:

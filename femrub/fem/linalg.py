@@ -102,6 +102,8 @@ class _Pardiso:
         self.A, self.mtype, self._s = A, mtype, s
 
     def solve(self, rhs, trans: str = "N"):
+        if np.size(rhs) == 0:  # Pardiso rejects an empty right-hand side (error -1)
+            return np.zeros(np.shape(rhs))
         if trans != "N" and not self.symmetric:
             if self._AT is None:
                 self._AT = _Pardiso(self.A.T, False)

@@ -38,6 +38,11 @@ class ContactSpec:
     restitution : Newton's coefficient e in [0, 1].
     heat_coefficient : α (m/s) in ``f_tip = α λ``; scalar, (n_c,) or callable of t.
     gap_rate : ``dg/dt`` of a moving obstacle, callable ``t -> (n_c,)`` (m/s), or None.
+    tangents : (2 n_c, n_u) rows giving the displacement of contact i along its two tangents
+        (rows ``2 i``, ``2 i + 1``), or None (no tangential force).
+    friction : Coulomb μ per contact; casing_velocity : (n_c, 2) velocity of the casing
+        surface along the tangents (m/s); frames : (n_c, 3, dim) normal and tangents in
+        global axes; heat_law ``"alpha"`` or ``"power"``; heat_partition η.
     """
 
     normals: object
@@ -47,6 +52,12 @@ class ContactSpec:
     heat_coefficient: object = 0.0
     names: list | None = None
     gap_rate: object = None
+    tangents: object = None
+    friction: object = 0.0
+    casing_velocity: object = None
+    frames: object = None
+    heat_law: str = "alpha"
+    heat_partition: object = 1.0
 
 
 @dataclass
@@ -85,7 +96,13 @@ def first_order_model(
     heat_loads = [ld for ld in loads if ld.field == "theta"]
     has_coupling = mats.Kut.count_nonzero() > 0 or mats.Ctu.count_nonzero() > 0
     has_heat = contact is not None and (
-        callable(contact.heat_coefficient) or np.any(np.asarray(contact.heat_coefficient) > 0)
+        callable(contact.heat_coefficient)
+        or np.any(np.asarray(contact.heat_coefficient) > 0)
+        or (
+            contact.heat_law == "power"
+            and np.any(np.asarray(contact.friction) > 0)
+            and np.any(np.asarray(contact.heat_partition) > 0)
+        )
     )
     dropped = []
     if thermal == "auto":
@@ -143,6 +160,12 @@ def first_order_model(
         Gv = np.zeros((n, nc))
         Gv[L.v] = -N.T.toarray()
         boundary["u"] = np.unique(N.indices).astype(int)
+        Gvt = None
+        if contact.tangents is not None:
+            T = _rows(contact.tangents, nu)
+            Gvt = np.zeros((n, T.shape[0]))
+            Gvt[L.v] = T.T.toarray()
+            boundary["u"] = np.union1d(boundary["u"], T.indices).astype(int)
         Ht = np.zeros((n, nc))
         if nt and contact.heat_dofs is not None:
             hd = np.asarray(contact.heat_dofs)
@@ -161,6 +184,12 @@ def first_order_model(
             heat_coefficient=contact.heat_coefficient if nt else 0.0,
             names=list(contact.names or []),
             gap_rate=contact.gap_rate,
+            Gvt=Gvt,
+            friction=contact.friction,
+            casing_velocity=contact.casing_velocity,
+            frames=contact.frames,
+            heat_law=contact.heat_law,
+            heat_partition=contact.heat_partition,
         )
 
     observations = {}

@@ -90,6 +90,22 @@ def _observations(normal_rows, heat_rows) -> dict:
     return observe
 
 
+def _friction_spec(points: ContactPoints, mats, friction: float, rotation_speed: float) -> dict:
+    """Tangent rows, μ, casing surface velocity ``(0, −Ω r)`` and frames of the contacts."""
+    if not friction > 0.0:
+        return {}
+    if points.tangents is None:
+        raise ValueError("Coulomb friction needs a 3D blade (the bar has no tangent plane)")
+    vc = np.zeros((points.n, 2))
+    vc[:, 1] = -float(rotation_speed) * points.radii
+    return {
+        "tangents": points.tangent_rows(mats),
+        "friction": float(friction),
+        "casing_velocity": vc,
+        "frames": points.frames(),
+    }
+
+
 def rub_model(
     disc: Discretisation,
     mats,
@@ -104,6 +120,9 @@ def rub_model(
     loads=(),
     thermal: str | bool = "auto",
     observe_at: ContactPoints | None = None,
+    friction: float = 0.0,
+    heat_law: str = "alpha",
+    heat_partition: float = 1.0,
 ) -> tuple[FirstOrderModel, FieldMap]:
     """First-order model of ``disc`` rubbing ``casing`` at ``points`` (module docstring).
 
@@ -117,6 +136,11 @@ def rub_model(
         ``True`` or ``False``.
     observe_at : points whose signals are observed (default ``points``; with no contact in
         reach, the candidate points still show the tip's response).
+    friction : Coulomb μ. With μ > 0 on a 3D blade each contact gets the axial and
+        circumferential tangents of ``points``, and the casing surface slides past it at
+        ``−Ω r_i`` along the circumferential one (the blade frame turns at Ω).
+    heat_law : ``"alpha"`` (heat ``α_i λ_i``) or ``"power"`` (heat ``η`` × friction power,
+        ``η = heat_partition``).
     """
     N, Q = points.normal_rows(mats), points.heat_rows(mats)
     if observe_at is None or observe_at is points:
@@ -135,6 +159,9 @@ def rub_model(
             restitution=restitution,
             heat_coefficient=np.broadcast_to(np.asarray(alpha, dtype=float), (points.n,)).copy(),
             names=list(points.names),
+            heat_law=heat_law,
+            heat_partition=heat_partition,
+            **_friction_spec(points, mats, friction, rotation_speed),
         )
     )
     model = first_order_model(mats, contact=spec, loads=loads, observe=observe, thermal=thermal)

@@ -15,6 +15,15 @@ energy is created at impacts (with Newton's law and e <= 1 the impulse satisfies
 ``P (ġ_{k+1} + e ġ_k) = 0``, hence ``ΔW_c = −P ġ_k (1 − e) / 2 <= 0`` for a fixed casing;
 a moving casing, ``ġ = ġ0(t) + Gvᵀ X``, can also do work on the structure). The frictional
 heat of a step is ``Σ_i α_i(t_{k+1}) P_i``.
+
+With Coulomb friction the tangential impulses ``P_t`` add their work ``P_t · Gvtᵀ X_m`` to
+``ΔW_c``; it splits exactly into the work of the moving casing surface and the friction
+dissipation::
+
+    ΔW_c,t = ΔW_casing − ΔW_friction,   ΔW_casing = P_t · v_c,   ΔW_friction = −P_t · w_t,m
+
+(``w_t,m = Gvtᵀ X_m − v_c``, the mid-step slip velocity). ``friction_heat`` is then the heat
+the stepper put into the blade and ``heat_to_casing = friction_work − friction_heat``.
 """
 
 from __future__ import annotations
@@ -79,11 +88,12 @@ class EnergyMeter:
         self._Q0 = d["heat_content"][0]
         self.scale, self.heat_scale = abs(self._E0), abs(self._Q0)
 
-    def update(self, i0, X, impulse, t, h, work=None) -> None:
+    def update(self, i0, X, impulse, t, h, work=None, friction=None) -> None:
         """Fill rows ``i0 + 1 .. i0 + m`` from a block of states (see class docstring).
 
         ``work`` (m,): the contact work of each step as the scheme computed it (impulses
         given inside the step, e.g. the exponential stepper); default ``Pᵀ Gvᵀ X_m``.
+        ``friction``: ``(P_t (m, n_c, 2), blade heat (m, n_c))`` of the steps, or ``None``.
         """
         f, d = self.forms, self.data
         m = X.shape[0] - 1
@@ -109,6 +119,18 @@ class EnergyMeter:
             inc["impact_dissipation"] = -dwc
             alpha = np.broadcast_to(c.alpha_at(t[1:]), impulse.shape)
             inc["friction_heat"] = np.einsum("ij,ij->i", alpha, impulse)
+            if friction is not None:
+                Pt, heat = friction
+                if Pt.shape[1]:
+                    vt = (Xm @ c.Gvt).reshape(Pt.shape)
+                    wt = np.einsum("kij,kij->k", Pt, vt)
+                    inc["contact_work"] = dwc + wt
+                    inc["casing_work"] = np.einsum("kij,ij->k", Pt, c.casing_velocity)
+                    inc["friction_work"] = inc["casing_work"] - wt
+                    inc["impact_dissipation"] = -dwc
+                inc["friction_heat"] = heat.sum(axis=1)
+                if c.heat_law == "power":
+                    inc["heat_to_casing"] = inc.get("friction_work", 0.0) - inc["friction_heat"]
         inc["heat_outflow"] = h * (Xm @ f.heat_outflow)
         for k, v in inc.items():
             d[k][rows] = d[k][i0] + np.cumsum(v)

@@ -4,6 +4,9 @@ For the rows ``k = 0 .. n`` of a run of ``n`` steps of size ``h`` the recorder k
 
     t_k,   s_k = O X_k (observations),   g_k = g0(t_k) + Gᵀ X_k,   P_k (impulse of step k)
 
+and, with friction, the tangential impulses, the blade's heat and the contact state of each
+step (the stepper's ``extra``) and the slip velocity ``w_t = Gvtᵀ X_k − v_c``
+
 and the energy balance of :class:`~femrub.output.energy.EnergyMeter`. States are buffered
 in chunks and post-processed with row-wise products. A chunk is checked before anything
 leaves it: a non-finite state or energy created from nothing ends the run with status
@@ -51,6 +54,7 @@ class State:
     impulse: np.ndarray
     gap: np.ndarray
     gap_velocity: np.ndarray
+    friction_impulse: np.ndarray | None = None
 
 
 class _Stop(Exception):
@@ -113,6 +117,13 @@ class Recorder:
         self._O = compact(sp.vstack(obs)) if obs else None
         self.obs = np.zeros((n + 1, sum(self.sizes)))
         self.t, self.gap, self.imp = np.zeros(n + 1), np.zeros((n + 1, nc)), np.zeros((n + 1, nc))
+        c = model.contact
+        self.tangents = c is not None and c.Gvt is not None
+        nf = nc if self.tangents else 0
+        self.imp_t, self.slip = np.zeros((n + 1, nf, 2)), np.zeros((n + 1, nf, 2))
+        self.heat = np.zeros((n + 1, nc))
+        self.cstate = np.zeros((n + 1, nc), dtype=np.int8)
+        self.has_friction = False
         self.meter = EnergyMeter(model, n + 1) if (energy and model.energy is not None) else None
         self.limits = dict(limits or {})
         self._lim_idx = _limit_index(self.limits, self.names, self.sizes)
@@ -130,10 +141,12 @@ class Recorder:
 
     # -- the run ---------------------------------------------------------------------------
     def record(self, start: State, advance: Callable, *, progress: bool = False) -> Results:
-        """Record ``start`` and ``n_steps`` calls of ``advance() -> (t, X, impulse)``.
+        """Record ``start`` and ``n_steps`` calls of ``advance() -> (t, X, impulse, extra)``.
 
-        ``advance`` may return a fourth value, the contact work of the step (J) as the scheme
-        computed it (impulses inside the step); the energy balance then uses it.
+        ``extra`` (a dict or ``None``) may hold the step's friction quantities
+        (``friction_impulse``, ``heat``, ``state``: see ``Stepper._step``) and
+        ``contact_work``, the contact work of the step (J) as the scheme computed it
+        (impulses inside the step); the energy balance then uses it.
         """
         n, buf, t, imp = self.n, self.buf, self.t, self.imp
         nc = self.model.n_contacts
@@ -153,7 +166,7 @@ class Recorder:
                 self._start(start)
                 for i in range(1, n + 1):
                     try:
-                        ti, X, P, *work = advance()
+                        ti, X, P, *more = advance()
                     except (FloatingPointError, ArithmeticError) as exc:
                         i_end = self._flush(i0, j)
                         raise _Stop("unstable", f"{type(exc).__name__}: {exc}", i_end) from None
@@ -161,8 +174,12 @@ class Recorder:
                     buf[j], t[i] = X, ti
                     if nc:
                         imp[i] = P
-                    if work:  # the scheme's own contact work of the step
-                        self._work_rows()[i] = work[0]
+                    info = more[0] if more else None
+                    if info:
+                        if "contact_work" in info:  # the scheme's own contact work
+                            self._work_rows()[i] = info["contact_work"]
+                        if "state" in info:
+                            self._friction_rows(i, info)
                     if j == self.chunk or i == n:
                         i_end = self._flush(i0, j)
                         self._deliver(i0, i_end)
@@ -197,11 +214,21 @@ class Recorder:
             self._work = np.zeros(self.n + 1)
         return self._work
 
+    def _friction_rows(self, i: int, extra: dict) -> None:
+        """Friction quantities of step ``i`` (see :meth:`Stepper._step`)."""
+        self.has_friction = True
+        if self.tangents:
+            self.imp_t[i] = extra["friction_impulse"]
+        self.heat[i] = extra["heat"]
+        self.cstate[i] = extra["state"]
+
     def _start(self, s: State) -> None:
         """Row 0: the initial state."""
         self.t[0], self.buf[0] = s.t, s.X
         if self.model.n_contacts:
             self.gap[0], self.imp[0] = s.gap, s.impulse
+            if self.tangents:
+                self.slip[0] = self.model.contact.slip_velocity(s.X)
         if self._O is not None:
             self.obs[0] = self._O @ s.X
         if self.meter is not None:
@@ -244,10 +271,13 @@ class Recorder:
             self.obs[rows] = X[1:] @ O.T if isinstance(O, np.ndarray) else (O @ X[1:].T).T
         if c is not None:
             self.gap[rows] = c.gap(t[rows], X[1:])
+            if self.tangents:
+                self.slip[rows] = c.slip_velocity(X[1:])
         if self.meter is not None and m:
+            friction = (self.imp_t[rows], self.heat[rows]) if self.has_friction else None
             with np.errstate(all="ignore"):
                 work = None if self._work is None else self._work[rows]
-                self.meter.update(i0, X, self.imp[rows], t[i0 : rows.stop], h, work)
+                self.meter.update(i0, X, self.imp[rows], t[i0 : rows.stop], h, work, friction)
             bad = self.meter.blown_up(rows) if self.blowup_check else None
             if bad is not None:
                 raise _Stop("unstable", f"energy created from nothing at t = {t[bad]:.6g} s", bad)
@@ -274,7 +304,8 @@ class Recorder:
         X = self.buf[1 : last - i0 + 1]
         gdot = np.zeros((X.shape[0], 0)) if c is None else c.gap_velocity(self.t[rows], X)
         for k, r in enumerate(range(rows.start, rows.stop)):
-            self.on_state(State(r, self.t[r], X[k], self.imp[r], self.gap[r], gdot[k]))
+            fi = self.imp_t[r] if self.tangents else None
+            self.on_state(State(r, self.t[r], X[k], self.imp[r], self.gap[r], gdot[k], fi))
 
     # -- the collected results -------------------------------------------------------------
     def per_step(self, rows: slice) -> dict[str, np.ndarray]:
@@ -306,6 +337,14 @@ class Recorder:
             if keep.any():
                 states = np.concatenate(self._stored)[keep]
                 times = self.t[rows[keep]]
+        c, nc = self.model.contact, self.model.n_contacts
+        if not self.has_friction:  # frictionless stepper: open or (frictionless) sliding
+            self.cstate[:m] = np.where(self.imp[:m] > 0.0, 2, 0)
+        ff = np.zeros((m, nc, 3))
+        sv = np.zeros((m, nc, 3))
+        if self.tangents and c.frames is not None:
+            ff = c.to_global(self.imp_t[:m] / self.h)
+            sv = c.to_global(self.slip[:m])
         return Results(
             scheme=self.scheme,
             h=self.h,
@@ -320,6 +359,10 @@ class Recorder:
             cpu_seconds=cpu_seconds,
             states=states,
             state_times=times,
+            friction_force=ff,
+            slip_velocity=sv,
+            contact_state=self.cstate[:m].copy(),
+            friction_limit=None if c is None else c.friction.copy(),
             info={"label": self.label, "stability_limit": self.h_lim, "n_dofs": self.model.n_dofs},
             extra={k: v[:m].copy() for k, v in self.extra.items()},
         )

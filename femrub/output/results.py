@@ -8,7 +8,10 @@ Energy columns (J), cumulative from ``t = 0``:
 ``thermal_work`` (work of the thermal stresses on the structure), ``damping_work`` (<= 0),
 ``contact_work`` (<= 0 when no energy is created at contacts; ``impact_dissipation`` is its
 opposite), ``heat_content`` (J above ambient), ``friction_heat`` (Σ α × impulse),
-``heat_load``, ``heat_outflow`` (through the boundaries), and the balance residuals
+``heat_load``, ``heat_outflow`` (through the boundaries), with Coulomb friction
+``friction_work`` (friction dissipation, >= 0), ``casing_work`` (work of the moving casing
+through friction; ``contact_work`` = normal work + ``casing_work`` − ``friction_work``) and
+``heat_to_casing`` (the friction power not put into the blade), and the balance residuals
 ``energy_error = E − E0 − (external + thermal + damping + contact work)`` and
 ``heat_error = Q − Q0 − (friction_heat + heat_load − heat_outflow)``.
 
@@ -51,6 +54,9 @@ ENERGY_KEYS = (
     "friction_heat",
     "heat_load",
     "heat_outflow",
+    "friction_work",
+    "casing_work",
+    "heat_to_casing",
     "energy_error",
     "heat_error",
 )
@@ -76,6 +82,10 @@ UNITS = {
     "state_times": "s",
     **{k: "J" for k in ENERGY_KEYS},
 }
+
+
+#: the per-contact friction arrays of ``history.npz`` (friction_limit: μ per contact)
+_FRICTION_ARRAYS = ("friction_force", "slip_velocity", "contact_state", "friction_limit")
 
 
 def unit_of(name: str) -> str:
@@ -139,6 +149,10 @@ class Results:
     cpu_seconds: float = 0.0
     states: np.ndarray | None = None
     state_times: np.ndarray | None = None
+    friction_force: np.ndarray | None = None
+    slip_velocity: np.ndarray | None = None
+    contact_state: np.ndarray | None = None
+    friction_limit: np.ndarray | None = None
     info: dict = field(default_factory=dict)
     extra: dict[str, np.ndarray] = field(default_factory=dict)
     warnings: list[str] = field(default_factory=list)
@@ -209,6 +223,7 @@ class Results:
         """SI unit of every ``history.npz`` array, by key."""
         names = ["t", "gap", "impulse", "normal_force", *[f"signal_{k}" for k in self.signals]]
         names += list(self.extra)
+        names += [k for k in _FRICTION_ARRAYS if getattr(self, k) is not None]
         names += [f"energy_{k}" for k in self.energy]
         return {k: unit_of(k) for k in names}
 
@@ -258,6 +273,9 @@ class Results:
         arrays.update({f"energy_{k}": v for k, v in self.energy.items()})
         if self.states is not None:
             arrays["states"], arrays["state_times"] = self.states, self.state_times
+        for k in _FRICTION_ARRAYS:
+            if getattr(self, k) is not None:
+                arrays[k] = getattr(self, k)
         tmp = path.with_name(path.name + ".tmp.npz")
         np.savez_compressed(
             tmp,
@@ -280,10 +298,13 @@ class Results:
             states = d["states"] if "states" in d.files else None
             stimes = d["state_times"] if "state_times" in d.files else None
             known = {"t", "gap", "impulse", "normal_force", "meta", "states", "state_times"}
+            friction = {k: d[k] for k in _FRICTION_ARRAYS if k in d.files}
             extra = {
                 k: d[k]
                 for k in d.files
-                if k not in known and not k.startswith(("signal_", "energy_"))
+                if k not in known
+                and k not in _FRICTION_ARRAYS
+                and not k.startswith(("signal_", "energy_"))
             }
             return cls(
                 scheme=meta["scheme"],
@@ -302,6 +323,7 @@ class Results:
                 info=meta.get("info", {}),
                 extra=extra,
                 warnings=meta.get("warnings", []),
+                **friction,
             )
 
 

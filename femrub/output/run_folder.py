@@ -52,6 +52,29 @@ def _max_or_none(arr) -> float | None:
     return float(np.max(arr)) if arr is not None and np.size(arr) else None
 
 
+def _friction_summary(res) -> dict:
+    """``max_friction_force`` (N), ``friction_work``, ``heat_to_blade``, ``heat_to_casing`` (J)
+    and the Coulomb check of every recorded step (:func:`femrub.contact.friction.coulomb_check`).
+    """
+    e = res.energy
+    ff = res.friction_force
+    out = {
+        "max_friction_force": float(np.linalg.norm(ff, axis=-1).max())
+        if ff is not None and ff.size
+        else 0.0,
+        "friction_work": float(e["friction_work"][-1]) if "friction_work" in e else 0.0,
+        "heat_to_blade": float(e["friction_heat"][-1]) if "friction_heat" in e else 0.0,
+        "heat_to_casing": float(e["heat_to_casing"][-1]) if "heat_to_casing" in e else 0.0,
+    }
+    if ff is not None and ff.size and res.friction_limit is not None:
+        from ..contact.friction import coulomb_check
+
+        out["coulomb_check"] = coulomb_check(
+            res.force, ff, res.slip_velocity, res.contact_state, res.friction_limit
+        )
+    return out
+
+
 def run_to_folder(
     stepper,
     t_end: float,
@@ -165,6 +188,13 @@ def _finish(
             ),
             out / "signals.png",
         )
+    if plots and rotation_speed and res.impulse.shape[1] and res.steps > 1:
+        from .rub_plots import contact_force_panel, response_panels, spectrum_panel
+
+        omega_ = float(rotation_speed)
+        savefig(response_panels(res, omega_), out / "response.png")
+        savefig(spectrum_panel(res, omega_), out / "spectrum.png")
+        savefig(contact_force_panel(res, omega_), out / "contact_forces.png")
     if series is not None and series.frames and snapshot and plots:
         from .vtk import snapshot_png
 
@@ -205,6 +235,7 @@ def _finish(
         vtk=str(series.pvd_path.relative_to(out)) if series is not None else None,
         vtk_frames=len(series.frames) if series is not None else 0,
     )
+    doc.update(_friction_summary(res))
     for name, arr in res.signals.items():
         doc.setdefault("signals_max_abs", {})[name] = float(np.abs(arr).max()) if arr.size else 0.0
     _write_json(summary_path, doc)

@@ -10,7 +10,10 @@ The recorder ends a run as ``unstable`` (blow-up), ``diverged-physically`` (a st
 * ``heat_balance``: the same for the heat balance and ``tolerances["heat"]``;
 * ``reduction``: the a-posteriori estimate of a reduced run, ``tolerances["reduction"]``
   (the dict of :func:`femrub.reduction.estimate.estimate` with its ``tolerance``, as
-  ``summary.json["reduction_error"]``), above its tolerance -> ``"inaccurate"``.
+  ``summary.json["reduction_error"]``), above its tolerance -> ``"inaccurate"``;
+* ``coulomb``: the recorded friction forces break Coulomb's law (outside the cone, not on it
+  while sliding, or not opposite to the slip velocity) beyond ``tolerances["coulomb"]``
+  (relative, :func:`femrub.contact.friction.coulomb_check`) -> ``"inaccurate"``.
 
 * ``resolution``: contact episodes (impulses less than ``merge_time`` apart form one
   episode) resolved by fewer than :data:`UNRESOLVED_STEPS` steps (median over the
@@ -41,13 +44,14 @@ __all__ = [
     "STATUSES",
     "TOLERANCES",
     "assess",
+    "coulomb_message",
     "resolution_warning",
 ]
 
 #: every status a run can end with
 STATUSES = ("ok", "inaccurate", "unstable", "diverged-physically", "interrupted", "failed")
 #: default tolerances of the balance residuals (relative to the run's energy / heat scale)
-TOLERANCES = {"energy": 0.05, "heat": 0.05}
+TOLERANCES = {"energy": 0.05, "heat": 0.05, "coulomb": 1e-8}
 #: fewest steps per contact episode (median) before a resolution warning
 MIN_CONTACT_STEPS = 20
 #: fewer steps per contact episode (median) than this make a run ``inaccurate``
@@ -84,7 +88,30 @@ def reduction(res, tol):
 
 
 #: status rules applied in order to a run the recorder ended as ``ok``
-RULES = [_balance("energy"), _balance("heat"), reduction]
+def coulomb_message(check: dict | None, bound: float) -> str | None:
+    """Why a :func:`~femrub.contact.friction.coulomb_check` fails at ``bound``, or ``None``."""
+    if not check:
+        return None
+    worst = max(check["cone"], check["slip_equality"], check["direction"])
+    if worst <= bound and check["force_without_normal"] == 0.0:
+        return None
+    return (
+        f"Coulomb law violated beyond {bound:g} (cone {check['cone']:.2g}, sliding "
+        f"{check['slip_equality']:.2g}, direction {check['direction']:.2g})"
+    )
+
+
+def _coulomb(res, tol):
+    ff, bound = getattr(res, "friction_force", None), tol.get("coulomb")
+    if ff is None or not ff.size or res.friction_limit is None or bound is None:
+        return None
+    from ..contact.friction import coulomb_check
+
+    check = coulomb_check(res.force, ff, res.slip_velocity, res.contact_state, res.friction_limit)
+    return coulomb_message(check, bound)
+
+
+RULES = [_balance("energy"), _balance("heat"), reduction, _coulomb]
 
 
 def _episodes(res, merge_time: float) -> list[int]:

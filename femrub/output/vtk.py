@@ -133,6 +133,13 @@ class VTKSeries:
             lam = state.impulse / self.h
             np.add.at(force, self._contact_vertex, -(lam * self._normals).T)
         point_data["contact_force"] = force
+        friction = np.zeros_like(self._points)
+        c = self.model.contact
+        fi = getattr(state, "friction_impulse", None)
+        if fi is not None and c is not None and c.frames is not None and fi.size:
+            f = c.to_global(fi / self.h)[:, : self._points.shape[1]]
+            np.add.at(friction, self._contact_vertex, f)
+        point_data["friction_force"] = friction
         cell_data = {"von_mises": [von_mises(self.fields, u)]}
         fname = f"{self.name}_{len(self.frames):06d}.vtu"
         tmp = self.dir / f"{fname}.tmp"

@@ -151,7 +151,14 @@ CONTACT = {
     "casing": CASING,
     "restitution": _f(0.0, "none", "Newton's restitution coefficient e", lo=0.0, hi=1.0),
     "friction": _f(
-        0.0, "none", "3D: Coulomb coefficient; heat input = heat_partition friction Ω r λ", **NONNEG
+        0.0, "none", "3D: Coulomb coefficient μ (tangential force |λ_t| <= μ λ)", **NONNEG
+    ),
+    "heat_law": Spec(
+        C,
+        "auto",
+        choices=("auto", "alpha", "power"),
+        doc="frictional heat: 'alpha' (heat_partition α λ), 'power' (heat_partition × friction "
+        "power |λ_t · v_slip|); 'auto': alpha on the bar, power on a blade",
     ),
     "heat_coefficient": _f(
         0.0, "velocity", "bar: α of the heat input heat_partition α λ", **NONNEG

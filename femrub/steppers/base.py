@@ -65,6 +65,7 @@ class Stepper:
         self.X = model.x0.copy()
         nc = model.n_contacts
         self.impulse = np.zeros(nc)
+        self.extra = None
         self._h_lim = None
         self._check_initial_gap()
         self._setup()
@@ -97,8 +98,10 @@ class Stepper:
     def _setup(self) -> None:
         """Factorise constant matrices, precompute operators."""
 
-    def _step(self) -> tuple[np.ndarray, np.ndarray]:
-        """Advance from ``(self.t, self.X)`` by ``h``; return ``(X_new, impulse)``."""
+    def _step(self) -> tuple:
+        """Advance from ``(self.t, self.X)`` by ``h``; return ``(X_new, impulse)`` or, with
+        friction, ``(X_new, impulse, extra)``: ``extra`` holds ``friction_impulse``
+        (n_c, 2), the blade's ``heat`` (n_c,) (J) and the contact ``state`` (n_c,) of the step."""
         raise NotImplementedError
 
     def _stability_limit(self) -> float:
@@ -119,13 +122,15 @@ class Stepper:
             return State(self.k, t, X, self.impulse, np.zeros(0), np.zeros(0))
         return State(self.k, t, X, self.impulse, c.gap(t, X), c.gap_velocity(t, X))
 
-    def _advance(self) -> tuple[float, np.ndarray, np.ndarray]:
-        """One step; return the new ``(t, X, impulse)``."""
-        X, impulse = self._step()
+    def _advance(self) -> tuple:
+        """One step; return the new ``(t, X, impulse, extra)`` (``extra``: see ``_step``)."""
+        out = self._step()
+        X, impulse = out[0], out[1]
+        self.extra = out[2] if len(out) > 2 else None
         self.k += 1
         self.t = self.t0 + self.k * self.h
         self.X, self.impulse = X, impulse
-        return self.t, X, impulse
+        return self.t, X, impulse, self.extra
 
     def step(self) -> State:
         """Advance one step of size ``h`` and return the new :class:`State`."""

@@ -17,6 +17,13 @@ impulse makes the gap exactly zero (projection), an LCP ``0 <= P ⊥ g_p + W_c P
 (``W_c = Gᵀ ∂X/∂P``, the ``G A⁻¹ Gᵀ`` of the model notes). The heat input ``α P`` enters the
 same step.
 
+With Coulomb friction the impulses are ``(P_n, P_t1, P_t2)`` per contact and
+:func:`femrub.contact.friction.solve_frictional_contact` solves the same projection with the
+Coulomb cone: the normal rows act on the predicted gap (``W_c``), the tangential rows on the
+slip velocity ``Gvtᵀ X − v_c`` of ``v_{n+1/2}`` (``Gvtᵀ ∂X/∂P``). With the ``"power"`` heat
+law the blade receives ``η (−P_t · w_t,m)`` after the contact solve (explicitly: unlike the
+θ-method, not iterated with the contact solve).
+
 The scheme is conditionally stable: ``h < 2 / ω_max`` for the mechanical part and
 ``h < 2 / μ_max`` for the explicit heat equation; :meth:`Carpenter.stability_limit` computes
 both from sparse eigen-solvers, once per stepper, and ``run()`` reports
@@ -34,6 +41,7 @@ import math
 import numpy as np
 import scipy.sparse as sp
 
+from ..contact.friction import solve_frictional_contact
 from ..contact.impulses import solve_impulses
 from ..fem.eigen import largest_modulus
 from ..fem.linalg import Factorised
@@ -63,10 +71,18 @@ class Carpenter(Stepper):
         self.X = X.copy()
         self.X[L.v] = self._vh
         c = m.contact
+        self._friction = False
         if c is not None:
             self._Cm = self._impulse_map(c.Hm)
             self._Ct = self._impulse_map(c.Ht)
             self._Wm, self._Wt = c.GT @ self._Cm, c.GT @ self._Ct
+            self._friction = c.has_friction
+            if self._friction:  # normal rows on the gap, tangential rows on the slip velocity
+                self._C3 = self._impulse_map(c.H3)
+                rows = c.V3T.copy()
+                rows[::3] = c.GT
+                self._R3 = rows
+                self._W3, self._W3t = rows @ self._C3, rows @ self._Ct
 
     def _solve(self, rhs):
         if self._diagA is not None:
@@ -101,6 +117,8 @@ class Carpenter(Stepper):
         Xp[L.v] = vh
         c = m.contact
         P = np.zeros(m.n_contacts)
+        if c is not None and self._friction:
+            return self._contact_friction(X, Xp)
         if c is not None:
             t1 = self.t + h
             alpha = c.alpha_at(t1)
@@ -112,6 +130,29 @@ class Carpenter(Stepper):
         self._vh = Xp[L.v].copy()
         self._a = self._deriv(Xp, m.load(self.t + h))
         return Xp, P
+
+    def _contact_friction(self, X, Xp):
+        """Signorini–Coulomb projection of the step (module docstring)."""
+        c, L, m = self.model.contact, self.model.layout, self.model
+        t1 = self.t + self.h
+        alpha = c.alpha_at(t1) if c.heat_law == "alpha" else np.zeros(c.n)
+        C3, W3 = self._C3, self._W3
+        if np.any(alpha):
+            C3, W3 = C3.copy(), W3.copy()
+            C3[:, ::3] += self._Ct * alpha
+            W3[:, ::3] += self._W3t * alpha
+        q = np.column_stack([c.gap(t1, Xp), c.slip_velocity(Xp)])
+        res = solve_frictional_contact(W3, q, c.friction, np.ones(c.n, dtype=bool))
+        P = res.P
+        Xn = Xp + C3 @ P.reshape(-1)
+        heat = alpha * P[:, 0]
+        if c.heat_law == "power" and L.n_t:
+            w_mid = 0.5 * (c.slip_velocity(X) + c.slip_velocity(Xn))
+            heat = c.heat_partition * -np.einsum("ij,ij->i", P[:, 1:], w_mid)
+            Xn = Xn + self._Ct @ heat
+        self._vh = Xn[L.v].copy()
+        self._a = self._deriv(Xn, m.load(t1))
+        return Xn, P[:, 0].copy(), {"friction_impulse": P[:, 1:], "heat": heat, "state": res.state}
 
     def _stability_limit(self) -> float:
         """Largest stable step (s): ``min(2 / ω_max, 2 / μ_max)`` of the explicit parts."""

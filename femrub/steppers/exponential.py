@@ -95,6 +95,12 @@ class ExponentialMoreau(Stepper):
                 f"(> {MAX_COORDINATES}); reduce it first (scene: reduction.method = "
                 "'craig-bampton'; API: ThermoelasticCraigBampton(model, ...).reduce())"
             )
+        c = getattr(model, "contact", None)
+        if c is not None and c.has_friction:
+            raise ValueError(
+                "the exponential stepper has no Coulomb friction yet; use scheme.name = "
+                "'theta' or 'carpenter', or contact.friction = 0"
+            )
         if not isinstance(events, bool):
             raise ValueError(f"events must be true or false, got {events!r}")
         if probes is not None and not (isinstance(probes, int) and 1 <= probes <= MAX_PROBES):
@@ -186,8 +192,8 @@ class ExponentialMoreau(Stepper):
 
     # -- one step ------------------------------------------------------------------------------
     def _advance(self):
-        t, X, P = super()._advance()
-        return t, X, P, self._work
+        t, X, P, extra = super()._advance()
+        return t, X, P, {**(extra or {}), "contact_work": self._work}
 
     def _step(self):
         h, t, c = self.h, self.t, self.model.contact

@@ -78,6 +78,11 @@ class Penalty(Stepper):
     def _setup(self):
         m = self.model
         self._refuse_restitution()
+        if m.contact is not None and m.contact.has_friction:
+            raise ValueError(
+                "the penalty baseline has no Coulomb friction; use scheme.name = 'theta' or "
+                "'carpenter', or contact.friction = 0"
+            )
         self._lu = Factorised(m.A, what="matrix A")
         self._B = compact(m.B)
         self._AinvB = self._lu.solve(m.B.toarray()) if self._lu.dense else None

@@ -22,6 +22,18 @@ pushes at an open gap and never creates energy.
 
 The heat input ``α P`` enters the same step as the impulse. Penetration is not prevented at
 the position level; it stays below ``h |ġ|`` (paper Sec. 4.3).
+
+**Coulomb friction** (a contact with tangents and ``μ > 0``): the impulse of a contact is
+``(P_n, P_t1, P_t2)``, ``X_{k+1} = X_p + Z₃ P`` with ``Z₃ = D⁻¹ [Hm, Hmt]``, and the local
+velocities ``(ġ_{k+1}, w_{t,k+1})`` (gap velocity, slip velocity relative to the casing
+surface) are affine in ``P`` through the Delassus operator ``W₃ = [Gv, Gvt]ᵀ Z₃``. Each step
+solves Signorini–Coulomb with Newton's law exactly
+(:func:`femrub.contact.friction.solve_frictional_contact`) inside the same activation rule.
+With the ``"power"`` heat law the blade then receives ``η (−P_t · w_t,m)`` per contact, with
+``w_t,m`` the slip velocity at the mid-step state (the value the energy balance uses), as a
+heat input of the same step; its effect on the step's velocities through the thermal
+coupling is fed back into the contact solve by a fixed point (contact solve, heat, contact
+solve with the heat's velocity shift ``W_θ Q``, ...) until the heat repeats to 1e-12.
 """
 
 from __future__ import annotations
@@ -29,13 +41,23 @@ from __future__ import annotations
 import numpy as np
 import scipy.sparse as sp
 
-from ..contact.activation import DEFAULT_RULE, RULES, check_rule, impulse_one, impulses
+from ..contact.activation import (
+    DEFAULT_RULE,
+    RULES,
+    check_rule,
+    frictional_fixed_point,
+    impulse_one,
+    impulses,
+)
+from ..contact.friction import solve_frictional_contact
 from ..fem.linalg import Factorised, compact
 from .base import Stepper
 
 __all__ = ["ThetaMethod", "ACTIVATION_RULES"]
 
 ACTIVATION_RULES = RULES
+#: fixed-point iterations between the contact solve and the frictional heat of a step
+MAX_HEAT_ITERATIONS = 20
 
 
 class ThetaMethod(Stepper):
@@ -112,6 +134,7 @@ class ThetaMethod(Stepper):
                 and not callable(c.gap0)
                 and not callable(c.heat_coefficient)
                 and c.gap_rate is None
+                and not c.has_friction
             ):
                 a = c.heat_coefficient
                 self._fast = True
@@ -123,6 +146,14 @@ class ThetaMethod(Stepper):
                 if self._w <= 0.0 or self._gz <= 0.0:
                     raise ValueError("non-positive Delassus operator at the contact")
         self._warm = None
+        self._friction = c is not None and c.has_friction
+        if self._friction:
+            self._Z3 = self._lu.solve(c.H3)
+            self._W3 = c.V3T @ self._Z3
+            self._W3t = c.V3T @ self._Zt  # heat columns seen by the local velocities
+            self._GZ3 = c.GT @ self._Z3
+            self._GZt = c.GT @ self._Zt
+            self._warm3 = None
 
     def _signal_values(self, t):
         return np.array([float(sig(t)) for sig in self._signals])
@@ -163,6 +194,8 @@ class ThetaMethod(Stepper):
         c = m.contact
         if c is None:
             return Xp, np.zeros(0)
+        if self._friction:
+            return self._step_friction(Xk, Xp, t1)
         alpha = c.alpha_at(t1)
         Z = self._Zm + self._Zt * alpha
         W = self._Wm + self._Wt * alpha
@@ -181,3 +214,50 @@ class ThetaMethod(Stepper):
         )
         self._warm = P > 0.0
         return Xp + Z @ P, P
+
+    def _step_friction(self, Xk, Xp, t1):
+        """Signorini–Coulomb step (active set: ``contact.activation.frictional_fixed_point``)."""
+        c, h = self.model.contact, self.h
+        n = c.n
+        alpha = c.alpha_at(t1) if c.heat_law == "alpha" else np.zeros(n)
+        Z, W, GZ = self._Z3, self._W3, self._GZ3
+        if np.any(alpha):  # α λ heat enters with the normal impulse
+            Z, W, GZ = Z.copy(), W.copy(), GZ.copy()
+            Z[:, ::3] += self._Zt * alpha
+            W[:, ::3] += self._W3t * alpha
+            GZ[:, ::3] += self._GZt * alpha
+        gdot_k = c.gap_velocity(self.t, Xk)
+        q = np.column_stack([c.gap_velocity(t1, Xp), c.slip_velocity(Xp)])
+        e = np.where(gdot_k > 0.0, 1.0, c.restitution)
+        gap_k = c.gap(self.t, Xk)
+
+        def solve(active, shift=0.0):
+            return solve_frictional_contact(
+                W, q + shift, c.friction, active, restitution=e, u_before=gdot_k,
+                warm=self._warm3,
+            )  # fmt: skip
+
+        active, res = frictional_fixed_point(
+            self.activation, gap_k, gdot_k, c.gap(t1, Xp), GZ, solve, h, self.gamma
+        )
+        heat = alpha * res.P[:, 0]  # the α λ heat is already in Z's normal columns
+        power = c.heat_law == "power" and self.model.layout.n_t > 0
+        if power:
+            # the heat η (−P_t · w_t,mid) moves the step's velocities through the thermal
+            # coupling: fixed point on it, so the final state meets Coulomb's law
+            w_k = c.slip_velocity(Xk)
+            heat = np.zeros(n)
+            for _ in range(MAX_HEAT_ITERATIONS):
+                w_mid = 0.5 * (w_k + res.u[:, 1:])
+                new = c.heat_partition * -np.einsum("ij,ij->i", res.P[:, 1:], w_mid)
+                if np.max(np.abs(new - heat), initial=0.0) <= 1e-12 * np.max(np.abs(new)):
+                    break
+                heat = new
+                res = solve(active, (self._W3t @ heat).reshape(n, 3))
+            heat = new
+        P = res.P
+        self._warm3 = P
+        X = Xp + Z @ P.reshape(-1)
+        if power:
+            X = X + self._Zt @ heat
+        return X, P[:, 0].copy(), {"friction_impulse": P[:, 1:], "heat": heat, "state": res.state}
