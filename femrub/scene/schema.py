@@ -327,8 +327,8 @@ REDUCTION = Variant(
         "auto": {
             "target": _f(0.01, "none", "relative error target", lo=0.0, hi=1.0, lo_open=True),
             "modes": Spec(I, 10, lo=1, hi=50, doc="natural frequencies that must meet it"),
-            "max_n_uv": Spec(I, 40, lo=2, hi=400, doc="largest n_uv tried"),
-            "max_n_theta": Spec(I, 40, lo=0, hi=400, doc="largest n_theta tried"),
+            "max_n_uv": Spec(I, 64, lo=2, hi=400, doc="largest n_uv tried"),
+            "max_n_theta": Spec(I, 64, lo=0, hi=400, doc="largest n_theta tried"),
         },
     },
 )
