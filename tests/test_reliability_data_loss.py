@@ -13,6 +13,7 @@ from pathlib import Path
 import meshio
 import numpy as np
 import pytest
+from bar_scenes import bar_scene
 
 import femrub.app.sweep as sweep_mod
 from femrub.app.cli import main
@@ -22,20 +23,7 @@ from femrub.steppers import ThetaMethod
 
 ROOT = Path(__file__).resolve().parents[1]
 
-TINY = """
-name = "tiny"
-[geometry]
-kind = "bar"
-n_elements = 5
-[contact]
-casing = { kind = "concentric", clearance = "15 um" }
-heat_coefficient = 3.0
-[loads]
-tip_force = { law = "sin", amplitude = 7.0, frequency = "209.4 rad/s" }
-[scheme]
-h = 1e-4
-t_end = 0.02
-"""
+TINY = bar_scene("tiny", 5, 0.02)
 
 BOX = """
 name = "box"

@@ -5,6 +5,7 @@ import json
 
 import numpy as np
 import pytest
+from bar_scenes import bar_scene
 
 import femrub.app.run as run_mod
 from femrub.app.cli import main
@@ -13,20 +14,7 @@ from femrub.output.results import Results
 from femrub.scene import SceneError, loads_scene
 from femrub.steppers import ThetaMethod
 
-TINY = """
-name = "tiny"
-[geometry]
-kind = "bar"
-n_elements = 5
-[contact]
-casing = { kind = "concentric", clearance = "15 um" }
-heat_coefficient = 3.0
-[loads]
-tip_force = { law = "sin", amplitude = 7.0, frequency = "209.4 rad/s" }
-[scheme]
-h = 1e-4
-t_end = 0.01
-"""
+TINY = bar_scene("tiny", 5, 0.01)
 
 
 @pytest.fixture()

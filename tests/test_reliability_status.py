@@ -6,6 +6,7 @@ from dataclasses import replace
 
 import numpy as np
 import pytest
+from bar_scenes import bar_scene
 
 from femrub.app import build
 from femrub.app.blade import _check_mesh
@@ -18,20 +19,7 @@ from femrub.output.verdict import assess
 from femrub.scene import SceneError, load_scene, loads_scene
 from femrub.steppers import Carpenter, Penalty, ThetaMethod
 
-BAR = """
-name = "bar"
-[geometry]
-kind = "bar"
-n_elements = 10
-[contact]
-casing = { kind = "concentric", clearance = "15 um" }
-heat_coefficient = 3.0
-[loads]
-tip_force = { law = "sin", amplitude = 7.0, frequency = "209.4 rad/s" }
-[scheme]
-h = 1e-4
-t_end = 0.4
-"""
+BAR = bar_scene("bar", 10, 0.4)
 
 
 def test_reduced_run_with_an_open_energy_balance_is_inaccurate():
