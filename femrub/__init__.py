@@ -3,7 +3,7 @@
 SI units throughout (m, kg, s, K, N, W, J, Pa).
 """
 
-from importlib import import_module as _import
+from ._lazy import lazy_attributes
 
 __version__ = "0.1.0"
 
@@ -59,13 +59,4 @@ __all__ = [
 ]
 
 
-def __getattr__(name):
-    if name not in _LAZY:
-        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-    value = getattr(_import(_LAZY[name], __name__), name)
-    globals()[name] = value
-    return value
-
-
-def __dir__():
-    return sorted(set(globals()) | set(__all__))
+__getattr__, __dir__ = lazy_attributes(__name__, _LAZY, __all__)

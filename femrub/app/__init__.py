@@ -5,7 +5,7 @@ Eq. 2 blocks -> contact points -> first-order model -> reduced model -> stepper)
 ``run_scene(scene, out)`` runs it into a results folder; ``run_sweep`` runs a grid of scenes.
 """
 
-from importlib import import_module as _import
+from .._lazy import lazy_attributes
 
 # imported on first use (PEP 562): `femrub --help` and `femrub scenes` stay fast
 _LAZY = {
@@ -19,13 +19,4 @@ _LAZY = {
 __all__ = ["FINISHED", "Simulation", "build", "folder_status", "run_scene"]
 
 
-def __getattr__(name):
-    if name not in _LAZY:
-        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-    value = getattr(_import(_LAZY[name], __name__), name)
-    globals()[name] = value
-    return value
-
-
-def __dir__():
-    return sorted(set(globals()) | set(__all__))
+__getattr__, __dir__ = lazy_attributes(__name__, _LAZY, __all__)

@@ -1,6 +1,6 @@
 """Contact: casing profiles, contact points, reach, gap algebra and impulse solvers."""
 
-from importlib import import_module as _import
+from .._lazy import lazy_attributes
 
 # imported on first use (PEP 562): `femrub --help` and `femrub scenes` stay fast
 _LAZY = {
@@ -14,13 +14,4 @@ _LAZY = {
 __all__ = ["CasingProfile", "Concentric", "Lobed", "TwoLobePiollet", "casing_profile"]
 
 
-def __getattr__(name):
-    if name not in _LAZY:
-        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-    value = getattr(_import(_LAZY[name], __name__), name)
-    globals()[name] = value
-    return value
-
-
-def __dir__():
-    return sorted(set(globals()) | set(__all__))
+__getattr__, __dir__ = lazy_attributes(__name__, _LAZY, __all__)

@@ -1,6 +1,6 @@
 """Finite elements: material, weak forms, lumping, linear algebra, damping, Eq. 2 blocks."""
 
-from importlib import import_module as _import
+from .._lazy import lazy_attributes
 
 # imported on first use (PEP 562): `femrub --help` and `femrub scenes` stay fast
 _LAZY = {
@@ -12,13 +12,4 @@ _LAZY = {
 __all__ = ["Material", "ThermoelasticMatrices", "assemble_thermoelastic"]
 
 
-def __getattr__(name):
-    if name not in _LAZY:
-        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-    value = getattr(_import(_LAZY[name], __name__), name)
-    globals()[name] = value
-    return value
-
-
-def __dir__():
-    return sorted(set(globals()) | set(__all__))
+__getattr__, __dir__ = lazy_attributes(__name__, _LAZY, __all__)

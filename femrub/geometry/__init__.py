@@ -9,7 +9,7 @@ Builders: :func:`box_blade`, :func:`naca_blade`, :func:`sections_blade`,
 :func:`read_gmsh`, :func:`read_meshio`, :func:`read_rotor37_mesh`.
 """
 
-from importlib import import_module as _import
+from .._lazy import lazy_attributes
 
 # imported on first use (PEP 562): `femrub --help` stays fast
 _LAZY = {
@@ -53,13 +53,4 @@ __all__ = [
 ]
 
 
-def __getattr__(name):
-    if name not in _LAZY:
-        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-    value = getattr(_import(_LAZY[name], __name__), name)
-    globals()[name] = value
-    return value
-
-
-def __dir__():
-    return sorted(set(globals()) | set(__all__))
+__getattr__, __dir__ = lazy_attributes(__name__, _LAZY, __all__)
