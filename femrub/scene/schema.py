@@ -300,8 +300,8 @@ REDUCTION = Variant(
         "projection": Spec(
             C,
             "petrov-galerkin",
-            choices=("petrov-galerkin", "galerkin", "adjoint"),
-            doc="left basis",
+            choices=("petrov-galerkin", "galerkin", "adjoint", "second-order"),
+            doc="left basis ('second-order': classical Galerkin Craig-Bampton of the mechanics)",
         ),
         "thermal": Spec(
             C,
