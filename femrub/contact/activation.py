@@ -189,6 +189,8 @@ def frictional_fixed_point(rule, g_k, gd_k, g_p, GZ3, solve, h, gamma):
         return active, solve(active)
     closed = g_k <= 0.0
     active = closed | (g_p <= 0.0)
+    if not active.any():  # no impulse, so the set is consistent (most steps of a rub)
+        return active, solve(active)
     seen = []
     while True:
         res = solve(active)
