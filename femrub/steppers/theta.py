@@ -254,10 +254,13 @@ class ThetaMethod(Stepper):
         e = np.where(gdot_k > 0.0, 1.0, c.restitution)
 
         def solve(active, shift=0.0):
-            return solve_frictional_contact(
+            res = solve_frictional_contact(
                 W, q + shift, c.friction, active, restitution=e, u_before=gdot_k,
                 warm=self._warm3,
             )  # fmt: skip
+            if active.any():  # the next active set of the fixed point starts from here
+                self._warm3 = res.P
+            return res
 
         active, res = frictional_fixed_point(
             self.activation, gap_k, gdot_k, gap_p, GZ, solve, h, self.gamma
