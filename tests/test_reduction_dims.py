@@ -162,8 +162,9 @@ def test_interior_solves_by_blocks_and_free(blade, monkeypatch):
     assert _rel(s.solve(rhs), s.solve(rhs.toarray())) < 1e-12
     assert _rel(s.solve_transposed(rhs), dense_T) < 1e-12
     s.free()
-    with pytest.raises(RuntimeError, match="released"):
-        s.solve_K(np.ones(s.n_u))
+    for solve, size in ((s.solve_K, s.n_u), (s.solve, n), (s.solve_transposed, n)):
+        with pytest.raises(RuntimeError, match="released"):
+            solve(np.ones(size))
     # the bases are kept: reduce and reconstruct still work without the factorisations
     Xr = np.ones(red.reduce(2, 1).n_dofs)
     assert red.reconstruct(Xr, 2, 1).shape == (blade.n_dofs,)

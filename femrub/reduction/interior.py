@@ -57,13 +57,15 @@ class InteriorSolver:
         self._lu_T = _splu(self.Ktt, "interior conductivity K^θθ_ii (is a temperature fixed?)")
 
     def free(self) -> None:
-        """Release the two factorisations (about 0.5 GB for a Rotor 37 blade) once no more
-        solves are needed; a later solve raises ``RuntimeError``."""
+        """Release the two factorisations (about 0.5 GB for a Rotor 37 blade) and the
+        interior blocks once no more solves are needed; a later solve raises
+        ``RuntimeError``."""
         for name in ("_lu_K", "_lu_T"):
             lu = getattr(self, name)
             if hasattr(lu, "free"):
                 lu.free()
             setattr(self, name, _Freed())
+        self.K = self.M = self.C = self.Kut = self.Ctu = self.Ctt = self.Ktt = None
 
     def solve_K(self, rhs, trans: bool = False) -> np.ndarray:
         """``K_ii⁻¹ rhs`` (or ``K_ii⁻ᵀ rhs``)."""
@@ -84,11 +86,15 @@ class InteriorSolver:
     def solve(self, rhs) -> np.ndarray:
         """``B_ii⁻¹ rhs`` for a (n_i,) vector or (n_i, k) columns, dense or sparse (paper
         Eq. 11); many columns are solved :data:`BLOCK` at a time (:func:`_by_blocks`)."""
+        if self.K is None:
+            _Freed().solve(rhs)
         return _by_blocks(self._solve, rhs)
 
     def solve_transposed(self, rhs) -> np.ndarray:
         """``B_ii⁻ᵀ rhs``: the interior problem of the adjoint system (columns as in
         :meth:`solve`)."""
+        if self.K is None:
+            _Freed().solve(rhs)
         return _by_blocks(self._solve_transposed, rhs)
 
     def _solve(self, rhs: np.ndarray) -> np.ndarray:
