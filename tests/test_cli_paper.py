@@ -101,7 +101,28 @@ def test_fig4_reduced_models(summary):
 
 def test_output_size_bounded(paper_out):
     total = sum(f.stat().st_size for f in paper_out.rglob("*") if f.is_file())
-    assert total < 300e6  # measured about 260 MB (the per-run CSVs dominate)
+    assert total < 30e6  # issue 13's bound (docs/performance.md: about 25 MB)
+
+
+def test_npz_histories(paper_out, summary):
+    """Every step in the .npz of the runs with h >= NPZ_DT; the h = 1e-6 s run one row per
+    NPZ_DT with its total impulse kept and forces that are mean forces over a row."""
+    from femrub.cases.paper import NPZ_DT
+
+    runs = paper_out / "runs"
+    coarse = Results.load_npz(runs / "theta_1e-05_3.0_True_full_position.npz")
+    assert coarse.steps == coarse.t.size - 1 == 40_000 and "every" not in coarse.info
+    fine = Results.load_npz(runs / "theta_1e-06_3.0_True_full_position.npz")
+    assert fine.steps == 400_000 and fine.t.size == 40_001
+    assert fine.info["every"] == 10 and fine.info["step"] == 1e-6
+    assert np.allclose(np.diff(fine.t), NPZ_DT) and fine.h == pytest.approx(NPZ_DT)
+    row = _row(summary, "fig5", "θ-method, h = 1e-6 s")
+    # total impulse (N s) as in the CSV (summed over 1e-4 s rows from the same steps);
+    # mean forces over a row cannot exceed the largest per-step force
+    csv = np.genfromtxt(runs / "theta_1e-06_3.0_True_full_position.csv", delimiter=",", names=True)
+    assert fine.impulse.sum() == pytest.approx(csv["contact_impulse_N_s"].sum(), rel=1e-7)
+    assert 0 < fine.force.max() <= row["max_contact_force"]
+    assert fine.energy["kinetic"].shape == fine.t.shape
 
 
 def test_bad_cli_input(capsys):

@@ -90,3 +90,14 @@ def test_decimated_columns_keep_the_total_impulse():
     np.testing.assert_allclose(out["contact_impulse"], [0.0, 3.0, 0.0, 0.5])
     np.testing.assert_allclose(out["contact_force"], [0.0, 7.5, 0.0, 2.5])
     assert out["contact_impulse"].sum() == pytest.approx(imp.sum())
+
+
+def test_pardiso_factor_is_released():
+    """``free`` releases MKL's memory (also when collected) and may be called twice."""
+    if not linalg.pardiso_available():
+        pytest.skip("pypardiso / MKL not installed")
+    f = linalg._Pardiso(_laplacian(50), symmetric=True)
+    assert np.isfinite(f.solve(np.ones(50))).all()
+    f.free()
+    f.free()
+    assert f._s is None

@@ -72,7 +72,7 @@ def test_full_basis_theta_method_reproduces_full_model(paper, projection):
     rom = ThermoelasticCraigBampton(paper, projection=projection).reduce()
     # Galerkin: θ̄ carries round-off before the first heat input; the run's blow-up detector
     # (steppers/base.py) compares the heat balance with an absolute 1e-30 J floor
-    res = fr.ThetaMethod(rom, 1e-4).run(0.1, energy=projection != "galerkin")
+    res = fr.ThetaMethod(rom, 1e-4).run(0.1, energy=projection not in ("galerkin", "second-order"))
     _same_run(res, ref, 1e-8)
 
 

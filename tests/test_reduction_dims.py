@@ -7,6 +7,7 @@ tolerance for the 3D blade), and the ``"auto"`` scene reduction must reuse its o
 
 import numpy as np
 import pytest
+import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 import femrub as fr
@@ -145,3 +146,25 @@ def test_auto_reduction_reuses_its_reductor(paper):
     rom_fixed, red_fixed, _ = reduce_model(paper, fixed)
     assert (red_fixed.n_uv, red_fixed.n_theta) == sizes
     _assert_same_model(rom, rom_fixed, TOL_DENSE)
+
+
+def test_interior_solves_by_blocks_and_free(blade, monkeypatch):
+    """Sparse right-hand sides solved a few columns at a time equal the dense solve; a
+    released solver refuses to solve."""
+    from femrub.reduction import interior
+
+    red = ThermoelasticCraigBampton(blade, 4, 2)
+    s = red.solver
+    n = 2 * s.n_u + s.n_t
+    rhs = sp.random(n, 11, density=0.02, random_state=3, format="csc")
+    dense_T = s.solve_transposed(rhs.toarray())
+    monkeypatch.setattr(interior, "BLOCK", 4)  # 11 columns: blocks of 4, 4, 3
+    assert _rel(s.solve(rhs), s.solve(rhs.toarray())) < 1e-12
+    assert _rel(s.solve_transposed(rhs), dense_T) < 1e-12
+    s.free()
+    for solve, size in ((s.solve_K, s.n_u), (s.solve, n), (s.solve_transposed, n)):
+        with pytest.raises(RuntimeError, match="released"):
+            solve(np.ones(size))
+    # the bases are kept: reduce and reconstruct still work without the factorisations
+    Xr = np.ones(red.reduce(2, 1).n_dofs)
+    assert red.reconstruct(Xr, 2, 1).shape == (blade.n_dofs,)

@@ -50,6 +50,10 @@ T_END = 0.4
 #: per ``CSV_DT`` (impulses summed, forces averaged in between), with 9 significant digits
 #: as the figure CSVs; every step is in the .npz, to the last bit.
 CSV_DT = 1e-4
+#: Time between two rows of a run's ``.npz`` history (s): every step of the runs with
+#: ``h >= NPZ_DT``; the h = 1e-6 s reference run one row per ``NPZ_DT``, impulses summed
+#: (:meth:`~femrub.output.results.Results.decimated`), which keeps the output under 30 MB.
+NPZ_DT = 1e-5
 
 
 @dataclass(frozen=True)
@@ -235,9 +239,10 @@ def summarise(figure: str, run: Run, res, model) -> dict:
     }
 
 
-def _stride(res) -> int:
-    """Rows of a run's CSV: one per :data:`CSV_DT` (every step when the step is larger)."""
-    return max(1, round(CSV_DT / res.h)) if res.h else 1
+def _stride(res, dt: float = CSV_DT) -> int:
+    """Steps per row of a run's CSV (``dt`` = :data:`CSV_DT`) or ``.npz`` (:data:`NPZ_DT`):
+    one row per ``dt``, every step when the step is larger."""
+    return max(1, round(dt / res.h)) if res.h else 1
 
 
 def _figure_csv(path: Path, runs, tlim=None) -> None:
@@ -330,7 +335,7 @@ def _figures(out, names, t_end, progress, log, rows, started) -> None:
                 cache[run.key()] = (res, model)
                 stem = "_".join(str(k) for k in run.key() if k is not None).replace(" ", "")
                 res.save_csv(out / "runs" / f"{stem}.csv", every=_stride(res), digits=9)
-                res.save_npz(out / "runs" / f"{stem}.npz")
+                res.decimated(_stride(res, NPZ_DT)).save_npz(out / "runs" / f"{stem}.npz")
                 log(
                     f"  {fig}: {run.label:<24} {res.status:<20} {res.steps:>7} steps "
                     f"{res.cpu_seconds:6.2f} s cpu"

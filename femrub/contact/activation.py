@@ -79,7 +79,7 @@ def impulse_one(rule, g_k, gd_k, g_p, gd_p, w, gz, e, h, gamma) -> float:
     if rule in ("capped", "position"):
         if g_k > 0.0 and g_p >= 0.0:  # open, and the free step does not reach the casing
             return 0.0
-        p_cap = (_target(g_k, e) - g_p) / gz
+        p_cap = (min(g_k, 0.0) + e * max(g_k, 0.0) - g_p) / gz  # _target, on floats
         if rule == "position":
             return max(0.0, p_cap)
         return max(0.0, min(-(gd_p + e * gd_k) / w, p_cap))
@@ -189,6 +189,8 @@ def frictional_fixed_point(rule, g_k, gd_k, g_p, GZ3, solve, h, gamma):
         return active, solve(active)
     closed = g_k <= 0.0
     active = closed | (g_p <= 0.0)
+    if not active.any():  # no impulse, so the set is consistent (most steps of a rub)
+        return active, solve(active)
     seen = []
     while True:
         res = solve(active)

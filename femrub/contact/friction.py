@@ -17,7 +17,7 @@ by the semi-smooth Newton method of Alart & Curnier (1991) on::
     F_n = P_n − max(0, P_n − ρ u_n) = 0
     F_t = P_t − proj_{B(μ max(0, P_n − ρ u_n))}(P_t − ρ u_t) = 0
 
-with per-contact ``ρ_i = 1 / ‖W_ii‖``, an Armijo line search on ``‖F‖²/2``, and projected
+with per-contact ``ρ_i = 1 / ‖W_ii‖_F``, an Armijo line search on ``‖F‖²/2``, and projected
 block Gauss–Seidel sweeps on the same map (then Newton again) when Newton stalls. The
 converged impulses are put on the cone exactly: a sliding contact gets ``|P_t| = μ P_n``
 and the direction of ``−u_t``. Without friction (``μ = 0`` everywhere) the problem is the
@@ -103,14 +103,13 @@ def solve_frictional_contact(
     q = np.asarray(q, dtype=float).reshape(-1, 3)
     n = q.shape[0]
     W = _as_local(W, n)
+    P = np.zeros((n, 3))
+    idx = np.flatnonzero(active)
+    if idx.size == 0:  # nothing to solve (most steps of a rub): no set-up
+        return FrictionResult(P, q.copy(), np.zeros(n, dtype=np.int8), 0.0, 0)
     mu = np.broadcast_to(np.asarray(mu, dtype=float), (n,))
     e = np.broadcast_to(np.asarray(restitution, dtype=float), (n,))
     ub = np.zeros(n) if u_before is None else np.asarray(u_before, dtype=float)
-    active = np.asarray(active, dtype=bool)
-    P = np.zeros((n, 3))
-    idx = np.flatnonzero(active)
-    if idx.size == 0:
-        return FrictionResult(P, q.copy(), np.zeros(n, dtype=np.int8), 0.0, 0)
     # Newton's law: scale the normal rows by 1 / (1 + e) and shift by e u_n⁻ / (1 + e)
     s = np.ones((n, 3))
     s[:, 0] = 1.0 / (1.0 + e)
@@ -153,7 +152,7 @@ def _residual(P, W, q, mu, rho):
     pos = a > 0.0
     r = mu * np.maximum(a, 0.0)
     x = P[:, 1:] - rho[:, None] * u[:, 1:]
-    nx = np.linalg.norm(x, axis=1)
+    nx = np.hypot(x[:, 0], x[:, 1])
     slip = nx > r
     F = np.empty_like(P)
     F[:, 0] = P[:, 0] - np.maximum(a, 0.0)
@@ -162,33 +161,40 @@ def _residual(P, W, q, mu, rho):
     return F, (u, pos, r, x, nx, slip)
 
 
+#: ``(W, ρ, ρ W, I − ρ W)`` of the last :func:`_jacobian` call: constant over the Newton
+#: iterations of a solve (checked by identity; holding W and ρ keeps their ids unique)
+_LAST_DA: list = [None]
+
+
 def _jacobian(W, mu, rho, aux):
-    """An element of the generalised Jacobian of :func:`_residual` (3m, 3m)."""
+    """An element of the generalised Jacobian of :func:`_residual` (3m, 3m).
+
+    With ``dA = I − ρ W`` (rows contact-major): normal rows ``ρ W_n`` where ``a > 0``, else
+    ``e_n``; stick rows ``e_t − dA_t = ρ W_t``; slip rows
+    ``e_t − x̂ (μ [a > 0] dA_n) − (r / |x|) (I − x̂ x̂ᵀ) dA_t``.
+    """
     u, pos, r, x, nx, slip = aux
     m = pos.size
-    J = np.zeros((m, 3, m, 3))
-    Wr = W.reshape(m, 3, m, 3)
-    ii = np.arange(m)
-    eye = np.zeros((m, 3, m, 3))
-    eye[ii, :, ii, :] = np.eye(3)
-    # d(P - rho u)/dP, per contact rows (m, 3, m, 3)
-    dA = eye - rho[:, None, None, None] * Wr
-    # normal: F_n = P_n - max(0, a)
-    J[:, 0] = eye[:, 0] - np.where(pos[:, None, None], dA[:, 0], 0.0)
-    # tangential, stick: F_t = P_t - x  (x = P_t - rho u_t)
-    J[:, 1:] = eye[:, 1:] - dA[:, 1:]
-    # tangential, slip: F_t = P_t - r x / |x|
+    last = _LAST_DA[0]
+    if last is None or last[0] is not W or last[1] is not rho:
+        rW = np.repeat(rho, 3)[:, None] * W
+        _LAST_DA[0] = last = (W, rho, rW, np.eye(3 * m) - rW)
+    dA = last[3].reshape(m, 3, 3 * m)
+    J = last[2].reshape(m, 3, 3 * m).copy()
+    off = np.flatnonzero(~pos)
+    if off.size:  # F_n = P_n
+        J[off, 0] = 0.0
+        J[off, 0, 3 * off] = 1.0
     k = np.flatnonzero(slip)
     if k.size:
         xh = x[k] / nx[k, None]
         proj = np.eye(2)[None] - xh[:, :, None] * xh[:, None, :]  # (s, 2, 2)
-        dr = np.where(pos[k, None, None], mu[k, None, None] * dA[k, 0], 0.0)  # (s, m, 3)
-        dx = dA[k, 1:]  # (s, 2, m, 3)
-        J[k, 1:] = (
-            eye[k, 1:]
-            - xh[:, :, None, None] * dr[:, None]
-            - (r[k] / nx[k])[:, None, None, None] * np.einsum("sab,sbjc->sajc", proj, dx)
+        dr = np.where(pos[k, None], mu[k, None] * dA[k, 0], 0.0)  # (s, 3m)
+        Jk = -xh[:, :, None] * dr[:, None, :] - (r[k] / nx[k])[:, None, None] * np.einsum(
+            "sab,sbj->saj", proj, dA[k, 1:]
         )
+        Jk[np.arange(k.size)[:, None], np.arange(2), 3 * k[:, None] + np.arange(1, 3)] += 1.0
+        J[k, 1:] = Jk
     return J.reshape(3 * m, 3 * m)
 
 
@@ -201,10 +207,10 @@ def _on_cone(P, u, mu, rho):
     P[:, 0] = np.maximum(P[:, 0], 0.0)
     bound = mu * P[:, 0]
     x = P[:, 1:] - rho[:, None] * u[:, 1:]
-    nx = np.linalg.norm(x, axis=1)
+    nx = np.hypot(x[:, 0], x[:, 1])
     slide = (nx > bound) & (P[:, 0] > 0.0)
     P[slide, 1:] = (bound[slide] / nx[slide])[:, None] * x[slide]
-    nt = np.linalg.norm(P[:, 1:], axis=1)
+    nt = np.hypot(P[:, 1], P[:, 2])
     over = ~slide & (nt > bound)
     if over.any():
         P[over, 1:] *= (bound[over] / nt[over])[:, None]
@@ -260,7 +266,7 @@ def _gauss_seidel(P, W, q, mu, rho, tol, sweeps=5000):
 def _alart_curnier(W, q, mu, warm, tol, max_iter):
     m = q.shape[0]
     Wd = _blocks(W, m)
-    norm = np.linalg.norm(Wd, ord=2, axis=(1, 2))
+    norm = np.sqrt(np.einsum("mij,mij->m", Wd, Wd))  # Frobenius: no SVD per step
     if np.any(~(norm > 0.0)) or np.any(Wd[:, 0, 0] <= 0.0):
         raise FloatingPointError("non-positive Delassus operator at a contact")
     rho = 1.0 / norm

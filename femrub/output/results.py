@@ -25,7 +25,7 @@ from __future__ import annotations
 import csv
 import json
 import os
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
@@ -253,6 +253,48 @@ class Results:
                 np.savetxt(fh, table, fmt=fmt, delimiter=",")
         os.replace(tmp, path)
         return path
+
+    def decimated(self, every: int) -> Results:
+        """The history at one row in ``every`` steps (rows ``0, every, 2 every, …`` and the
+        last), for storage.
+
+        ``impulse`` and the friction impulse are summed over the steps since the previous
+        row, ``(t_{j-1}, t_j]``, and ``h`` becomes the row spacing ``every · h``, so
+        ``force = impulse / h`` is the mean force over a row and the total impulse is kept;
+        every other array is its value at the row's time. ``info`` records the integration
+        step (``step``) and ``every``; ``steps`` and ``cpu_seconds`` are the run's.
+        """
+        every = int(every)
+        n = self.t.size
+        if every <= 1 or n < 2:
+            return self
+        idx = np.unique(np.r_[np.arange(0, n, every), n - 1])
+
+        def summed(a):
+            out = a[idx].copy()
+            out[1:] = np.add.reduceat(a, idx[:-1] + 1, axis=0)
+            return out
+
+        def at(a):
+            return None if a is None else np.asarray(a)[idx].copy()
+
+        h_row = self.h * every
+        ff = self.friction_force
+        return replace(
+            self,
+            h=h_row,
+            t=self.t[idx].copy(),
+            signals={k: at(v) for k, v in self.signals.items()},
+            gap=at(self.gap),
+            impulse=summed(self.impulse),
+            energy={k: at(v) for k, v in self.energy.items()},
+            friction_force=None if ff is None else summed(ff * self.h) / h_row,
+            slip_velocity=at(self.slip_velocity),
+            contact_state=at(self.contact_state),
+            info={**self.info, "step": self.h, "every": every},
+            extra={k: at(v) for k, v in self.extra.items()},
+            warnings=list(self.warnings),
+        )
 
     def save_npz(self, path) -> Path:
         """Every step, compressed (``numpy.savez_compressed``); :meth:`load_npz` reads it."""

@@ -113,7 +113,8 @@ class ThermoelasticCraigBampton:
     mu : (n_theta,) clamped thermal eigenvalues (1/s) of ``K^θθ χ = μ C^θθ χ``.
     solver : the :class:`~femrub.reduction.interior.InteriorSolver` (LU factorisations of
         ``K_ii`` and ``K^θθ_ii``), kept for further solves on the same interior (the full
-        model's modes, :func:`~femrub.reduction.interior.condensed_solve`).
+        model's modes, :func:`~femrub.reduction.interior.condensed_solve`);
+        :func:`~femrub.reduction.sizes.reduce_model` releases it once the sizes are chosen.
     timings : seconds spent in the static shapes, the modes and the bases (the projection
         time of a reduced model is in its ``info["timings"]``).
     """
@@ -165,8 +166,7 @@ class ThermoelasticCraigBampton:
         self._bnd = np.r_[mb, nu + mb, 2 * nu + tb].astype(int)
         self._int = np.r_[mi, nu + mi, 2 * nu + ti].astype(int)
         B = fom.B.tocsr()
-        B_ib = B[self._int][:, self._bnd].toarray()
-        psi = solver.solve(-B_ib)  # Eq. (11)
+        psi = solver.solve(-B[self._int][:, self._bnd])  # Eq. (11), sparse right-hand sides
         if projection == "second-order":  # velocity shapes = displacement shapes [I; Ψ]
             n_mi, nb = mi.size, mb.size
             psi[n_mi : 2 * n_mi, nb : 2 * nb] = psi[:n_mi, :nb]
@@ -195,9 +195,9 @@ class ThermoelasticCraigBampton:
             self.left = self.R
         else:  # left (adjoint) modes; boundary columns: adjoint static shapes or unit vectors
             if projection == "adjoint":
-                psi_l = solver.solve_transposed(-B[self._bnd][:, self._int].T.toarray())
-            else:  # boundary equations kept as in the full model
-                psi_l = np.zeros_like(psi)
+                psi_l = solver.solve_transposed(-B[self._bnd][:, self._int].T)
+            else:  # boundary equations kept as in the full model: no static shapes
+                psi_l = None
             mphi = _orient(normalise_columns(solver.M @ phi[:, : self.n_qu]))
             self.left = self._assemble(psi_l, mphi, phi, chi, solver.Ctu.T @ chi)
         self.timings["bases"] = time.perf_counter() - t0
@@ -222,7 +222,8 @@ class ThermoelasticCraigBampton:
         ):  # boundary dofs kept (Eq. 12) with their static shapes (Eq. 11)
             V[rows, cols] = 1.0
             first = [0, nb, 2 * nb][k]
-            V[self._int[:, None], cols[None, :]] = psi[:, first : first + cols.size]
+            if psi is not None:  # None: zero static shapes (unit left vectors)
+                V[self._int[:, None], cols[None, :]] = psi[:, first : first + cols.size]
         V[mi[:, None], np.arange(nb, nb + self.n_qu)[None, :]] = u_shapes
         V[(nu + mi)[:, None], (Lr.v.start + nb + np.arange(self.n_qv))[None, :]] = v_shapes
         cq_t = Lr.t.start + tb.size + np.arange(chi.shape[1])
@@ -264,9 +265,10 @@ class ThermoelasticCraigBampton:
         n_uv, n_theta, cols, layout = self._columns(n_uv, n_theta)
         t0 = time.perf_counter()
         m = self.fom
-        R = np.take(self.R, cols, axis=1)  # C-ordered copies: faster sparse products
-        galerkin = self.projection in ("galerkin", "second-order")
-        Lt = R if galerkin else np.take(self.left, cols, axis=1)
+        every = cols.size == self.R.shape[1]  # the largest sizes: the bases, no copies
+        R = self.R if every else np.take(self.R, cols, axis=1)  # C-ordered, as self.R
+        Lt = self.left if every else np.take(self.left, cols, axis=1)
+        Lt = R if self.projection in ("galerkin", "second-order") else Lt
         Ar = project(Lt, m.A, R)
         Br = project(Lt, m.B, R)
         loads = [
@@ -382,7 +384,11 @@ class ThermoelasticCraigBampton:
         Xr = np.asarray(Xr, dtype=float)
         if Xr.shape[-1] != layout.n:
             raise ValueError(f"a reduced state has {layout.n} entries, got {Xr.shape}")
-        R = self.R[:, cols]
+        R = self.R
+        if cols.size < R.shape[1]:  # zero coordinates on the columns left out: no copy of R
+            full = np.zeros(Xr.shape[:-1] + (R.shape[1],))
+            full[..., cols] = Xr
+            Xr = full
         return R @ Xr if Xr.ndim == 1 else Xr @ R.T
 
     def restrict(self, X: np.ndarray, n_uv=None, n_theta=None) -> np.ndarray:

@@ -240,6 +240,7 @@ def reduce_model(model, scene, log=None, make_stepper=None):
         report["target"] = opts["target"]
     else:
         n_uv, n_theta = want
+    red.solver.free()  # no more interior solves: release the factorisations' memory
     if make_stepper is not None:
         n_uv, n_theta = _checked(red, model, want, make_stepper, scene, report, log)
     reduced = red.reduce(n_uv, n_theta)

@@ -154,6 +154,29 @@ class ThetaMethod(Stepper):
             self._GZ3 = c.GT @ self._Z3
             self._GZt = c.GT @ self._Zt
             self._warm3 = None
+            # gap and local velocity rows in one product: [g, ġ, w_t] = S X + casing terms
+            self._S = np.vstack([c.GT, c.V3T])
+            self._memo = (None, 0.0, None, None)
+
+    def _casing(self, k: int, t: float):
+        """``(g0(t), ġ0(t))`` of the casing at step ``k``: each time is asked for twice
+        (as ``t_{k+1}``, then as ``t_k``), the last one is kept."""
+        memo = self._memo
+        if memo[0] != k or abs(memo[1] - t) > 1e-9 * self.h:
+            c = self.model.contact
+            self._memo = memo = (k, t, c.gap_at(t), c.rate_at(t))
+        return memo[2], memo[3]
+
+    def _local(self, k: int, t: float, X):
+        """Gap (n,), gap velocity (n,) and ``(ġ, w_t)`` (n, 3) of the state ``X`` at step ``k``."""
+        c = self.model.contact
+        g0, r0 = self._casing(k, t)
+        y = self._S @ X
+        n = c.n
+        loc = y[n:].reshape(n, 3)
+        loc[:, 0] += r0
+        loc[:, 1:] -= c.casing_velocity
+        return g0 + y[:n], loc[:, 0].copy(), loc
 
     def _signal_values(self, t):
         return np.array([float(sig(t)) for sig in self._signals])
@@ -226,19 +249,21 @@ class ThetaMethod(Stepper):
             Z[:, ::3] += self._Zt * alpha
             W[:, ::3] += self._W3t * alpha
             GZ[:, ::3] += self._GZt * alpha
-        gdot_k = c.gap_velocity(self.t, Xk)
-        q = np.column_stack([c.gap_velocity(t1, Xp), c.slip_velocity(Xp)])
+        gap_k, gdot_k, _ = self._local(self.k, self.t, Xk)
+        gap_p, _, q = self._local(self.k + 1, t1, Xp)
         e = np.where(gdot_k > 0.0, 1.0, c.restitution)
-        gap_k = c.gap(self.t, Xk)
 
         def solve(active, shift=0.0):
-            return solve_frictional_contact(
+            res = solve_frictional_contact(
                 W, q + shift, c.friction, active, restitution=e, u_before=gdot_k,
                 warm=self._warm3,
             )  # fmt: skip
+            if active.any():  # the next active set of the fixed point starts from here
+                self._warm3 = res.P
+            return res
 
         active, res = frictional_fixed_point(
-            self.activation, gap_k, gdot_k, c.gap(t1, Xp), GZ, solve, h, self.gamma
+            self.activation, gap_k, gdot_k, gap_p, GZ, solve, h, self.gamma
         )
         heat = alpha * res.P[:, 0]  # the α λ heat is already in Z's normal columns
         power = c.heat_law == "power" and self.model.layout.n_t > 0
@@ -257,7 +282,7 @@ class ThetaMethod(Stepper):
             heat = new
         P = res.P
         self._warm3 = P
-        X = Xp + Z @ P.reshape(-1)
+        X = Xp + Z @ P.reshape(-1) if active.any() else Xp
         if power:
             X = X + self._Zt @ heat
         return X, P[:, 0].copy(), {"friction_impulse": P[:, 1:], "heat": heat, "state": res.state}

@@ -1,0 +1,166 @@
+"""Per-step cost of a reduced frictional θ-method run, and its floor (issue 13, target 3).
+
+Builds ``SCENE`` (default ``rotor37``; through the model cache, so a second call loads the
+reduced model in seconds), then steps it ``--revolutions`` revolutions without output
+(``run(energy=False)`` and the default ``run()`` with the energy balance), in this process:
+
+* CPU per step (``time.process_time``), and split between the steps where no contact takes
+  an impulse and those where some do (wall time of each ``_advance``, median);
+* the floor: the dense ``T X`` product of the step and one ``numpy.linalg.solve`` of the
+  Delassus block of the contacts active together (the small contact solve), each timed alone.
+
+Writes a table between ``<!-- step_cost:begin -->`` and ``<!-- step_cost:end -->`` in
+``docs/performance.md`` with the machine's load (``os.getloadavg``).
+
+Run: ``python benchmarks/step_cost.py [--scene rotor37] [--revolutions 5] [--no-write]``
+(Rotor 37 needs ``../shared/data``; wrap the first, uncached call in
+``flock /tmp/femrub-heavy.lock`` on a shared machine).
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import os
+import re
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+from threadpoolctl import threadpool_limits
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))
+
+
+def _per_step(model, scheme: dict, opts: dict, t_end: float, energy: bool) -> dict:
+    from femrub.steppers import make_stepper
+
+    st = make_stepper(scheme["name"], model, scheme["h"], **opts)
+    c0 = time.process_time()
+    res = st.run(t_end, energy=energy)
+    cpu = time.process_time() - c0
+    return {"steps": res.steps, "us": 1e6 * cpu / res.steps, "status": res.status}
+
+
+def _split(model, scheme: dict, opts: dict, t_end: float) -> dict:
+    """Median wall time of a step without / with an impulse, and the contacts active."""
+    from femrub.steppers import make_stepper
+
+    st = make_stepper(scheme["name"], model, scheme["h"], **opts)
+    n = st.steps_to(t_end)
+    dt, act = np.zeros(n), np.zeros(n, dtype=int)
+    with threadpool_limits(limits=1, user_api="blas"):
+        for i in range(n):
+            t0 = time.perf_counter()
+            out = st._advance()
+            dt[i] = time.perf_counter() - t0
+            act[i] = np.count_nonzero(out[2] > 0.0)
+    on = act > 0
+    T = getattr(st, "_T", None)
+    floor = {}
+    with threadpool_limits(limits=1, user_api="blas"):
+        if T is not None:
+            X, k = np.ones(T.shape[0]), 20000
+            t0 = time.perf_counter()
+            for _ in range(k):
+                T @ X
+            floor["matvec_us"] = 1e6 * (time.perf_counter() - t0) / k
+        m = int(np.percentile(act[on], 90)) if on.any() else 1
+        W = getattr(st, "_W3", None)
+        if W is not None and m:
+            Wa = W[: 3 * m, : 3 * m] + 0.0
+            b, k = np.ones(3 * m), 5000
+            t0 = time.perf_counter()
+            for _ in range(k):
+                np.linalg.solve(Wa, b)
+            floor["solve_us"], floor["solve_size"] = 1e6 * (time.perf_counter() - t0) / k, 3 * m
+    return {
+        "quiet_us": 1e6 * float(np.median(dt[~on])) if (~on).any() else None,
+        "contact_us": 1e6 * float(np.median(dt[on])) if on.any() else None,
+        "contact_share": float(on.mean()),
+        "active_mean": float(act[on].mean()) if on.any() else 0.0,
+        **floor,
+    }
+
+
+def measure(scene_name: str, revolutions: float) -> dict:
+    from femrub.app.cache import ModelCache
+    from femrub.app.simulation import _scheme_options, build
+    from femrub.scene import load_scene
+
+    scene = load_scene(scene_name)
+    load0 = os.getloadavg()[0]
+    t0 = time.perf_counter()
+    sim = build(scene, log=lambda s: None, cache=ModelCache())
+    build_s = time.perf_counter() - t0
+    omega = scene["loads"]["rotation_speed"]
+    t_end = revolutions * 2 * math.pi / omega if omega else scene["scheme"]["t_end"]
+    opts = _scheme_options(scene)
+    m = sim.model
+    row = {
+        "scene": scene_name, "n_dofs": m.n_dofs, "contacts": m.contact.n, "t_end": t_end,
+        "build_s": build_s, "no_energy": _per_step(m, scene["scheme"], opts, t_end, False),
+        "energy": _per_step(m, scene["scheme"], opts, t_end, True),
+        **_split(m, scene["scheme"], opts, t_end),
+    }  # fmt: skip
+    row["load"] = [load0, os.getloadavg()[0]]
+    return row
+
+
+def table(row: dict) -> str:
+    f = lambda x: "—" if x is None else f"{x:.1f}"  # noqa: E731
+    floor = f(row.get("matvec_us", 0.0) + row.get("solve_us", 0.0))
+    return (
+        f"`{row['scene']}` reduced ({row['n_dofs']} coordinates, {row['contacts']} frictional "
+        f"contacts), θ-method, {row['no_energy']['steps']} steps, one process; load "
+        f"{row['load'][0]:.2f}–{row['load'][1]:.2f} (1-minute average).\n\n"
+        "| quantity | µs per step |\n|---|---|\n"
+        f"| CPU per step, no output, `run(energy=False)` | {f(row['no_energy']['us'])} |\n"
+        f"| CPU per step, energy balance on (default `run()`) | {f(row['energy']['us'])} |\n"
+        f"| step without impulse (median wall, {100 * (1 - row['contact_share']):.0f} % of "
+        f"the steps) | {f(row['quiet_us'])} |\n"
+        f"| step with impulses (median wall, {100 * row['contact_share']:.0f} % of the steps, "
+        f"{row['active_mean']:.1f} contacts active on average) | {f(row['contact_us'])} |\n"
+        f"| floor: dense `T X` ({row['n_dofs']}²) | {f(row.get('matvec_us'))} |\n"
+        f"| floor: `numpy.linalg.solve` of the {row.get('solve_size', 0)}×"
+        f"{row.get('solve_size', 0)} Delassus block | {f(row.get('solve_us'))} |\n"
+        f"| floor: sum | {floor} |\n"
+    )
+
+
+def write(text: str, path: Path = ROOT / "docs" / "performance.md") -> None:
+    doc = path.read_text()
+    block = f"<!-- step_cost:begin -->\n{text}<!-- step_cost:end -->"
+    pat = re.compile(r"<!-- step_cost:begin -->.*?<!-- step_cost:end -->", re.S)
+    if pat.search(doc):
+        doc = pat.sub(lambda _: block, doc)
+    else:
+        doc += "\n" + block + "\n"
+    path.write_text(doc)
+
+
+def main(argv=None) -> int:
+    from femrub.scene import SceneError
+
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--scene", default="rotor37")
+    ap.add_argument("--revolutions", type=float, default=5.0)
+    ap.add_argument("--no-write", action="store_true", help="print, do not edit the docs")
+    args = ap.parse_args(argv)
+    try:
+        row = measure(args.scene, args.revolutions)
+    except (FileNotFoundError, SceneError) as exc:
+        print(f"skipped: {exc}")
+        return 0
+    text = table(row)
+    print(row)
+    print(text)
+    if not args.no_write:
+        write(text)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
