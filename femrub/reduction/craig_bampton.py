@@ -16,6 +16,13 @@ any number of contacts) and builds
     contact dofs) and the interior equations are projected on the left eigenvectors of the
     clamped uncoupled problem (``M_ii φ_j`` for the kinematic rows, ``φ_j`` for the momentum
     rows, ``χ_k`` with the adjoint correction ``C^θu_iiᵀ χ_k`` for the heat rows);
+  - ``"static-mass"``: as ``"petrov-galerkin"``, but the boundary velocities move the
+    interior with their displacement static shapes (``v_i = Ψ_uu v_b + Φ q_v``) and the
+    boundary momentum rows are projected on the same shapes, so the contact dofs carry the
+    Craig–Bampton mass of their static shapes, ``m_b + Ψ_uuᵀ M_ii Ψ_uu``, coupled to the
+    modes by ``Ψ_uuᵀ M_ii Φ`` (Galerkin on the momentum rows; the kinematic and heat rows
+    as ``"petrov-galerkin"``). The Petrov–Galerkin model leaves the interior mass that the
+    modes miss out of the contact dynamics (``docs/reduction.md`` section 10);
   - ``"galerkin"``: ``R̃ = R``;
   - ``"adjoint"``: the Craig–Bampton basis of the adjoint problem, static shapes
     ``−B_ii⁻ᵀ B_biᵀ`` and the same left modes (two-sided moment matching at s = 0);
@@ -58,7 +65,7 @@ from .thermal_inputs import input_basis, input_distributions
 
 __all__ = ["PROJECTIONS", "ThermoelasticCraigBampton", "craig_bampton_thermal"]
 
-PROJECTIONS = ("petrov-galerkin", "galerkin", "adjoint")
+PROJECTIONS = ("petrov-galerkin", "static-mass", "galerkin", "adjoint")
 #: Thermal reductions: the paper's boundary temperature dofs, or one input distribution each.
 THERMAL = ("inputs", "boundary")
 #: Relative gap within which entries of a shape tie for its largest (mirror-symmetric modes).
@@ -83,7 +90,8 @@ class ThermoelasticCraigBampton:
         (``fom.boundary``), as :func:`~femrub.model.build.first_order_model` builds it.
     max_n_uv : largest number of first-order mechanical shapes (``None``: all, ``2 n_i``).
     max_n_theta : largest number of thermal modes (``None``: all interior temperature dofs).
-    projection : ``"petrov-galerkin"``, ``"galerkin"`` or ``"adjoint"`` (module docstring).
+    projection : ``"petrov-galerkin"``, ``"static-mass"``, ``"galerkin"`` or ``"adjoint"``
+        (module docstring).
     boundary : optional ``{"u": positions in the u-block, "theta": positions in the θ-block}``
         overriding ``fom.boundary``.
     thermal : ``"boundary"`` (the paper's Eq. 10: every heated temperature dof is a boundary
@@ -159,6 +167,9 @@ class ThermoelasticCraigBampton:
         B = fom.B.tocsr()
         B_ib = B[self._int][:, self._bnd].toarray()
         psi = solver.solve(-B_ib)  # Eq. (11)
+        n_i = mi.size
+        if projection == "static-mass":  # v_i = Ψ_uu v_b: the static shapes' inertia
+            psi[n_i : 2 * n_i, mb.size : 2 * mb.size] = psi[:n_i, : mb.size]
         self.timings["static_shapes"] = time.perf_counter() - t0
         t0 = time.perf_counter()
         self.omega2, phi = lowest_modes(solver.K, solver.M, self.n_qv, solver.solve_K)
@@ -186,6 +197,8 @@ class ThermoelasticCraigBampton:
                 psi_l = solver.solve_transposed(-B[self._bnd][:, self._int].T.toarray())
             else:  # boundary equations kept as in the full model
                 psi_l = np.zeros_like(psi)
+                if projection == "static-mass":  # momentum rows of v_b on [1; Ψ_uu]
+                    psi_l[n_i : 2 * n_i, mb.size : 2 * mb.size] = psi[:n_i, : mb.size]
             mphi = _orient(normalise_columns(solver.M @ phi[:, : self.n_qu]))
             self.left = self._assemble(psi_l, mphi, phi, chi, solver.Ctu.T @ chi)
         self.timings["bases"] = time.perf_counter() - t0

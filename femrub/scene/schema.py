@@ -299,9 +299,9 @@ REDUCTION = Variant(
     common={
         "projection": Spec(
             C,
-            "petrov-galerkin",
-            choices=("petrov-galerkin", "galerkin", "adjoint"),
-            doc="left basis",
+            "static-mass",
+            choices=("static-mass", "petrov-galerkin", "galerkin", "adjoint"),
+            doc="left basis (static-mass: Petrov-Galerkin with the static shapes' inertia)",
         ),
         "thermal": Spec(
             C,
