@@ -10,7 +10,9 @@ The recorder ends a run as ``unstable`` (blow-up), ``diverged-physically`` (a st
 * ``heat_balance``: the same for the heat balance and ``tolerances["heat"]``;
 * ``reduction``: the a-posteriori estimate of a reduced run, ``tolerances["reduction"]``
   (the dict of :func:`femrub.reduction.estimate.estimate` with its ``tolerance``, as
-  ``summary.json["reduction_error"]``), above its tolerance -> ``"inaccurate"``;
+  ``summary.json["reduction_error"]``), above its tolerance -> ``"inaccurate"``; also when
+  the reduced dynamics can create energy: its largest relative energy growth rate
+  (``energy_growth_rate``, 1/s) times the run's duration above ``tolerances["energy"]``;
 * ``coulomb``: the recorded friction forces break Coulomb's law (outside the cone, not on it
   while sliding, or not opposite to the slip velocity) beyond ``tolerances["coulomb"]``
   (relative, :func:`femrub.contact.friction.coulomb_check`) -> ``"inaccurate"``.
@@ -78,6 +80,13 @@ def reduction(res, tol):
     err = tol.get("reduction")
     if not err:
         return None
+    growth = err.get("energy_growth_rate", 0.0) * float(res.t[-1] - res.t[0])
+    if growth > tol.get("energy", math.inf):
+        return (
+            f"the reduced model can create energy (growth exp({growth:.3g}) over the run, "
+            "reduction_error.energy_growth_rate): use reduction.projection = "
+            "'petrov-galerkin' or a full model"
+        )
     est, bound = err.get("estimate", 0.0), err.get("tolerance")
     if bound is None or est <= bound:
         return None

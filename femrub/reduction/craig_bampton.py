@@ -56,6 +56,7 @@ import warnings
 
 import numpy as np
 import scipy.sparse as sp
+from scipy.linalg import eigh
 
 from ..fem.eigen import lowest_modes, normalise_columns
 from ..fem.linalg import project
@@ -275,7 +276,7 @@ class ThermoelasticCraigBampton:
         ]
         contact = None if m.contact is None else m.contact.project(Lt, R)
         obs = {k: np.asarray(O @ R) for k, O in m.observations.items()}
-        energy = None if m.energy is None else self._energy(R, Ar, Br)
+        energy = None if m.energy is None else self._energy(R, Ar, Br, layout)
         to_full = None if m.to_full is None else np.asarray(m.to_full @ R)
         x0 = self.restrict(m.x0, n_uv, n_theta)
         info = {
@@ -288,6 +289,7 @@ class ThermoelasticCraigBampton:
             "n_boundary_u": int(self.boundary["u"].size),
             "n_boundary_theta": int(self.n_theta_b),
             "thermal": self.thermal,
+            "energy_growth_rate": self.energy_growth_rate if m.energy is not None else 0.0,
             "n_full": m.n_dofs,
             "n_reduced": layout.n,
             "timings": dict(self.timings, projection=time.perf_counter() - t0),
@@ -306,28 +308,70 @@ class ThermoelasticCraigBampton:
             info=info,
         )
 
-    def _energy(self, R, Ar, Br):
-        """Energy forms projected on ``R``; the thermal-stress work uses ``u̇``, not ``v``.
+    def _energy(self, R, Ar, Br, layout):
+        """Energy forms of the reduced model: the energy its own dynamics conserves.
 
-        The full model's thermal power ``vᵀ(−K^uθ θ)`` equals ``u̇ᵀ(−K^uθ θ)`` because
-        ``u̇ = v``; a reduced model only keeps ``u̇_b = v_b`` (its interior ``u̇`` is the rate of
-        ``R_u X̄``, which holds thermal-expansion shapes that ``v`` lacks), so the power of the
-        thermal stresses on the reduced displacement is ``(R_u Ā⁻¹ B̄ X̄)ᵀ(−K^uθ)(R_θ X̄)``
-        (``Pth``), and the work over a step, impulses included, is
-        ``ΔW_th = (R_u ΔX̄)ᵀ(−K^uθ)(R_θ X̄_m)`` (``Wth``: a heat impulse moves the expansion
-        shapes at once; docs/reduction.md section 8).
+        * kinetic ``½ (R_v X̄)ᵀ M (R_v X̄)``, as projected;
+        * elastic ``½ (R_z X̄)ᵀ K (R_z X̄)`` on the displacement the reduced kinematics
+          integrates: ``R_z = R`` except that the displacement part of each boundary-velocity
+          static shape, ``Γ = −K_ii⁻¹ C_ib`` (a damped model's quasi-static response to a
+          boundary velocity), is replaced by its M-orthogonal projection on the kept modes
+          ``Φ (Φᵀ M_ii Φ)⁻¹ Φᵀ M_ii Γ``
+          (the interior kinematic rows, projected on ``M_ii Φ``, only integrate that part);
+        * damping power: the rate of that energy along the homogeneous reduced dynamics,
+          ``P_d = sym(Q Ā⁻¹ B̄)`` on the mechanical coordinates (``Q`` kinetic + elastic);
+          with a lumped boundary mass and ``C = a M + b K`` this is negative semi-definite,
+          a positive part is energy the reduction creates, reported as the largest relative growth
+          rate ``max λ: P_d x = λ Q x`` (``info["energy_growth_rate"]``, 1/s);
+        * thermal-stress work on ``u̇``, not ``v``: the full model's power ``vᵀ(−K^uθ θ)``
+          equals ``u̇ᵀ(−K^uθ θ)`` because ``u̇ = v``; a reduced model only keeps
+          ``u̇_b = v_b`` (its interior ``u̇`` is the rate of ``R_u X̄``, which holds
+          thermal-expansion shapes that ``v`` lacks), so the power of the thermal stresses is
+          ``(R_u Ā⁻¹ B̄ X̄)ᵀ(−K^uθ)(R_θ X̄)`` (``Pth``) and the work over a step, impulses
+          included, ``ΔW_th = (R_u ΔX̄)ᵀ(−K^uθ)(R_θ X̄_m)`` (``Wth``: a heat impulse moves
+          the expansion shapes at once; docs/reduction.md section 8).
         """
         m = self.fom
-        forms = m.energy.project(R)
         L = m.layout
+        Rz = self._elastic_basis(R, layout)
+        forms = m.energy.project(R)
+        forms.Qe = sp.csr_matrix(project(Rz, m.energy.Qe, Rz))
+        rate = np.linalg.solve(Ar, Br)  # Ẋ̄ = Ā⁻¹ B̄ X̄ without loads and impulses
         if L.n_t:
             P = sp.csr_matrix(m.energy.Pth)
             P_u = sp.vstack([P[L.v], P[L.u], P[L.t]], format="csr")  # v-rows moved to u-rows
-            W = np.asarray(project(R, P_u, R))
-            rate = np.linalg.solve(Ar, Br)  # Ẋ̄ = Ā⁻¹ B̄ X̄ without loads and impulses
+            W = np.asarray(project(Rz, P_u, R))
             forms.Pth = sp.csr_matrix(rate.T @ W)
             forms.Wth = sp.csr_matrix(W)
+        self.energy_growth_rate = 0.0
+        if sp.csr_matrix(m.energy.Pd).count_nonzero():
+            mech = np.r_[np.arange(layout.n_u), layout.v.start + np.arange(layout.n_v)]
+            Q = (forms.Qk + forms.Qe).toarray()[np.ix_(mech, mech)]
+            D = Q @ rate[np.ix_(mech, mech)]
+            D = 0.5 * (D + D.T)
+            Pd = np.zeros((layout.n, layout.n))
+            Pd[np.ix_(mech, mech)] = D
+            forms.Pd = sp.csr_matrix(Pd)
+            # fastest relative growth d ln E / dt the damped reduced dynamics allows (1/s)
+            self.energy_growth_rate = float(eigh(D, Q, eigvals_only=True)[-1])
         return forms
+
+    def _elastic_basis(self, R, layout):
+        """``R`` with the boundary-velocity static shapes' displacement projected on the kept
+        modes (see :meth:`_energy`)."""
+        m = self.fom
+        L = m.layout
+        nb = self.boundary["u"].size
+        n_qu = layout.n_u - nb
+        cv_b = layout.v.start + np.arange(nb)
+        G = R[L.u][:, cv_b]
+        if not np.any(G):
+            return R
+        Phi = R[L.u][:, nb : nb + n_qu]
+        Rz = R.copy()
+        MPhi = m.blocks.M @ Phi
+        Rz[L.u, cv_b[0] : cv_b[-1] + 1] = Phi @ np.linalg.solve(Phi.T @ MPhi, MPhi.T @ G)
+        return Rz
 
     def reconstruct(self, Xr: np.ndarray, n_uv=None, n_theta=None) -> np.ndarray:
         """Full state ``R X̄`` of a reduced state (r,) or of the rows of an (m, r) array.

@@ -238,6 +238,8 @@ def reduce_model(model, scene, log=None, make_stepper=None):
     if make_stepper is not None:
         n_uv, n_theta = _checked(red, model, want, make_stepper, scene, report, log)
     reduced = red.reduce(n_uv, n_theta)
+    if "error" in report:  # energy the reduced dynamics can create (verdict rule ``reduction``)
+        report["error"]["energy_growth_rate"] = reduced.info["energy_growth_rate"]
     report.update(
         n_uv=n_uv,
         n_theta=n_theta,
