@@ -32,7 +32,7 @@ from pathlib import Path
 import numpy as np
 
 from femrub.app.simulation import build
-from femrub.reduction import ThermoelasticCraigBampton
+from femrub.reduction import PROJECTIONS, ThermoelasticCraigBampton
 from femrub.reduction.estimate import compare, field_norms
 from femrub.reduction.sizes import lobe_passage
 from femrub.scene.scene import load_scene
@@ -51,7 +51,7 @@ INTRO = (
 )
 
 
-def study(name, changes, sizes, thermal, every):
+def study(name, changes, sizes, thermal, every, projection="static-mass"):
     scene = load_scene(name, {"reduction.method": "none", "outputs.vtk_stride": 0, **changes})
     sim = build(scene)
     full, t_end = sim.model, scene["scheme"]["t_end"]
@@ -63,7 +63,7 @@ def study(name, changes, sizes, thermal, every):
     norms = field_norms(full)
     most = (max(s[0] for s in sizes), max(s[1] for s in sizes))
     t0 = time.process_time()
-    red = ThermoelasticCraigBampton(full, *most, thermal=thermal)
+    red = ThermoelasticCraigBampton(full, *most, thermal=thermal, projection=projection)
     cpu_red = time.process_time() - t0
     rows, big = [], None
     for n_uv, n_t in sizes:
@@ -86,7 +86,15 @@ def study(name, changes, sizes, thermal, every):
         r["est"] = compare(r["res"], big[0], r["X"], big[1], norms, window)
     return dict(scene=name, full=ref, cpu_full=cpu_full, cpu_reductor=cpu_red, rows=rows,
                 window=window, n_full=full.n_dofs, t_end=t_end, thermal=thermal,
-                full_energy=ref.energy_error(), full_heat=ref.heat_error())  # fmt: skip
+                projection=projection, full_energy=ref.energy_error(),
+                full_heat=ref.heat_error())  # fmt: skip
+
+
+def _heading(st) -> str:
+    return (
+        f"### {st['scene']} (thermal reduction `{st['thermal']}`, projection "
+        f"`{st.get('projection', 'petrov-galerkin')}`)"
+    )
 
 
 def _opts(sim):
@@ -98,7 +106,7 @@ def _opts(sim):
 def table(st) -> str:
     pct = lambda x: f"{100 * x:.2f} %"  # noqa: E731
     lines = [
-        f"### {st['scene']} (thermal reduction `{st['thermal']}`)",
+        _heading(st),
         "",
         f"Full model {st['n_full']} state dofs, t_end = {st['t_end']:g} s, lobe passage "
         f"{st['window']:.3g} s; full run CPU {st['cpu_full']:.1f} s, energy balance "
@@ -155,6 +163,7 @@ def main(argv=None):
     ap.add_argument("--rotor37", action="store_true")
     ap.add_argument("--quick", action="store_true")
     ap.add_argument("--thermal", default="inputs", choices=("inputs", "boundary"))
+    ap.add_argument("--projection", default="static-mass", choices=PROJECTIONS)
     ap.add_argument("--default", action="store_true", help="default reduction vs full model")
     ap.add_argument("--scene", default="twisted-naca")
     ap.add_argument("--set", action="append", default=[], metavar="KEY=VALUE")
@@ -173,11 +182,11 @@ def main(argv=None):
         changes["scheme.t_end"] = 0.002
         sizes = sizes[1:4]
     every = 500 if not a.rotor37 else 250
-    st = study(name, changes, sizes, a.thermal, every)
+    st = study(name, changes, sizes, a.thermal, every, a.projection)
     text = table(st)
     print(text)
     if not a.quick:
-        png = DOCS / f"reduction_3d_{name}_{a.thermal}.png"
+        png = DOCS / f"reduction_3d_{name}_{a.thermal}_{a.projection}.png"
         plot(st, png)
         write_section(DOCS / "reduction_3d.md", st, text + f"\n![{name}]({png.name})\n")
     return st
@@ -188,7 +197,7 @@ def write_section(path: Path, st, text: str) -> None:
     doc = path.read_text(encoding="utf-8") if path.exists() else "# 3D reduction cost\n"
     if HEADING not in doc:
         doc = doc.rstrip("\n") + "\n" + HEADING + "\n\n" + INTRO + "\n"
-    sub = st.get("heading") or f"### {st['scene']} (thermal reduction `{st['thermal']}`)"
+    sub = st.get("heading") or _heading(st)
     head, _, rest = doc.partition(HEADING)
     parts = rest.split("\n### ")
     kept = [p for p in parts[1:] if not ("### " + p).startswith(sub)]
