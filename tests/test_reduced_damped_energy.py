@@ -38,3 +38,31 @@ def test_reduced_damped_frictional_rub_closes_energy_balance(tmp_path, thermal):
     assert res.energy_error() < 1e-6, res.energy_error()
     rate = built.model.info["energy_growth_rate"]
     assert rate < 1e-3 * res.t[-1] ** -1, rate  # the reduction creates no energy
+
+
+def test_second_order_craig_bampton_is_the_classical_galerkin_model(tmp_path):
+    """``projection = "second-order"``: M̄ = TᵀMT, K̄ = TᵀKT, C̄ = TᵀCT with T = [I 0; Ψ Φ]
+    on u and v alike; the damped frictional rub closes its energy balance."""
+    import scipy.sparse as sp
+
+    from femrub.reduction import ThermoelasticCraigBampton
+
+    over = dict(SCENE, **{"physics.thermal": "off", "reduction.n_theta": 0})
+    over["reduction.projection"] = "second-order"
+    res, built = run_scene(load_scene("twisted-naca", over), tmp_path / "run")
+    assert res.energy_error() < 1e-6, res.energy_error()
+    full = built.full
+    red = ThermoelasticCraigBampton(full, 8, 0, projection="second-order")
+    rm = red.reduce()
+    L, Lr = full.layout, rm.layout
+    T = red.R[L.u][:, Lr.u]
+    assert np.allclose(red.R[L.v][:, Lr.v], T)  # velocity shapes = displacement shapes
+    b = full.blocks
+    A, B = rm.A.toarray(), rm.B.toarray()
+    for got, want in (
+        (A[Lr.v, Lr.v], T.T @ (b.M @ T)),
+        (-B[Lr.v, Lr.u], T.T @ (b.K @ T)),
+        (-B[Lr.v, Lr.v], T.T @ (sp.csr_matrix(b.C) @ T)),
+    ):
+        assert np.allclose(got, want, rtol=1e-9, atol=1e-9 * np.abs(want).max())
+    assert rm.info["energy_growth_rate"] < 1e-3

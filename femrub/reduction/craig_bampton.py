@@ -24,6 +24,12 @@ any number of contacts) and builds
     as ``"petrov-galerkin"``). The Petrov–Galerkin model leaves the interior mass that the
     modes miss out of the contact dynamics (``docs/reduction.md`` section 10);
   - ``"galerkin"``: ``R̃ = R``;
+  - ``"second-order"``: the classical second-order Craig–Bampton model of the mechanics
+    (Galerkin, ``R̃ = R``, with the boundary velocity shapes equal to the displacement ones,
+    ``v = [I, 0; Ψ, Φ] v̄``, instead of the first-order static shapes of Eq. 11): the reduced
+    mass ``TᵀMT`` keeps the static shapes' inertia, the model is symmetric and conserves
+    its energy, and its contact impulses converge much faster with the number of modes
+    (``docs/reduction.md`` section 8);
   - ``"adjoint"``: the Craig–Bampton basis of the adjoint problem, static shapes
     ``−B_ii⁻ᵀ B_biᵀ`` and the same left modes (two-sided moment matching at s = 0);
 
@@ -66,7 +72,7 @@ from .thermal_inputs import input_basis, input_distributions
 
 __all__ = ["PROJECTIONS", "ThermoelasticCraigBampton", "craig_bampton_thermal"]
 
-PROJECTIONS = ("petrov-galerkin", "static-mass", "galerkin", "adjoint")
+PROJECTIONS = ("petrov-galerkin", "static-mass", "galerkin", "adjoint", "second-order")
 #: Thermal reductions: the paper's boundary temperature dofs, or one input distribution each.
 THERMAL = ("inputs", "boundary")
 #: Relative gap within which entries of a shape tie for its largest (mirror-symmetric modes).
@@ -91,7 +97,8 @@ class ThermoelasticCraigBampton:
         (``fom.boundary``), as :func:`~femrub.model.build.first_order_model` builds it.
     max_n_uv : largest number of first-order mechanical shapes (``None``: all, ``2 n_i``).
     max_n_theta : largest number of thermal modes (``None``: all interior temperature dofs).
-    projection : ``"petrov-galerkin"``, ``"static-mass"``, ``"galerkin"`` or ``"adjoint"``
+    projection : ``"petrov-galerkin"``, ``"static-mass"``, ``"galerkin"``, ``"adjoint"`` or
+        ``"second-order"``
         (module docstring).
     boundary : optional ``{"u": positions in the u-block, "theta": positions in the θ-block}``
         overriding ``fom.boundary``.
@@ -171,6 +178,10 @@ class ThermoelasticCraigBampton:
         n_i = mi.size
         if projection == "static-mass":  # v_i = Ψ_uu v_b: the static shapes' inertia
             psi[n_i : 2 * n_i, mb.size : 2 * mb.size] = psi[:n_i, : mb.size]
+        if projection == "second-order":  # velocity shapes = displacement shapes [I; Ψ]
+            n_mi, nb = mi.size, mb.size
+            psi[n_mi : 2 * n_mi, nb : 2 * nb] = psi[:n_mi, :nb]
+            psi[:n_mi, nb : 2 * nb] = 0.0
         self.timings["static_shapes"] = time.perf_counter() - t0
         t0 = time.perf_counter()
         self.omega2, phi = lowest_modes(solver.K, solver.M, self.n_qv, solver.solve_K)
@@ -191,7 +202,7 @@ class ThermoelasticCraigBampton:
         self._idx = (mb, mi, tb, ti)
         self.layout = self._layout(self.n_uv, self.n_theta)
         self.R = self._assemble(psi, phi[:, : self.n_qu], phi, chi, phi_ut)
-        if projection == "galerkin":
+        if projection in ("galerkin", "second-order"):
             self.left = self.R
         else:  # left (adjoint) modes; boundary columns: adjoint static shapes or unit vectors
             if projection == "adjoint":
@@ -267,7 +278,8 @@ class ThermoelasticCraigBampton:
         t0 = time.perf_counter()
         m = self.fom
         R = np.take(self.R, cols, axis=1)  # C-ordered copies: faster sparse products
-        Lt = R if self.projection == "galerkin" else np.take(self.left, cols, axis=1)
+        galerkin = self.projection in ("galerkin", "second-order")
+        Lt = R if galerkin else np.take(self.left, cols, axis=1)
         Ar = project(Lt, m.A, R)
         Br = project(Lt, m.B, R)
         loads = [

@@ -179,7 +179,9 @@ def _checked(red, model, want, make_stepper, scene, report, log) -> tuple[int, i
 def lobe_passage(scene) -> float:
     """Duration (s) of one lobe passage of the casing (0 without lobes or rotation)."""
     cas, omega = scene["contact"]["casing"], abs(scene["loads"]["rotation_speed"])
-    lobes = cas.get("lobes", 0) if isinstance(cas, dict) else 0
+    lobes = 0
+    if isinstance(cas, dict):  # the two-lobe casing of Piollet et al. has two, by definition
+        lobes = 2 if cas.get("kind") == "two-lobe" else cas.get("lobes", 0)
     return 2.0 * np.pi / (omega * lobes) if lobes and omega else 0.0
 
 

@@ -300,8 +300,9 @@ REDUCTION = Variant(
         "projection": Spec(
             C,
             "static-mass",
-            choices=("static-mass", "petrov-galerkin", "galerkin", "adjoint"),
-            doc="left basis (static-mass: Petrov-Galerkin with the static shapes' inertia)",
+            choices=("static-mass", "petrov-galerkin", "galerkin", "adjoint", "second-order"),
+            doc="left basis (static-mass: Petrov-Galerkin with the static shapes' inertia; "
+            "second-order: classical Galerkin Craig-Bampton of the mechanics)",
         ),
         "thermal": Spec(
             C,
