@@ -12,6 +12,14 @@ and heat balance residuals, the lowest temperature reached, the hierarchical est
 ``python benchmarks/reduction_convergence_3d.py [--rotor37] [--quick]`` writes its table
 into the section "Reduced vs full model in 3D" of ``docs/reduction_3d.md`` (one
 subsection per scene) and a plot ``docs/reduction_3d_<scene>.png``.
+
+``--default`` instead runs the scene as ``femrub run`` does (default reduction: ``auto``
+sizes, its estimate and verdict) and the same scene with ``reduction.method = "none"``,
+and writes the issue-11 acceptance numbers (final temperature and displacement fields,
+contact temperature history, balances, lowest temperature) into the subsection
+"default reduction vs full" (:mod:`default_vs_full`). ``--scene NAME`` and ``--set
+KEY=VALUE`` choose the scene (default ``twisted-naca``; ``rotor37-thermal`` with
+``--set scheme.t_end=2.3e-3`` for one lobe passage).
 """
 
 from __future__ import annotations
@@ -24,7 +32,7 @@ from pathlib import Path
 import numpy as np
 
 from femrub.app.simulation import build
-from femrub.reduction import ThermoelasticCraigBampton
+from femrub.reduction import PROJECTIONS, ThermoelasticCraigBampton
 from femrub.reduction.estimate import compare, field_norms
 from femrub.reduction.sizes import lobe_passage
 from femrub.scene.scene import load_scene
@@ -32,9 +40,11 @@ from femrub.scene.scene import load_scene
 DOCS = Path(__file__).resolve().parents[1] / "docs"
 HEADING = "\n## Reduced vs full model in 3D"
 INTRO = (
-    "`python benchmarks/reduction_convergence_3d.py [--rotor37]` (issue 11): one full run, "
-    "one reductor at the largest sizes, its sub-basis models stepped with the same scheme "
-    "and step. Errors relative to the full model: contact impulse per lobe passage, "
+    "`python benchmarks/reduction_convergence_3d.py [--rotor37] [--projection P]` (issue "
+    "11): one full run, one reductor at the largest sizes, its sub-basis models stepped with "
+    "the same scheme and step (`--default`: the scene reduced as `femrub run` does, against "
+    "the same scene unreduced). Errors relative to the full model: contact impulse per "
+    "lobe passage, "
     "contact temperature history, displacement and temperature fields (mass / heat-capacity "
     "weighted L2 over the blade; largest over 1 ms checkpoints relative to the largest "
     "norm, and at the final time relative to the final norm); balances relative to the "
@@ -43,7 +53,7 @@ INTRO = (
 )
 
 
-def study(name, changes, sizes, thermal, every):
+def study(name, changes, sizes, thermal, every, projection="static-mass"):
     scene = load_scene(name, {"reduction.method": "none", "outputs.vtk_stride": 0, **changes})
     sim = build(scene)
     full, t_end = sim.model, scene["scheme"]["t_end"]
@@ -55,7 +65,7 @@ def study(name, changes, sizes, thermal, every):
     norms = field_norms(full)
     most = (max(s[0] for s in sizes), max(s[1] for s in sizes))
     t0 = time.process_time()
-    red = ThermoelasticCraigBampton(full, *most, thermal=thermal)
+    red = ThermoelasticCraigBampton(full, *most, thermal=thermal, projection=projection)
     cpu_red = time.process_time() - t0
     rows, big = [], None
     for n_uv, n_t in sizes:
@@ -78,7 +88,15 @@ def study(name, changes, sizes, thermal, every):
         r["est"] = compare(r["res"], big[0], r["X"], big[1], norms, window)
     return dict(scene=name, full=ref, cpu_full=cpu_full, cpu_reductor=cpu_red, rows=rows,
                 window=window, n_full=full.n_dofs, t_end=t_end, thermal=thermal,
-                full_energy=ref.energy_error(), full_heat=ref.heat_error())  # fmt: skip
+                projection=projection, full_energy=ref.energy_error(),
+                full_heat=ref.heat_error())  # fmt: skip
+
+
+def _heading(st) -> str:
+    return (
+        f"### {st['scene']} (thermal reduction `{st['thermal']}`, projection "
+        f"`{st.get('projection', 'petrov-galerkin')}`)"
+    )
 
 
 def _opts(sim):
@@ -90,7 +108,7 @@ def _opts(sim):
 def table(st) -> str:
     pct = lambda x: f"{100 * x:.2f} %"  # noqa: E731
     lines = [
-        f"### {st['scene']} (thermal reduction `{st['thermal']}`)",
+        _heading(st),
         "",
         f"Full model {st['n_full']} state dofs, t_end = {st['t_end']:g} s, lobe passage "
         f"{st['window']:.3g} s; full run CPU {st['cpu_full']:.1f} s, energy balance "
@@ -147,7 +165,15 @@ def main(argv=None):
     ap.add_argument("--rotor37", action="store_true")
     ap.add_argument("--quick", action="store_true")
     ap.add_argument("--thermal", default="inputs", choices=("inputs", "boundary"))
+    ap.add_argument("--projection", default="static-mass", choices=PROJECTIONS)
+    ap.add_argument("--default", action="store_true", help="default reduction vs full model")
+    ap.add_argument("--scene", default="twisted-naca")
+    ap.add_argument("--set", action="append", default=[], metavar="KEY=VALUE")
     a = ap.parse_args(argv)
+    if a.default:
+        from default_vs_full import run_default
+
+        return run_default(a.scene, a.set, DOCS / "reduction_3d.md", write_section)
     if a.rotor37:
         name, changes = "rotor37", {"scheme.t_end": 0.00175}  # one lobe passage
         sizes = [(4, 4), (8, 8), (16, 16), (32, 32)]
@@ -158,11 +184,11 @@ def main(argv=None):
         changes["scheme.t_end"] = 0.002
         sizes = sizes[1:4]
     every = 500 if not a.rotor37 else 250
-    st = study(name, changes, sizes, a.thermal, every)
+    st = study(name, changes, sizes, a.thermal, every, a.projection)
     text = table(st)
     print(text)
     if not a.quick:
-        png = DOCS / f"reduction_3d_{name}_{a.thermal}.png"
+        png = DOCS / f"reduction_3d_{name}_{a.thermal}_{a.projection}.png"
         plot(st, png)
         write_section(DOCS / "reduction_3d.md", st, text + f"\n![{name}]({png.name})\n")
     return st
@@ -173,7 +199,7 @@ def write_section(path: Path, st, text: str) -> None:
     doc = path.read_text(encoding="utf-8") if path.exists() else "# 3D reduction cost\n"
     if HEADING not in doc:
         doc = doc.rstrip("\n") + "\n" + HEADING + "\n\n" + INTRO + "\n"
-    sub = f"### {st['scene']} (thermal reduction `{st['thermal']}`)"
+    sub = st.get("heading") or _heading(st)
     head, _, rest = doc.partition(HEADING)
     parts = rest.split("\n### ")
     kept = [p for p in parts[1:] if not ("### " + p).startswith(sub)]

@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import math
 
+from ..reduction.estimate import QUANTITIES
+
 __all__ = ["explain", "format_timings"]
 
 
@@ -77,11 +79,7 @@ def _reduction(r: dict) -> list[str]:
             )
     err = r.get("error")
     if err:
-        q = ", ".join(
-            f"{k.replace('_', ' ')} {100 * err[k]:.2g} %"
-            for k in ("contact_force", "contact_temperature", "displacement", "temperature")
-            if k in err
-        )
+        q = ", ".join(f"{k.replace('_', ' ')} {100 * err[k]:.2g} %" for k in QUANTITIES if k in err)
         verdict = "within" if err["estimate"] <= err["tolerance"] else "EXCEEDS"
         lines.append(
             f"estimated error {100 * err['estimate']:.2g} % ({verdict} tolerance "

@@ -16,6 +16,13 @@ any number of contacts) and builds
     contact dofs) and the interior equations are projected on the left eigenvectors of the
     clamped uncoupled problem (``M_ii φ_j`` for the kinematic rows, ``φ_j`` for the momentum
     rows, ``χ_k`` with the adjoint correction ``C^θu_iiᵀ χ_k`` for the heat rows);
+  - ``"static-mass"``: as ``"petrov-galerkin"``, but the boundary velocities move the
+    interior with their displacement static shapes (``v_i = Ψ_uu v_b + Φ q_v``) and the
+    boundary momentum rows are projected on the same shapes, so the contact dofs carry the
+    Craig–Bampton mass of their static shapes, ``m_b + Ψ_uuᵀ M_ii Ψ_uu``, coupled to the
+    modes by ``Ψ_uuᵀ M_ii Φ`` (Galerkin on the momentum rows; the kinematic and heat rows
+    as ``"petrov-galerkin"``). The Petrov–Galerkin model leaves the interior mass that the
+    modes miss out of the contact dynamics (``docs/reduction.md`` section 10);
   - ``"galerkin"``: ``R̃ = R``;
   - ``"second-order"``: the classical second-order Craig–Bampton model of the mechanics
     (Galerkin, ``R̃ = R``, with the boundary velocity shapes equal to the displacement ones,
@@ -65,7 +72,7 @@ from .thermal_inputs import input_basis, input_distributions
 
 __all__ = ["PROJECTIONS", "ThermoelasticCraigBampton", "craig_bampton_thermal"]
 
-PROJECTIONS = ("petrov-galerkin", "galerkin", "adjoint", "second-order")
+PROJECTIONS = ("petrov-galerkin", "static-mass", "galerkin", "adjoint", "second-order")
 #: Thermal reductions: the paper's boundary temperature dofs, or one input distribution each.
 THERMAL = ("inputs", "boundary")
 #: Relative gap within which entries of a shape tie for its largest (mirror-symmetric modes).
@@ -90,7 +97,8 @@ class ThermoelasticCraigBampton:
         (``fom.boundary``), as :func:`~femrub.model.build.first_order_model` builds it.
     max_n_uv : largest number of first-order mechanical shapes (``None``: all, ``2 n_i``).
     max_n_theta : largest number of thermal modes (``None``: all interior temperature dofs).
-    projection : ``"petrov-galerkin"``, ``"galerkin"``, ``"adjoint"`` or ``"second-order"``
+    projection : ``"petrov-galerkin"``, ``"static-mass"``, ``"galerkin"``, ``"adjoint"`` or
+        ``"second-order"``
         (module docstring).
     boundary : optional ``{"u": positions in the u-block, "theta": positions in the θ-block}``
         overriding ``fom.boundary``.
@@ -167,6 +175,9 @@ class ThermoelasticCraigBampton:
         self._int = np.r_[mi, nu + mi, 2 * nu + ti].astype(int)
         B = fom.B.tocsr()
         psi = solver.solve(-B[self._int][:, self._bnd])  # Eq. (11), sparse right-hand sides
+        n_i = mi.size
+        if projection == "static-mass":  # v_i = Ψ_uu v_b: the static shapes' inertia
+            psi[n_i : 2 * n_i, mb.size : 2 * mb.size] = psi[:n_i, : mb.size]
         if projection == "second-order":  # velocity shapes = displacement shapes [I; Ψ]
             n_mi, nb = mi.size, mb.size
             psi[n_mi : 2 * n_mi, nb : 2 * nb] = psi[:n_mi, :nb]
@@ -196,6 +207,9 @@ class ThermoelasticCraigBampton:
         else:  # left (adjoint) modes; boundary columns: adjoint static shapes or unit vectors
             if projection == "adjoint":
                 psi_l = solver.solve_transposed(-B[self._bnd][:, self._int].T)
+            elif projection == "static-mass":  # momentum rows of v_b on [1; Ψ_uu]
+                psi_l = np.zeros_like(psi)
+                psi_l[n_i : 2 * n_i, mb.size : 2 * mb.size] = psi[:n_i, : mb.size]
             else:  # boundary equations kept as in the full model: no static shapes
                 psi_l = None
             mphi = _orient(normalise_columns(solver.M @ phi[:, : self.n_qu]))

@@ -15,7 +15,9 @@ for the quantities users read:
   ``max_t ‖ΔT_c‖_∞ / max_t ‖T_c,ref‖_∞``;
 * ``displacement`` and ``temperature``: the fields at ``checkpoints`` times,
   ``max_k ‖Δu(t_k)‖_M / max_k ‖u_ref(t_k)‖_M`` (mass-weighted L2 over the blade; heat
-  capacity for θ).
+  capacity for θ), and at the final checkpoint ``‖Δu(t_end)‖_M / ‖u_ref(t_end)‖_M``
+  (``displacement_end``, ``temperature_end``: the fields a user looks at when the run ends,
+  whose norm can be a fraction of the largest).
 
 Both models are stepped with the scene's scheme and step. The same comparison against the
 full model is :func:`compare` (benchmarks/reduction_convergence_3d.py).
@@ -54,8 +56,16 @@ __all__ = [
 ]
 
 #: Relative errors reported (``summary.json["reduction_error"]``); the first three decide.
-QUANTITIES = ("contact_force", "contact_temperature", "displacement", "temperature")
-DECISIVE = ("contact_force", "contact_temperature", "displacement")
+QUANTITIES = (
+    "contact_force",
+    "contact_temperature",
+    "displacement",
+    "temperature",
+    "displacement_end",
+    "temperature_end",
+)
+DECISIVE = ("contact_force", "contact_temperature", "displacement", "displacement_end",
+            "temperature_end")  # fmt: skip
 #: displacement perturbation (m, random on the u-coordinates) of the sensitivity twin
 PERTURBATION = 1e-15
 #: the predictable horizon ends where the twin differs by this share of the tolerance
@@ -121,6 +131,7 @@ def compare(run, ref, fields_run, fields_ref, norms: dict, window: float) -> dic
         dn = np.sqrt(np.einsum("ij,ij->i", D, (W @ D.T).T))
         bn = np.sqrt(np.einsum("ij,ij->i", B, (W @ B.T).T))
         out[name] = _rel(dn.max(), bn.max())
+        out[name + "_end"] = _rel(dn[-1], bn[-1])
     return out
 
 

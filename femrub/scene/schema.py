@@ -299,9 +299,10 @@ REDUCTION = Variant(
     common={
         "projection": Spec(
             C,
-            "petrov-galerkin",
-            choices=("petrov-galerkin", "galerkin", "adjoint", "second-order"),
-            doc="left basis ('second-order': classical Galerkin Craig-Bampton of the mechanics)",
+            "static-mass",
+            choices=("static-mass", "petrov-galerkin", "galerkin", "adjoint", "second-order"),
+            doc="left basis (static-mass: Petrov-Galerkin with the static shapes' inertia; "
+            "second-order: classical Galerkin Craig-Bampton of the mechanics)",
         ),
         "thermal": Spec(
             C,
