@@ -49,6 +49,29 @@ def _contacts(c: dict, reach_key) -> list[str]:
     return lines
 
 
+def _centrifugal(c: dict | None) -> list[str]:
+    if not c:
+        return []
+    if c["method"] == "off":
+        return [f"off ({c['why']})"]
+    head = (
+        f"{c['method']} prestress at {c['rotation_speed']:g} rad/s "
+        f"({c['newton_iterations']} Newton iterations, {c['load_increments']} load "
+        f"increment(s), residual {c['residual']:.1e}); geometric stiffness and spin "
+        "softening in K"
+    )
+    grow = (
+        f"radial tip growth at the contacts {_um(c['tip_growth_min'])} .. "
+        f"{_um(c['tip_growth_max'])} (mean {_um(c['tip_growth_mean'])})"
+    )
+    if c["clearance"] == "running":
+        gaps = "running clearances (contact.clearance = 'running'): the growth closes nothing"
+    else:
+        gaps = "cold clearances (contact.clearance = 'cold'): the growth closes the gaps"
+    gaps += f"; smallest gap over a revolution {_um(c['min_gap'])} .. {_um(c['max_min_gap'])}"
+    return [head, grow, gaps]
+
+
 def _reduction(r: dict) -> list[str]:
     if r["method"] == "none":
         return ["none (reduction.method = 'none'): the full model runs"]
@@ -89,6 +112,7 @@ def explain(report: dict, reach_key=None) -> str:
     rows.append(("thermal", report["thermal"]))
     for d in report["dropped"]:
         rows.append(("dropped", d))
+    rows += [("prestress", x) for x in _centrifugal(report.get("centrifugal"))]
     reach_key = reach_key or report.get("reach_key", "auto")
     rows += [("contacts", x) for x in _contacts(report["contacts"], reach_key)]
     rows += [("reduction", x) for x in _reduction(report["reduction"])]

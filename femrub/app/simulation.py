@@ -25,6 +25,7 @@ from ..contact.heat import heat_coefficients
 from ..contact.points import locate_contacts
 from ..contact.reach import contact_reach, normal_deflection
 from ..fem.discretisation import assemble, discretise
+from ..fem.prestress import centrifugal_prestress
 from ..model.rub import rub_model, tip_load
 from ..reduction.sizes import natural_frequencies, reduce_model
 from ..scene.spec import SceneError, fail
@@ -120,13 +121,15 @@ def _build(scene, log, modes) -> Simulation:
     try:
         disc = discretise(blade, p["order"] if blade.dim == 3 else 1,
                           clamped=scene["boundary"]["clamped"])  # fmt: skip
+        prestress = _prestress(scene, disc, material, omega, log)
         mats = assemble(
             disc, material, area=tr.area_of(scene), lumping=p["lumping"],
             coupling=tr.coupling_of(scene), beta=p["beta"], strain_heating=p["strain_heating"],
             rayleigh=tuple(p["rayleigh"]), damping_ratio=p["damping_ratio"],
-            damping_modes=tuple(p["damping_modes"]),
+            damping_modes=tuple(p["damping_modes"]), prestress=prestress,
         )  # fmt: skip
         candidates = locate_contacts(disc)
+        growth = prestress.growth(candidates) if prestress is not None else np.zeros(candidates.n)
         force = tr.force_law(scene)
         loads = []
         if force:
@@ -135,7 +138,7 @@ def _build(scene, log, modes) -> Simulation:
             loads = [tip_load(disc, mats, vector, signal)]
         reach = contact_reach(
             candidates, casing, rotation_speed=omega, gap_reference=c["gap_reference"],
-            reach=c["reach"], margin=c["reach_margin"],
+            reach=c["reach"], margin=c["reach_margin"], growth=growth, clearance=c["clearance"],
             deflection=normal_deflection(mats, candidates.normal_rows(mats),
                                          loads[0].vector if loads else None, force and force[2]),
         )  # fmt: skip
@@ -158,6 +161,7 @@ def _build(scene, log, modes) -> Simulation:
     report["dropped"] += [d for d in full.info.get("dropped", []) if "temperature" not in d]
     report["full"] = {"n_dofs": full.n_dofs, "fe_dofs": mats.n_u + mats.n_t, **_layout(full)}
     report["contacts"] = _contacts_report(candidates, reach)
+    report["centrifugal"] = _centrifugal_report(scene, prestress, growth, reach)
     model, limits = _select_signals(scene, full, report)
     if modes:
         report["natural_frequencies_hz"] = natural_frequencies(model, modes).tolist()
@@ -173,6 +177,34 @@ def _build(scene, log, modes) -> Simulation:
     return Simulation(
         scene, reduced, full, fields, reductor, stepper, limits, report, clock.timings
     )
+
+
+def _prestress(scene, disc, material, omega, log):
+    """The scene's centrifugal prestress (:mod:`femrub.fem.prestress`), or ``None``."""
+    method = tr.centrifugal_of(scene)
+    if method is None:
+        return None
+    if log:
+        log(f"centrifugal prestress ({method}) at {omega:g} rad/s ...")
+    return centrifugal_prestress(disc, material, omega, method, log=log)
+
+
+def _centrifugal_report(scene, prestress, growth, reach) -> dict:
+    if prestress is None:
+        why = "loads.centrifugal = 'off'" if scene["loads"]["centrifugal"] == "off" else (
+            "the 1D bar" if tr.is_bar(scene) else "loads.rotation_speed = 0")
+        return {"method": "off", "why": why}
+    g = np.asarray(growth, dtype=float)
+    return {
+        "method": prestress.method, "rotation_speed": prestress.omega,
+        "newton_iterations": prestress.iterations, "load_increments": prestress.increments,
+        "residual": prestress.residual, "clearance": scene["contact"]["clearance"],
+        "tip_growth_min": float(g.min()) if g.size else 0.0,
+        "tip_growth_max": float(g.max()) if g.size else 0.0,
+        "tip_growth_mean": float(g.mean()) if g.size else 0.0,
+        "min_gap": float(reach.min_gap.min()) if g.size else 0.0,
+        "max_min_gap": float(reach.min_gap.max()) if g.size else 0.0,
+    }  # fmt: skip
 
 
 def _stepper(scene, model, report):

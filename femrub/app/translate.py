@@ -18,6 +18,7 @@ __all__ = [
     "ForceLaw",
     "area_of",
     "casing_of",
+    "centrifugal_of",
     "coupling_of",
     "force_law",
     "heat_law_of",
@@ -77,6 +78,14 @@ def coupling_of(scene) -> str:
 def heat_law_of(scene) -> str:
     """``"alpha"`` (α given, the bar) or ``"friction"`` (μ Ω r, blades)."""
     return "alpha" if is_bar(scene) else "friction"
+
+
+def centrifugal_of(scene) -> str | None:
+    """Prestress method (``"linear"``/``"nonlinear"``) at the scene's speed, or ``None``."""
+    mode = scene["loads"]["centrifugal"]
+    if mode == "off" or is_bar(scene) or scene["loads"]["rotation_speed"] == 0.0:
+        return None
+    return "nonlinear" if mode == "auto" else mode
 
 
 def area_of(scene) -> float:

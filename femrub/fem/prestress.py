@@ -72,19 +72,19 @@ class _Forms:
     """The forms of :mod:`femrub.fem.centrifugal` on one basis, with fixed parameters."""
 
     def __init__(self, basis, material, axis, linear: bool):
-        lam, mu = lame_parameters(material.young, material.poisson, 3)
-        self.basis = basis
-        self.p = dict(lam=lam, mu=mu, linear=1.0 if linear else 0.0, **cf.axis_params(axis))
+        self.lam, self.mu = lame_parameters(material.young, material.poisson, 3)
+        self.basis, self.axis, self.linear = basis, axis, linear
         self.rho = float(material.rho)
 
     def force(self, u, omega2):
-        return cf.centrifugal_force.assemble(self.basis, u0=u, rho_w2=self.rho * omega2, **self.p)
+        return cf.centrifugal_force(self.basis, u, self.rho * omega2, self.axis)
 
     def internal(self, u):
-        return cf.internal_force.assemble(self.basis, u0=u, **self.p)
+        return cf.internal_force(self.basis, u, self.lam, self.mu, self.linear)
 
     def tangent(self, u, MP, omega2):
-        return cf.tangent_stiffness.assemble(self.basis, u0=u, **self.p) - omega2 * MP
+        K = cf.tangent_stiffness(self.basis, u, self.lam, self.mu, self.linear)
+        return K if MP is None else K - omega2 * MP
 
 
 def _free(basis, fixed) -> np.ndarray:
@@ -139,8 +139,8 @@ def centrifugal_prestress(
     w2 = omega * omega
     u = np.zeros(basis.N)
     if w2 == 0.0:
-        return Prestress(0.0, method, u, _sub(forms.tangent(u, 0.0, 0.0), free), free, 0, 0.0, 0)
-    MP = cf.spin_mass.assemble(basis, rho=forms.rho, **forms.p)
+        return Prestress(0.0, method, u, _sub(forms.tangent(u, None, 0.0), free), free, 0, 0.0, 0)
+    MP = cf.spin_mass(basis, forms.rho, disc.blade.axis)
     scale = float(np.linalg.norm(forms.force(u, w2)[free])) or 1.0
     if method == "linear":
         K0 = _sub(forms.tangent(u, MP, w2), free)

@@ -167,6 +167,13 @@ CONTACT = {
         **NONNEG,
     ),
     "reach_margin": _f(0.0, "length", "added to the automatic reach", **NONNEG),
+    "clearance": Spec(
+        C,
+        "running",
+        choices=("running", "cold"),
+        doc="casing clearances are measured from the tip at speed (running) or at rest "
+        "(cold: the centrifugal tip growth closes them)",
+    ),
     "gap_reference": Spec(
         C,
         "per-node",
@@ -208,6 +215,13 @@ TIP_FORCE = Variant(
 
 LOADS = {
     "rotation_speed": _f(0.0, "angular_speed", "rotation speed Ω", **NONNEG),
+    "centrifugal": Spec(
+        C,
+        "auto",
+        choices=("auto", "off", "linear", "nonlinear"),
+        doc="3D: static centrifugal prestress at Ω, its geometric stiffness and spin "
+        "softening (auto: nonlinear when Ω > 0; the bar: off)",
+    ),
     "tip_force": TIP_FORCE,
 }
 

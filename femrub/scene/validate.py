@@ -139,6 +139,12 @@ def _cross_check(d: dict) -> None:
             )
         if d["boundary"].get("root") is not None:
             fail("boundary.root", d["boundary"]["root"], "the bar is clamped at x = 0; remove it")
+        if loads["centrifugal"] in ("linear", "nonlinear"):
+            fail(
+                "loads.centrifugal",
+                loads["centrifugal"],
+                "the 1D bar has no rotation axis; use 'auto' or 'off'",
+            )
     else:
         if contact["heat_coefficient"] != 0.0:
             fail(
