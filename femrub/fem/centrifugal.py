@@ -45,7 +45,7 @@ def axis_params(axis) -> dict:
 
 
 def _radial(a, x):
-    """``P x = x − a (a · x)`` for a field ``x`` of shape (3, ...), ``a`` from :func:`axis_params`."""
+    """``P x = x − a (a · x)`` for a field ``x`` (3, ...); ``a`` from :func:`axis_params`."""
     a = (a["a0"], a["a1"], a["a2"])
     ax = a[0] * x[0] + a[1] * x[1] + a[2] * x[2]
     return np.array([x[i] - a[i] * ax for i in range(3)])

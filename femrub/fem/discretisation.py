@@ -133,7 +133,8 @@ def assemble(
     if prestress is not None:
         if not np.array_equal(prestress.free_u, mats.free_u):
             raise ValueError("the prestress was computed on another discretisation")
-        mats = replace(mats, K=prestress.K, C=(rayleigh[0] * mats.M + rayleigh[1] * prestress.K).tocsr())
+        C = (rayleigh[0] * mats.M + rayleigh[1] * prestress.K).tocsr()
+        mats = replace(mats, K=prestress.K, C=C)
         mats.info["prestress_speed"] = prestress.omega
     if damping_ratio:
         i, j = damping_modes
