@@ -249,7 +249,7 @@ def build_parser() -> argparse.ArgumentParser:
         "--samples", type=int, default=3, help="prestress solves, equally spaced in Ω² (default 3)"
     )
     cb.add_argument(
-        "--no-check", action="store_true", help="skip the full eigen-solve checking the interpolation"
+        "--no-check", action="store_true", help="skip the full solve checking the interpolation"
     )
     cb.set_defaults(func=_campbell)
     lp = sub.add_parser("scenes", help="list the built-in scenes")
