@@ -113,6 +113,13 @@ def explain(report: dict, reach_key=None) -> str:
     for d in report["dropped"]:
         rows.append(("dropped", d))
     rows += [("prestress", x) for x in _centrifugal(report.get("centrifugal"))]
+    a = report.get("abradable")
+    if a:
+        rows.append((
+            "abradable",
+            f"coating {_um(a['thickness'])} thick, yields at {a['yield']:g} N per contact; "
+            f"wear map {a['n_angle']} angles × {a['n_axial']} axial cells",
+        ))  # fmt: skip
     reach_key = reach_key or report.get("reach_key", "auto")
     rows += [("contacts", x) for x in _contacts(report["contacts"], reach_key)]
     rows += [("reduction", x) for x in _reduction(report["reduction"])]

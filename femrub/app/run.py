@@ -119,4 +119,9 @@ def run_scene(
         n_full=built.full.n_dofs,
         rotation_speed=scene["loads"]["rotation_speed"],
     )
+    contact = built.model.contact
+    if contact is not None and contact.wear is not None:
+        from ..output.wear import write_wear
+
+        res.info.update(write_wear(contact.wear, out))
     return res, built

@@ -21,6 +21,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..contact.abradable import Abradable
 from ..contact.heat import heat_coefficients
 from ..contact.points import locate_contacts
 from ..contact.reach import contact_reach, normal_deflection
@@ -152,6 +153,7 @@ def _build(scene, log, modes) -> Simulation:
             disc, mats, points, material, casing=casing, rotation_speed=omega, alpha=alpha,
             restitution=c["restitution"], offset=reach.offset[reach.keep], loads=loads,
             thermal=keep_t, observe_at=points if points.n else candidates,
+            wear=_abradable(scene, blade, points, omega, growth[reach.keep]),
         )  # fmt: skip
     except ValueError as exc:  # a value the schema cannot see (e.g. a singular clamp)
         if isinstance(exc, SceneError):
@@ -162,6 +164,8 @@ def _build(scene, log, modes) -> Simulation:
     report["full"] = {"n_dofs": full.n_dofs, "fe_dofs": mats.n_u + mats.n_t, **_layout(full)}
     report["contacts"] = _contacts_report(candidates, reach)
     report["centrifugal"] = _centrifugal_report(scene, prestress, growth, reach)
+    wear = full.contact.wear if full.contact is not None else None
+    report["abradable"] = wear.as_dict() if wear is not None else None
     model, limits = _select_signals(scene, full, report)
     if modes:
         report["natural_frequencies_hz"] = natural_frequencies(model, modes).tolist()
@@ -187,6 +191,18 @@ def _prestress(scene, disc, material, omega, log):
     if log:
         log(f"centrifugal prestress ({method}) at {omega:g} rad/s ...")
     return centrifugal_prestress(disc, material, omega, method, log=log)
+
+
+def _abradable(scene, blade, points, omega, growth):
+    """The coating of ``contact.abradable`` over the kept contacts, or ``None``."""
+    a = scene["contact"]["abradable"]
+    if a["thickness"] <= 0.0 or points.n == 0:
+        return None
+    axial = blade.axis @ points.points if blade.dim == 3 else np.zeros(points.n)
+    return Abradable(
+        a["thickness"], a["yield"], points.angles, axial, float(np.max(points.radii + growth)),
+        omega, n_angle=a["n_angle"], n_axial=a["n_axial"],
+    )  # fmt: skip
 
 
 def _centrifugal_report(scene, prestress, growth, reach) -> dict:

@@ -34,6 +34,9 @@ class Contact:
     restitution : Newton restitution coefficient e in [0, 1].
     heat_coefficient : α (m/s) per contact, scalar, array or callable ``t -> (n_c,)``.
     names : labels of the contacts.
+    wear : optional :class:`~femrub.contact.abradable.Abradable` coating: its wear depth
+        under each contact is added to ``g0(t)`` (the worn surface) and it bounds the
+        impulses (``impulse_cap``); steppers update it after every step (:meth:`after_step`).
 
     Callables are evaluated at one time per call (their contract is a scalar ``t``); the
     products with the states are vectorised over rows.
@@ -48,6 +51,7 @@ class Contact:
     heat_coefficient: float | np.ndarray | Callable = 0.0
     names: list[str] = field(default_factory=list)
     gap_rate: Callable | None = None
+    wear: object = None
 
     def __post_init__(self):
         self.G, self.Gv, self.Hm, self.Ht = (
@@ -86,13 +90,33 @@ class Contact:
 
     # -- time functions: (n_c,) at a scalar time, (m, n_c) at an array of times (m,) ------
     def gap_at(self, t) -> np.ndarray:
-        """``g0(t)``: the gap of the undeformed structure (m)."""
+        """``g0(t)``: the gap of the undeformed structure (m), on the worn surface.
+
+        With a wear map, rows at an array of times use the current map (post-processing).
+        """
         g0 = self.gap0
-        if not callable(g0):
+        if callable(g0):
+            if isinstance(t, np.ndarray) and t.ndim:
+                g0 = _over_times(g0, t, self.n)
+            else:
+                g0 = np.asarray(g0(t), dtype=float)
+        if self.wear is None:
             return g0
         if isinstance(t, np.ndarray) and t.ndim:
-            return _over_times(g0, t, self.n)
-        return np.asarray(g0(t), dtype=float)
+            return g0 + _over_times(self.wear.depth_at, t, self.n)
+        return g0 + self.wear.depth_at(t)
+
+    def impulse_cap(self, t: float, h: float):
+        """Upper bound of the impulses over the step ending at ``t`` (``None``: unbounded)."""
+        return None if self.wear is None else self.wear.impulse_cap(t, h)
+
+    def after_step(self, t: float, X: np.ndarray, impulse: np.ndarray, h: float) -> None:
+        """Remove the coating the blade penetrated where it yielded (impulse at its cap)."""
+        if self.wear is None or impulse.size == 0:
+            return
+        yielded = impulse >= (1.0 - 1e-9) * self.wear.impulse_cap(t, h)
+        if np.any(yielded):
+            self.wear.update(t, self.gap(t, X), yielded)
 
     def rate_at(self, t) -> np.ndarray | float:
         """``ġ0(t) = dg0/dt`` (m/s); the scalar 0 for a fixed obstacle."""

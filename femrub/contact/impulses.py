@@ -11,11 +11,43 @@ import numpy as np
 
 from .lcp import solve_lcp
 
-__all__ = ["solve_impulses"]
+__all__ = ["cap", "solve_impulses"]
 
 
-def solve_impulses(W: np.ndarray, q: np.ndarray, active: np.ndarray, warm=None) -> np.ndarray:
-    """Impulses ``P`` (zero on inactive contacts) solving the LCP restricted to ``active``."""
+def solve_impulses(
+    W: np.ndarray, q: np.ndarray, active: np.ndarray, warm=None, upper=None
+) -> np.ndarray:
+    """Impulses ``P`` (zero on inactive contacts) solving the LCP restricted to ``active``.
+
+    ``upper`` (n_c,) bounds the impulses (:func:`cap`; ``None`` or ``inf``: unbounded).
+    """
+    if upper is not None and np.any(np.isfinite(np.asarray(upper)[active])):
+        return cap(_solve, W, q, active, np.asarray(upper, dtype=float), warm)
+    return _solve(W, q, active, warm)
+
+
+def cap(solve, W, q, active, upper, warm=None) -> np.ndarray:
+    """Impulses bounded above, ``0 <= P <= upper``, with any impulse solve ``solve``.
+
+    A contact whose impulse exceeds its bound is held at the bound (its contribution
+    ``W[:, i] upper_i`` moves to the right-hand side) and the others are solved again,
+    until no impulse exceeds its bound (at most ``n_c`` solves; exact for one contact:
+    ``P = min(max(0, −q / W), upper)``). At the bound the contact may penetrate: the
+    abradable coating yields there (:mod:`femrub.contact.abradable`).
+    """
+    fixed = np.zeros(q.size, dtype=bool)
+    for _ in range(q.size + 1):
+        qf = q + W[:, fixed] @ upper[fixed]
+        P = solve(W, qf, active & ~fixed, warm)
+        P[fixed] = upper[fixed]
+        over = active & ~fixed & (P > upper)
+        if not np.any(over):
+            return P
+        fixed |= over
+    return P
+
+
+def _solve(W: np.ndarray, q: np.ndarray, active: np.ndarray, warm=None) -> np.ndarray:
     P = np.zeros(q.size)
     idx = np.flatnonzero(active)
     if idx.size == 0:

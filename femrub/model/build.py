@@ -38,6 +38,7 @@ class ContactSpec:
     restitution : Newton's coefficient e in [0, 1].
     heat_coefficient : α (m/s) in ``f_tip = α λ``; scalar, (n_c,) or callable of t.
     gap_rate : ``dg/dt`` of a moving obstacle, callable ``t -> (n_c,)`` (m/s), or None.
+    wear : :class:`~femrub.contact.abradable.Abradable` coating on the obstacle, or None.
     """
 
     normals: object
@@ -47,6 +48,7 @@ class ContactSpec:
     heat_coefficient: object = 0.0
     names: list | None = None
     gap_rate: object = None
+    wear: object = None
 
 
 @dataclass
@@ -161,6 +163,7 @@ def first_order_model(
             heat_coefficient=contact.heat_coefficient if nt else 0.0,
             names=list(contact.names or []),
             gap_rate=contact.gap_rate,
+            wear=contact.wear,
         )
 
     observations = {}

@@ -104,6 +104,7 @@ def rub_model(
     loads=(),
     thermal: str | bool = "auto",
     observe_at: ContactPoints | None = None,
+    wear=None,
 ) -> tuple[FirstOrderModel, FieldMap]:
     """First-order model of ``disc`` rubbing ``casing`` at ``points`` (module docstring).
 
@@ -117,6 +118,7 @@ def rub_model(
         ``True`` or ``False``.
     observe_at : points whose signals are observed (default ``points``; with no contact in
         reach, the candidate points still show the tip's response).
+    wear : :class:`~femrub.contact.abradable.Abradable` coating over ``points``, or None.
     """
     N, Q = points.normal_rows(mats), points.heat_rows(mats)
     if observe_at is None or observe_at is points:
@@ -135,6 +137,7 @@ def rub_model(
             restitution=restitution,
             heat_coefficient=np.broadcast_to(np.asarray(alpha, dtype=float), (points.n,)).copy(),
             names=list(points.names),
+            wear=wear,
         )
     )
     model = first_order_model(mats, contact=spec, loads=loads, observe=observe, thermal=thermal)

@@ -144,7 +144,17 @@ CASING = Variant(
     },
 )
 
+ABRADABLE = {
+    "thickness": _f(0.0, "length", "coating thickness e (0: no coating, rigid casing)", **NONNEG),
+    "yield": _f(
+        0.0, "force", "force per contact at which the coating yields and is cut", **NONNEG
+    ),
+    "n_angle": Spec(I, 360, lo=1, hi=100_000, doc="wear-map cells around the casing"),
+    "n_axial": Spec(I, 16, lo=1, hi=10_000, doc="wear-map cells along the axis"),
+}
+
 CONTACT = {
+    "abradable": ABRADABLE,
     "group": Spec(S, "contact", doc="node group of the contact points ('tip': every tip node)"),
     "nodes": Spec("ints", None, doc="node numbers of the contact points (mesh files)"),
     "casing": CASING,

@@ -104,6 +104,16 @@ def _cross_check(d: dict) -> None:
     scheme, outputs, casing = d["scheme"], d["outputs"], d["contact"]["casing"]
     kind = geo["kind"]
     force = loads["tip_force"]
+    abr = contact["abradable"]
+    if abr["thickness"] > 0.0:
+        if abr["yield"] <= 0.0:
+            fail("contact.abradable.yield", abr["yield"], "give the coating's yield force (N) > 0")
+        if scheme["name"] != "theta":
+            fail(
+                "contact.abradable.thickness",
+                abr["thickness"],
+                "an abradable coating needs scheme.name = 'theta' (bounded impulses)",
+            )
     if kind == "bar":
         if casing["kind"] != "concentric":
             fail(

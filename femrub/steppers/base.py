@@ -42,6 +42,8 @@ class Stepper:
     """Base class; see the module docstring. ``h`` is the time step (s)."""
 
     name = "stepper"
+    #: bounds its impulses by ``Contact.impulse_cap`` (abradable coatings)
+    supports_wear = False
 
     def __init__(self, model: FirstOrderModel, h: float, *, t0: float = 0.0):
         if not isinstance(model, FirstOrderModel):
@@ -54,6 +56,14 @@ class Stepper:
         nc = model.n_contacts
         self.impulse = np.zeros(nc)
         self._h_lim = None
+        wear = None if model.contact is None else model.contact.wear
+        if wear is not None:
+            if not self.supports_wear:
+                raise ValueError(
+                    f"an abradable coating needs scheme.name = 'theta' (the {self.name} "
+                    "scheme does not bound its contact impulses)"
+                )
+            wear.reset()
         self._setup()
 
     # -- to be implemented by subclasses ---------------------------------------------------
@@ -87,6 +97,8 @@ class Stepper:
         X, impulse = self._step()
         self.k += 1
         self.t = self.t0 + self.k * self.h
+        if self.model.contact is not None:
+            self.model.contact.after_step(self.t, X, impulse, self.h)
         self.X, self.impulse = X, impulse
         return self.t, X, impulse
 

@@ -70,6 +70,7 @@ class ThetaMethod(Stepper):
     """
 
     name = "theta"
+    supports_wear = True
 
     def __init__(
         self,
@@ -130,6 +131,7 @@ class ThetaMethod(Stepper):
                 and not callable(c.gap0)
                 and not callable(c.heat_coefficient)
                 and c.gap_rate is None
+                and c.wear is None
             ):
                 a = c.heat_coefficient
                 self._fast = True
@@ -189,9 +191,10 @@ class ThetaMethod(Stepper):
         q = (gdot_p + e * gdot_k) / (1.0 + e)
         Wn = W / (1.0 + e)[:, None]
         gap_k = c.gap(self.t, Xk)
+        upper = c.impulse_cap(t1, h)
         if self.activation == "predicted":
             active = gap_k + g * h * gdot_k <= 0.0
-            P = solve_impulses(Wn, q, active, self._warm)
+            P = solve_impulses(Wn, q, active, self._warm, upper)
         else:
             gap_p = c.gap(t1, Xp)
             GZ = c.GT @ Z
@@ -199,13 +202,13 @@ class ThetaMethod(Stepper):
             active = closed | (gap_p <= 0.0)
             seen = []
             while True:
-                P = solve_impulses(Wn, q, active, self._warm)
+                P = solve_impulses(Wn, q, active, self._warm, upper)
                 new = closed | (gap_p + GZ @ P <= 0.0)
                 if np.array_equal(new, active):
                     break
                 if any(np.array_equal(new, a) for a in seen):  # no consistent set: keep impulse
                     active = new | active
-                    P = solve_impulses(Wn, q, active, self._warm)
+                    P = solve_impulses(Wn, q, active, self._warm, upper)
                     break
                 seen.append(active)
                 active = new
