@@ -83,9 +83,7 @@ def _m_orthonormal(V, M, tol=1e-10):
 
 def _track(Q_prev, Q, n):
     """Columns of ``Q`` following the ``n`` columns of ``Q_prev`` (largest MAC)."""
-    mac = (Q_prev.T @ Q) ** 2 / np.outer(
-        np.sum(Q_prev**2, axis=0), np.sum(Q**2, axis=0)
-    )
+    mac = (Q_prev.T @ Q) ** 2 / np.outer(np.sum(Q_prev**2, axis=0), np.sum(Q**2, axis=0))
     rows, cols = linear_sum_assignment(-mac[:n])
     return cols[np.argsort(rows)], mac[rows, cols].min()
 
@@ -138,8 +136,9 @@ def campbell(scene, speeds, *, modes: int = 6, samples: int = 3, check: bool = T
         "basis_size": int(V.shape[1]),
         "sample_speeds": fam.speeds.tolist(),
         "worst_tracking_mac": worst,
-        "rest_frequencies_hz": (np.sqrt(lowest_modes(Kr0, np.eye(V.shape[1]), modes, vectors=False))
-                                / (2 * np.pi)).tolist(),  # fmt: skip
+        "rest_frequencies_hz": (
+            np.sqrt(lowest_modes(Kr0, np.eye(V.shape[1]), modes, vectors=False)) / (2 * np.pi)
+        ).tolist(),  # fmt: skip
         "seconds_prestress": t_pre - t0,
     }
     if method != "off":

@@ -207,8 +207,11 @@ def _abradable(scene, blade, points, omega, growth):
 
 def _centrifugal_report(scene, prestress, growth, reach) -> dict:
     if prestress is None:
-        why = "loads.centrifugal = 'off'" if scene["loads"]["centrifugal"] == "off" else (
-            "the 1D bar" if tr.is_bar(scene) else "loads.rotation_speed = 0")
+        why = (
+            "loads.centrifugal = 'off'"
+            if scene["loads"]["centrifugal"] == "off"
+            else ("the 1D bar" if tr.is_bar(scene) else "loads.rotation_speed = 0")
+        )
         return {"method": "off", "why": why}
     g = np.asarray(growth, dtype=float)
     return {
