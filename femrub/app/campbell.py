@@ -29,8 +29,8 @@ import numpy as np
 import scipy.linalg as sla
 from scipy.optimize import linear_sum_assignment
 
-from ..fem.discretisation import assemble, discretise
 from ..contact.points import locate_contacts
+from ..fem.discretisation import assemble, discretise
 from ..fem.eigen import lowest_modes
 from ..fem.linalg import sparse_lu
 from ..fem.prestress import centrifugal_prestress

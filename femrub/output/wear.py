@@ -32,8 +32,10 @@ def write_wear(wear, out) -> dict:
     np.savetxt(out / "wear_history.csv", hist, delimiter=",", header="t_s,max_wear_depth_m",
                comments="", fmt="%.8g")  # fmt: skip
     fig, (ax, bx) = plt.subplots(1, 2, figsize=(11, 4), gridspec_kw={"width_ratios": [3, 2]})
-    im = ax.pcolormesh(np.degrees(np.linspace(0, 2 * np.pi, wear.n_angle + 1)),
-                       wear.z_edges * 1e3, wear.depth.T * 1e6, shading="flat", cmap="magma_r")  # fmt: skip
+    edges = np.degrees(np.linspace(0, 2 * np.pi, wear.n_angle + 1))
+    im = ax.pcolormesh(
+        edges, wear.z_edges * 1e3, wear.depth.T * 1e6, shading="flat", cmap="magma_r"
+    )
     fig.colorbar(im, ax=ax, label="wear depth (µm)")
     ax.set_xlabel("casing angle (deg)")
     ax.set_ylabel("axial position (mm)")
