@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from femrub.app.run import run_scene
-from femrub.contact.abradable import Abradable
+from femrub.contact.abradable import Abradable, CasingGrid
 from femrub.contact.impulses import solve_impulses
 from femrub.scene import SceneError, load_scene
 
@@ -79,8 +79,8 @@ def test_bounded_impulses_one_and_several_contacts():
 
 
 def test_wear_map_cells_and_volume():
-    wear = Abradable(1e-4, 10.0, angles=[0.0, np.pi], axial=[0.0, 0.01], radius=0.5,
-                     rotation_speed=100.0, n_angle=4, n_axial=2)  # fmt: skip
+    grid = CasingGrid([0.0, np.pi], [0.0, 0.01], 0.5, 100.0, n_angle=4, n_axial=2)
+    wear = Abradable(1e-4, 10.0, grid)
     wear.update(0.0, np.array([-2e-5, -5e-4]), np.array([True, True]))
     assert wear.depth_at(0.0) == pytest.approx([2e-5, 1e-4])  # second one worn through
     assert np.isinf(wear.impulse_cap(0.0, 1e-6)[1]) and wear.impulse_cap(0.0, 1e-6)[

@@ -21,7 +21,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..contact.abradable import Abradable
+from ..contact.abradable import Abradable, CasingGrid
 from ..contact.heat import heat_coefficients
 from ..contact.points import locate_contacts
 from ..contact.reach import contact_reach, normal_deflection
@@ -199,10 +199,9 @@ def _abradable(scene, blade, points, omega, growth):
     if a["thickness"] <= 0.0 or points.n == 0:
         return None
     axial = blade.axis @ points.points if blade.dim == 3 else np.zeros(points.n)
-    return Abradable(
-        a["thickness"], a["yield"], points.angles, axial, float(np.max(points.radii + growth)),
-        omega, n_angle=a["n_angle"], n_axial=a["n_axial"],
-    )  # fmt: skip
+    grid = CasingGrid(points.angles, axial, float(np.max(points.radii + growth)), omega,
+                      n_angle=a["n_angle"], n_axial=a["n_axial"])  # fmt: skip
+    return Abradable(a["thickness"], a["yield"], grid)
 
 
 def _centrifugal_report(scene, prestress, growth, reach) -> dict:

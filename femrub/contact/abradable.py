@@ -31,41 +31,72 @@ import numpy as np
 
 from ..fem.material import check_finite_positive
 
-__all__ = ["Abradable"]
+__all__ = ["Abradable", "CasingGrid"]
 
 
-class Abradable:
-    """Abradable coating swept by contacts (module docstring).
+class CasingGrid:
+    """Cells of the casing swept by contacts: ``n_angle`` around × ``n_axial`` along the axis.
 
     Parameters
     ----------
-    thickness : coating thickness ``e`` (m).
-    yield_force : force per contact at which the coating yields ``F_y`` (N).
     angles : (n_c,) angular positions ``φ_i`` of the contacts (rad).
     axial : (n_c,) axial positions ``z_i`` of the contacts (m).
     radius : casing radius used for areas and volumes (m).
     rotation_speed : Ω (rad/s).
-    n_angle, n_axial : grid cells around the casing and along the axis.
+    n_angle, n_axial : grid cells around the casing and along the axis (over the contacts'
+        axial extent, half a cell beyond each end).
     """
 
-    def __init__(self, thickness, yield_force, angles, axial, radius, rotation_speed,
-                 n_angle: int = 360, n_axial: int = 16):  # fmt: skip
-        self.thickness = check_finite_positive("contact.abradable.thickness", thickness)
-        self.yield_force = check_finite_positive("contact.abradable.yield", yield_force)
-        self.radius = check_finite_positive("abradable casing radius", radius)
+    def __init__(self, angles, axial, radius, rotation_speed, n_angle=360, n_axial=16):
+        self.radius = check_finite_positive("casing radius", radius)
         self.omega = float(rotation_speed)
         self.angles = np.asarray(angles, dtype=float).ravel()
         self.axial = np.asarray(axial, dtype=float).ravel()
         if self.angles.shape != self.axial.shape:
-            raise ValueError("abradable: one angle and one axial position per contact")
+            raise ValueError("casing grid: one angle and one axial position per contact")
         if not (int(n_angle) >= 1 and int(n_axial) >= 1):
-            raise ValueError("abradable grid needs n_angle >= 1 and n_axial >= 1")
+            raise ValueError("casing grid needs n_angle >= 1 and n_axial >= 1")
         self.n_angle, self.n_axial = int(n_angle), int(n_axial)
         z0, z1 = (float(self.axial.min()), float(self.axial.max())) if self.axial.size else (0, 0)
         pad = 0.5 * (z1 - z0) / max(self.n_axial - 1, 1) if z1 > z0 else 0.5e-3
         self.z_edges = np.linspace(z0 - pad, z1 + pad, self.n_axial + 1)
         k = np.searchsorted(self.z_edges, self.axial, side="right") - 1
         self.axial_cell = np.clip(k, 0, self.n_axial - 1)
+
+    def cells(self, t: float) -> np.ndarray:
+        """Flat indices of the cells under the contacts at time ``t``."""
+        psi = np.mod(self.omega * t + self.angles, 2 * math.pi)
+        j = np.minimum((psi * self.n_angle / (2 * math.pi)).astype(int), self.n_angle - 1)
+        return j * self.n_axial + self.axial_cell
+
+    @property
+    def cell_area(self) -> np.ndarray:
+        """(n_axial,) area of a cell of each axial row (m²)."""
+        return 2 * math.pi * self.radius / self.n_angle * np.diff(self.z_edges)
+
+    def angle_centres(self) -> np.ndarray:
+        return (np.arange(self.n_angle) + 0.5) * 2 * math.pi / self.n_angle
+
+    def axial_centres(self) -> np.ndarray:
+        return 0.5 * (self.z_edges[1:] + self.z_edges[:-1])
+
+
+class Abradable:
+    """Abradable coating on the cells of a :class:`CasingGrid` (module docstring).
+
+    Parameters
+    ----------
+    thickness : coating thickness ``e`` (m).
+    yield_force : force per contact at which the coating yields ``F_y`` (N).
+    grid : :class:`CasingGrid` of the contacts.
+    """
+
+    def __init__(self, thickness, yield_force, grid: CasingGrid):
+        self.thickness = check_finite_positive("contact.abradable.thickness", thickness)
+        self.yield_force = check_finite_positive("contact.abradable.yield", yield_force)
+        self.grid = grid
+        self.n_angle, self.n_axial, self.z_edges = grid.n_angle, grid.n_axial, grid.z_edges
+        self.radius = grid.radius
         self.reset()
 
     # -- state --------------------------------------------------------------------------
@@ -75,10 +106,7 @@ class Abradable:
         self.history = [(0.0, 0.0)]
 
     def cells(self, t: float) -> np.ndarray:
-        """Flat indices of the grid cells under the contacts at time ``t``."""
-        psi = np.mod(self.omega * t + self.angles, 2 * math.pi)
-        j = np.minimum((psi * self.n_angle / (2 * math.pi)).astype(int), self.n_angle - 1)
-        return j * self.n_axial + self.axial_cell
+        return self.grid.cells(t)
 
     def depth_at(self, t: float) -> np.ndarray:
         """Wear depth under each contact at ``t`` (m): what the worn surface adds to the gap."""
@@ -111,8 +139,7 @@ class Abradable:
 
     @property
     def cell_area(self) -> np.ndarray:
-        """(n_axial,) area of a cell of each axial row (m²)."""
-        return 2 * math.pi * self.radius / self.n_angle * np.diff(self.z_edges)
+        return self.grid.cell_area
 
     @property
     def worn_volume(self) -> float:
@@ -120,10 +147,10 @@ class Abradable:
         return float(np.sum(self.depth * self.cell_area[None, :]))
 
     def angle_centres(self) -> np.ndarray:
-        return (np.arange(self.n_angle) + 0.5) * 2 * math.pi / self.n_angle
+        return self.grid.angle_centres()
 
     def axial_centres(self) -> np.ndarray:
-        return 0.5 * (self.z_edges[1:] + self.z_edges[:-1])
+        return self.grid.axial_centres()
 
     def as_dict(self) -> dict:
         return {
