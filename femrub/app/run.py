@@ -124,4 +124,8 @@ def run_scene(
         from ..output.wear import write_wear
 
         res.info.update(write_wear(contact.wear, out))
+    if contact is not None and contact.casing_heat is not None:
+        from ..output.wear import write_casing_heat
+
+        res.info.update(write_casing_heat(contact.casing_heat, float(res.t[-1]), out))
     return res, built

@@ -22,6 +22,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..contact.abradable import Abradable, CasingGrid
+from ..contact.casing_heat import CasingHeat
 from ..contact.heat import heat_coefficients
 from ..contact.points import locate_contacts
 from ..contact.reach import contact_reach, normal_deflection
@@ -144,16 +145,19 @@ def _build(scene, log, modes) -> Simulation:
                                          loads[0].vector if loads else None, force and force[2]),
         )  # fmt: skip
         points = candidates.restrict(reach.keep)
+        eta = tr.heat_partition_of(scene)
         alpha = heat_coefficients(
             points.radii, tr.heat_law_of(scene), alpha=c["heat_coefficient"],
-            friction=c["friction"], rotation_speed=omega, heat_partition=c["heat_partition"],
+            friction=c["friction"], rotation_speed=omega, heat_partition=eta,
         )  # fmt: skip
+        grid = _grid(scene, blade, points, omega, growth[reach.keep])
         keep_t, report["thermal"] = tr.thermal_choice(scene, bool(np.any(alpha > 0)), points.n > 0)
         full, fields = rub_model(
             disc, mats, points, material, casing=casing, rotation_speed=omega, alpha=alpha,
             restitution=c["restitution"], offset=reach.offset[reach.keep], loads=loads,
             thermal=keep_t, observe_at=points if points.n else candidates,
-            wear=_abradable(scene, blade, points, omega, growth[reach.keep]),
+            wear=_abradable(scene, grid),
+            casing_heat=_casing_heat(scene, grid, eta, alpha),
         )  # fmt: skip
     except ValueError as exc:  # a value the schema cannot see (e.g. a singular clamp)
         if isinstance(exc, SceneError):
@@ -166,6 +170,9 @@ def _build(scene, log, modes) -> Simulation:
     report["centrifugal"] = _centrifugal_report(scene, prestress, growth, reach)
     wear = full.contact.wear if full.contact is not None else None
     report["abradable"] = wear.as_dict() if wear is not None else None
+    ch = full.contact.casing_heat if full.contact is not None else None
+    report["casing_heat"] = None if ch is None else {
+        "thickness": ch.b, "tau": ch.tau, "partition": eta, "expansion": ch.expansion}  # fmt: skip
     model, limits = _select_signals(scene, full, report)
     if modes:
         report["natural_frequencies_hz"] = natural_frequencies(model, modes).tolist()
@@ -193,15 +200,37 @@ def _prestress(scene, disc, material, omega, log):
     return centrifugal_prestress(disc, material, omega, method, log=log)
 
 
-def _abradable(scene, blade, points, omega, growth):
+def _grid(scene, blade, points, omega, growth):
+    """Casing cells swept by the kept contacts (wear map, casing heat), or ``None``."""
+    c = scene["contact"]
+    a, h = c["abradable"], c["casing_heat"]
+    if points.n == 0 or (a["thickness"] <= 0.0 and h["thickness"] <= 0.0):
+        return None
+    n = a if a["thickness"] > 0.0 else h
+    axial = blade.axis @ points.points if blade.dim == 3 else np.zeros(points.n)
+    return CasingGrid(points.angles, axial, float(np.max(points.radii + growth)), omega,
+                      n_angle=n["n_angle"], n_axial=n["n_axial"])  # fmt: skip
+
+
+def _abradable(scene, grid):
     """The coating of ``contact.abradable`` over the kept contacts, or ``None``."""
     a = scene["contact"]["abradable"]
-    if a["thickness"] <= 0.0 or points.n == 0:
+    if grid is None or a["thickness"] <= 0.0:
         return None
-    axial = blade.axis @ points.points if blade.dim == 3 else np.zeros(points.n)
-    grid = CasingGrid(points.angles, axial, float(np.max(points.radii + growth)), omega,
-                      n_angle=a["n_angle"], n_axial=a["n_axial"])  # fmt: skip
     return Abradable(a["thickness"], a["yield"], grid)
+
+
+def _casing_heat(scene, grid, eta, alpha):
+    """The lumped casing thermal model of ``contact.casing_heat``, or ``None``."""
+    h = scene["contact"]["casing_heat"]
+    if grid is None or h["thickness"] <= 0.0:
+        return None
+    if not 0.0 < eta < 1.0 or not np.any(alpha > 0):
+        fail("contact.casing_heat.thickness", h["thickness"],
+             f"no frictional heat reaches the casing (heat_partition {eta:g}, no heat "
+             "coefficient); set contact.friction / heat_coefficient and heat_partition < 1")  # fmt: skip
+    return CasingHeat(grid, h["thickness"], h["density"], h["specific_heat"], h["conductivity"],
+                      h["expansion"], eta, alpha)  # fmt: skip
 
 
 def _centrifugal_report(scene, prestress, growth, reach) -> dict:

@@ -12,6 +12,7 @@ import math
 import numpy as np
 
 from ..contact.casing import casing_profile
+from ..contact.casing_heat import effusivity_partition
 from ..fem.material import Material
 
 __all__ = [
@@ -20,6 +21,7 @@ __all__ = [
     "casing_of",
     "centrifugal_of",
     "coupling_of",
+    "heat_partition_of",
     "force_law",
     "heat_law_of",
     "material_of",
@@ -88,6 +90,21 @@ def centrifugal_of(scene) -> str | None:
     return "nonlinear" if mode == "auto" else mode
 
 
+def heat_partition_of(scene) -> float:
+    """Share η of the frictional power entering the blade (``contact.heat_partition``)."""
+    c, m = scene["contact"], scene["material"]
+    eta = c["heat_partition"]
+    if eta == "auto":
+        eta = "effusivity" if c["casing_heat"]["thickness"] > 0.0 else 1.0
+    if eta == "effusivity":
+        h = c["casing_heat"]
+        return effusivity_partition(
+            (m["conductivity"], m["density"], m["specific_heat"]),
+            (h["conductivity"], h["density"], h["specific_heat"]),
+        )
+    return float(eta)
+
+
 def area_of(scene) -> float:
     """Cross-section of the bar (m²); 1 for a solid."""
     return scene["geometry"]["area"] if is_bar(scene) else 1.0
@@ -133,7 +150,7 @@ def thermal_choice(scene, heated: bool, reachable: bool = True) -> tuple[bool, s
     c = scene["contact"]
     if not reachable:
         why = "no contact the casing can reach"
-    elif c["heat_partition"] == 0.0:
+    elif heat_partition_of(scene) == 0.0:
         why = "contact.heat_partition = 0"
     elif is_bar(scene):
         why = "contact.heat_coefficient = 0"

@@ -74,6 +74,8 @@ class CasingHeat:
         shape = (self.grid.n_angle * self.grid.n_axial,)
         self.T = np.zeros(shape)
         self.t_last = np.zeros(shape)
+        self.q = np.zeros(shape)  # W of the last update
+        self.h = math.inf  # step of the last update
         self.heat_in = 0.0  # J
         self.history = [(0.0, 0.0)]
 
@@ -89,9 +91,20 @@ class CasingHeat:
         """How much the wall's expansion closes each contact's gap at ``t`` (m)."""
         return self.expansion * self.b * self.temperature_at(t)
 
+    def closure_rate_at(self, t: float) -> np.ndarray:
+        """``d/dt`` of :meth:`closure_at` (m/s): ``α_c b (q − G T) / C`` with the power ``q``
+        of the step just done (zero in cells no contact heated then). It enters the gap rate
+        ``ġ0`` so the velocity-level contact law follows the wall as it expands."""
+        cells = self.grid.cells(t)
+        T = self._cool_to(cells, t)
+        G = self.conductance[cells % self.grid.n_axial]
+        q = np.where(t - self.t_last[cells] <= 1.01 * self.h, self.q[cells], 0.0)
+        return self.expansion * self.b * (q - G * T) / (G * self.tau)
+
     def update(self, t: float, impulse: np.ndarray, h: float) -> None:
         """Add the step's casing heat (step ending at ``t``) to the cells under the contacts."""
         Q = self.power_per_impulse * np.asarray(impulse, dtype=float)  # J over the step
+        self.h = h
         if not np.any(Q > 0.0):
             return
         c, inv = np.unique(self.grid.cells(t), return_inverse=True)
@@ -101,6 +114,7 @@ class CasingHeat:
             c % self.grid.n_axial
         ] * (1.0 - decay)
         self.t_last[c] = t
+        self.q[c] = q
         self.heat_in += float(Q.sum())
         self.history.append((float(t), float(self.T[c].max())))
 

@@ -37,6 +37,8 @@ class Contact:
     wear : optional :class:`~femrub.contact.abradable.Abradable` coating: its wear depth
         under each contact is added to ``g0(t)`` (the worn surface) and it bounds the
         impulses (``impulse_cap``); steppers update it after every step (:meth:`after_step`).
+    casing_heat : optional :class:`~femrub.contact.casing_heat.CasingHeat`: the casing
+        wall's thermal expansion under each contact is subtracted from ``g0(t)``.
 
     Callables are evaluated at one time per call (their contract is a scalar ``t``); the
     products with the states are vectorised over rows.
@@ -52,6 +54,7 @@ class Contact:
     names: list[str] = field(default_factory=list)
     gap_rate: Callable | None = None
     wear: object = None
+    casing_heat: object = None
 
     def __post_init__(self):
         self.G, self.Gv, self.Hm, self.Ht = (
@@ -100,19 +103,28 @@ class Contact:
                 g0 = _over_times(g0, t, self.n)
             else:
                 g0 = np.asarray(g0(t), dtype=float)
-        if self.wear is None:
-            return g0
-        if isinstance(t, np.ndarray) and t.ndim:
-            return g0 + _over_times(self.wear.depth_at, t, self.n)
-        return g0 + self.wear.depth_at(t)
+        rows = isinstance(t, np.ndarray) and t.ndim
+        if self.wear is not None:
+            g0 = g0 + (
+                _over_times(self.wear.depth_at, t, self.n) if rows else self.wear.depth_at(t)
+            )
+        if self.casing_heat is not None:
+            ch = self.casing_heat
+            g0 = g0 - (_over_times(ch.closure_at, t, self.n) if rows else ch.closure_at(t))
+        return g0
 
     def impulse_cap(self, t: float, h: float):
         """Upper bound of the impulses over the step ending at ``t`` (``None``: unbounded)."""
         return None if self.wear is None else self.wear.impulse_cap(t, h)
 
     def after_step(self, t: float, X: np.ndarray, impulse: np.ndarray, h: float) -> None:
-        """Remove the coating the blade penetrated where it yielded (impulse at its cap)."""
-        if self.wear is None or impulse.size == 0:
+        """Remove the coating the blade penetrated where it yielded (impulse at its cap), and
+        heat the casing with its share of the step's frictional heat."""
+        if impulse.size == 0:
+            return
+        if self.casing_heat is not None:
+            self.casing_heat.update(t, impulse, h)
+        if self.wear is None:
             return
         yielded = impulse >= (1.0 - 1e-9) * self.wear.impulse_cap(t, h)
         if np.any(yielded):
@@ -120,12 +132,16 @@ class Contact:
 
     def rate_at(self, t) -> np.ndarray | float:
         """``ġ0(t) = dg0/dt`` (m/s); the scalar 0 for a fixed obstacle."""
-        rate = self.gap_rate
-        if rate is None:
-            return 0.0
-        if isinstance(t, np.ndarray) and t.ndim:
-            return _over_times(rate, t, self.n)
-        return np.asarray(rate(t), dtype=float)
+        rate, ch = self.gap_rate, self.casing_heat
+        rows = isinstance(t, np.ndarray) and t.ndim
+        out = 0.0
+        if rate is not None:
+            out = _over_times(rate, t, self.n) if rows else np.asarray(rate(t), dtype=float)
+        if ch is not None:
+            out = out - (
+                _over_times(ch.closure_rate_at, t, self.n) if rows else ch.closure_rate_at(t)
+            )
+        return out
 
     def alpha_at(self, t) -> np.ndarray:
         """Heat coefficient ``α(t)`` (m/s)."""

@@ -49,6 +49,7 @@ class ContactSpec:
     names: list | None = None
     gap_rate: object = None
     wear: object = None
+    casing_heat: object = None
 
 
 @dataclass
@@ -164,6 +165,7 @@ def first_order_model(
             names=list(contact.names or []),
             gap_rate=contact.gap_rate,
             wear=contact.wear,
+            casing_heat=contact.casing_heat,
         )
 
     observations = {}

@@ -105,6 +105,7 @@ def rub_model(
     thermal: str | bool = "auto",
     observe_at: ContactPoints | None = None,
     wear=None,
+    casing_heat=None,
 ) -> tuple[FirstOrderModel, FieldMap]:
     """First-order model of ``disc`` rubbing ``casing`` at ``points`` (module docstring).
 
@@ -119,6 +120,7 @@ def rub_model(
     observe_at : points whose signals are observed (default ``points``; with no contact in
         reach, the candidate points still show the tip's response).
     wear : :class:`~femrub.contact.abradable.Abradable` coating over ``points``, or None.
+    casing_heat : :class:`~femrub.contact.casing_heat.CasingHeat` of the casing, or None.
     """
     N, Q = points.normal_rows(mats), points.heat_rows(mats)
     if observe_at is None or observe_at is points:
@@ -138,6 +140,7 @@ def rub_model(
             heat_coefficient=np.broadcast_to(np.asarray(alpha, dtype=float), (points.n,)).copy(),
             names=list(points.names),
             wear=wear,
+            casing_heat=casing_heat,
         )
     )
     model = first_order_model(mats, contact=spec, loads=loads, observe=observe, thermal=thermal)

@@ -1,4 +1,4 @@
-"""Abradable wear outputs of a run: wear map (CSV, PNG), wear history, summary keys."""
+"""Casing outputs of a run: wear map (CSV, PNG), wear history, casing temperatures."""
 
 from __future__ import annotations
 
@@ -11,7 +11,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-__all__ = ["write_wear"]
+__all__ = ["write_casing_heat", "write_wear"]
 
 
 def write_wear(wear, out) -> dict:
@@ -48,6 +48,29 @@ def write_wear(wear, out) -> dict:
     fig.savefig(out / "wear_map.png", dpi=110)
     plt.close(fig)
     keys = {"max_wear_depth": wear.max_depth, "worn_volume": wear.worn_volume}
+    path = out / "summary.json"
+    if path.exists():
+        doc = json.loads(path.read_text())
+        doc.update(keys)
+        path.write_text(json.dumps(doc, indent=2))
+    return keys
+
+
+def write_casing_heat(heat, t_end: float, out) -> dict:
+    """Write ``casing_temperature.csv`` (wall temperature rise per cell at ``t_end``, laid out
+    as ``wear_map.csv``) and add ``max_casing_temperature`` (K) and ``casing_heat_in`` (J)
+    to ``out/summary.json``; return them."""
+    out = Path(out)
+    grid = heat.grid
+    T = heat.map_at(t_end)
+    header = "angle_deg," + ",".join(f"z={v:.6g}" for v in grid.axial_centres())
+    np.savetxt(out / "casing_temperature.csv", np.column_stack([np.degrees(grid.angle_centres()), T]),
+               delimiter=",", header=header, comments="", fmt="%.8g")  # fmt: skip
+    hist = np.array(heat.history, dtype=float)
+    keys = {
+        "max_casing_temperature": float(hist[:, 1].max()),
+        "casing_heat_in": heat.heat_in,
+    }
     path = out / "summary.json"
     if path.exists():
         doc = json.loads(path.read_text())

@@ -146,11 +146,21 @@ CASING = Variant(
 
 ABRADABLE = {
     "thickness": _f(0.0, "length", "coating thickness e (0: no coating, rigid casing)", **NONNEG),
-    "yield": _f(
-        0.0, "force", "force per contact at which the coating yields and is cut", **NONNEG
-    ),
+    "yield": _f(0.0, "force", "force per contact at which the coating yields and is cut", **NONNEG),
     "n_angle": Spec(I, 360, lo=1, hi=100_000, doc="wear-map cells around the casing"),
     "n_axial": Spec(I, 16, lo=1, hi=10_000, doc="wear-map cells along the axis"),
+}
+
+CASING_HEAT = {
+    "thickness": _f(
+        0.0, "length", "casing wall thickness b of the lumped thermal model (0: off)", **NONNEG
+    ),
+    "density": _f(7800.0, "density", "casing wall density", **POS),
+    "specific_heat": _f(460.0, "specific_heat", "casing wall specific heat", **POS),
+    "conductivity": _f(15.0, "conductivity", "casing wall conductivity", **POS),
+    "expansion": _f(12e-6, "expansion", "casing wall expansion (closes the gap by α b T)"),
+    "n_angle": Spec(I, 360, lo=1, hi=100_000, doc="casing cells around (without a coating)"),
+    "n_axial": Spec(I, 16, lo=1, hi=10_000, doc="casing cells along the axis (without a coating)"),
 }
 
 CONTACT = {
@@ -165,9 +175,17 @@ CONTACT = {
     "heat_coefficient": _f(
         0.0, "velocity", "bar: α of the heat input heat_partition α λ", **NONNEG
     ),
-    "heat_partition": _f(
-        1.0, "none", "fraction of the frictional power that enters the blade", lo=0.0, hi=1.0
+    "heat_partition": Spec(
+        F,
+        "auto",
+        "none",
+        choices=("auto", "effusivity"),
+        doc="fraction η of the frictional power that enters the blade (auto: 1, or from the "
+        "effusivities of blade and casing with contact.casing_heat)",
+        lo=0.0,
+        hi=1.0,
     ),
+    "casing_heat": CASING_HEAT,
     "reach": Spec(
         F,
         "auto",

@@ -64,6 +64,8 @@ class Stepper:
                     "scheme does not bound its contact impulses)"
                 )
             wear.reset()
+        if model.contact is not None and model.contact.casing_heat is not None:
+            model.contact.casing_heat.reset()
         self._setup()
 
     # -- to be implemented by subclasses ---------------------------------------------------

@@ -132,6 +132,7 @@ class ThetaMethod(Stepper):
                 and not callable(c.heat_coefficient)
                 and c.gap_rate is None
                 and c.wear is None
+                and c.casing_heat is None
             ):
                 a = c.heat_coefficient
                 self._fast = True
