@@ -46,7 +46,15 @@ n_elements = 10
 casing = { kind = "concentric", clearance = "5 um" }
 heat_coefficient = 3.0
 heat_partition = 0.5
-casing_heat = { thickness = 2e-3, density = 100.0, specific_heat = 100.0, conductivity = 0.5, expansion = 1e-4, n_angle = 1, n_axial = 1 }
+
+[contact.casing_heat]
+thickness = 2e-3
+density = 100.0
+specific_heat = 100.0
+conductivity = 0.5
+expansion = 1e-4
+n_angle = 1
+n_axial = 1
 [loads]
 tip_force = { law = "ramp", amplitude = 7.0, ramp_time = 0.05 }
 [physics]

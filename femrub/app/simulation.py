@@ -226,9 +226,12 @@ def _casing_heat(scene, grid, eta, alpha):
     if grid is None or h["thickness"] <= 0.0:
         return None
     if not 0.0 < eta < 1.0 or not np.any(alpha > 0):
-        fail("contact.casing_heat.thickness", h["thickness"],
-             f"no frictional heat reaches the casing (heat_partition {eta:g}, no heat "
-             "coefficient); set contact.friction / heat_coefficient and heat_partition < 1")  # fmt: skip
+        fail(
+            "contact.casing_heat.thickness",
+            h["thickness"],
+            f"no frictional heat reaches the casing (heat_partition {eta:g}, no heat "
+            "coefficient); set contact.friction / heat_coefficient and heat_partition < 1",
+        )
     return CasingHeat(grid, h["thickness"], h["density"], h["specific_heat"], h["conductivity"],
                       h["expansion"], eta, alpha)  # fmt: skip
 

@@ -64,8 +64,9 @@ def write_casing_heat(heat, t_end: float, out) -> dict:
     grid = heat.grid
     T = heat.map_at(t_end)
     header = "angle_deg," + ",".join(f"z={v:.6g}" for v in grid.axial_centres())
-    np.savetxt(out / "casing_temperature.csv", np.column_stack([np.degrees(grid.angle_centres()), T]),
-               delimiter=",", header=header, comments="", fmt="%.8g")  # fmt: skip
+    table = np.column_stack([np.degrees(grid.angle_centres()), T])
+    np.savetxt(out / "casing_temperature.csv", table, delimiter=",", header=header,
+               comments="", fmt="%.8g")  # fmt: skip
     hist = np.array(heat.history, dtype=float)
     keys = {
         "max_casing_temperature": float(hist[:, 1].max()),
