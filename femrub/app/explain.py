@@ -120,6 +120,14 @@ def explain(report: dict, reach_key=None) -> str:
             f"coating {_um(a['thickness'])} thick, yields at {a['yield']:g} N per contact; "
             f"wear map {a['n_angle']} angles × {a['n_axial']} axial cells",
         ))  # fmt: skip
+    ch = report.get("casing_heat")
+    if ch:
+        rows.append((
+            "casing",
+            f"lumped wall {_um(ch['thickness'])} thick (τ = {ch['tau']:.3g} s) takes "
+            f"{100 * (1 - ch['partition']):.3g} % of the frictional power; its expansion "
+            "closes the gaps",
+        ))  # fmt: skip
     reach_key = reach_key or report.get("reach_key", "auto")
     rows += [("contacts", x) for x in _contacts(report["contacts"], reach_key)]
     rows += [("reduction", x) for x in _reduction(report["reduction"])]

@@ -91,7 +91,7 @@ def internal_force(basis, u, lam: float, mu: float, linear: bool = False):
     return form.assemble(basis)
 
 
-def tangent_stiffness(basis, u, lam: float, mu: float, linear: bool = False, chunk=4000):
+def tangent_stiffness(basis, u, lam: float, mu: float, linear: bool = False, chunk=1500):
     """Material + geometric stiffness at ``u`` (module docstring), without spin softening.
 
     Assembled element by element in vectorised form (every pair of local shape functions at
@@ -116,9 +116,11 @@ def tangent_stiffness(basis, u, lam: float, mu: float, linear: bool = False, chu
         Ke += np.einsum("aijEq,bijEq,Eq->Eab", G, GS, dx, optimize=True)
         data.append(Ke)
     Ke = np.concatenate(data)  # (n_elements, nb, nb): rows a (test), columns b (trial)
-    rows = np.broadcast_to(dofs.T[:, :, None], Ke.shape).ravel()
-    cols = np.broadcast_to(dofs.T[:, None, :], Ke.shape).ravel()
-    return sp.coo_matrix((Ke.ravel(), (rows, cols)), shape=(basis.N, basis.N)).tocsr()
+    del data
+    idx = dofs.T.astype(np.int32)
+    rows = np.broadcast_to(idx[:, :, None], Ke.shape).ravel()
+    cols = np.broadcast_to(idx[:, None, :], Ke.shape).ravel()
+    return sp.csr_matrix((Ke.ravel(), (rows, cols)), shape=(basis.N, basis.N))
 
 
 def spin_mass(basis, rho: float, axis):
