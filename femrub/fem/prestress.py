@@ -150,7 +150,9 @@ def centrifugal_prestress(
     done, step, iters, n_inc = 0.0, 1.0, 0, 0
     while done < 1.0:
         step = min(step, 1.0 - done)
-        trial, k, ok = _newton(forms, u.copy(), MP, w2 * (done + step), free, scale, tol, max_iter)
+        trial, k, ok = _newton(
+            forms, u.copy(), MP, w2 * (done + step), free, scale, tol, max_iter, log
+        )
         iters += k
         if ok:
             u, done, n_inc = trial, done + step, n_inc + 1
@@ -174,12 +176,14 @@ def _residual(forms, u, w2, free) -> float:
     return float(np.linalg.norm((forms.internal(u) - forms.force(u, w2))[free]))
 
 
-def _newton(forms, u, MP, w2, free, scale, tol, max_iter):
+def _newton(forms, u, MP, w2, free, scale, tol, max_iter, log=None):
     """Newton iterations at load ``w2``; returns ``(u, iterations, converged)``."""
     prev = math.inf
     for k in range(1, max_iter + 1):
         r = (forms.internal(u) - forms.force(u, w2))[free]
         norm = float(np.linalg.norm(r)) / scale
+        if log:
+            log(f"prestress: Newton iteration {k - 1}, relative residual {norm:.2e}")
         if not math.isfinite(norm) or norm > 1e3 * max(prev, 1.0):
             return u, k, False
         if norm <= tol:
