@@ -7,8 +7,9 @@ at the rotation speed Ω on the free (unclamped) displacement dofs of a
     r(u) = f_int(u) − f_Ω(u) = 0,   f_Ω(u) = ∫ ρ Ω² P (X + u) · v dX
 
 * ``"nonlinear"`` (default): Newton on the total-Lagrangian form, ``K_T(u_k) Δu = −r(u_k)``,
-  with the load on the deformed geometry; when a full step does not converge the load
-  ``Ω²`` is applied in increments (continuation), halved until Newton converges.
+  with a backtracking line search on ``‖r‖`` and the load on the deformed geometry; when a
+  full step does not converge the load ``Ω²`` is applied in increments (continuation),
+  halved until Newton converges.
 * ``"linear"``: one solve of ``(K − Ω² M_P) u = f_Ω(0)`` (small displacements; the first
   Newton iterate of the nonlinear problem).
 
@@ -177,19 +178,30 @@ def _residual(forms, u, w2, free) -> float:
 
 
 def _newton(forms, u, MP, w2, free, scale, tol, max_iter, log=None):
-    """Newton iterations at load ``w2``; returns ``(u, iterations, converged)``."""
-    prev = math.inf
+    """Newton iterations at load ``w2`` with a backtracking line search on ``‖r‖`` (the step
+    is halved, at most 6 times, until the residual decreases); returns ``(u, iterations,
+    converged)``."""
+    r = (forms.internal(u) - forms.force(u, w2))[free]
+    norm = float(np.linalg.norm(r)) / scale
     for k in range(1, max_iter + 1):
-        r = (forms.internal(u) - forms.force(u, w2))[free]
-        norm = float(np.linalg.norm(r)) / scale
         if log:
             log(f"prestress: Newton iteration {k - 1}, relative residual {norm:.2e}")
-        if not math.isfinite(norm) or norm > 1e3 * max(prev, 1.0):
+        if not math.isfinite(norm):
             return u, k, False
         if norm <= tol:
             return u, k - 1, True
-        prev = norm
         KT = _sub(forms.tangent(u, MP, w2), free)
-        u[free] -= sparse_lu(KT, symmetric=True, what="prestressed tangent").solve(r)
-    r = (forms.internal(u) - forms.force(u, w2))[free]
-    return u, max_iter, float(np.linalg.norm(r)) / scale <= tol
+        du = sparse_lu(KT, symmetric=True, what="prestressed tangent").solve(r)
+        step = 1.0
+        for _ in range(7):
+            trial = u.copy()
+            trial[free] -= step * du
+            r_t = (forms.internal(trial) - forms.force(trial, w2))[free]
+            n_t = float(np.linalg.norm(r_t)) / scale
+            if n_t < norm or step < 0.02:
+                break
+            step *= 0.5
+        if not n_t < norm:  # no decrease along the Newton direction
+            return u, k, False
+        u, r, norm = trial, r_t, n_t
+    return u, max_iter, norm <= tol
