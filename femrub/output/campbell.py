@@ -13,7 +13,7 @@ import numpy as np  # noqa: E402
 __all__ = ["engine_order_range", "plot_campbell", "draw_campbell"]
 
 
-def engine_order_range(max_speed: float, max_frequency: float, limit: int = 24) -> range:
+def engine_order_range(max_speed: float, max_frequency: float, limit: int = 12) -> range:
     """Engine orders ``k`` whose line ``f = k Ω / 2π`` stays below ``1.1 max_frequency``
     up to 40 % of ``max_speed`` (the readable ones), at most ``limit``."""
     if max_speed <= 0:
