@@ -179,8 +179,9 @@ def _residual(forms, u, w2, free) -> float:
 
 def _newton(forms, u, MP, w2, free, scale, tol, max_iter, log=None):
     """Newton iterations at load ``w2`` with a backtracking line search on ``‖r‖`` (the step
-    is halved, at most 6 times, until the residual decreases); returns ``(u, iterations,
-    converged)``."""
+    is halved until the residual decreases); returns ``(u, iterations, converged)``. A step
+    cut below 1/4 means the load increment is too large: give up at once (the continuation
+    then halves it) rather than crawl."""
     r = (forms.internal(u) - forms.force(u, w2))[free]
     norm = float(np.linalg.norm(r)) / scale
     for k in range(1, max_iter + 1):
@@ -193,12 +194,12 @@ def _newton(forms, u, MP, w2, free, scale, tol, max_iter, log=None):
         KT = _sub(forms.tangent(u, MP, w2), free)
         du = sparse_lu(KT, symmetric=True, what="prestressed tangent").solve(r)
         step = 1.0
-        for _ in range(7):
+        while True:
             trial = u.copy()
             trial[free] -= step * du
             r_t = (forms.internal(trial) - forms.force(trial, w2))[free]
             n_t = float(np.linalg.norm(r_t)) / scale
-            if n_t < norm or step < 0.02:
+            if n_t < norm or step <= 0.25:
                 break
             step *= 0.5
         if not n_t < norm:  # no decrease along the Newton direction
