@@ -106,7 +106,7 @@ def centrifugal_prestress(
     *,
     tol: float = 1e-10,
     max_iter: int = 25,
-    max_increments: int = 64,
+    max_increments: int = 16,
     log=None,
 ) -> Prestress:
     """Static prestress of ``disc`` spinning at ``omega`` about its blade's axis.
