@@ -166,7 +166,7 @@ def centrifugal_prestress(
                 raise ValueError(
                     f"Newton on the centrifugal prestress at Ω = {omega:g} rad/s did not "
                     f"converge with {max_increments} load increments; use "
-                    "loads.centrifugal = 'linear' or a lower rotation speed"
+                    "loads.centrifugal = 'off' or 'linear', or a lower rotation speed"
                 )
     res = _residual(forms, u, w2, free) / scale
     KT = _sub(forms.tangent(u, MP, w2), free)
