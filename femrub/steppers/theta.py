@@ -77,6 +77,7 @@ class ThetaMethod(Stepper):
     """
 
     name = "theta"
+    supports_wear = True
 
     def __init__(
         self,
@@ -135,6 +136,8 @@ class ThetaMethod(Stepper):
                 and not callable(c.heat_coefficient)
                 and c.gap_rate is None
                 and not c.has_friction
+                and c.wear is None
+                and c.casing_heat is None
             ):
                 a = c.heat_coefficient
                 self._fast = True
@@ -211,6 +214,7 @@ class ThetaMethod(Stepper):
             h,
             g,
             self._warm,
+            upper=c.impulse_cap(t1, h),
         )
         self._warm = P > 0.0
         return Xp + Z @ P, P
@@ -230,11 +234,12 @@ class ThetaMethod(Stepper):
         q = np.column_stack([c.gap_velocity(t1, Xp), c.slip_velocity(Xp)])
         e = np.where(gdot_k > 0.0, 1.0, c.restitution)
         gap_k = c.gap(self.t, Xk)
+        upper = c.impulse_cap(t1, h)
 
         def solve(active, shift=0.0):
             return solve_frictional_contact(
                 W, q + shift, c.friction, active, restitution=e, u_before=gdot_k,
-                warm=self._warm3,
+                warm=self._warm3, upper=upper,
             )  # fmt: skip
 
         active, res = frictional_fixed_point(

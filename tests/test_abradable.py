@@ -1,0 +1,98 @@
+"""Abradable coating: a bar cutting the coating against the hand-derived removal depth."""
+
+import json
+
+import numpy as np
+import pytest
+
+from femrub.app.run import run_scene
+from femrub.contact.abradable import Abradable, CasingGrid
+from femrub.contact.impulses import solve_impulses
+from femrub.scene import SceneError, load_scene
+
+E, A, L = 110e9, 1e-6, 0.30
+K_TIP = E * A / L  # static tip stiffness of the clamped bar (N/m)
+F, F_Y, D = 7.0, 2.0, 5e-6  # tip force, coating yield force (N), cold gap (m)
+
+SCENE = """
+name = "bar-abradable"
+[geometry]
+kind = "bar"
+n_elements = 10
+[contact]
+casing = {{ kind = "concentric", clearance = "5 um" }}
+abradable = {{ thickness = {e}, yield = 2.0, n_angle = 1, n_axial = 1 }}
+[loads]
+tip_force = {{ law = "ramp", amplitude = 7.0, ramp_time = 0.1 }}
+[physics]
+damping_ratio = 0.05
+damping_modes = [1, 2]
+[scheme]
+name = "theta"
+h = 2e-5
+t_end = 0.15
+"""
+
+
+def _run(tmp_path, e):
+    path = tmp_path / f"bar-{e:g}.toml"
+    path.write_text(SCENE.format(e=e))
+    out = tmp_path / f"out-{e:g}"
+    res, built = run_scene(load_scene(str(path)), out)
+    return res, json.loads((out / "summary.json").read_text()), out
+
+
+def test_bar_cuts_the_coating_to_the_hand_derived_depth(tmp_path):
+    """Quasi-static: the coating holds F_y, so k x = F − F_y, wear = x − d = (F − F_y)/k − d."""
+    res, summary, out = _run(tmp_path, 50e-6)
+    expected = (F - F_Y) / K_TIP - D
+    assert summary["status"] == "ok"
+    assert summary["max_wear_depth"] == pytest.approx(expected, rel=0.02)
+    assert summary["worn_volume"] > 0
+    hist = np.loadtxt(out / "wear_history.csv", delimiter=",", skiprows=1)
+    assert np.all(np.diff(hist[:, 1]) >= 0) and hist[:, 1].min() >= 0  # monotone, >= 0
+    assert (out / "wear_map.png").exists() and (out / "wear_map.csv").exists()
+    # while cutting, the contact force is the yield force
+    force = res.force.sum(axis=1)
+    assert force.max() == pytest.approx(F_Y, rel=0.02)
+
+
+def test_wear_never_deeper_than_the_coating(tmp_path):
+    """A 4 µm coating is worn through; the rigid casing behind it then takes the force."""
+    e = 4e-6
+    res, summary, out = _run(tmp_path, e)
+    assert summary["max_wear_depth"] == pytest.approx(e, rel=1e-12)
+    hist = np.loadtxt(out / "wear_history.csv", delimiter=",", skiprows=1)
+    assert hist[:, 1].max() <= e
+    final = res.force.sum(axis=1)[-1]
+    assert final == pytest.approx(F - K_TIP * (D + e), rel=0.02)  # > F_Y: the casing holds
+
+
+def test_bounded_impulses_one_and_several_contacts():
+    W = np.array([[2.0, 0.5], [0.5, 1.0]])
+    q = np.array([-4.0, -3.0])
+    free = solve_impulses(W, q, np.ones(2, bool))
+    capped = solve_impulses(W, q, np.ones(2, bool), upper=np.array([0.5, np.inf]))
+    assert capped[0] == 0.5 and free[0] > 0.5
+    # the uncapped contact is solved with the capped one's impulse known
+    assert capped[1] == pytest.approx((3.0 - 0.5 * 0.5) / 1.0)
+
+
+def test_wear_map_cells_and_volume():
+    grid = CasingGrid([0.0, np.pi], [0.0, 0.01], 0.5, 100.0, n_angle=4, n_axial=2)
+    wear = Abradable(1e-4, 10.0, grid)
+    wear.update(0.0, np.array([-2e-5, -5e-4]), np.array([True, True]))
+    assert wear.depth_at(0.0) == pytest.approx([2e-5, 1e-4])  # second one worn through
+    assert np.isinf(wear.impulse_cap(0.0, 1e-6)[1]) and wear.impulse_cap(0.0, 1e-6)[
+        0
+    ] == pytest.approx(1e-5)
+    wear.update(0.0, np.array([+1e-5, -1e-5]), np.array([True, False]))  # no removal
+    assert wear.max_depth == 1e-4
+    assert wear.worn_volume == pytest.approx(np.sum(wear.depth * wear.cell_area[None, :]))
+
+
+def test_yield_is_required(tmp_path):
+    path = tmp_path / "bad.toml"
+    path.write_text(SCENE.format(e=1e-5).replace("yield = 2.0", "yield = 0.0"))
+    with pytest.raises(SceneError, match="contact.abradable.yield"):
+        load_scene(str(path))
