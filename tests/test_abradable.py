@@ -64,7 +64,9 @@ def test_wear_never_deeper_than_the_coating(tmp_path):
     assert summary["max_wear_depth"] == pytest.approx(e, rel=1e-12)
     hist = np.loadtxt(out / "wear_history.csv", delimiter=",", skiprows=1)
     assert hist[:, 1].max() <= e
-    final = res.force.sum(axis=1)[-1]
+    # mean over the last steps: the default position rule's held impulse alternates from one
+    # step to the next (trapezoidal rule on a held contact) about the static force
+    final = res.force.sum(axis=1)[-100:].mean()
     assert final == pytest.approx(F - K_TIP * (D + e), rel=0.02)  # > F_Y: the casing holds
 
 

@@ -28,7 +28,7 @@ def test_lumped_cell_step_response():
     G = 0.5 * grid.cell_area[0] / 2e-3
     h, P = 1e-3, 2e-3  # impulse per step: λ = 2 N, power (1 − η)/η α λ = 6 W
     for k in range(1, 201):
-        heat.update(k * h, np.array([P]), h)
+        heat.update(k * h, heat.power_per_impulse * P, h)  # J over the step
     t = 200 * h
     assert heat.temperature_at(t)[0] == pytest.approx(6.0 / G * (1 - math.exp(-t / heat.tau)))
     T1 = heat.temperature_at(t + 0.05)[0]

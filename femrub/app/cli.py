@@ -1,4 +1,5 @@
-"""Command line: ``femrub run | check | sweep | campbell | scenes | scene show | paper | mesh | cache``.
+"""Command line: ``femrub run | check | sweep | campbell | scenes | scene show | paper | mesh |
+cache``.
 
 ``run``, ``check`` and ``sweep`` keep the assembled and reduced models in a cache folder
 (:mod:`femrub.app.cache`): ``--cache-dir`` or ``$FEMRUB_CACHE_DIR`` (default: the user's

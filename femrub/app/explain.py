@@ -51,6 +51,8 @@ def _contacts(c: dict, reach_key) -> list[str]:
 
 def _thermal_word(r: dict) -> str:
     return "input shapes" if r.get("thermal") == "inputs" else "dofs"
+
+
 def _centrifugal(c: dict | None) -> list[str]:
     if not c:
         return []

@@ -252,7 +252,7 @@ def _build(scene, log, modes, stages) -> Simulation:
     ch = full.contact.casing_heat if full.contact is not None else None
     report["casing_heat"] = None if ch is None else {
         "thickness": ch.b, "tau": ch.tau, "partition": eta, "expansion": ch.expansion}  # fmt: skip
-        model, limits = _select_signals(scene, full, report, size)
+    model, limits = _select_signals(scene, full, report, size)
     if modes:
         report["natural_frequencies_hz"] = stages.frequencies(model, modes).tolist()
     make = lambda m: _bare_stepper(scene, m)  # noqa: E731  (the reduction error estimate)
@@ -276,6 +276,8 @@ def _bare_stepper(scene, model):
         return make_stepper(s["name"], model, s["h"], **_scheme_options(scene))
     except ValueError as exc:
         raise SceneError(f"scheme ({s['name']}): {exc}") from None
+
+
 def _prestress(scene, disc, material, omega, log, stages):
     """The scene's centrifugal prestress (:mod:`femrub.fem.prestress`), or ``None``."""
     method = tr.centrifugal_of(scene)

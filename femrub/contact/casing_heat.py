@@ -10,15 +10,17 @@ shell ``G = k A / b``, so with the power ``q`` it receives::
 
 integrated exactly for a power constant over a step (``T ← T e^{−h/τ} + q/G (1 − e^{−h/τ})``)
 and lazily (a cell cools as ``e^{−Δt/τ}`` since its last update, evaluated when a contact
-meets it). The contact ``i`` over the step puts the casing's share of the frictional power
+meets it). The step being solved sees the wall as the last step's power, continued, left
+it (explicit in the power, exact in the cooling): so a held contact follows the wall
+instead of finding itself inside it after the update. The contact ``i`` over the step puts the casing's share of the frictional power
 into the cell under it::
 
     q_i = (1 − η) P_i α_i / (η h)     (α_i = η μ |Ω| r_i: heat law of the blade, P_i impulse)
 
 i.e. ``(1 − η) μ |Ω| r_i λ_i`` (heat law ``"alpha"``), or with Coulomb friction (heat law
 ``"power"``) ``q_i = (1 − η) (−P_t,i · w_t,i) / h``, the casing's share of the friction
-power (:meth:`~femrub.contact.gap.Contact.after_step`). The wall expands through its thickness towards the blade
-(the outer shell holds it), closing the gap by ``δ = α_c b T``:
+power (:meth:`~femrub.contact.gap.Contact.after_step`). The wall expands through its
+thickness towards the blade (the outer shell holds it), closing the gap by ``δ = α_c b T``:
 
     g_i(t, X) = ... − α_c b T(Ω t + φ_i, z_i)
 
@@ -85,9 +87,19 @@ class CasingHeat:
         dt = t - self.t_last[cells]
         return self.T[cells] * np.exp(-np.maximum(dt, 0.0) / self.tau)
 
+    def _predict(self, cells, t) -> np.ndarray:
+        """``T`` at ``t``: a cell heated over the last step keeps that power up to one step
+        on (the step being solved sees the wall the heat of the last one expands), else
+        it cools. The update after the step then puts the step's own power in."""
+        dt = np.maximum(t - self.t_last[cells], 0.0)
+        decay = np.exp(-dt / self.tau)
+        G = self.conductance[cells % self.grid.n_axial]
+        q = np.where(dt <= 1.01 * self.h, self.q[cells], 0.0)
+        return self.T[cells] * decay + q / G * (1.0 - decay)
+
     def temperature_at(self, t: float) -> np.ndarray:
         """Wall temperature rise under each contact at ``t`` (K)."""
-        return self._cool_to(self.grid.cells(t), t)
+        return self._predict(self.grid.cells(t), t)
 
     def closure_at(self, t: float) -> np.ndarray:
         """How much the wall's expansion closes each contact's gap at ``t`` (m)."""
@@ -98,7 +110,7 @@ class CasingHeat:
         of the step just done (zero in cells no contact heated then). It enters the gap rate
         ``ġ0`` so the velocity-level contact law follows the wall as it expands."""
         cells = self.grid.cells(t)
-        T = self._cool_to(cells, t)
+        T = self._predict(cells, t)
         G = self.conductance[cells % self.grid.n_axial]
         q = np.where(t - self.t_last[cells] <= 1.01 * self.h, self.q[cells], 0.0)
         return self.expansion * self.b * (q - G * T) / (G * self.tau)
@@ -108,18 +120,17 @@ class CasingHeat:
         the cells under the contacts (:meth:`~femrub.contact.gap.Contact.after_step`)."""
         Q = np.asarray(heat, dtype=float)
         self.h = h
-        if not np.any(Q > 0.0):
-            return
+        # every cell under a contact is updated (with zero power where no heat came)
         c, inv = np.unique(self.grid.cells(t), return_inverse=True)
-        q = np.bincount(inv, weights=Q / h)  # W per cell (contacts in one cell add up)
+        q = np.bincount(inv, weights=Q / h, minlength=c.size)  # W per cell
         decay = math.exp(-h / self.tau)
-        self.T[c] = self._cool_to(c, t - h) * decay + q / self.conductance[
-            c % self.grid.n_axial
-        ] * (1.0 - decay)
+        G = self.conductance[c % self.grid.n_axial]
+        self.T[c] = self._cool_to(c, t - h) * decay + q / G * (1.0 - decay)
         self.t_last[c] = t
         self.q[c] = q
-        self.heat_in += float(Q.sum())
-        self.history.append((float(t), float(self.T[c].max())))
+        if np.any(Q > 0.0):
+            self.heat_in += float(Q.sum())
+            self.history.append((float(t), float(self.T[c].max())))
 
     def map_at(self, t: float) -> np.ndarray:
         """(n_angle, n_axial) wall temperature rise at ``t`` (K)."""

@@ -86,6 +86,4 @@ def speed_family(disc, material, speeds, method: str = "nonlinear", *, log=None)
         if log:
             log(f"prestress ({method}) at {omega:g} rad/s ...")
         states.append(centrifugal_prestress(disc, material, omega, method, log=log))
-    return SpeedFamily(
-        speeds, [p.K for p in states], np.array([p.u for p in states]), method
-    )
+    return SpeedFamily(speeds, [p.K for p in states], np.array([p.u for p in states]), method)
