@@ -12,8 +12,8 @@ integrated exactly for a power constant over a step (``T ← T e^{−h/τ} + q/G
 and lazily (a cell cools as ``e^{−Δt/τ}`` since its last update, evaluated when a contact
 meets it). The step being solved sees the wall as the last step's power, continued, left
 it (explicit in the power, exact in the cooling): so a held contact follows the wall
-instead of finding itself inside it after the update. The contact ``i`` over the step puts the casing's share of the frictional power
-into the cell under it::
+instead of finding itself inside it after the update. The contact ``i`` over the step puts
+the casing's share of the frictional power into the cell under it::
 
     q_i = (1 − η) P_i α_i / (η h)     (α_i = η μ |Ω| r_i: heat law of the blade, P_i impulse)
 
