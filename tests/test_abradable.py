@@ -7,6 +7,8 @@ import pytest
 
 from femrub.app.run import run_scene
 from femrub.contact.abradable import Abradable, CasingGrid
+from femrub.contact.activation import RULES, impulse_one, impulses
+from femrub.contact.friction import SLIP, solve_frictional_contact
 from femrub.contact.impulses import solve_impulses
 from femrub.scene import SceneError, load_scene
 
@@ -98,3 +100,70 @@ def test_yield_is_required(tmp_path):
     path.write_text(SCENE.format(e=1e-5).replace("yield = 2.0", "yield = 0.0"))
     with pytest.raises(SceneError, match="contact.abradable.yield"):
         load_scene(str(path))
+
+
+@pytest.mark.parametrize("rule", RULES)
+def test_every_activation_rule_honours_the_bound(rule):
+    """The wear cap: 0 <= P <= upper under every rule; one contact: the capped closed form;
+    several: a box LCP (held at the bound only where the residual asks for more)."""
+    rng = np.random.default_rng(3)
+    h, gamma = 1e-4, 0.5
+    for _ in range(100):
+        n = int(rng.integers(1, 5))
+        a = rng.normal(size=(n, n))
+        W = a @ a.T + 0.5 * np.eye(n)
+        g_k, gd_k, gd_p = rng.normal(0, 1e-6, n), rng.normal(0, 1e-2, n), rng.normal(0, 1e-2, n)
+        g_p = g_k + 0.5 * h * (gd_k + gd_p)
+        e = rng.choice([0.0, 1.0], n)
+        args = (rule, g_k, gd_k, g_p, gd_p, W, 0.5 * h * W, e, h, gamma)
+        free = impulses(*args)
+        upper = 0.5 * free + 1e-9 * rng.uniform(size=n)
+        P = impulses(*args, upper=upper)
+        assert np.all(P >= 0.0) and np.all(P <= upper)
+        if n == 1:
+            one = impulse_one(rule, g_k[0], gd_k[0], g_p[0], gd_p[0], W[0, 0], 0.5 * h * W[0, 0],
+                              e[0], h, gamma, upper[0])  # fmt: skip
+            assert P[0] == pytest.approx(min(free[0], upper[0]), rel=1e-9, abs=1e-18)
+            assert one == pytest.approx(P[0], rel=1e-9, abs=1e-18)
+
+
+def test_box_lcp_conditions():
+    rng = np.random.default_rng(4)
+    for _ in range(200):
+        n = int(rng.integers(2, 6))
+        a = rng.normal(size=(n, n))
+        W = a @ a.T + 0.2 * np.eye(n)
+        q = rng.normal(size=n)
+        upper = rng.uniform(0.0, 1.0, n)
+        P = solve_impulses(W, q, np.ones(n, bool), upper=upper)
+        r = W @ P + q
+        tol = 1e-9 * (1 + np.abs(q).max())
+        assert np.all(P >= 0) and np.all(P <= upper)
+        at0, atU = P <= 1e-14, P >= upper - 1e-14
+        inside = ~at0 & ~atU
+        assert np.all(r[at0 & ~atU] >= -tol) and np.all(r[atU & ~at0] <= tol)
+        assert np.all(np.abs(r[inside]) <= tol)
+
+
+def test_frictional_solve_caps_the_normal_impulse_and_its_cone():
+    """With friction the normal impulse is capped at U and |P_t| <= μ P_n, = μ U when the
+    contact slides at its bound."""
+    rng = np.random.default_rng(5)
+    for _ in range(100):
+        n = int(rng.integers(1, 5))
+        a = rng.normal(size=(3 * n, 3 * n))
+        W = a @ a.T + 0.05 * np.eye(3 * n)
+        q, mu = rng.normal(size=(n, 3)), rng.uniform(0.05, 1.0, n)
+        free = solve_frictional_contact(W, q, mu, np.ones(n, bool))
+        U = 0.5 * free.P[:, 0] + 1e-3
+        r = solve_frictional_contact(W, q, mu, np.ones(n, bool), upper=U)
+        P, u = r.P, r.u
+        assert np.all(P[:, 0] >= 0.0) and np.all(P[:, 0] <= U * (1 + 1e-12))
+        inside = (P[:, 0] > 1e-12) & (P[:, 0] < U * (1 - 1e-9))
+        assert np.all(np.abs(u[inside, 0]) <= 1e-8)  # Signorini below the bound
+        at = P[:, 0] >= U * (1 - 1e-9)
+        assert np.all(u[at, 0] <= 1e-8)  # at the bound: approaching (the coating yields)
+        nt = np.linalg.norm(P[:, 1:], axis=1)
+        assert np.all(nt <= mu * P[:, 0] * (1 + 1e-10) + 1e-14)
+        slip = r.state == SLIP
+        np.testing.assert_allclose(nt[slip], mu[slip] * P[slip, 0], rtol=1e-10)
