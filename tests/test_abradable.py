@@ -167,3 +167,22 @@ def test_frictional_solve_caps_the_normal_impulse_and_its_cone():
         assert np.all(nt <= mu * P[:, 0] * (1 + 1e-10) + 1e-14)
         slip = r.state == SLIP
         np.testing.assert_allclose(nt[slip], mu[slip] * P[slip, 0], rtol=1e-10)
+
+
+def test_frictional_blade_cuts_the_coating_at_the_yield_force(tmp_path):
+    """3D blade, Coulomb friction and frictional heat (θ-method, frictional solve with the
+    bound): the normal force never exceeds the coating's yield, Coulomb's law holds with the
+    capped normal force, coating is removed, the balances close."""
+    changes = {
+        "geometry.h": 0.03, "geometry.n_sections": 2, "contact.reach": "all",
+        "contact.friction": 0.15, "contact.abradable.thickness": "30 um",
+        "contact.abradable.yield": 5.0, "loads.centrifugal": "off",
+        "reduction.method": "none", "scheme.t_end": 1.5e-3, "outputs.vtk_stride": 0,
+    }  # fmt: skip
+    res, _ = run_scene(load_scene("twisted-naca", changes), tmp_path / "out")
+    s = json.loads((tmp_path / "out" / "summary.json").read_text())
+    assert s["status"] == "ok", s.get("message")
+    assert s["max_contact_force"] == pytest.approx(5.0, rel=1e-9)  # held at the yield
+    assert 0.0 < s["max_wear_depth"] <= 30e-6
+    c = s["coulomb_check"]
+    assert c["cone"] <= 1e-8 and c["slip_equality"] <= 1e-8 and c["slip_steps"] > 0
