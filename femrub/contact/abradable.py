@@ -100,10 +100,12 @@ class Abradable:
         self.reset()
 
     # -- state --------------------------------------------------------------------------
-    def reset(self) -> None:
-        """A fresh coating: no wear, empty history."""
+    def reset(self, h: float | None = None) -> None:
+        """A fresh coating: no wear, empty history; ``h``: the time step of the stepper that
+        runs it (for :meth:`rate_at`; ``None``: no rate)."""
         self.depth = np.zeros((self.n_angle, self.n_axial))
         self.history = [(0.0, 0.0)]
+        self.h = h
 
     def cells(self, t: float) -> np.ndarray:
         return self.grid.cells(t)
@@ -111,6 +113,20 @@ class Abradable:
     def depth_at(self, t: float) -> np.ndarray:
         """Wear depth under each contact at ``t`` (m): what the worn surface adds to the gap."""
         return self.depth.ravel()[self.cells(t)]
+
+    def rate_at(self, t: float) -> np.ndarray | float:
+        """Rate of the worn surface under each contact, ``(w(t) − w(t − h)) / h`` (m/s).
+
+        The map is piecewise constant in the casing angle: a contact moving from a worn cell
+        into a less worn one meets the coating as a surface approaching it. This rate enters
+        ``ġ0`` (:meth:`~femrub.contact.gap.Contact.rate_at`) so a velocity-level contact law
+        stops the blade there and the coating yields (as the casing profile's own rate does
+        on a continuous lobe); without it, the blade would cross the unworn coating with no
+        force and no wear wherever the profile recedes.
+        """
+        if not self.h:
+            return 0.0
+        return (self.depth_at(t) - self.depth_at(t - self.h)) / self.h
 
     def impulse_cap(self, t: float, h: float) -> np.ndarray:
         """Largest impulse ``h F_y`` per contact over a step; ``inf`` where worn through."""

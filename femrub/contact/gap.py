@@ -190,12 +190,16 @@ class Contact:
             self.wear.update(t, self.gap(t, X), yielded)
 
     def rate_at(self, t) -> np.ndarray | float:
-        """``ġ0(t) = dg0/dt`` (m/s); the scalar 0 for a fixed obstacle."""
-        rate, ch = self.gap_rate, self.casing_heat
+        """``ġ0(t) = dg0/dt`` (m/s); the scalar 0 for a fixed obstacle. With a coating it
+        includes the worn surface's rate over a step (:meth:`Abradable.rate_at`), with casing
+        heat the wall's expansion rate."""
+        rate, ch, wear = self.gap_rate, self.casing_heat, self.wear
         rows = isinstance(t, np.ndarray) and t.ndim
         out = 0.0
         if rate is not None:
             out = _over_times(rate, t, self.n) if rows else np.asarray(rate(t), dtype=float)
+        if wear is not None:
+            out = out + (_over_times(wear.rate_at, t, self.n) if rows else wear.rate_at(t))
         if ch is not None:
             out = out - (
                 _over_times(ch.closure_rate_at, t, self.n) if rows else ch.closure_rate_at(t)

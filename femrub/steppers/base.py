@@ -76,7 +76,7 @@ class Stepper:
                     f"an abradable coating needs scheme.name = 'theta' (the {self.name} "
                     "scheme does not bound its contact impulses)"
                 )
-            wear.reset()
+            wear.reset(self.h)
         if model.contact is not None and model.contact.casing_heat is not None:
             model.contact.casing_heat.reset()
         self._check_initial_gap()
