@@ -1,6 +1,7 @@
 """Abradable coating: a bar cutting the coating against the hand-derived removal depth."""
 
 import json
+import math
 
 import numpy as np
 import pytest
@@ -9,6 +10,7 @@ from femrub.app.run import run_scene
 from femrub.contact.abradable import Abradable, CasingGrid
 from femrub.contact.activation import RULES, impulse_one, impulses
 from femrub.contact.friction import SLIP, solve_frictional_contact
+from femrub.contact.gap import Contact
 from femrub.contact.impulses import solve_impulses
 from femrub.scene import SceneError, load_scene
 
@@ -186,3 +188,18 @@ def test_frictional_blade_cuts_the_coating_at_the_yield_force(tmp_path):
     assert 0.0 < s["max_wear_depth"] <= 30e-6
     c = s["coulomb_check"]
     assert c["cone"] <= 1e-8 and c["slip_equality"] <= 1e-8 and c["slip_steps"] > 0
+
+
+def test_worn_surface_rate_enters_the_gap_rate():
+    """A contact moving from a worn cell into an unworn one meets the coating approaching
+    (ġ0 = −w / h over that step), so a velocity-level law stops it there and it cuts."""
+    grid = CasingGrid([0.0], [0.0], 0.3, 100.0, n_angle=4, n_axial=1)
+    wear = Abradable(1e-3, 10.0, grid)
+    wear.reset(h=1e-3)
+    wear.depth[0, 0] = 2e-4  # first quarter worn
+    t_cross = (math.pi / 2) / 100.0  # the contact enters the second cell
+    assert wear.rate_at(t_cross + 0.5e-3) == pytest.approx([-2e-4 / 1e-3])
+    assert wear.rate_at(t_cross - 0.5e-3) == pytest.approx([0.0])
+    c = Contact(G=[[1.0]], Gv=[[1.0]], Hm=[[1.0]], Ht=[[0.0]], gap0=0.0, wear=wear)
+    assert c.rate_at(t_cross + 0.5e-3) == pytest.approx([-0.2])
+    assert c.gap_at(t_cross - 0.5e-3) == pytest.approx([2e-4])
