@@ -4,7 +4,8 @@
 ``DIR/campbell.png`` and ``DIR/campbell.json``. The blade is built as for a run (mesh,
 material, lumping; no contact), then:
 
-1. the centrifugal prestress (``loads.centrifugal``; ``"auto"``: nonlinear) is solved at
+1. the centrifugal prestress (``loads.centrifugal``; ``"auto"`` and ``"off"``: nonlinear,
+   ``"off"`` being a choice for runs: a diagram without prestress has flat lines) is solved at
    ``samples`` speeds equally spaced in ``Ω²`` up to the largest speed asked for
    (:func:`~femrub.fem.speed_family.speed_family`);
 2. the lowest ``modes + 4`` clamped modes at every sample speed, M-orthonormalised
@@ -102,9 +103,12 @@ def campbell(scene, speeds, *, modes: int = 6, samples: int = 3, check: bool = T
     material = tr.material_of(scene)
     mats = assemble(disc, material, lumping=scene["physics"]["lumping"]).mechanical()
     mode = scene["loads"]["centrifugal"]
-    method = "nonlinear" if mode == "auto" else mode
+    method = "nonlinear" if mode in ("auto", "off") else mode
+    if mode == "off" and log:  # e.g. the Rotor 37 scenes: off for their runs only
+        log("notice: loads.centrifugal = 'off' applies to runs; the Campbell diagram uses the "
+            "nonlinear prestress (--set loads.centrifugal=linear for the linear one)")  # fmt: skip
     top = float(speeds.max())
-    if method == "off" or top == 0.0:
+    if top == 0.0:
         method, samples = "off", 1
         from ..fem.speed_family import SpeedFamily
 
