@@ -14,8 +14,10 @@ from femrub.app.simulation import build
 from femrub.scene import load_scene
 
 # a coarse twisted blade (a few hundred tetrahedra) reduced with fixed sizes; every contact
-# kept whatever the speed, so a speed change keeps the same boundary dofs
+# kept whatever the speed, so a speed change keeps the same boundary dofs; no centrifugal
+# prestress (it makes the stiffness depend on the speed: test_prestress_is_cached_per_speed)
 SMALL = {
+    "loads.centrifugal": "off",
     "geometry.h": 0.03,
     "geometry.n_sections": 2,
     "contact.reach": "all",
@@ -95,6 +97,23 @@ def test_speed_change_reuses_the_matrices_with_the_new_gap_and_heat(first):
     fresh = _build(None, None, **{"loads.rotation_speed": 1700.0})
     _same_model(hit.model, fresh.model)
     _close(_states(hit), _states(fresh), 1e-6)
+
+
+def test_prestress_is_cached_per_speed(tmp_path):
+    cache = ModelCache(tmp_path / "cache")
+    on = {"loads.centrifugal": "nonlinear"}
+    notes = []
+    a = _build(cache, notes, **on)
+    assert any("prestress stored" in n for n in notes)
+    notes = []
+    b = _build(cache, notes, **on)
+    assert any("prestress loaded" in n for n in notes)
+    assert any("assembly loaded" in n for n in notes)
+    _close(a.model.B.toarray(), b.model.B.toarray())
+    notes = []
+    _build(cache, notes, **on, **{"loads.rotation_speed": 1000.0})
+    assert any("prestress stored" in n for n in notes)  # another speed: another K_T
+    assert any("assembly stored" in n for n in notes)
 
 
 def test_changed_material_misses(first):

@@ -12,11 +12,15 @@ cache it only calls them:
   projects (``A``, ``B``, contact rows, load vectors, observations, energy forms, map to the
   mesh, boundary dofs, initial state), the ``reduction`` options and, for ``"auto"``, the
   end time that sets its thermal frequencies;
-* ``frequencies``: the natural frequencies of the full model (sweeps, ``--modes``).
+* ``frequencies``: the natural frequencies of the full model (sweeps, ``--modes``);
+* ``prestress``: the centrifugal prestress (:func:`femrub.fem.prestress.centrifugal_prestress`,
+  a Newton solve on the full mesh); key: the mesh, the material, Ω and the method. The
+  prestressed tangent then enters the assembly key (a prestressed model is per speed).
 
 What a rotation speed changes without changing a matrix (the casing gap swept at Ω, the
 heat coefficients, the restitution, the load signals) is not in the assembly key: every
-point of a speed sweep on one blade shares the assembled model. The reduction error
+point of a speed sweep on one blade shares the assembled model (unless a centrifugal
+prestress, which depends on Ω, changes the stiffness). The reduction error
 estimate (``docs/reduction.md``) steps the run itself, so a reduced model is keyed by the
 scene's ``scheme``, ``loads`` and ``contact`` too; a cached reduced model takes the gap
 functions and signals from the full model built in this run. Every key also holds
@@ -33,6 +37,7 @@ import time
 import numpy as np
 
 from ..fem.discretisation import assemble
+from ..fem.prestress import centrifugal_prestress
 from ..reduction.sizes import natural_frequencies, reduce_model
 from .cache import content_key
 
@@ -84,6 +89,22 @@ class Stages:
         bare = dataclasses.replace(mats, basis_u=None, basis_t=None)
         self._keep("assembly", key, bare, f"{mats.n_u} + {mats.n_t} FE dofs")
         return mats
+
+    def prestress(self, disc, material, omega: float, method: str):
+        """:func:`~femrub.fem.prestress.centrifugal_prestress` of ``disc``, through the cache."""
+        if self.cache is None:
+            return centrifugal_prestress(disc, material, omega, method, log=self.log)
+        mesh = disc.mesh
+        key = content_key(
+            "prestress", type(mesh).__name__, mesh.p, mesh.t, disc.order,
+            type(disc.basis_u.elem).__name__, disc.fixed_u, material, float(omega), method,
+        )  # fmt: skip
+        hit = self._fetch("prestress", key)
+        if hit is not None:
+            return hit
+        ps = centrifugal_prestress(disc, material, omega, method, log=self.log)
+        self._keep("prestress", key, ps, f"{method} at {omega:g} rad/s")
+        return ps
 
     def _model_key(self, model, *extra) -> str:
         n = model.n_dofs

@@ -1,4 +1,5 @@
-"""Command line: ``femrub run | check | sweep | scenes | scene show | paper | mesh | cache``.
+"""Command line: ``femrub run | check | sweep | campbell | scenes | scene show | paper | mesh |
+cache``.
 
 ``run``, ``check`` and ``sweep`` keep the assembled and reduced models in a cache folder
 (:mod:`femrub.app.cache`): ``--cache-dir`` or ``$FEMRUB_CACHE_DIR`` (default: the user's
@@ -231,6 +232,28 @@ def _sweep(args) -> int:
     return 1 if failed else 0
 
 
+def _campbell(args) -> int:
+    from .campbell import campbell, parse_speeds, write_campbell
+
+    scene = _load(args)
+    speeds = parse_speeds(args.speeds)
+    out = Path(args.out or f"{scene.name}-campbell")
+    t0 = time.perf_counter()
+    res = campbell(
+        scene, speeds, modes=args.modes, samples=args.samples, check=not args.no_check,
+        log=_log(args),
+    )  # fmt: skip
+    doc = write_campbell(res, out)
+    if not args.quiet:
+        rest = ", ".join(f"{f:.5g}" for f in doc["rest_frequencies_hz"])
+        print(f"done in {time.perf_counter() - t0:.1f} s: {out / 'campbell.png'}, "
+              f"{out / 'campbell.csv'}; at rest {rest} Hz")  # fmt: skip
+        if "check_max_relative_error" in doc:
+            print(f"  interpolation checked at {doc['check_speed']:.5g} rad/s: largest "
+                  f"frequency error {100 * doc['check_max_relative_error']:.2g} %")  # fmt: skip
+    return 0
+
+
 def _scene_args(p: argparse.ArgumentParser, out: bool = True) -> None:
     p.add_argument("scene", help="scene file (.toml) or built-in scene name (femrub scenes)")
     p.add_argument(
@@ -285,6 +308,17 @@ def build_parser() -> argparse.ArgumentParser:
     sp.add_argument("--workers", type=int, default=2, help="local worker processes (default 2)")
     sp.add_argument("--scheduler", help="address of a dask scheduler (default: LocalCluster)")
     sp.set_defaults(func=_sweep)
+    cb = sub.add_parser("campbell", help="Campbell diagram of a scene's blade (PNG + CSV)")
+    _scene_args(cb)
+    cb.add_argument("--speeds", required=True, help="START:STOP:STEP (rad/s, stop included)")
+    cb.add_argument("--modes", type=int, default=6, help="mode lines (default 6)")
+    cb.add_argument(
+        "--samples", type=int, default=3, help="prestress solves, equally spaced in Ω² (default 3)"
+    )
+    cb.add_argument(
+        "--no-check", action="store_true", help="skip the full solve checking the interpolation"
+    )
+    cb.set_defaults(func=_campbell)
     lp = sub.add_parser("scenes", help="list the built-in scenes")
     lp.set_defaults(func=_scenes)
     shp = sub.add_parser("scene", help="show a built-in scene")

@@ -55,6 +55,29 @@ def _thermal_word(r: dict) -> str:
     return "input shapes" if r.get("thermal") == "inputs" else "dofs"
 
 
+def _centrifugal(c: dict | None) -> list[str]:
+    if not c:
+        return []
+    if c["method"] == "off":
+        return [f"off ({c['why']})"]
+    head = (
+        f"{c['method']} prestress at {c['rotation_speed']:g} rad/s "
+        f"({c['newton_iterations']} Newton iterations, {c['load_increments']} load "
+        f"increment(s), residual {c['residual']:.1e}); geometric stiffness and spin "
+        "softening in K"
+    )
+    grow = (
+        f"radial tip growth at the contacts {_um(c['tip_growth_min'])} .. "
+        f"{_um(c['tip_growth_max'])} (mean {_um(c['tip_growth_mean'])})"
+    )
+    if c["clearance"] == "running":
+        gaps = "running clearances (contact.clearance = 'running'): the growth closes nothing"
+    else:
+        gaps = "cold clearances (contact.clearance = 'cold'): the growth closes the gaps"
+    gaps += f"; smallest gap over a revolution {_um(c['min_gap'])} .. {_um(c['max_min_gap'])}"
+    return [head, grow, gaps]
+
+
 def _reduction(r: dict) -> list[str]:
     if r["method"] == "none":
         return ["none (reduction.method = 'none'): the full model runs"]
@@ -110,6 +133,22 @@ def explain(report: dict, reach_key=None) -> str:
     rows.append(("thermal", report["thermal"]))
     for d in report["dropped"]:
         rows.append(("dropped", d))
+    rows += [("prestress", x) for x in _centrifugal(report.get("centrifugal"))]
+    a = report.get("abradable")
+    if a:
+        rows.append((
+            "abradable",
+            f"coating {_um(a['thickness'])} thick, yields at {a['yield']:g} N per contact; "
+            f"wear map {a['n_angle']} angles × {a['n_axial']} axial cells",
+        ))  # fmt: skip
+    ch = report.get("casing_heat")
+    if ch:
+        rows.append((
+            "casing",
+            f"lumped wall {_um(ch['thickness'])} thick (τ = {ch['tau']:.3g} s) takes "
+            f"{100 * (1 - ch['partition']):.3g} % of the frictional power; its expansion "
+            "closes the gaps",
+        ))  # fmt: skip
     reach_key = reach_key or report.get("reach_key", "auto")
     rows += [("contacts", x) for x in _contacts(report["contacts"], reach_key)]
     f = report.get("friction")

@@ -152,4 +152,13 @@ def _run_claimed(scene, out, progress, log, on_built, modes, cache):
             f"stepping done in {t.get('stepping', 0.0):.2f} s ({res.steps} steps, "
             f"{per_step:.0f} µs/step wall), output {t.get('output', 0.0):.2f} s"
         )
+    contact = built.model.contact
+    if contact is not None and contact.wear is not None:
+        from ..output.wear import write_wear
+
+        res.info.update(write_wear(contact.wear, out))
+    if contact is not None and contact.casing_heat is not None:
+        from ..output.wear import write_casing_heat
+
+        res.info.update(write_casing_heat(contact.casing_heat, float(res.t[-1]), out))
     return res, built

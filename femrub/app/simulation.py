@@ -28,6 +28,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .. import progress
+from ..contact.abradable import Abradable, CasingGrid
+from ..contact.casing_heat import CasingHeat
 from ..contact.heat import heat_coefficients
 from ..contact.points import locate_contacts
 from ..contact.reach import contact_reach, normal_deflection
@@ -192,13 +194,15 @@ def _build(scene, log, modes, stages) -> Simulation:
     try:
         disc = discretise(blade, p["order"] if blade.dim == 3 else 1,
                           clamped=scene["boundary"]["clamped"])  # fmt: skip
+        prestress = _prestress(scene, disc, material, omega, log, stages)
         mats = stages.assemble(
             disc, material, area=tr.area_of(scene), lumping=p["lumping"],
             coupling=tr.coupling_of(scene), beta=p["beta"], strain_heating=p["strain_heating"],
             rayleigh=tuple(p["rayleigh"]), damping_ratio=p["damping_ratio"],
-            damping_modes=tuple(p["damping_modes"]),
+            damping_modes=tuple(p["damping_modes"]), prestress=prestress,
         )  # fmt: skip
         candidates = locate_contacts(disc)
+        growth = prestress.growth(candidates) if prestress is not None else np.zeros(candidates.n)
         force = tr.force_law(scene)
         loads = []
         if force:
@@ -207,29 +211,32 @@ def _build(scene, log, modes, stages) -> Simulation:
             loads = [tip_load(disc, mats, vector, signal)]
         reach = contact_reach(
             candidates, casing, rotation_speed=omega, gap_reference=c["gap_reference"],
-            reach=c["reach"], margin=c["reach_margin"],
+            reach=c["reach"], margin=c["reach_margin"], growth=growth, clearance=c["clearance"],
             deflection=normal_deflection(mats, candidates.normal_rows(mats),
                                          loads[0].vector if loads else None, force and force[2]),
         )  # fmt: skip
         points = candidates.restrict(reach.keep)
         law = tr.heat_law_of(scene)
         mu = c["friction"] if blade.dim == 3 else 0.0
+        eta = tr.heat_partition_of(scene)
         if law == "power":
             alpha = np.zeros(points.n)
-            heated = mu > 0.0 and c["heat_partition"] > 0.0
+            heated = mu > 0.0 and eta > 0.0
         else:
             alpha = heat_coefficients(points.radii, "alpha", alpha=c["heat_coefficient"],
-                                      heat_partition=c["heat_partition"])  # fmt: skip
+                                      heat_partition=eta)  # fmt: skip
             heated = bool(np.any(alpha > 0))
+        grid = _grid(scene, blade, points, omega, growth[reach.keep])
         keep_t, report["thermal"] = tr.thermal_choice(scene, heated, points.n > 0)
         full, fields = rub_model(
             disc, mats, points, material, casing=casing, rotation_speed=omega, alpha=alpha,
             restitution=c["restitution"], offset=reach.offset[reach.keep], loads=loads,
             thermal=keep_t, observe_at=points if points.n else candidates,
             friction=mu, heat_law="power" if law == "power" else "alpha",
-            heat_partition=c["heat_partition"],
+            heat_partition=eta, wear=_abradable(scene, grid),
+            casing_heat=_casing_heat(scene, grid, eta, alpha, mu if law == "power" else 0.0),
         )  # fmt: skip
-        report["friction"] = {"mu": mu, "heat_law": law, "heat_partition": c["heat_partition"]}
+        report["friction"] = {"mu": mu, "heat_law": law, "heat_partition": eta}
         _initial_penetration(full, report, log)
     except ValueError as exc:  # a value the schema cannot see (e.g. a singular clamp)
         if isinstance(exc, SceneError):
@@ -239,6 +246,12 @@ def _build(scene, log, modes, stages) -> Simulation:
     report["dropped"] += [d for d in full.info.get("dropped", []) if "temperature" not in d]
     report["full"] = {"n_dofs": full.n_dofs, "fe_dofs": mats.n_u + mats.n_t, **_layout(full)}
     report["contacts"] = _contacts_report(candidates, reach)
+    report["centrifugal"] = _centrifugal_report(scene, prestress, growth, reach)
+    wear = full.contact.wear if full.contact is not None else None
+    report["abradable"] = wear.as_dict() if wear is not None else None
+    ch = full.contact.casing_heat if full.contact is not None else None
+    report["casing_heat"] = None if ch is None else {
+        "thickness": ch.b, "tau": ch.tau, "partition": eta, "expansion": ch.expansion}  # fmt: skip
     model, limits = _select_signals(scene, full, report, size)
     if modes:
         report["natural_frequencies_hz"] = stages.frequencies(model, modes).tolist()
@@ -263,6 +276,74 @@ def _bare_stepper(scene, model):
         return make_stepper(s["name"], model, s["h"], **_scheme_options(scene))
     except ValueError as exc:
         raise SceneError(f"scheme ({s['name']}): {exc}") from None
+
+
+def _prestress(scene, disc, material, omega, log, stages):
+    """The scene's centrifugal prestress (:mod:`femrub.fem.prestress`), or ``None``."""
+    method = tr.centrifugal_of(scene)
+    if method is None:
+        return None
+    if log:
+        log(f"centrifugal prestress ({method}) at {omega:g} rad/s ...")
+    return stages.prestress(disc, material, omega, method)
+
+
+def _grid(scene, blade, points, omega, growth):
+    """Casing cells swept by the kept contacts (wear map, casing heat), or ``None``."""
+    c = scene["contact"]
+    a, h = c["abradable"], c["casing_heat"]
+    if points.n == 0 or (a["thickness"] <= 0.0 and h["thickness"] <= 0.0):
+        return None
+    n = a if a["thickness"] > 0.0 else h
+    axial = blade.axis @ points.points if blade.dim == 3 else np.zeros(points.n)
+    return CasingGrid(points.angles, axial, float(np.max(points.radii + growth)), omega,
+                      n_angle=n["n_angle"], n_axial=n["n_axial"])  # fmt: skip
+
+
+def _abradable(scene, grid):
+    """The coating of ``contact.abradable`` over the kept contacts, or ``None``."""
+    a = scene["contact"]["abradable"]
+    if grid is None or a["thickness"] <= 0.0:
+        return None
+    return Abradable(a["thickness"], a["yield"], grid)
+
+
+def _casing_heat(scene, grid, eta, alpha, mu):
+    """The lumped casing thermal model of ``contact.casing_heat``, or ``None``; ``mu``: the
+    Coulomb coefficient of the ``"power"`` heat law (0 with the ``"alpha"`` law)."""
+    h = scene["contact"]["casing_heat"]
+    if grid is None or h["thickness"] <= 0.0:
+        return None
+    if not 0.0 < eta < 1.0 or not (mu > 0.0 or np.any(alpha > 0)):
+        fail(
+            "contact.casing_heat.thickness",
+            h["thickness"],
+            f"no frictional heat reaches the casing (heat_partition {eta:g}, no heat "
+            "coefficient); set contact.friction / heat_coefficient and heat_partition < 1",
+        )
+    return CasingHeat(grid, h["thickness"], h["density"], h["specific_heat"], h["conductivity"],
+                      h["expansion"], eta, alpha)  # fmt: skip
+
+
+def _centrifugal_report(scene, prestress, growth, reach) -> dict:
+    if prestress is None:
+        why = (
+            "loads.centrifugal = 'off'"
+            if scene["loads"]["centrifugal"] == "off"
+            else ("the 1D bar" if tr.is_bar(scene) else "loads.rotation_speed = 0")
+        )
+        return {"method": "off", "why": why}
+    g = np.asarray(growth, dtype=float)
+    return {
+        "method": prestress.method, "rotation_speed": prestress.omega,
+        "newton_iterations": prestress.iterations, "load_increments": prestress.increments,
+        "residual": prestress.residual, "clearance": scene["contact"]["clearance"],
+        "tip_growth_min": float(g.min()) if g.size else 0.0,
+        "tip_growth_max": float(g.max()) if g.size else 0.0,
+        "tip_growth_mean": float(g.mean()) if g.size else 0.0,
+        "min_gap": float(reach.min_gap.min()) if g.size else 0.0,
+        "max_min_gap": float(reach.min_gap.max()) if g.size else 0.0,
+    }  # fmt: skip
 
 
 def _stepper(scene, model, report):

@@ -92,6 +92,8 @@ def point_metrics(folder) -> dict:
         "status": s.get("status"),
         "message": s.get("message", ""),
         "max_tip_displacement": max(disp) if disp else None,
+        "rms_tip_displacement": _rms(folder / "history.npz", "signal_tip_displacement"),
+        "max_wear_depth": s.get("max_wear_depth", 0.0),
         "max_contact_force": s.get("max_contact_force"),
         "max_temperature": max(temps) if temps else 0.0,
         "first_contact_time": s.get("first_contact_time"),
@@ -99,6 +101,16 @@ def point_metrics(folder) -> dict:
         "wall_seconds": s.get("wall_seconds"),
         "natural_frequencies_hz": build.get("natural_frequencies_hz", []),
     }
+
+
+def _rms(path, key):
+    """Root mean square of ``key`` in a ``history.npz`` (``None`` when absent)."""
+    try:
+        with np.load(path) as h:
+            x = np.asarray(h[key], dtype=float)
+    except (OSError, KeyError, ValueError):
+        return None
+    return float(np.sqrt(np.mean(x**2))) if x.size else None
 
 
 def run_point(
@@ -258,7 +270,8 @@ def _write_csv(rows, keys, path) -> None:
     n_f = max((len(r.get("natural_frequencies_hz") or []) for r in rows), default=0)
     cols = ["point", *keys, "status", "max_tip_displacement_m", "max_contact_force_N",
             "max_temperature_K", "first_contact_time_s", "t_reached_s",
-            *[f"f{j + 1}_hz" for j in range(n_f)], "skipped", "folder", "message"]  # fmt: skip
+            *[f"f{j + 1}_hz" for j in range(n_f)], "skipped", "folder", "message",
+            "rms_tip_displacement_m", "max_wear_depth_m"]  # fmt: skip
     with open(path, "w", newline="") as fh:
         w = csv.writer(fh)
         w.writerow(cols)
@@ -268,4 +281,5 @@ def _write_csv(rows, keys, path) -> None:
                         r.get("status"), r.get("max_tip_displacement"),
                         r.get("max_contact_force"), r.get("max_temperature"),
                         r.get("first_contact_time"), r.get("t_reached"), *f[:n_f],
-                        r["skipped"], r["folder"], r.get("message", "")])  # fmt: skip
+                        r["skipped"], r["folder"], r.get("message", ""),
+                        r.get("rms_tip_displacement"), r.get("max_wear_depth")])  # fmt: skip

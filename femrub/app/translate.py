@@ -12,13 +12,16 @@ import math
 import numpy as np
 
 from ..contact.casing import casing_profile
+from ..contact.casing_heat import effusivity_partition
 from ..fem.material import Material
 
 __all__ = [
     "ForceLaw",
     "area_of",
     "casing_of",
+    "centrifugal_of",
     "coupling_of",
+    "heat_partition_of",
     "force_law",
     "heat_law_of",
     "material_of",
@@ -86,6 +89,29 @@ def heat_law_of(scene) -> str:
     return law
 
 
+def centrifugal_of(scene) -> str | None:
+    """Prestress method (``"linear"``/``"nonlinear"``) at the scene's speed, or ``None``."""
+    mode = scene["loads"]["centrifugal"]
+    if mode == "off" or is_bar(scene) or scene["loads"]["rotation_speed"] == 0.0:
+        return None
+    return "nonlinear" if mode == "auto" else mode
+
+
+def heat_partition_of(scene) -> float:
+    """Share η of the frictional power entering the blade (``contact.heat_partition``)."""
+    c, m = scene["contact"], scene["material"]
+    eta = c["heat_partition"]
+    if eta == "auto":
+        eta = "effusivity" if c["casing_heat"]["thickness"] > 0.0 else 1.0
+    if eta == "effusivity":
+        h = c["casing_heat"]
+        return effusivity_partition(
+            (m["conductivity"], m["density"], m["specific_heat"]),
+            (h["conductivity"], h["density"], h["specific_heat"]),
+        )
+    return float(eta)
+
+
 def area_of(scene) -> float:
     """Cross-section of the bar (m²); 1 for a solid."""
     return scene["geometry"]["area"] if is_bar(scene) else 1.0
@@ -144,7 +170,7 @@ def thermal_choice(scene, heated: bool, reachable: bool = True) -> tuple[bool, s
     c = scene["contact"]
     if not reachable:
         why = "no contact the casing can reach"
-    elif c["heat_partition"] == 0.0:
+    elif heat_partition_of(scene) == 0.0:
         why = "contact.heat_partition = 0"
     elif is_bar(scene):
         why = "contact.heat_coefficient = 0"

@@ -42,6 +42,12 @@ except ``"plain"``:
 * ``"predicted"``: Moreau–Jean (Siconos) rule ``g_k + γ h ġ_k <= 0``, ``e = 1`` on
   separating contacts.
 
+Every rule takes an optional bound ``upper`` (n_c,) on the impulses, ``0 <= P <= upper``
+(:func:`femrub.contact.impulses.cap`): an abradable coating yields at ``upper = h F_y``
+(:mod:`femrub.contact.abradable`), and a contact held at its bound may penetrate the worn
+surface by what the coating then loses. :func:`frictional_fixed_point` passes it through
+``solve`` (:func:`femrub.contact.friction.solve_frictional_contact`, ``upper=``).
+
 Measured accuracy of each on the paper case: ``docs/paper-reproduction.md``.
 """
 
@@ -71,11 +77,15 @@ def check_rule(rule: str) -> str:
     return rule
 
 
-def impulse_one(rule, g_k, gd_k, g_p, gd_p, w, gz, e, h, gamma) -> float:
+def impulse_one(rule, g_k, gd_k, g_p, gd_p, w, gz, e, h, gamma, upper=np.inf) -> float:
     """Impulse of a single contact (scalar closed form of :func:`impulses`).
 
-    ``w = ∂ġ_{k+1}/∂P > 0`` and ``gz = ∂g_{k+1}/∂P > 0``.
+    ``w = ∂ġ_{k+1}/∂P > 0`` and ``gz = ∂g_{k+1}/∂P > 0``; ``upper``: bound on the impulse.
     """
+    return min(_impulse_one(rule, g_k, gd_k, g_p, gd_p, w, gz, e, h, gamma), upper)
+
+
+def _impulse_one(rule, g_k, gd_k, g_p, gd_p, w, gz, e, h, gamma) -> float:
     if rule in ("capped", "position"):
         if g_k > 0.0 and g_p >= 0.0:  # open, and the free step does not reach the casing
             return 0.0
@@ -95,7 +105,7 @@ def impulse_one(rule, g_k, gd_k, g_p, gd_p, w, gz, e, h, gamma) -> float:
     return max(0.0, -(gd_p + e * gd_k) / w)
 
 
-def impulses(rule, g_k, gd_k, g_p, gd_p, W, GZ, e, h, gamma, warm=None) -> np.ndarray:
+def impulses(rule, g_k, gd_k, g_p, gd_p, W, GZ, e, h, gamma, warm=None, upper=None):
     """Impulses of all contacts for one step under ``rule`` (see module docstring).
 
     Parameters
@@ -105,43 +115,48 @@ def impulses(rule, g_k, gd_k, g_p, gd_p, W, GZ, e, h, gamma, warm=None) -> np.nd
     W, GZ : ``∂ġ_{k+1}/∂P`` and ``∂g_{k+1}/∂P``, shape ``(n_c, n_c)``.
     e : restitution coefficients, ``(n_c,)``.
     warm : previous step's ``P > 0`` (warm start of the LCP), or ``None``.
+    upper : (n_c,) bound on the impulses (``None``: unbounded).
+
+    Returns
+    -------
+    (n_c,) impulses ``P``.
     """
     if rule == "capped":
-        return _capped(g_k, gd_k, g_p, gd_p, W, GZ, e, h, warm)
+        return _capped(g_k, gd_k, g_p, gd_p, W, GZ, e, h, warm, upper)
     if rule == "position":
         q = (2.0 / h) * (g_p - _target(g_k, e))
         M = (2.0 / h) * GZ
         closed = g_k <= 0.0
         active = (q < 0.0) & (closed | (g_p < 0.0))
         while True:  # add contacts that the others' impulses pull below their target
-            P = solve_impulses(M, q, active, warm)
+            P = solve_impulses(M, q, active, warm, upper)
             r = M @ P + q
             low = ~active & (r < -1e-12 * np.abs(q).max()) & (closed | (g_p + GZ @ P < 0.0))
             if not low.any():
                 return P
             active |= low
     if rule == "plain":
-        return solve_impulses(W, gd_p + e * gd_k, g_p <= 0.0, warm)
+        return solve_impulses(W, gd_p + e * gd_k, g_p <= 0.0, warm, upper)
     e = np.where(gd_k > 0.0, 1.0, e)  # midpoint law on separating contacts
     q = (gd_p + e * gd_k) / (1.0 + e)
     Wn = W / (1.0 + e)[:, None]
     if rule == "predicted":
-        return solve_impulses(Wn, q, g_k + gamma * h * gd_k <= 0.0, warm)
+        return solve_impulses(Wn, q, g_k + gamma * h * gd_k <= 0.0, warm, upper)
     closed = g_k <= 0.0
     active = closed | (g_p <= 0.0)
     seen = []
     while True:
-        P = solve_impulses(Wn, q, active, warm)
+        P = solve_impulses(Wn, q, active, warm, upper)
         new = closed | (g_p + GZ @ P <= 0.0)
         if np.array_equal(new, active):
             return P
         if any(np.array_equal(new, a) for a in seen):  # no consistent set: keep impulse
-            return solve_impulses(Wn, q, new | active, warm)
+            return solve_impulses(Wn, q, new | active, warm, upper)
         seen.append(active)
         active = new
 
 
-def _capped(g_k, gd_k, g_p, gd_p, W, GZ, e, h, warm):
+def _capped(g_k, gd_k, g_p, gd_p, W, GZ, e, h, warm, upper=None):
     """``0 <= P ⊥ max(r_v, r_g) >= 0`` by switching each contact's binding row.
 
     ``r_v = W P + ġ_p + e ġ_k`` (Newton) and ``r_g = (2/h)(GZ P + g_p − g*)``
@@ -159,8 +174,10 @@ def _capped(g_k, gd_k, g_p, gd_p, W, GZ, e, h, warm):
     for _ in range(2 * g_k.size + 2):
         M = np.where(use_g[:, None], Wg, W)
         q = np.where(use_g, qg, qv)
-        P = solve_impulses(M, q, cand, warm)
+        P = solve_impulses(M, q, cand, warm, upper)
         other = np.where(use_g, W @ P + qv, Wg @ P + qg)
+        if upper is not None:  # a contact at its bound is not limited by either row
+            other = np.where(P >= upper, -np.inf, other)
         switch = cand & (P > 0.0) & (other > 1e-10 * np.maximum(np.abs(qv), np.abs(qg)))
         if not switch.any():
             return P

@@ -14,8 +14,13 @@ with the velocity ``u_n⁻`` at the start of the step and the restitution ``e``;
 gives ``u_n⁺``'s free part and ``u_n⁻``. The problem is solved exactly (never regularised)
 by the semi-smooth Newton method of Alart & Curnier (1991) on::
 
-    F_n = P_n − max(0, P_n − ρ u_n) = 0
-    F_t = P_t − proj_{B(μ max(0, P_n − ρ u_n))}(P_t − ρ u_t) = 0
+    F_n = P_n − proj_[0, U](P_n − ρ u_n) = 0
+    F_t = P_t − proj_{B(μ proj_[0, U](P_n − ρ u_n))}(P_t − ρ u_t) = 0
+
+with an optional bound ``U`` on the normal impulse (``U = ∞`` by default; an abradable
+coating yields at ``U = h F_y``, :mod:`femrub.contact.abradable`): a contact at its bound
+may penetrate and its tangential impulse lies in the cone of the bounded normal impulse,
+``|P_t| <= μ U``.
 
 with per-contact ``ρ_i = 1 / ‖W_ii‖_F``, an Armijo line search on ``‖F‖²/2``, and projected
 block Gauss–Seidel sweeps on the same map (then Newton again) when Newton stalls. The
@@ -74,6 +79,7 @@ def solve_frictional_contact(
     restitution=0.0,
     u_before=None,
     warm=None,
+    upper=None,
     tol: float = 1e-12,
     max_iter: int = 60,
 ) -> FrictionResult:
@@ -88,6 +94,7 @@ def solve_frictional_contact(
     restitution : (n,) or scalar ``e``; the normal law acts on ``(u_n⁺ + e u_n⁻) / (1 + e)``.
     u_before : (n,) normal velocity ``u_n⁻`` at the start of the step (default 0).
     warm : (n, 3) impulses of the previous step (a start for Newton).
+    upper : (n,) bound ``U`` on the normal impulses (``None``: unbounded).
     tol : convergence tolerance on the relative residual.
     max_iter : Newton iterations before the fixed-point fallback.
 
@@ -110,6 +117,7 @@ def solve_frictional_contact(
     mu = np.broadcast_to(np.asarray(mu, dtype=float), (n,))
     e = np.broadcast_to(np.asarray(restitution, dtype=float), (n,))
     ub = np.zeros(n) if u_before is None else np.asarray(u_before, dtype=float)
+    U = np.full(n, np.inf) if upper is None else np.broadcast_to(np.asarray(upper, float), (n,))
     # Newton's law: scale the normal rows by 1 / (1 + e) and shift by e u_n⁻ / (1 + e)
     s = np.ones((n, 3))
     s[:, 0] = 1.0 / (1.0 + e)
@@ -121,13 +129,13 @@ def solve_frictional_contact(
     Wa, qa, mua = Wl[np.ix_(rows, rows)], ql[idx], mu[idx]
     slide = np.zeros(idx.size, dtype=bool)
     if not np.any(mua > 0.0):  # frictionless: the exact LCP on the normal part
-        Pn = solve_impulses(Wa[::3, ::3], qa[:, 0], np.ones(idx.size, dtype=bool))
+        Pn = solve_impulses(Wa[::3, ::3], qa[:, 0], np.ones(idx.size, dtype=bool), upper=U[idx])
         Pa = np.zeros((idx.size, 3))
         Pa[:, 0] = Pn
         res, it = 0.0, 0
     else:
         w0 = None if warm is None else np.asarray(warm, dtype=float).reshape(-1, 3)[idx]
-        Pa, slide, res, it = _alart_curnier(Wa, qa, mua, w0, tol, max_iter)
+        Pa, slide, res, it = _alart_curnier(Wa, qa, mua, U[idx], w0, tol, max_iter)
     P[idx] = Pa
     u = (W @ P.reshape(-1)).reshape(n, 3) + q
     state = np.zeros(n, dtype=np.int8)
@@ -145,17 +153,18 @@ def _blocks(W, m):
     return W.reshape(m, 3, m, 3)[r, :, r, :]
 
 
-def _residual(P, W, q, mu, rho):
+def _residual(P, W, q, mu, rho, U):
     """Alart–Curnier function ``F(P)`` (m, 3) and the quantities its Jacobian needs."""
     u = (W @ P.reshape(-1)).reshape(-1, 3) + q
     a = P[:, 0] - rho * u[:, 0]
-    pos = a > 0.0
-    r = mu * np.maximum(a, 0.0)
+    pn = np.clip(a, 0.0, U)
+    pos = (a > 0.0) & (a < U)  # where the projected normal impulse follows a
+    r = mu * pn
     x = P[:, 1:] - rho[:, None] * u[:, 1:]
     nx = np.hypot(x[:, 0], x[:, 1])
     slip = nx > r
     F = np.empty_like(P)
-    F[:, 0] = P[:, 0] - np.maximum(a, 0.0)
+    F[:, 0] = P[:, 0] - pn
     scale = np.where(slip, r / np.where(nx > 0.0, nx, 1.0), 1.0)
     F[:, 1:] = P[:, 1:] - scale[:, None] * x
     return F, (u, pos, r, x, nx, slip)
@@ -198,13 +207,13 @@ def _jacobian(W, mu, rho, aux):
     return J.reshape(3 * m, 3 * m)
 
 
-def _on_cone(P, u, mu, rho):
+def _on_cone(P, u, mu, rho, U):
     """Exact cone membership; sliding contacts get ``|P_t| = μ P_n`` along ``P_t − ρ u_t``.
 
     Returns the impulses and the mask of sliding contacts.
     """
     P = P.copy()
-    P[:, 0] = np.maximum(P[:, 0], 0.0)
+    P[:, 0] = np.clip(P[:, 0], 0.0, U)
     bound = mu * P[:, 0]
     x = P[:, 1:] - rho[:, None] * u[:, 1:]
     nx = np.hypot(x[:, 0], x[:, 1])
@@ -217,10 +226,10 @@ def _on_cone(P, u, mu, rho):
     return P, slide
 
 
-def _newton(P, W, q, mu, rho, tol, max_iter):
+def _newton(P, W, q, mu, rho, U, tol, max_iter):
     """Semi-smooth Newton with Armijo line search on ``‖F‖²/2``; stops when it stalls."""
     m = q.shape[0]
-    F, aux = _residual(P, W, q, mu, rho)
+    F, aux = _residual(P, W, q, mu, rho, U)
     merit = 0.5 * np.sum(F**2)
     it = 0
     for it in range(1, max_iter + 1):
@@ -233,7 +242,7 @@ def _newton(P, W, q, mu, rho, tol, max_iter):
             break
         t = 1.0
         while True:
-            Fn, auxn = _residual(P + t * d, W, q, mu, rho)
+            Fn, auxn = _residual(P + t * d, W, q, mu, rho, U)
             mn = 0.5 * np.sum(Fn**2)
             if mn <= (1.0 - 1e-4 * t) * merit:
                 break
@@ -244,7 +253,7 @@ def _newton(P, W, q, mu, rho, tol, max_iter):
     return P, F, aux, it
 
 
-def _gauss_seidel(P, W, q, mu, rho, tol, sweeps=5000):
+def _gauss_seidel(P, W, q, mu, rho, U, tol, sweeps=5000):
     """Projected block Gauss–Seidel on the Alart–Curnier map (robust, linear convergence)."""
     P = P.copy()
     m = q.shape[0]
@@ -253,7 +262,7 @@ def _gauss_seidel(P, W, q, mu, rho, tol, sweeps=5000):
         P0 = P.copy()
         for i in range(m):
             u = Wr[i] @ P.reshape(-1) + q[i]
-            pn = max(0.0, P[i, 0] - rho[i] * u[0])
+            pn = min(max(0.0, P[i, 0] - rho[i] * u[0]), U[i])
             x = P[i, 1:] - rho[i] * u[1:]
             nx = np.linalg.norm(x)
             r = mu[i] * pn
@@ -263,7 +272,7 @@ def _gauss_seidel(P, W, q, mu, rho, tol, sweeps=5000):
     return P
 
 
-def _alart_curnier(W, q, mu, warm, tol, max_iter):
+def _alart_curnier(W, q, mu, U, warm, tol, max_iter):
     m = q.shape[0]
     Wd = _blocks(W, m)
     norm = np.sqrt(np.einsum("mij,mij->m", Wd, Wd))  # Frobenius: no SVD per step
@@ -273,19 +282,19 @@ def _alart_curnier(W, q, mu, warm, tol, max_iter):
     scale = max(float(np.max(np.abs(rho[:, None] * q))), 1e-300)
     P = np.zeros((m, 3)) if warm is None else warm.copy()
     if warm is not None:  # a cold start when the warm one is worse
-        F0 = _residual(np.zeros((m, 3)), W, q, mu, rho)[0]
-        Fw = _residual(P, W, q, mu, rho)[0]
+        F0 = _residual(np.zeros((m, 3)), W, q, mu, rho, U)[0]
+        Fw = _residual(P, W, q, mu, rho, U)[0]
         if np.sum(Fw**2) > np.sum(F0**2):
             P = np.zeros((m, 3))
-    P, F, aux, it = _newton(P, W, q, mu, rho, tol * scale, max_iter)
+    P, F, aux, it = _newton(P, W, q, mu, rho, U, tol * scale, max_iter)
     if np.max(np.abs(F)) > tol * scale:  # Newton stalled: Gauss-Seidel sweeps, then Newton
-        P = _gauss_seidel(P, W, q, mu, rho, tol * scale)
-        P, F, aux, it2 = _newton(P, W, q, mu, rho, tol * scale, max_iter)
+        P = _gauss_seidel(P, W, q, mu, rho, U, tol * scale)
+        P, F, aux, it2 = _newton(P, W, q, mu, rho, U, tol * scale, max_iter)
         it += it2
     res = float(np.max(np.abs(F)) / scale)
     if not res <= np.sqrt(tol):
         raise FloatingPointError(f"frictional contact not solved: residual {res:.3g}")
-    P, slide = _on_cone(P, aux[0], mu, rho)
+    P, slide = _on_cone(P, aux[0], mu, rho, U)
     return P, slide, res, it
 
 

@@ -49,6 +49,11 @@ class Contact:
     frames : (n_c, 3, dim) unit normal and tangents of each contact in global axes (output).
     heat_law : ``"alpha"`` (heat ``α λ``) or ``"power"`` (heat ``η`` × friction power).
     heat_partition : η, the blade's share of the friction power (``"power"`` law).
+    wear : optional :class:`~femrub.contact.abradable.Abradable` coating: its wear depth
+        under each contact is added to ``g0(t)`` (the worn surface) and it bounds the
+        impulses (``impulse_cap``); steppers update it after every step (:meth:`after_step`).
+    casing_heat : optional :class:`~femrub.contact.casing_heat.CasingHeat`: the casing
+        wall's thermal expansion under each contact is subtracted from ``g0(t)``.
 
     Callables are evaluated at one time per call (their contract is a scalar ``t``); the
     products with the states are vectorised over rows.
@@ -70,6 +75,8 @@ class Contact:
     frames: np.ndarray | None = None
     heat_law: str = "alpha"
     heat_partition: float | np.ndarray = 1.0
+    wear: object = None
+    casing_heat: object = None
 
     def __post_init__(self):
         self.G, self.Gv, self.Hm, self.Ht = (
@@ -127,22 +134,77 @@ class Contact:
 
     # -- time functions: (n_c,) at a scalar time, (m, n_c) at an array of times (m,) ------
     def gap_at(self, t) -> np.ndarray:
-        """``g0(t)``: the gap of the undeformed structure (m)."""
+        """``g0(t)``: the gap of the undeformed structure (m), on the worn surface.
+
+        With a wear map, rows at an array of times use the current map (post-processing).
+        """
         g0 = self.gap0
-        if not callable(g0):
-            return g0
-        if isinstance(t, np.ndarray) and t.ndim:
-            return _over_times(g0, t, self.n)
-        return np.asarray(g0(t), dtype=float)
+        if callable(g0):
+            if isinstance(t, np.ndarray) and t.ndim:
+                g0 = _over_times(g0, t, self.n)
+            else:
+                g0 = np.asarray(g0(t), dtype=float)
+        rows = isinstance(t, np.ndarray) and t.ndim
+        if self.wear is not None:
+            g0 = g0 + (
+                _over_times(self.wear.depth_at, t, self.n) if rows else self.wear.depth_at(t)
+            )
+        if self.casing_heat is not None:
+            ch = self.casing_heat
+            g0 = g0 - (_over_times(ch.closure_at, t, self.n) if rows else ch.closure_at(t))
+        return g0
+
+    def impulse_cap(self, t: float, h: float):
+        """Upper bound of the impulses over the step ending at ``t`` (``None``: unbounded)."""
+        return None if self.wear is None else self.wear.impulse_cap(t, h)
+
+    def after_step(self, t: float, X: np.ndarray, impulse: np.ndarray, h: float,
+                   extra: dict | None = None) -> None:  # fmt: skip
+        """Remove the coating the blade penetrated where it yielded (impulse at its cap), and
+        heat the casing with its share of the step's frictional heat.
+
+        ``extra``: the step's extra output (``friction_impulse`` (n_c, 2), N s) for the
+        ``"power"`` heat law: the casing takes ``(1 − η) (−P_t · w_t)`` with the slip
+        velocity ``w_t`` at the end of the step; with the ``"alpha"`` law it takes
+        ``(1 − η)/η α P`` (:mod:`femrub.contact.casing_heat`).
+        """
+        if impulse.size == 0:
+            return
+        if self.casing_heat is not None:
+            ch = self.casing_heat
+            if self.heat_law == "power":
+                Pt = None if extra is None else extra.get("friction_impulse")
+                heat = np.zeros(self.n)
+                if Pt is not None:
+                    w = self.slip_velocity(X)
+                    heat = (1.0 - self.heat_partition) * np.maximum(
+                        -np.einsum("ij,ij->i", Pt, w), 0.0
+                    )
+            else:
+                heat = ch.power_per_impulse * impulse
+            ch.update(t, heat, h)
+        if self.wear is None:
+            return
+        yielded = impulse >= (1.0 - 1e-9) * self.wear.impulse_cap(t, h)
+        if np.any(yielded):
+            self.wear.update(t, self.gap(t, X), yielded)
 
     def rate_at(self, t) -> np.ndarray | float:
-        """``ġ0(t) = dg0/dt`` (m/s); the scalar 0 for a fixed obstacle."""
-        rate = self.gap_rate
-        if rate is None:
-            return 0.0
-        if isinstance(t, np.ndarray) and t.ndim:
-            return _over_times(rate, t, self.n)
-        return np.asarray(rate(t), dtype=float)
+        """``ġ0(t) = dg0/dt`` (m/s); the scalar 0 for a fixed obstacle. With a coating it
+        includes the worn surface's rate over a step (:meth:`Abradable.rate_at`), with casing
+        heat the wall's expansion rate."""
+        rate, ch, wear = self.gap_rate, self.casing_heat, self.wear
+        rows = isinstance(t, np.ndarray) and t.ndim
+        out = 0.0
+        if rate is not None:
+            out = _over_times(rate, t, self.n) if rows else np.asarray(rate(t), dtype=float)
+        if wear is not None:
+            out = out + (_over_times(wear.rate_at, t, self.n) if rows else wear.rate_at(t))
+        if ch is not None:
+            out = out - (
+                _over_times(ch.closure_rate_at, t, self.n) if rows else ch.closure_rate_at(t)
+            )
+        return out
 
     def alpha_at(self, t) -> np.ndarray:
         """Heat coefficient ``α(t)`` (m/s)."""

@@ -11,11 +11,49 @@ import numpy as np
 
 from .lcp import solve_lcp
 
-__all__ = ["solve_impulses"]
+__all__ = ["cap", "solve_impulses"]
 
 
-def solve_impulses(W: np.ndarray, q: np.ndarray, active: np.ndarray, warm=None) -> np.ndarray:
-    """Impulses ``P`` (zero on inactive contacts) solving the LCP restricted to ``active``."""
+def solve_impulses(
+    W: np.ndarray, q: np.ndarray, active: np.ndarray, warm=None, upper=None
+) -> np.ndarray:
+    """Impulses ``P`` (zero on inactive contacts) solving the LCP restricted to ``active``.
+
+    ``upper`` (n_c,) bounds the impulses (:func:`cap`; ``None`` or ``inf``: unbounded).
+    """
+    if upper is not None and np.any(np.isfinite(np.asarray(upper)[active])):
+        return cap(_solve, W, q, active, np.asarray(upper, dtype=float), warm)
+    return _solve(W, q, active, warm)
+
+
+def cap(solve, W, q, active, upper, warm=None) -> np.ndarray:
+    """Impulses bounded above, ``0 <= P <= upper``, with any impulse solve ``solve``.
+
+    The box-constrained complementarity problem: on each active contact either ``P = 0``
+    and ``(W P + q) >= 0``, or ``0 < P < upper`` and ``(W P + q) = 0``, or ``P = upper``
+    and ``(W P + q) <= 0``. A contact whose impulse exceeds its bound is held at the bound
+    (its contribution ``W[:, i] upper_i`` moves to the right-hand side) and the others are
+    solved again; a held contact whose residual turns positive is released (at most
+    ``2 n_c + 2`` passes; exact for one contact: ``P = min(max(0, −q / W), upper)``). At
+    the bound the contact may penetrate: the abradable coating yields there
+    (:mod:`femrub.contact.abradable`).
+    """
+    fixed = np.zeros(q.size, dtype=bool)
+    tol = 1e-12 * max(float(np.max(np.abs(q), initial=0.0)), 1e-300)
+    P = np.zeros(q.size)
+    for _ in range(2 * q.size + 2):
+        qf = q + W[:, fixed] @ upper[fixed]
+        P = solve(W, qf, active & ~fixed, warm)
+        P[fixed] = upper[fixed]
+        over = active & ~fixed & (P > upper)
+        release = fixed & ((W @ P + q) > tol)
+        if not np.any(over) and not np.any(release):
+            return P
+        fixed = (fixed | over) & ~(release if not np.any(over) else np.zeros_like(fixed))
+    return np.minimum(P, upper)
+
+
+def _solve(W: np.ndarray, q: np.ndarray, active: np.ndarray, warm=None) -> np.ndarray:
     P = np.zeros(q.size)
     idx = np.flatnonzero(active)
     if idx.size == 0:

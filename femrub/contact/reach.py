@@ -7,6 +7,11 @@ larger). ``contact.reach = "auto"`` takes ``2 × deflection + intrusion + margin
 amplitude (static and at the forcing frequency) and ``intrusion`` the deepest casing
 intrusion. With ``gap_reference = "outermost"`` the casing is a cylinder around the
 outermost point: every other point sees the extra clearance ``r_max − r_i``.
+
+A spinning blade grows radially by ``g_i`` at contact ``i`` (centrifugal prestress). With
+``clearance = "running"`` (default) the casing clearance is measured from the tip at
+speed, so the radii above are ``r_i + g_i`` and the growth closes nothing; with
+``"cold"`` it is measured at rest and the growth closes the gap: ``offset_i −= g_i``.
 """
 
 from __future__ import annotations
@@ -64,14 +69,23 @@ def contact_reach(
     reach="auto",
     margin: float = 0.0,
     deflection: float = 0.0,
+    growth=0.0,
+    clearance: str = "running",
 ) -> Reach:
     """The :class:`Reach` of ``casing`` over ``points`` (module docstring).
 
-    ``reach`` is a length (m), ``"auto"`` or ``"all"``.
+    ``reach`` is a length (m), ``"auto"`` or ``"all"``; ``growth`` the radial tip growth
+    at speed of each point (m) and ``clearance`` ``"running"`` or ``"cold"``.
     """
+    if clearance not in ("running", "cold"):
+        raise ValueError(f"clearance must be 'running' or 'cold', got {clearance!r}")
     n = points.n
-    radii = points.radii
-    offset = radii.max() - radii if gap_reference == "outermost" else np.zeros(n)
+    growth = np.broadcast_to(np.asarray(growth, dtype=float), (n,))
+    running = clearance == "running"
+    radii = points.radii + growth if running else points.radii
+    offset = radii.max() - radii if gap_reference == "outermost" and n else np.zeros(n)
+    if not running:
+        offset = offset - growth
     if rotation_speed > 0.0:
         min_gap = casing.min_gap() + offset
     else:

@@ -125,12 +125,16 @@ def assemble(
     rayleigh: tuple[float, float] = (0.0, 0.0),
     damping_ratio: float | None = None,
     damping_modes: tuple[int, int] = (1, 5),
+    prestress=None,
 ) -> ThermoelasticMatrices:
     """Eq. (2) blocks of ``disc`` (see :func:`~femrub.fem.assembly.assemble_thermoelastic`).
 
     ``damping_ratio`` ζ replaces ``rayleigh``: ``C = a M + b K`` with ``ζ(ω_i) = ζ(ω_j) = ζ``
     at the clamped modes ``damping_modes = (i, j)`` (1-based); ``info["rayleigh"]`` holds
-    the ``(a, b)`` used.
+    the ``(a, b)`` used. ``prestress`` (a :class:`~femrub.fem.prestress.Prestress` of
+    ``disc``) replaces ``K^uu`` by its prestressed tangent (material + geometric stiffness −
+    spin softening) before the damping is set, so the blade vibrates about its spinning
+    equilibrium; ``info["prestress_speed"]`` holds its Ω.
     """
     lumping = default_lumping(disc.order) if lumping == "auto" else lumping
     mats = assemble_thermoelastic(
@@ -147,6 +151,12 @@ def assemble(
         fixed_u=disc.fixed_u,
         fixed_t=disc.fixed_t,
     )
+    if prestress is not None:
+        if not np.array_equal(prestress.free_u, mats.free_u):
+            raise ValueError("the prestress was computed on another discretisation")
+        C = (rayleigh[0] * mats.M + rayleigh[1] * prestress.K).tocsr()
+        mats = replace(mats, K=prestress.K, C=C)
+        mats.info["prestress_speed"] = prestress.omega
     if damping_ratio:
         i, j = damping_modes
         w = angular_frequencies(mats.K, mats.M, max(i, j))

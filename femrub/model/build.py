@@ -43,6 +43,8 @@ class ContactSpec:
     friction : Coulomb μ per contact; casing_velocity : (n_c, 2) velocity of the casing
         surface along the tangents (m/s); frames : (n_c, 3, dim) normal and tangents in
         global axes; heat_law ``"alpha"`` or ``"power"``; heat_partition η.
+    wear : :class:`~femrub.contact.abradable.Abradable` coating on the obstacle, or None;
+        casing_heat : :class:`~femrub.contact.casing_heat.CasingHeat`, or None.
     """
 
     normals: object
@@ -58,6 +60,8 @@ class ContactSpec:
     frames: object = None
     heat_law: str = "alpha"
     heat_partition: object = 1.0
+    wear: object = None
+    casing_heat: object = None
 
 
 @dataclass
@@ -190,6 +194,8 @@ def first_order_model(
             frames=contact.frames,
             heat_law=contact.heat_law,
             heat_partition=contact.heat_partition,
+            wear=contact.wear,
+            casing_heat=contact.casing_heat,
         )
 
     observations = {}

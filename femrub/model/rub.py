@@ -123,6 +123,8 @@ def rub_model(
     friction: float = 0.0,
     heat_law: str = "alpha",
     heat_partition: float = 1.0,
+    wear=None,
+    casing_heat=None,
 ) -> tuple[FirstOrderModel, FieldMap]:
     """First-order model of ``disc`` rubbing ``casing`` at ``points`` (module docstring).
 
@@ -141,6 +143,8 @@ def rub_model(
         ``−Ω r_i`` along the circumferential one (the blade frame turns at Ω).
     heat_law : ``"alpha"`` (heat ``α_i λ_i``) or ``"power"`` (heat ``η`` × friction power,
         ``η = heat_partition``).
+    wear : :class:`~femrub.contact.abradable.Abradable` coating over ``points``, or None.
+    casing_heat : :class:`~femrub.contact.casing_heat.CasingHeat` of the casing, or None.
     """
     N, Q = points.normal_rows(mats), points.heat_rows(mats)
     if observe_at is None or observe_at is points:
@@ -162,6 +166,8 @@ def rub_model(
             heat_law=heat_law,
             heat_partition=heat_partition,
             **_friction_spec(points, mats, friction, rotation_speed),
+            wear=wear,
+            casing_heat=casing_heat,
         )
     )
     model = first_order_model(mats, contact=spec, loads=loads, observe=observe, thermal=thermal)

@@ -1,8 +1,9 @@
 """Interaction map of a sweep: response peaks against the swept parameter, Campbell diagram.
 
-Panels: maximum tip displacement, maximum contact force and maximum temperature against the
-first swept parameter (one curve per combination of the others) and, when that parameter is
-the rotation speed, the Campbell diagram: natural frequencies of the blade against the
+Panels: maximum and RMS tip displacement, maximum contact force, maximum temperature and
+maximum abradable wear depth against the first swept parameter (one curve per combination
+of the others) and, when that parameter is the rotation speed, the Campbell diagram: the
+natural frequencies of each point's model (prestressed at its speed) against the
 engine-order lines ``k Ω / 2π`` of the casing lobes (and of the tip force), with the
 crossings (interaction speeds ``Ω = 2π f / k``) drawn as dotted lines across every panel.
 """
@@ -19,8 +20,10 @@ __all__ = ["engine_orders", "plot_interaction_map"]
 
 _PANELS = [
     ("max_tip_displacement", "max |tip displacement| (µm)", 1e6),
+    ("rms_tip_displacement", "RMS tip displacement (µm)", 1e6),
     ("max_contact_force", "max contact force (N)", 1.0),
     ("max_temperature", "max temperature rise (K)", 1.0),
+    ("max_wear_depth", "max wear depth (µm)", 1e6),
 ]
 
 
@@ -73,23 +76,38 @@ def plot_interaction_map(rows, keys, scene, path) -> None:
 
 
 def _campbell(ax, rows, scene, axes) -> None:
+    """Natural frequencies of each point's (prestressed) model against Ω, engine orders and
+    their crossings ``k Ω / 2π = f_j(Ω)`` (interpolated between the points)."""
+    done = sorted((r for r in rows if r.get("natural_frequencies_hz")), key=lambda r: r["x"])
     xs = np.array(sorted({r["x"] for r in rows}), dtype=float)
-    freqs = [r.get("natural_frequencies_hz") or [] for r in sorted(rows, key=lambda r: r["x"])]
-    f_ref = next((f for f in freqs if f), [])
+    n_f = min((len(r["natural_frequencies_hz"]) for r in done), default=0)
+    xf = np.array([r["x"] for r in done], dtype=float)
+    F = np.array([r["natural_frequencies_hz"][:n_f] for r in done]).reshape(len(done), n_f)
+    f_ref = list(F[0]) if len(done) else []
     x_line = np.linspace(0.0, max(xs.max(), 1e-12) * 1.05, 50)
-    for j, f in enumerate(f_ref):
-        ax.axhline(
-            f, color="C0", lw=1.0, alpha=0.8, label="natural frequencies" if j == 0 else None
+    for j in range(n_f):
+        ax.plot(
+            xf, F[:, j], "-", color="C0", lw=1.2, label="natural frequencies" if j == 0 else None
         )
     orders = engine_orders(scene)
     for k in orders:
         ax.plot(x_line, k * x_line / (2 * math.pi), "--", lw=0.9, color="0.35")
         ax.annotate(f"EO {k}", (x_line[-1], k * x_line[-1] / (2 * math.pi)), fontsize=7)
-        for f in f_ref:
-            w = 2 * math.pi * f / k
-            if xs.min() <= w <= xs.max():
+        for j in range(n_f):
+            d = F[:, j] - k * xf / (2 * math.pi)
+            for i in np.flatnonzero(np.sign(d[:-1]) * np.sign(d[1:]) <= 0):
+                w = (
+                    xf[i] + (xf[i + 1] - xf[i]) * d[i] / (d[i] - d[i + 1])
+                    if d[i] != d[i + 1]
+                    else xf[i]
+                )
                 for a in axes:
                     a.axvline(w, color="C3", lw=0.7, ls=":")
+            if len(done) == 1:  # one point: the crossing of its constant line
+                w = 2 * math.pi * F[0, j] / k
+                if xs.min() <= w <= xs.max():
+                    for a in axes:
+                        a.axvline(w, color="C3", lw=0.7, ls=":")
     # the engine-order fan and at least the first natural frequency
     top = max(max(orders) * x_line[-1] / (2 * math.pi), f_ref[0] if f_ref else 0.0) * 1.2
     ax.set_ylim(0.0, top)

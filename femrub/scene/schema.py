@@ -145,7 +145,27 @@ CASING = Variant(
     },
 )
 
+ABRADABLE = {
+    "thickness": _f(0.0, "length", "coating thickness e (0: no coating, rigid casing)", **NONNEG),
+    "yield": _f(0.0, "force", "force per contact at which the coating yields and is cut", **NONNEG),
+    "n_angle": Spec(I, 360, lo=1, hi=100_000, doc="wear-map cells around the casing"),
+    "n_axial": Spec(I, 16, lo=1, hi=10_000, doc="wear-map cells along the axis"),
+}
+
+CASING_HEAT = {
+    "thickness": _f(
+        0.0, "length", "casing wall thickness b of the lumped thermal model (0: off)", **NONNEG
+    ),
+    "density": _f(7800.0, "density", "casing wall density", **POS),
+    "specific_heat": _f(460.0, "specific_heat", "casing wall specific heat", **POS),
+    "conductivity": _f(15.0, "conductivity", "casing wall conductivity", **POS),
+    "expansion": _f(12e-6, "expansion", "casing wall expansion (closes the gap by α b T)"),
+    "n_angle": Spec(I, 360, lo=1, hi=100_000, doc="casing cells around (without a coating)"),
+    "n_axial": Spec(I, 16, lo=1, hi=10_000, doc="casing cells along the axis (without a coating)"),
+}
+
 CONTACT = {
+    "abradable": ABRADABLE,
     "group": Spec(S, "contact", doc="node group of the contact points ('tip': every tip node)"),
     "nodes": Spec("ints", None, doc="node numbers of the contact points (mesh files)"),
     "casing": CASING,
@@ -163,9 +183,17 @@ CONTACT = {
     "heat_coefficient": _f(
         0.0, "velocity", "bar: α of the heat input heat_partition α λ", **NONNEG
     ),
-    "heat_partition": _f(
-        1.0, "none", "fraction of the frictional power that enters the blade", lo=0.0, hi=1.0
+    "heat_partition": Spec(
+        F,
+        "auto",
+        "none",
+        choices=("auto", "effusivity"),
+        doc="fraction η of the frictional power that enters the blade (auto: 1, or from the "
+        "effusivities of blade and casing with contact.casing_heat)",
+        lo=0.0,
+        hi=1.0,
     ),
+    "casing_heat": CASING_HEAT,
     "reach": Spec(
         F,
         "auto",
@@ -175,6 +203,13 @@ CONTACT = {
         **NONNEG,
     ),
     "reach_margin": _f(0.0, "length", "added to the automatic reach", **NONNEG),
+    "clearance": Spec(
+        C,
+        "running",
+        choices=("running", "cold"),
+        doc="casing clearances are measured from the tip at speed (running) or at rest "
+        "(cold: the centrifugal tip growth closes them)",
+    ),
     "gap_reference": Spec(
         C,
         "per-node",
@@ -216,6 +251,13 @@ TIP_FORCE = Variant(
 
 LOADS = {
     "rotation_speed": _f(0.0, "angular_speed", "rotation speed Ω", **NONNEG),
+    "centrifugal": Spec(
+        C,
+        "auto",
+        choices=("auto", "off", "linear", "nonlinear"),
+        doc="3D: static centrifugal prestress at Ω, its geometric stiffness and spin "
+        "softening (auto: nonlinear when Ω > 0; the bar: off)",
+    ),
     "tip_force": TIP_FORCE,
 }
 

@@ -106,6 +106,16 @@ def _cross_check(d: dict) -> None:
     scheme, outputs, casing = d["scheme"], d["outputs"], d["contact"]["casing"]
     kind = geo["kind"]
     force = loads["tip_force"]
+    abr = contact["abradable"]
+    if abr["thickness"] > 0.0:
+        if abr["yield"] <= 0.0:
+            fail("contact.abradable.yield", abr["yield"], "give the coating's yield force (N) > 0")
+        if scheme["name"] != "theta":
+            fail(
+                "contact.abradable.thickness",
+                abr["thickness"],
+                "an abradable coating needs scheme.name = 'theta' (bounded impulses)",
+            )
     if kind == "bar":
         if casing["kind"] != "concentric":
             fail(
@@ -141,6 +151,12 @@ def _cross_check(d: dict) -> None:
             )
         if d["boundary"].get("root") is not None:
             fail("boundary.root", d["boundary"]["root"], "the bar is clamped at x = 0; remove it")
+        if loads["centrifugal"] in ("linear", "nonlinear"):
+            fail(
+                "loads.centrifugal",
+                loads["centrifugal"],
+                "the 1D bar has no rotation axis; use 'auto' or 'off'",
+            )
     else:
         if contact["heat_coefficient"] != 0.0:
             fail(

@@ -54,6 +54,8 @@ class Stepper:
     blowup_check = True
     #: the step locates contact events inside itself (no contact-resolution check needed)
     locates_events = False
+    #: bounds its impulses by ``Contact.impulse_cap`` (abradable coatings)
+    supports_wear = False
 
     def __init__(self, model: FirstOrderModel, h: float, *, t0: float = 0.0):
         if not isinstance(model, FirstOrderModel):
@@ -67,6 +69,16 @@ class Stepper:
         self.impulse = np.zeros(nc)
         self.extra = None
         self._h_lim = None
+        wear = None if model.contact is None else model.contact.wear
+        if wear is not None:
+            if not self.supports_wear:
+                raise ValueError(
+                    f"an abradable coating needs scheme.name = 'theta' (the {self.name} "
+                    "scheme does not bound its contact impulses)"
+                )
+            wear.reset(self.h)
+        if model.contact is not None and model.contact.casing_heat is not None:
+            model.contact.casing_heat.reset()
         self._check_initial_gap()
         self._setup()
 
@@ -129,6 +141,8 @@ class Stepper:
         self.extra = out[2] if len(out) > 2 else None
         self.k += 1
         self.t = self.t0 + self.k * self.h
+        if self.model.contact is not None:
+            self.model.contact.after_step(self.t, X, impulse, self.h, self.extra)
         self.X, self.impulse = X, impulse
         return self.t, X, impulse, self.extra
 

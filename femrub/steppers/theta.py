@@ -77,6 +77,7 @@ class ThetaMethod(Stepper):
     """
 
     name = "theta"
+    supports_wear = True
 
     def __init__(
         self,
@@ -135,6 +136,8 @@ class ThetaMethod(Stepper):
                 and not callable(c.heat_coefficient)
                 and c.gap_rate is None
                 and not c.has_friction
+                and c.wear is None
+                and c.casing_heat is None
             ):
                 a = c.heat_coefficient
                 self._fast = True
@@ -234,6 +237,7 @@ class ThetaMethod(Stepper):
             h,
             g,
             self._warm,
+            upper=c.impulse_cap(t1, h),
         )
         self._warm = P > 0.0
         return Xp + Z @ P, P
@@ -252,11 +256,12 @@ class ThetaMethod(Stepper):
         gap_k, gdot_k, _ = self._local(self.k, self.t, Xk)
         gap_p, _, q = self._local(self.k + 1, t1, Xp)
         e = np.where(gdot_k > 0.0, 1.0, c.restitution)
+        upper = c.impulse_cap(t1, h)
 
         def solve(active, shift=0.0):
             res = solve_frictional_contact(
                 W, q + shift, c.friction, active, restitution=e, u_before=gdot_k,
-                warm=self._warm3,
+                warm=self._warm3, upper=upper,
             )  # fmt: skip
             if active.any():  # the next active set of the fixed point starts from here
                 self._warm3 = res.P

@@ -1,0 +1,178 @@
+"""Abradable coating on the casing: a wear map that deepens where the blade cuts it.
+
+The coating (thickness ``e``) lines the casing. Its current wear depth ``w(ψ, z) ∈ [0, e]``
+is stored on a grid of casing angle ``ψ`` (``n_angle`` cells over a revolution) × axial
+position ``z`` (``n_axial`` cells over the contacts' axial extent). Contact ``i`` (angle
+``φ_i``, axial position ``z_i``) meets the worn surface, so its gap is::
+
+    g_i(t, X) = g0_i(t) + w(Ω t + φ_i, z_i) − n_i · u(p_i)
+
+Removal law (rigid–perfectly plastic coating, in the spirit of the plastic abradable law
+of Batailly & Legrand): the coating carries at most the yield force ``F_y`` per contact; the
+impulse of a step is bounded, ``0 <= P_i <= h F_y`` (:func:`femrub.contact.impulses.cap`),
+and below that bound contact complementarity holds on the worn surface. When the bound is
+reached the coating yields: the blade penetrates the current surface and the material it
+penetrates is removed permanently (after each step, :meth:`Abradable.update`)::
+
+    w(ψ_i, z_i) <- min(e, w(ψ_i, z_i) + max(0, −g_i))     for contacts at the bound
+
+Once a cell is worn through (``w = e``) the rigid casing behind it takes any force. Wear
+is monotone, never negative and never deeper than ``e``.
+
+The wear map is casing state that evolves during a run: a stepper calls :meth:`reset` when
+it starts. ``history`` keeps ``(t, max depth)`` at every step that removed material.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ..fem.material import check_finite_positive
+
+__all__ = ["Abradable", "CasingGrid"]
+
+
+class CasingGrid:
+    """Cells of the casing swept by contacts: ``n_angle`` around × ``n_axial`` along the axis.
+
+    Parameters
+    ----------
+    angles : (n_c,) angular positions ``φ_i`` of the contacts (rad).
+    axial : (n_c,) axial positions ``z_i`` of the contacts (m).
+    radius : casing radius used for areas and volumes (m).
+    rotation_speed : Ω (rad/s).
+    n_angle, n_axial : grid cells around the casing and along the axis (over the contacts'
+        axial extent, half a cell beyond each end).
+    """
+
+    def __init__(self, angles, axial, radius, rotation_speed, n_angle=360, n_axial=16):
+        self.radius = check_finite_positive("casing radius", radius)
+        self.omega = float(rotation_speed)
+        self.angles = np.asarray(angles, dtype=float).ravel()
+        self.axial = np.asarray(axial, dtype=float).ravel()
+        if self.angles.shape != self.axial.shape:
+            raise ValueError("casing grid: one angle and one axial position per contact")
+        if not (int(n_angle) >= 1 and int(n_axial) >= 1):
+            raise ValueError("casing grid needs n_angle >= 1 and n_axial >= 1")
+        self.n_angle, self.n_axial = int(n_angle), int(n_axial)
+        z0, z1 = (float(self.axial.min()), float(self.axial.max())) if self.axial.size else (0, 0)
+        pad = 0.5 * (z1 - z0) / max(self.n_axial - 1, 1) if z1 > z0 else 0.5e-3
+        self.z_edges = np.linspace(z0 - pad, z1 + pad, self.n_axial + 1)
+        k = np.searchsorted(self.z_edges, self.axial, side="right") - 1
+        self.axial_cell = np.clip(k, 0, self.n_axial - 1)
+
+    def cells(self, t: float) -> np.ndarray:
+        """Flat indices of the cells under the contacts at time ``t``."""
+        psi = np.mod(self.omega * t + self.angles, 2 * math.pi)
+        j = np.minimum((psi * self.n_angle / (2 * math.pi)).astype(int), self.n_angle - 1)
+        return j * self.n_axial + self.axial_cell
+
+    @property
+    def cell_area(self) -> np.ndarray:
+        """(n_axial,) area of a cell of each axial row (m²)."""
+        return 2 * math.pi * self.radius / self.n_angle * np.diff(self.z_edges)
+
+    def angle_centres(self) -> np.ndarray:
+        return (np.arange(self.n_angle) + 0.5) * 2 * math.pi / self.n_angle
+
+    def axial_centres(self) -> np.ndarray:
+        return 0.5 * (self.z_edges[1:] + self.z_edges[:-1])
+
+
+class Abradable:
+    """Abradable coating on the cells of a :class:`CasingGrid` (module docstring).
+
+    Parameters
+    ----------
+    thickness : coating thickness ``e`` (m).
+    yield_force : force per contact at which the coating yields ``F_y`` (N).
+    grid : :class:`CasingGrid` of the contacts.
+    """
+
+    def __init__(self, thickness, yield_force, grid: CasingGrid):
+        self.thickness = check_finite_positive("contact.abradable.thickness", thickness)
+        self.yield_force = check_finite_positive("contact.abradable.yield", yield_force)
+        self.grid = grid
+        self.n_angle, self.n_axial, self.z_edges = grid.n_angle, grid.n_axial, grid.z_edges
+        self.radius = grid.radius
+        self.reset()
+
+    # -- state --------------------------------------------------------------------------
+    def reset(self, h: float | None = None) -> None:
+        """A fresh coating: no wear, empty history; ``h``: the time step of the stepper that
+        runs it (for :meth:`rate_at`; ``None``: no rate)."""
+        self.depth = np.zeros((self.n_angle, self.n_axial))
+        self.history = [(0.0, 0.0)]
+        self.h = h
+
+    def cells(self, t: float) -> np.ndarray:
+        return self.grid.cells(t)
+
+    def depth_at(self, t: float) -> np.ndarray:
+        """Wear depth under each contact at ``t`` (m): what the worn surface adds to the gap."""
+        return self.depth.ravel()[self.cells(t)]
+
+    def rate_at(self, t: float) -> np.ndarray | float:
+        """Rate of the worn surface under each contact, ``(w(t) − w(t − h)) / h`` (m/s).
+
+        The map is piecewise constant in the casing angle: a contact moving from a worn cell
+        into a less worn one meets the coating as a surface approaching it. This rate enters
+        ``ġ0`` (:meth:`~femrub.contact.gap.Contact.rate_at`) so a velocity-level contact law
+        stops the blade there and the coating yields (as the casing profile's own rate does
+        on a continuous lobe); without it, the blade would cross the unworn coating with no
+        force and no wear wherever the profile recedes.
+        """
+        if not self.h:
+            return 0.0
+        return (self.depth_at(t) - self.depth_at(t - self.h)) / self.h
+
+    def impulse_cap(self, t: float, h: float) -> np.ndarray:
+        """Largest impulse ``h F_y`` per contact over a step; ``inf`` where worn through."""
+        worn = self.depth_at(t) >= self.thickness
+        return np.where(worn, math.inf, h * self.yield_force)
+
+    def update(self, t: float, gap: np.ndarray, yielded: np.ndarray) -> None:
+        """Remove the coating the blade penetrates at contacts that ``yielded`` (module doc).
+
+        ``gap`` is the gap on the current worn surface at ``t`` (m).
+        """
+        pen = np.where(yielded, np.maximum(0.0, -np.asarray(gap, dtype=float)), 0.0)
+        if not np.any(pen > 0.0):
+            return
+        flat = self.depth.ravel()
+        cells = self.cells(t)
+        # several contacts in one cell: the deepest cut counts
+        new = np.minimum(self.thickness, flat[cells] + pen)
+        np.maximum.at(flat, cells, new)
+        self.history.append((float(t), float(flat.max())))
+
+    # -- results ------------------------------------------------------------------------
+    @property
+    def max_depth(self) -> float:
+        return float(self.depth.max())
+
+    @property
+    def cell_area(self) -> np.ndarray:
+        return self.grid.cell_area
+
+    @property
+    def worn_volume(self) -> float:
+        """Removed coating volume ``Σ w A_cell`` (m³)."""
+        return float(np.sum(self.depth * self.cell_area[None, :]))
+
+    def angle_centres(self) -> np.ndarray:
+        return self.grid.angle_centres()
+
+    def axial_centres(self) -> np.ndarray:
+        return self.grid.axial_centres()
+
+    def as_dict(self) -> dict:
+        return {
+            "thickness": self.thickness,
+            "yield": self.yield_force,
+            "n_angle": self.n_angle,
+            "n_axial": self.n_axial,
+            "radius": self.radius,
+        }

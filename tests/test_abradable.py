@@ -1,0 +1,205 @@
+"""Abradable coating: a bar cutting the coating against the hand-derived removal depth."""
+
+import json
+import math
+
+import numpy as np
+import pytest
+
+from femrub.app.run import run_scene
+from femrub.contact.abradable import Abradable, CasingGrid
+from femrub.contact.activation import RULES, impulse_one, impulses
+from femrub.contact.friction import SLIP, solve_frictional_contact
+from femrub.contact.gap import Contact
+from femrub.contact.impulses import solve_impulses
+from femrub.scene import SceneError, load_scene
+
+E, A, L = 110e9, 1e-6, 0.30
+K_TIP = E * A / L  # static tip stiffness of the clamped bar (N/m)
+F, F_Y, D = 7.0, 2.0, 5e-6  # tip force, coating yield force (N), cold gap (m)
+
+SCENE = """
+name = "bar-abradable"
+[geometry]
+kind = "bar"
+n_elements = 10
+[contact]
+casing = {{ kind = "concentric", clearance = "5 um" }}
+abradable = {{ thickness = {e}, yield = 2.0, n_angle = 1, n_axial = 1 }}
+[loads]
+tip_force = {{ law = "ramp", amplitude = 7.0, ramp_time = 0.1 }}
+[physics]
+damping_ratio = 0.05
+damping_modes = [1, 2]
+[scheme]
+name = "theta"
+h = 2e-5
+t_end = 0.15
+"""
+
+
+def _run(tmp_path, e):
+    path = tmp_path / f"bar-{e:g}.toml"
+    path.write_text(SCENE.format(e=e))
+    out = tmp_path / f"out-{e:g}"
+    res, built = run_scene(load_scene(str(path)), out)
+    return res, json.loads((out / "summary.json").read_text()), out
+
+
+def test_bar_cuts_the_coating_to_the_hand_derived_depth(tmp_path):
+    """Quasi-static: the coating holds F_y, so k x = F − F_y, wear = x − d = (F − F_y)/k − d."""
+    res, summary, out = _run(tmp_path, 50e-6)
+    expected = (F - F_Y) / K_TIP - D
+    assert summary["status"] == "ok"
+    assert summary["max_wear_depth"] == pytest.approx(expected, rel=0.02)
+    assert summary["worn_volume"] > 0
+    hist = np.loadtxt(out / "wear_history.csv", delimiter=",", skiprows=1)
+    assert np.all(np.diff(hist[:, 1]) >= 0) and hist[:, 1].min() >= 0  # monotone, >= 0
+    assert (out / "wear_map.png").exists() and (out / "wear_map.csv").exists()
+    # while cutting, the contact force is the yield force
+    force = res.force.sum(axis=1)
+    assert force.max() == pytest.approx(F_Y, rel=0.02)
+
+
+def test_wear_never_deeper_than_the_coating(tmp_path):
+    """A 4 µm coating is worn through; the rigid casing behind it then takes the force."""
+    e = 4e-6
+    res, summary, out = _run(tmp_path, e)
+    assert summary["max_wear_depth"] == pytest.approx(e, rel=1e-12)
+    hist = np.loadtxt(out / "wear_history.csv", delimiter=",", skiprows=1)
+    assert hist[:, 1].max() <= e
+    # mean over the last steps: the default position rule's held impulse alternates from one
+    # step to the next (trapezoidal rule on a held contact) about the static force
+    final = res.force.sum(axis=1)[-100:].mean()
+    assert final == pytest.approx(F - K_TIP * (D + e), rel=0.02)  # > F_Y: the casing holds
+
+
+def test_bounded_impulses_one_and_several_contacts():
+    W = np.array([[2.0, 0.5], [0.5, 1.0]])
+    q = np.array([-4.0, -3.0])
+    free = solve_impulses(W, q, np.ones(2, bool))
+    capped = solve_impulses(W, q, np.ones(2, bool), upper=np.array([0.5, np.inf]))
+    assert capped[0] == 0.5 and free[0] > 0.5
+    # the uncapped contact is solved with the capped one's impulse known
+    assert capped[1] == pytest.approx((3.0 - 0.5 * 0.5) / 1.0)
+
+
+def test_wear_map_cells_and_volume():
+    grid = CasingGrid([0.0, np.pi], [0.0, 0.01], 0.5, 100.0, n_angle=4, n_axial=2)
+    wear = Abradable(1e-4, 10.0, grid)
+    wear.update(0.0, np.array([-2e-5, -5e-4]), np.array([True, True]))
+    assert wear.depth_at(0.0) == pytest.approx([2e-5, 1e-4])  # second one worn through
+    assert np.isinf(wear.impulse_cap(0.0, 1e-6)[1]) and wear.impulse_cap(0.0, 1e-6)[
+        0
+    ] == pytest.approx(1e-5)
+    wear.update(0.0, np.array([+1e-5, -1e-5]), np.array([True, False]))  # no removal
+    assert wear.max_depth == 1e-4
+    assert wear.worn_volume == pytest.approx(np.sum(wear.depth * wear.cell_area[None, :]))
+
+
+def test_yield_is_required(tmp_path):
+    path = tmp_path / "bad.toml"
+    path.write_text(SCENE.format(e=1e-5).replace("yield = 2.0", "yield = 0.0"))
+    with pytest.raises(SceneError, match="contact.abradable.yield"):
+        load_scene(str(path))
+
+
+@pytest.mark.parametrize("rule", RULES)
+def test_every_activation_rule_honours_the_bound(rule):
+    """The wear cap: 0 <= P <= upper under every rule; one contact: the capped closed form;
+    several: a box LCP (held at the bound only where the residual asks for more)."""
+    rng = np.random.default_rng(3)
+    h, gamma = 1e-4, 0.5
+    for _ in range(100):
+        n = int(rng.integers(1, 5))
+        a = rng.normal(size=(n, n))
+        W = a @ a.T + 0.5 * np.eye(n)
+        g_k, gd_k, gd_p = rng.normal(0, 1e-6, n), rng.normal(0, 1e-2, n), rng.normal(0, 1e-2, n)
+        g_p = g_k + 0.5 * h * (gd_k + gd_p)
+        e = rng.choice([0.0, 1.0], n)
+        args = (rule, g_k, gd_k, g_p, gd_p, W, 0.5 * h * W, e, h, gamma)
+        free = impulses(*args)
+        upper = 0.5 * free + 1e-9 * rng.uniform(size=n)
+        P = impulses(*args, upper=upper)
+        assert np.all(P >= 0.0) and np.all(P <= upper)
+        if n == 1:
+            one = impulse_one(rule, g_k[0], gd_k[0], g_p[0], gd_p[0], W[0, 0], 0.5 * h * W[0, 0],
+                              e[0], h, gamma, upper[0])  # fmt: skip
+            assert P[0] == pytest.approx(min(free[0], upper[0]), rel=1e-9, abs=1e-18)
+            assert one == pytest.approx(P[0], rel=1e-9, abs=1e-18)
+
+
+def test_box_lcp_conditions():
+    rng = np.random.default_rng(4)
+    for _ in range(200):
+        n = int(rng.integers(2, 6))
+        a = rng.normal(size=(n, n))
+        W = a @ a.T + 0.2 * np.eye(n)
+        q = rng.normal(size=n)
+        upper = rng.uniform(0.0, 1.0, n)
+        P = solve_impulses(W, q, np.ones(n, bool), upper=upper)
+        r = W @ P + q
+        tol = 1e-9 * (1 + np.abs(q).max())
+        assert np.all(P >= 0) and np.all(P <= upper)
+        at0, atU = P <= 1e-14, P >= upper - 1e-14
+        inside = ~at0 & ~atU
+        assert np.all(r[at0 & ~atU] >= -tol) and np.all(r[atU & ~at0] <= tol)
+        assert np.all(np.abs(r[inside]) <= tol)
+
+
+def test_frictional_solve_caps_the_normal_impulse_and_its_cone():
+    """With friction the normal impulse is capped at U and |P_t| <= μ P_n, = μ U when the
+    contact slides at its bound."""
+    rng = np.random.default_rng(5)
+    for _ in range(100):
+        n = int(rng.integers(1, 5))
+        a = rng.normal(size=(3 * n, 3 * n))
+        W = a @ a.T + 0.05 * np.eye(3 * n)
+        q, mu = rng.normal(size=(n, 3)), rng.uniform(0.05, 1.0, n)
+        free = solve_frictional_contact(W, q, mu, np.ones(n, bool))
+        U = 0.5 * free.P[:, 0] + 1e-3
+        r = solve_frictional_contact(W, q, mu, np.ones(n, bool), upper=U)
+        P, u = r.P, r.u
+        assert np.all(P[:, 0] >= 0.0) and np.all(P[:, 0] <= U * (1 + 1e-12))
+        inside = (P[:, 0] > 1e-12) & (P[:, 0] < U * (1 - 1e-9))
+        assert np.all(np.abs(u[inside, 0]) <= 1e-8)  # Signorini below the bound
+        at = P[:, 0] >= U * (1 - 1e-9)
+        assert np.all(u[at, 0] <= 1e-8)  # at the bound: approaching (the coating yields)
+        nt = np.linalg.norm(P[:, 1:], axis=1)
+        assert np.all(nt <= mu * P[:, 0] * (1 + 1e-10) + 1e-14)
+        slip = r.state == SLIP
+        np.testing.assert_allclose(nt[slip], mu[slip] * P[slip, 0], rtol=1e-10)
+
+
+def test_frictional_blade_cuts_the_coating_at_the_yield_force(tmp_path):
+    """3D blade, Coulomb friction and frictional heat (θ-method, frictional solve with the
+    bound): the normal force never exceeds the coating's yield, Coulomb's law holds with the
+    capped normal force, coating is removed, the balances close."""
+    changes = {
+        "geometry.h": 0.03, "geometry.n_sections": 2, "contact.reach": "all",
+        "contact.friction": 0.15, "contact.abradable.thickness": "30 um",
+        "contact.abradable.yield": 5.0, "loads.centrifugal": "off",
+        "reduction.method": "none", "scheme.t_end": 1.5e-3, "outputs.vtk_stride": 0,
+    }  # fmt: skip
+    res, _ = run_scene(load_scene("twisted-naca", changes), tmp_path / "out")
+    s = json.loads((tmp_path / "out" / "summary.json").read_text())
+    assert s["status"] == "ok", s.get("message")
+    assert s["max_contact_force"] == pytest.approx(5.0, rel=1e-9)  # held at the yield
+    assert 0.0 < s["max_wear_depth"] <= 30e-6
+    c = s["coulomb_check"]
+    assert c["cone"] <= 1e-8 and c["slip_equality"] <= 1e-8 and c["slip_steps"] > 0
+
+
+def test_worn_surface_rate_enters_the_gap_rate():
+    """A contact moving from a worn cell into an unworn one meets the coating approaching
+    (ġ0 = −w / h over that step), so a velocity-level law stops it there and it cuts."""
+    grid = CasingGrid([0.0], [0.0], 0.3, 100.0, n_angle=4, n_axial=1)
+    wear = Abradable(1e-3, 10.0, grid)
+    wear.reset(h=1e-3)
+    wear.depth[0, 0] = 2e-4  # first quarter worn
+    t_cross = (math.pi / 2) / 100.0  # the contact enters the second cell
+    assert wear.rate_at(t_cross + 0.5e-3) == pytest.approx([-2e-4 / 1e-3])
+    assert wear.rate_at(t_cross - 0.5e-3) == pytest.approx([0.0])
+    c = Contact(G=[[1.0]], Gv=[[1.0]], Hm=[[1.0]], Ht=[[0.0]], gap0=0.0, wear=wear)
+    assert c.rate_at(t_cross + 0.5e-3) == pytest.approx([-0.2])
+    assert c.gap_at(t_cross - 0.5e-3) == pytest.approx([2e-4])
