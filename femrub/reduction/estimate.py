@@ -163,6 +163,7 @@ def _signal_gap(a, b, k0: int, k1: int) -> float:
     """Largest relative difference of the contact signals of ``a`` and ``b`` on steps
     ``k0:k1`` (each signal relative to its largest reference value)."""
     out = 0.0
+    k1 = min(k1, len(a.t), len(b.t))
     for key in SIGNALS:
         if key in a.signals and key in b.signals:
             x, y = a.signals[key][k0:k1], b.signals[key][k0:k1]
@@ -188,16 +189,19 @@ def _horizon(tw, ref, share: float, first: int) -> int:
     return max(int(off[0]) if off.size else n, first)
 
 
-def statistics(res, k0: int = 0) -> dict:
-    """Per-contact statistics of steps ``k0:``: mean and largest normal force, RMS and largest
-    magnitude of each contact signal (module docstring)."""
+def statistics(res, k0: int = 0, k1: int | None = None) -> dict:
+    """Per-contact statistics of steps ``k0:k1``: mean and largest normal force, RMS and
+    largest magnitude of each contact signal (module docstring)."""
     out = {}
-    f = res.force[k0:] if res.force.size else np.zeros((0, 0))
+    k1 = len(res.t) if k1 is None else min(k1, len(res.t))
+    if k1 <= k0:
+        return out
+    f = res.force[k0:k1] if res.force.size else np.zeros((0, 0))
     if f.size:
         out["mean_force"], out["max_force"] = f.mean(axis=0), f.max(axis=0)
     for key in SIGNALS:
         if key in res.signals:
-            y = res.signals[key][k0:].reshape(len(res.signals[key]) - k0, -1)
+            y = res.signals[key][k0:k1].reshape(k1 - k0, -1)
             if y.size:
                 out[f"rms_{key}"] = np.sqrt(np.mean(y**2, axis=0))
                 out[f"max_{key}"] = np.abs(y).max(axis=0)
@@ -205,7 +209,8 @@ def statistics(res, k0: int = 0) -> dict:
 
 
 def _statistical(run, ref, k0: int) -> dict:
-    a, b = statistics(run, k0), statistics(ref, k0)
+    k1 = min(len(run.t), len(ref.t))
+    a, b = statistics(run, k0, k1), statistics(ref, k0, k1)
     return {k: _rel(np.linalg.norm(a[k] - b[k]), np.linalg.norm(b[k])) for k in b if k in a}
 
 
