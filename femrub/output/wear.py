@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 
 import matplotlib
@@ -10,6 +9,8 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
+
+from .jsonfile import read_json, write_json  # noqa: E402
 
 __all__ = ["write_casing_heat", "write_wear"]
 
@@ -48,11 +49,7 @@ def write_wear(wear, out) -> dict:
     fig.savefig(out / "wear_map.png", dpi=110)
     plt.close(fig)
     keys = {"max_wear_depth": wear.max_depth, "worn_volume": wear.worn_volume}
-    path = out / "summary.json"
-    if path.exists():
-        doc = json.loads(path.read_text())
-        doc.update(keys)
-        path.write_text(json.dumps(doc, indent=2))
+    _add_to_summary(out / "summary.json", keys)
     return keys
 
 
@@ -72,9 +69,11 @@ def write_casing_heat(heat, t_end: float, out) -> dict:
         "max_casing_temperature": float(hist[:, 1].max()),
         "casing_heat_in": heat.heat_in,
     }
-    path = out / "summary.json"
-    if path.exists():
-        doc = json.loads(path.read_text())
-        doc.update(keys)
-        path.write_text(json.dumps(doc, indent=2))
+    _add_to_summary(out / "summary.json", keys)
     return keys
+
+
+def _add_to_summary(path: Path, keys: dict) -> None:
+    """Add ``keys`` to an existing ``summary.json`` (written whole, as every summary is)."""
+    if path.exists():
+        write_json(path, {**read_json(path), **keys})
