@@ -351,7 +351,9 @@ class ThermoelasticCraigBampton:
         Rz = self._elastic_basis(R, layout)
         forms = m.energy.project(R)
         forms.Qe = sp.csr_matrix(project(Rz, m.energy.Qe, Rz))
-        rate = np.linalg.solve(Ar, Br)  # Ẋ̄ = Ā⁻¹ B̄ X̄ without loads and impulses
+        damped = sp.csr_matrix(m.energy.Pd).count_nonzero() > 0
+        if L.n_t or damped:  # Ẋ̄ = Ā⁻¹ B̄ X̄ without loads and impulses
+            rate = np.linalg.solve(Ar, Br)
         if L.n_t:
             P = sp.csr_matrix(m.energy.Pth)
             P_u = sp.vstack([P[L.v], P[L.u], P[L.t]], format="csr")  # v-rows moved to u-rows
@@ -359,7 +361,7 @@ class ThermoelasticCraigBampton:
             forms.Pth = sp.csr_matrix(rate.T @ W)
             forms.Wth = sp.csr_matrix(W)
         self.energy_growth_rate = 0.0
-        if sp.csr_matrix(m.energy.Pd).count_nonzero():
+        if damped:
             mech = np.r_[np.arange(layout.n_u), layout.v.start + np.arange(layout.n_v)]
             Q = (forms.Qk + forms.Qe).toarray()[np.ix_(mech, mech)]
             D = Q @ rate[np.ix_(mech, mech)]

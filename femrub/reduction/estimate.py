@@ -110,6 +110,14 @@ def _rel(diff: float, ref: float) -> float:
     return float(diff / ref) if ref > 0 else (0.0 if diff == 0 else float("inf"))
 
 
+def _impulse_error(run, ref, window: float, k1: int | None = None) -> float:
+    """``‖ΔI‖_F / ‖I_ref‖_F`` of the impulses per window of steps ``:k1`` (module docstring)."""
+    Ia = _windows(run.t[:k1], run.impulse[:k1], window)
+    Ib = _windows(ref.t[:k1], ref.impulse[:k1], window)
+    n = min(len(Ia), len(Ib))
+    return _rel(np.linalg.norm(Ia[:n] - Ib[:n]), np.linalg.norm(Ib[:n]))
+
+
 def compare(run, ref, fields_run, fields_ref, norms: dict, window: float) -> dict:
     """Relative differences of ``run`` against ``ref`` (module docstring).
 
@@ -119,9 +127,7 @@ def compare(run, ref, fields_run, fields_ref, norms: dict, window: float) -> dic
     out = {}
     m = min(fields_run.shape[0], fields_ref.shape[0])
     fields_run, fields_ref = fields_run[:m], fields_ref[:m]
-    Ia, Ib = _windows(run.t, run.impulse, window), _windows(ref.t, ref.impulse, window)
-    n = min(len(Ia), len(Ib))
-    out["contact_force"] = _rel(np.linalg.norm(Ia[:n] - Ib[:n]), np.linalg.norm(Ib[:n]))
+    out["contact_force"] = _impulse_error(run, ref, window)
     key = "contact_temperature" if "contact_temperature" in ref.signals else "tip_temperature"
     if key in ref.signals and key in run.signals:
         k = min(len(run.t), len(ref.t))
@@ -159,16 +165,21 @@ def twin(reductor, sizes, make_stepper, t_end, checkpoints=5):
     return res, reductor.reconstruct(res.states, *sizes)
 
 
-def _signal_gap(a, b, k0: int, k1: int) -> float:
-    """Largest relative difference of the contact signals of ``a`` and ``b`` on steps
-    ``k0:k1`` (each signal relative to its largest reference value)."""
-    out = 0.0
+def _signal_pairs(a, b, k1: int):
+    """``(x, y)``: each contact signal (:data:`SIGNALS`) of ``a`` and ``b`` on steps ``:k1``."""
     k1 = min(k1, len(a.t), len(b.t))
     for key in SIGNALS:
         if key in a.signals and key in b.signals:
-            x, y = a.signals[key][k0:k1], b.signals[key][k0:k1]
-            if len(y):
-                out = max(out, _rel(np.abs(x - y).max(), np.abs(y).max()))
+            yield a.signals[key][:k1], b.signals[key][:k1]
+
+
+def _signal_gap(a, b, k1: int) -> float:
+    """Largest relative difference of the contact signals of ``a`` and ``b`` on steps ``:k1``
+    (each signal relative to its largest reference value)."""
+    out = 0.0
+    for x, y in _signal_pairs(a, b, k1):
+        if len(y):
+            out = max(out, _rel(np.abs(x - y).max(), np.abs(y).max()))
     return out
 
 
@@ -178,12 +189,10 @@ def _horizon(tw, ref, share: float, first: int) -> int:
     steps, or leave the reference by ``share``, whichever comes first (or the end)."""
     n = min(len(tw.t), len(ref.t))
     d = np.zeros(n)
-    for key in SIGNALS:
-        if key in tw.signals and key in ref.signals:
-            x, y = tw.signals[key][:n], ref.signals[key][:n]
-            scale = np.abs(y).max()
-            if scale > 0:
-                d = np.maximum(d, np.abs(x - y).reshape(n, -1).max(axis=1) / scale)
+    for x, y in _signal_pairs(tw, ref, n):
+        scale = np.abs(y).max()
+        if scale > 0:
+            d = np.maximum(d, np.abs(x - y).reshape(n, -1).max(axis=1) / scale)
     bound = min(share, AMPLIFICATION * d[: max(1, first)].max())
     off = np.flatnonzero(d > bound)
     return max(int(off[0]) if off.size else n, first)
@@ -235,15 +244,7 @@ def estimate(run, ref, fom, *, window=0.0, twin=None, tolerance=None) -> dict:
         if tolerance is not None and sens > HORIZON_SHARE * tolerance:  # chaotic: split
             first = int(np.searchsorted(b.t, b.t[0] + (window or 0.0)))
             kp = _horizon(tw, b, HORIZON_SHARE * tolerance, first)
-            Ia, Ib = (
-                _windows(a.t[:kp], a.impulse[:kp], window),
-                _windows(b.t[:kp], b.impulse[:kp], window),
-            )
-            n = min(len(Ia), len(Ib))
-            early = max(
-                _rel(np.linalg.norm(Ia[:n] - Ib[:n]), np.linalg.norm(Ib[:n])),
-                _signal_gap(a, b, 0, kp),
-            )
+            early = max(_impulse_error(a, b, window, kp), _signal_gap(a, b, kp))
             stats = _statistical(a, b, kp)
             late = max(stats.values()) if stats else 0.0
             value = float(max(early, late))
