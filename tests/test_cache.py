@@ -92,8 +92,11 @@ def test_speed_change_reuses_the_matrices_with_the_new_gap_and_heat(first):
     notes = []
     hit = _build(cache, notes, **{"loads.rotation_speed": 1700.0})
     assert any("assembly loaded" in n for n in notes)
-    # the reduction error estimate steps the run at this speed: the reduced model is rebuilt
+    # the reduction error estimate steps the run at this speed: the reduced model is rebuilt,
+    # on the bases this process built for the first speed (same matrices)
     assert "cache" not in hit.report["reduction"]
+    assert hit.report["reduction"]["bases"].startswith("reused")
+    assert not any("static shapes" in n for n in notes if n.startswith("reduction phases"))
     fresh = _build(None, None, **{"loads.rotation_speed": 1700.0})
     _same_model(hit.model, fresh.model)
     _close(_states(hit), _states(fresh), 1e-6)

@@ -27,6 +27,11 @@ functions and signals from the full model built in this run. Every key also hold
 :func:`~femrub.app.cache.code_version`.
 On a hit ``Simulation.reductor`` is ``None`` (the bases are not stored: the reduced model
 carries what the run needs, including its map to the mesh).
+
+A reduced model missing from the cache but whose bases this process already built (the
+next point of a speed sweep on a dask worker: same matrices, same ``reduction`` options,
+given sizes) reuses that reductor (:data:`_REDUCTORS`, the last one only): the reduction
+error estimate and the projection run again, the static shapes and modes do not.
 """
 
 from __future__ import annotations
@@ -42,6 +47,9 @@ from ..reduction.sizes import natural_frequencies, reduce_model
 from .cache import content_key
 
 __all__ = ["Stages"]
+
+#: the last reductor this process built, ``{key: reductor}`` (its bases are speed-free)
+_REDUCTORS: dict = {}
 
 
 class Stages:
@@ -133,7 +141,13 @@ class Stages:
         hit = self._fetch("reduction", key)
         if hit is not None:
             return _attach(hit, model), None, dict(hit["report"], cache="hit")
-        reduced, reductor, report = reduce_model(model, scene, log, make_stepper)
+        bases = self._model_key(model, "bases", opts) if opts["method"] != "auto" else None
+        reduced, reductor, report = reduce_model(
+            model, scene, log, make_stepper, reductor=_REDUCTORS.get(bases)
+        )
+        if bases is not None:
+            _REDUCTORS.clear()
+            _REDUCTORS[bases] = reductor
         _say_phases(self._say, reduced.info.get("timings", {}))
         self._keep("reduction", key, _detach(reduced, report), f"{reduced.n_dofs} dofs")
         return reduced, reductor, report

@@ -57,6 +57,7 @@ Petrov–Galerkin model (a frozen interior displacement with no inertia).
 
 from __future__ import annotations
 
+import copy
 import time
 import warnings
 
@@ -418,6 +419,21 @@ class ThermoelasticCraigBampton:
             return np.zeros(X.shape[:-1] + (layout.n,))
         sol = np.linalg.lstsq(self.R[:, cols], X.T if X.ndim == 2 else X, rcond=None)[0]
         return sol.T if X.ndim == 2 else sol
+
+    def for_model(self, fom) -> ThermoelasticCraigBampton:
+        """This reductor's bases on ``fom``: a full model with the same matrices.
+
+        What a rotation speed changes without changing a matrix (the casing's gap functions,
+        heat coefficients, load signals) is taken from ``fom`` by :meth:`reduce`; the bases
+        are shared, not copied. The caller vouches for the matrices (the model cache keys
+        them, :mod:`femrub.app.cached`); the layout and the operators' shapes are checked.
+        """
+        old = self.fom
+        if fom.layout != old.layout or fom.A.shape != old.A.shape or fom.B.shape != old.B.shape:
+            raise ValueError("for_model: the model's layout or operators differ from the bases'")
+        new = copy.copy(self)
+        new.fom, new.timings = fom, {}  # nothing built: the reduced model's info says so
+        return new
 
 
 def craig_bampton_thermal(model, n_uv=None, n_theta=None, **kw):

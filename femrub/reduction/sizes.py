@@ -188,7 +188,7 @@ def lobe_passage(scene) -> float:
     return 2.0 * np.pi / (omega * lobes) if lobes and omega else 0.0
 
 
-def reduce_model(model, scene, log=None, make_stepper=None):
+def reduce_model(model, scene, log=None, make_stepper=None, reductor=None):
     """Reduce ``model`` as ``scene["reduction"]`` asks; return ``(model, reductor, report)``.
 
     ``reductor`` is the one reductor built (at the largest sizes for ``"auto"``, at
@@ -196,7 +196,10 @@ def reduce_model(model, scene, log=None, make_stepper=None):
     ``report["n_uv"]``, ``report["n_theta"]`` are the sizes of the returned model. With
     ``make_stepper`` (``model -> stepper`` of the scene's scheme) the run's error is
     estimated (``report["error"]``, :mod:`femrub.reduction.estimate`) and ``"auto"`` picks
-    the sizes from that estimate.
+    the sizes from that estimate. ``reductor``: one built by an earlier call for a model with
+    the same matrices and the same ``reduction`` options (a point of a speed sweep): its
+    bases are reused (:meth:`~femrub.reduction.craig_bampton.ThermoelasticCraigBampton.for_model`)
+    and only the estimate and the projection run again.
     """
     opts = scene["reduction"]
     method = opts["method"]
@@ -226,9 +229,13 @@ def reduce_model(model, scene, log=None, make_stepper=None):
             if n_uv <= cap[0] and n_theta <= cap[1]:  # else the reductor names the key
                 n_uv, n_theta = reference_sizes(n_uv, n_theta, cap)
     try:
-        red = ThermoelasticCraigBampton(
-            model, n_uv, n_theta, projection=opts["projection"], thermal=opts["thermal"]
-        )
+        if reductor is not None:
+            red = reductor.for_model(model)
+            report["bases"] = "reused (same matrices and reduction options)"
+        else:
+            red = ThermoelasticCraigBampton(
+                model, n_uv, n_theta, projection=opts["projection"], thermal=opts["thermal"]
+            )
     except ValueError as exc:
         text = str(exc)
         key = next((f"reduction.{k}" for k in ("n_theta", "n_uv") if k in text), None)
