@@ -122,28 +122,30 @@ class Stages:
             model.observations, model.energy, model.to_full, *extra,
         )  # fmt: skip
 
-    def reduce(self, model, scene, log=None, make_stepper=None):
+    def reduce(self, model, scene, log=None, make_stepper=None, limits=None):
         """:func:`~femrub.reduction.sizes.reduce_model`: ``(reduced, reductor, report)``.
 
         ``make_stepper`` (for the reduction error estimate, which steps the run itself)
-        puts the scene's ``scheme``, ``loads`` and ``contact`` into the key.
+        puts the scene's ``scheme``, ``loads`` and ``contact`` and the stop ``limits`` it
+        applies to its runs into the key.
         """
         if self.cache is None or self._mats_key is None:
-            out = reduce_model(model, scene, log, make_stepper)
+            out = reduce_model(model, scene, log, make_stepper, limits=limits)
             _say_phases(self._say, out[0].info.get("timings", {}))
             return out
         opts = dict(scene["reduction"])
         if opts["method"] == "none":
-            return reduce_model(model, scene, log, make_stepper)  # nothing to store
+            return reduce_model(model, scene, log, make_stepper, limits=limits)  # nothing stored
         t_end = scene["scheme"]["t_end"] if opts["method"] == "auto" else None
         run = [dict(scene[k]) for k in ("scheme", "loads", "contact")] if make_stepper else None
+        run = run and run + [dict(limits or {})]
         key = self._model_key(model, "reduction", opts, t_end, run)
         hit = self._fetch("reduction", key)
         if hit is not None:
             return _attach(hit, model), None, dict(hit["report"], cache="hit")
         bases = self._model_key(model, "bases", opts) if opts["method"] != "auto" else None
         reduced, reductor, report = reduce_model(
-            model, scene, log, make_stepper, reductor=_REDUCTORS.get(bases)
+            model, scene, log, make_stepper, reductor=_REDUCTORS.get(bases), limits=limits
         )
         if bases is not None:
             _REDUCTORS.clear()

@@ -256,7 +256,7 @@ def _build(scene, log, modes, stages) -> Simulation:
     if modes:
         report["natural_frequencies_hz"] = stages.frequencies(model, modes).tolist()
     make = lambda m: _bare_stepper(scene, m)  # noqa: E731  (the reduction error estimate)
-    reduced, reductor, report["reduction"] = stages.reduce(model, scene, log, make)
+    reduced, reductor, report["reduction"] = stages.reduce(model, scene, log, make, limits)
     clock.done("reduction", f"{reduced.n_dofs} dofs")
     report["model"] = {"n_dofs": reduced.n_dofs, **_layout(reduced)}
     stepper = _stepper(scene, reduced, report)

@@ -19,7 +19,8 @@ for the quantities users read:
   (``displacement_end``, ``temperature_end``: the fields a user looks at when the run ends,
   whose norm can be a fraction of the largest).
 
-Both models are stepped with the scene's scheme and step. The same comparison against the
+Both models are stepped with the scene's scheme and step, and stop at the run's stop limits
+(the estimate covers what the run itself can reach). The same comparison against the
 full model is :func:`compare` (benchmarks/reduction_convergence_3d.py).
 
 *Sensitive (chaotic) responses.* A long frictional rub can be sensitive to its initial
@@ -146,23 +147,27 @@ def compare(run, ref, fields_run, fields_ref, norms: dict, window: float) -> dic
     return out
 
 
-def simulate(reductor, sizes, make_stepper, t_end, checkpoints=5):
-    """Step ``reductor.reduce(*sizes)``; return the results and the full states stored."""
-    st = make_stepper(reductor.reduce(*sizes))
-    every = max(1, st.steps_to(t_end) // checkpoints)
-    res = st.run(t_end, store_every=every)
-    return res, reductor.reconstruct(res.states, *sizes)
+def simulate(reductor, sizes, make_stepper, t_end, checkpoints=5, limits=None, perturb=0.0):
+    """Step ``reductor.reduce(*sizes)``; return the results and the full states stored.
 
-
-def twin(reductor, sizes, make_stepper, t_end, checkpoints=5):
-    """:func:`simulate` with the displacement perturbed by :data:`PERTURBATION` (m)."""
+    ``limits``: the run's stop limits (``Stepper.run``): the estimate compares the models
+    over what the run itself can reach, not past a physical stop. ``perturb``: random
+    displacement (m) added to the initial state (:func:`twin`).
+    """
     m = reductor.reduce(*sizes)
-    x0 = np.array(m.x0, dtype=float)
-    x0[m.layout.u] += PERTURBATION * np.random.default_rng(0).standard_normal(m.layout.n_u)
-    st = make_stepper(m.with_(x0=x0))
+    if perturb:
+        x0 = np.array(m.x0, dtype=float)
+        x0[m.layout.u] += perturb * np.random.default_rng(0).standard_normal(m.layout.n_u)
+        m = m.with_(x0=x0)
+    st = make_stepper(m)
     every = max(1, st.steps_to(t_end) // checkpoints)
-    res = st.run(t_end, store_every=every)
+    res = st.run(t_end, store_every=every, limits=limits)
     return res, reductor.reconstruct(res.states, *sizes)
+
+
+def twin(reductor, sizes, make_stepper, t_end, checkpoints=5, limits=None):
+    """:func:`simulate` with the displacement perturbed by :data:`PERTURBATION` (m)."""
+    return simulate(reductor, sizes, make_stepper, t_end, checkpoints, limits, PERTURBATION)
 
 
 def _signal_pairs(a, b, k1: int):

@@ -139,7 +139,7 @@ def _ladder(most: tuple[int, int]) -> list[tuple[int, int]]:
     return out + [most]
 
 
-def _checked(red, model, want, make_stepper, scene, report, log) -> tuple[int, int]:
+def _checked(red, model, want, make_stepper, scene, report, log, limits) -> tuple[int, int]:
     """Sizes to run and their a-posteriori estimate (``report["error"]``).
 
     ``want``: the sizes asked for (``None`` for ``"auto"``: the smallest of :func:`_ladder`
@@ -150,16 +150,16 @@ def _checked(red, model, want, make_stepper, scene, report, log) -> tuple[int, i
     tol, t_end = scene["reduction"]["tolerance"], scene["scheme"]["t_end"]
     window = lobe_passage(scene)
     most = (red.n_uv, red.n_theta)
-    ref = simulate(red, most, make_stepper, t_end)
+    ref = simulate(red, most, make_stepper, t_end, limits=limits)
     cands = [want] if want is not None else _ladder(most)
     chosen, err, tried, tw = None, None, [], None
     for c in cands:
         if c == most:
             break
-        run = simulate(red, c, make_stepper, t_end)
+        run = simulate(red, c, make_stepper, t_end, limits=limits)
         err = estimate((c, *run), (most, *ref), model, window=window)
         if err["estimate"] > SAFETY * tol:  # measure how sensitive the response is
-            tw = tw or twin(red, most, make_stepper, t_end)
+            tw = tw or twin(red, most, make_stepper, t_end, limits=limits)
             err = estimate((c, *run), (most, *ref), model, window=window, twin=tw, tolerance=tol)
         tried.append({"sizes": list(c), "estimate": err["estimate"]})
         if want is not None or err["estimate"] <= SAFETY * tol:
@@ -188,7 +188,7 @@ def lobe_passage(scene) -> float:
     return 2.0 * np.pi / (omega * lobes) if lobes and omega else 0.0
 
 
-def reduce_model(model, scene, log=None, make_stepper=None, reductor=None):
+def reduce_model(model, scene, log=None, make_stepper=None, reductor=None, limits=None):
     """Reduce ``model`` as ``scene["reduction"]`` asks; return ``(model, reductor, report)``.
 
     ``reductor`` is the one reductor built (at the largest sizes for ``"auto"``, at
@@ -199,7 +199,9 @@ def reduce_model(model, scene, log=None, make_stepper=None, reductor=None):
     the sizes from that estimate. ``reductor``: one built by an earlier call for a model with
     the same matrices and the same ``reduction`` options (a point of a speed sweep): its
     bases are reused (:meth:`~femrub.reduction.craig_bampton.ThermoelasticCraigBampton.for_model`)
-    and only the estimate and the projection run again.
+    and only the estimate and the projection run again. ``limits``: the run's stop limits
+    (``Stepper.run``), applied to the estimate's runs: they compare the models over the
+    part of the run that the run itself can reach.
     """
     opts = scene["reduction"]
     method = opts["method"]
@@ -249,7 +251,7 @@ def reduce_model(model, scene, log=None, make_stepper=None, reductor=None):
         n_uv, n_theta = want
     red.solver.free()  # no more interior solves: release the factorisations' memory
     if make_stepper is not None:
-        n_uv, n_theta = _checked(red, model, want, make_stepper, scene, report, log)
+        n_uv, n_theta = _checked(red, model, want, make_stepper, scene, report, log, limits)
     reduced = red.reduce(n_uv, n_theta)
     if "error" in report:  # energy the reduced dynamics can create (verdict rule ``reduction``)
         report["error"]["energy_growth_rate"] = reduced.info["energy_growth_rate"]
