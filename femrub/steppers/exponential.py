@@ -170,8 +170,11 @@ class ExponentialMoreau(Stepper):
         h, nodes = self.h, self._nodes
         S = np.empty((nodes.size, self._m0 + self._n_a))
         S[0] = self._sk
-        for j in range(1, nodes.size):
-            S[j] = self._signal_values(t + nodes[j] * h)
+        times = t + nodes[1:] * h
+        for k, sig in enumerate(self._signals):
+            S[1:, k] = [sig(tj) for tj in times]
+        if self._n_a:
+            S[1:, self._m0 :] = self.model.contact.rate_at(times)
         self._sk = S[-1]
         b = self._Vinv @ S
         if self._n_a:  # g̈0 = dġ0/dt: the derivative of the rates' interpolant
@@ -245,7 +248,10 @@ class ExponentialMoreau(Stepper):
     def _impact(self, te, X, S, P, forced=None, plastic=None):
         """Newton impulses at time ``te`` (shared LCP); update ``P`` in place; new held set."""
         c = self.model.contact
-        g, gd = c.gap(te, X), c.gap_velocity(te, X)
+        g = c.gap(te, X)
+        if forced is None and not (g <= 0.0).any():  # nothing touches
+            return X, S
+        gd = c.gap_velocity(te, X)
         held = np.zeros(c.n, dtype=bool)
         held[list(S)] = True
         trigger = ~held & (g <= 0.0) & (gd < 0.0)
@@ -277,53 +283,58 @@ class ExponentialMoreau(Stepper):
 
         The exact gaps and held multipliers are checked on a grid of spacing ``h / probes``
         (probe rows on a full step, the cached flow marched on a part step); the first sign
-        change is then bisected on the exact flow (cached dyadic sub-steps).
+        change is then located on the exact flow (cached sub-step flows over ``h / probes × 2^e``).
         """
         c, h, t, flows, q = self.model.contact, self.h, self.t, self._flows, self.probes
         n_s, d = len(S), h / self.probes
+        if a == 0.0 and not S and self._nothing_closes(Xa, Xe, b):
+            return None
 
         def values(tau, X):
-            lam = flows.multiplier(S, X, self._u(b, tau / h)) if S else np.zeros(0)
-            return np.r_[c.gap(t + tau, X), lam]
+            g = c.gap(t + tau, X)
+            return np.concatenate([g, flows.multiplier(S, X, self._u(b, tau / h))]) if S else g
 
-        # grid: a, the next multiples of d, h; rows of gaps and multipliers on it
-        grid, rows, states = [a], [values(a, Xa)], {0: (Xa, np.zeros(n_s))}
+        # grid: a, the next multiples of d, h; rows of gaps and multipliers on it (blocks)
+        grid, rows, states = [[a]], [values(a, Xa)[None]], {0: (Xa, np.zeros(n_s))}
         i1 = math.floor(a / d * (1.0 + 1e-12)) + 1  # first grid index after a
         if i1 < q:
             g1 = i1 * d
             if a > 0.0:  # part step: to the grid with cached sub-step flows
                 X1, P1 = flows.advance(S, Xa, a, g1, b, d)
-                grid.append(g1)
-                rows.append(values(g1, X1))
+                grid.append([g1])
+                rows.append(values(g1, X1)[None])
                 states[1] = (X1, P1)
             else:
                 X1 = Xa
-            k0 = len(grid) - 1  # index of the grid start the probe rows run from
+            start = g1 if a > 0.0 else 0.0  # the grid start the probe rows run from
             if q - i1 > 1 or a == 0.0:
                 Rx, Rb = flows.probe(S, c.GT, q)
                 nj = q - 1 - (i1 if a > 0.0 else 0)  # probe points before h
                 r = Rx.shape[0] // (q - 1)
-                sig0 = grid[k0] / h  # the load polynomial re-expanded at the grid start
+                sig0 = start / h  # the load polynomial re-expanded at the grid start
                 b1 = b if sig0 == 0.0 else self._Dinv @ shift(b, sig0, 1.0)
-                V = (Rx[: nj * r] @ X1 + Rb[: nj * r] @ b1.ravel()).reshape(nj, r)
-                taus = grid[k0] + d * np.arange(1, nj + 1)
-                if callable(c.gap0):
-                    V[:, : c.n] += np.array([c.gap_at(t + tau) for tau in taus])
-                else:
-                    V[:, : c.n] += c.gap0
-                grid.extend(taus)
-                rows.extend(V)
-        grid.append(h)
-        rows.append(values(h, Xe))
-        V = np.array(rows)
+                V = Rx[: nj * r] @ X1
+                if Rb.shape[1]:
+                    V += Rb[: nj * r] @ b1.ravel()
+                V = V.reshape(nj, r)
+                taus = start + d * np.arange(1, nj + 1)
+                V[:, : c.n] += c.gap_at(t + taus) if callable(c.gap0) else c.gap0
+                grid.append(taus)
+                rows.append(V)
+        grid.append([h])
+        rows.append(values(h, Xe)[None])
+        grid, V = np.concatenate(grid), np.concatenate(rows)
         gv, lv = V[:, : c.n], V[:, c.n :]
-        held = np.zeros(c.n, dtype=bool)
-        held[list(S)] = True
-        cand = []  # (bracket j, kind, contact, f(τ, X) -> (value, d/dτ))
-        lam, c_n = (flows.generator(S)[2], self.model.n_dofs) if S else (None, 0)
         # closing: the gap falls below min(g(a), 0) after having been above it
         f_cl = gv - np.minimum(gv[0], 0.0)
-        for i in np.flatnonzero(~held & np.any(f_cl[1:] < 0.0, axis=0)):
+        closing = (f_cl[1:] < 0.0).any(axis=0)
+        if S:
+            closing[list(S)] = False
+        elif not closing.any():  # the common case: free flight, nothing closes
+            return None
+        cand = []  # (bracket j, kind, contact, f(τ, X) -> (value, d/dτ))
+        lam, c_n = (flows.generator(S)[2], self.model.n_dofs) if S else (None, 0)
+        for i in np.flatnonzero(closing):
             ref = min(gv[0, i], 0.0)
 
             def f(tau, X, i=i, ref=ref):
@@ -366,13 +377,43 @@ class ExponentialMoreau(Stepper):
         tau, X, Pl, kind, i = best
         return tau, kind, i, X, P0 + Pl
 
+    def _nothing_closes(self, Xa, Xe, b) -> bool:
+        """Free flight over a whole step: no gap falls below ``min(g(0), 0)`` on the probe
+        grid (the common case, checked with one product of the probe rows)."""
+        c, t, h, q = self.model.contact, self.t, self.h, self.probes
+        ref = np.minimum(c.gap(t, Xa), 0.0)
+        if (c.gap(t + h, Xe) < ref).any():
+            return False
+        if q == 1:
+            return True
+        Rx, Rb = self._flows.probe((), c.GT, q)
+        V = Rx @ Xa
+        if Rb.shape[1]:
+            V += Rb @ b.ravel()
+        V = V.reshape(q - 1, c.n)
+        if callable(c.gap0):
+            V += c.gap_at(t + (h / q) * np.arange(1, q))
+        else:
+            V += c.gap0
+        return not (V < ref).any()
+
     def _root(self, S, f, lo, hi, X_lo, b):
         """First zero of ``f`` in ``(lo, hi]`` on the exact flow from ``(lo, X_lo)``
-        (:func:`~femrub.steppers.flows.first_zero`): ``(τ, X(τ), P_S(lo..τ))`` or ``None``."""
+        (:func:`~femrub.steppers.flows.first_zero`): ``(τ, X(τ), P_S(lo..τ))`` or ``None``.
+        Each evaluation starts from the latest state already computed before it (the open
+        side of the bracket), so Newton's shrinking corrections compose few sub-step flows."""
         h, flows, d = self.h, self._flows, self.h / self.probes
+        n, s = self.model.n_dofs, len(S)
+        known = [(lo, np.concatenate([X_lo, np.zeros(s), flows.chain(b, lo / h)]))]
 
         def at(tau):
-            X, P = flows.advance(S, X_lo, lo, tau, b, d)
-            return X, P, *f(tau, X)
+            t0, z0 = max((k for k in known if k[0] <= tau), key=lambda k: k[0])
+            z = flows.advance_z(S, z0, tau - t0, d)
+            X = z[:n]
+            val, dval = f(tau, X)
+            if val > 0.0:
+                known.append((tau, z))
+            return X, z[n : n + s], val, dval
 
-        return first_zero(at, f(lo, X_lo)[0], lo, hi, _XTOL * h)
+        f_lo, df_lo = f(lo, X_lo)
+        return first_zero(at, f_lo, lo, hi, _XTOL * h, df_lo)
