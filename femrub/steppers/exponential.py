@@ -287,7 +287,7 @@ class ExponentialMoreau(Stepper):
         """
         c, h, t, flows, q = self.model.contact, self.h, self.t, self._flows, self.probes
         n_s, d = len(S), h / self.probes
-        if a == 0.0 and not S and self._nothing_closes(Xa, Xe, b):
+        if a == 0.0 and self._quiet(S, Xa, Xe, b):
             return None
 
         def values(tau, X):
@@ -377,25 +377,37 @@ class ExponentialMoreau(Stepper):
         tau, X, Pl, kind, i = best
         return tau, kind, i, X, P0 + Pl
 
-    def _nothing_closes(self, Xa, Xe, b) -> bool:
-        """Free flight over a whole step: no gap falls below ``min(g(0), 0)`` on the probe
-        grid (the common case, checked with one product of the probe rows)."""
-        c, t, h, q = self.model.contact, self.t, self.h, self.probes
-        ref = np.minimum(c.gap(t, Xa), 0.0)
-        if (c.gap(t + h, Xe) < ref).any():
+    def _quiet(self, S, Xa, Xe, b) -> bool:
+        """A whole step without event: no free gap falls below ``min(g(0), 0)`` and no held
+        multiplier is negative on the probe grid (the common case, checked with one product
+        of the probe rows)."""
+        c, t, h, q, flows = self.model.contact, self.t, self.h, self.probes, self._flows
+        g0, g1 = c.gap(t, Xa), c.gap(t + h, Xe)
+        ref = np.minimum(g0, 0.0)
+        free = np.ones(c.n, dtype=bool)
+        if S:
+            idx = list(S)
+            free[idx] = False
+            ref[idx] = -np.inf
+            if (flows.multiplier(S, Xa, b[0]) < 0.0).any():
+                return False
+            if (flows.multiplier(S, Xe, b.sum(axis=0)) < 0.0).any():
+                return False
+        if (g1 < ref).any():
             return False
         if q == 1:
             return True
-        Rx, Rb = self._flows.probe((), c.GT, q)
+        Rx, Rb = flows.probe(S, c.GT, q)
         V = Rx @ Xa
         if Rb.shape[1]:
             V += Rb @ b.ravel()
-        V = V.reshape(q - 1, c.n)
+        V = V.reshape(q - 1, -1)
+        gv = V[:, : c.n]
         if callable(c.gap0):
-            V += c.gap_at(t + (h / q) * np.arange(1, q))
+            gv += c.gap_at(t + (h / q) * np.arange(1, q))
         else:
-            V += c.gap0
-        return not (V < ref).any()
+            gv += c.gap0
+        return not ((gv < ref).any() or (V[:, c.n :] < 0.0).any())
 
     def _root(self, S, f, lo, hi, X_lo, b):
         """First zero of ``f`` in ``(lo, hi]`` on the exact flow from ``(lo, X_lo)``

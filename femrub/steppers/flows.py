@@ -39,7 +39,7 @@ __all__ = ["Flow", "FlowFamily", "LEVEL_MIN", "first_zero", "shift"]
 
 #: Smallest sub-step flow, ``unit 2^LEVEL_MIN`` (events are located to this resolution).
 LEVEL_MIN = -36
-_FLUSH = 1e-250  # entries of sub-step flows below this are set to zero
+_FLUSH = 1e-150  # entries of sub-step flows below this are set to zero (no subnormals)
 
 
 def shift(b: np.ndarray, alpha: float, delta: float) -> np.ndarray:
@@ -174,10 +174,12 @@ class FlowFamily:
                 M[r : r + m, r + m : r + 2 * m] = np.eye(m)
             e_max = max(math.ceil(math.log2(self.h / unit)), 0) + 1
             T = unit * 2.0**LEVEL_MIN * M
+            T[np.abs(T) < _FLUSH] = 0.0
             if np.linalg.norm(T, 1) < 0.5:  # Taylor series of e^T − I to round-off
                 D, term = T.copy(), T
                 for k in range(2, 40):
                     term = term @ T / k
+                    term[np.abs(term) < _FLUSH] = 0.0
                     D += term
                     if np.max(np.abs(term)) <= 1e-18 * np.max(np.abs(D)):
                         break
