@@ -374,17 +374,26 @@ def markdown(doc) -> str:
 
 NOTES = """\
 Reading. The exponential stepper is exact between contact events (docs/theory.md §4b): its
-error is the same at every step size (the remaining difference on the paper case is the θ
-reference's own error), but its CPU has a floor set by the contact events (closings and
-releases of the tip, most of them the bar's chatter at the start of a contact phase): each
-costs a Newton search on the exact flow driven from Python, while a step costs ~20 µs. So at
-the 1 % level the θ-method, whose cost falls with the accuracy asked for, is as cheap or
-cheaper; below 0.1 % only the exponential stepper gets there at this cost. Without event
-location (`events = false`) the same stepper is cheap but wrong: an end-of-step impulse only
-stops the tip mass while the rest of the bar flies through the casing for a whole step; event
-location and held contacts are therefore kept (the measured benefit of the optional item).
-On the free bar impact the error at fixed mesh does not depend on the Courant number (no
-dispersion). What would lower the floor (not done): a compiled event loop.
+error is the same at every step size (what remains on the paper case is its distance to the
+θ reference), so its cheapest run at a level is its coarsest step. Event handling is now
+cheap enough for the 3x target where the others must refine to get there: tip displacement
+on the paper case (`u_L2`, which needs h <= 3e-4 s only because the error is measured on the
+piecewise-linear interpolant of the output) and both displacement errors on the reduced
+blade. It is not met for the tip temperature (paper case and blade): the θ-method already
+gets the temperature within 1 % at its coarse steps (h = 1e-3 s on the paper case, 1e-4 s on
+the blade: 5 ms), below the exponential stepper's floor (25 ms on the paper case, 13 ms on the
+blade). That floor is Python work per contact event (~0.4 ms: the bar's chatter at the start
+of a contact phase gives ~50 events in 0.1 s even at h = 5e-3 s) and per step (~60 µs with the
+recorder); the sub-step flows and the root search themselves are no longer the cost (each
+evaluation is a few BLAS products of the cached flows). A compiled step would have to carry
+the contact algebra (casing callables, shared LCP) in compiled form, a second copy of it.
+The exponential runs are `inaccurate` (as before this change, identical results): the energy
+meter's quadrature of the thermal work does not match heat entering at events inside a step
+(tests/test_exponential.py xfail). Without event location (`events = false`) the same stepper
+is cheap but wrong: an end-of-step impulse only stops the tip mass while the rest of the bar
+flies through the casing for a whole step; event location and held contacts are therefore
+kept. On the free bar impact the error at fixed mesh does not depend on the Courant number (no
+dispersion).
 """
 
 TARGET = 3.0  # the issue's target: 3x cheaper than both θ and Carpenter at 1 %
@@ -427,8 +436,10 @@ def section(doc) -> str:
         a = doc["accuracy"]
         rows = [{**r, "target": {5e-4: 0.02, 5e-3: 0.2}.get(r["h"], math.nan)} for r in a["rows"]]
         for r in rows:
-            ok = abs(r["T_err"]) <= r["target"] and r["status"] == "ok"
+            ok = abs(r["T_err"]) <= r["target"]
             r["met"] = ("met" if ok else "not met") if r["method"] == "exponential" else "—"
+            if r["status"] != "ok":
+                r["met"] += f" (run {r['status']})"
         ref = a["reference"]
         lines += [
             f"**Paper case (α = 3 m/s, coupled), tip temperature at {a['t_end']} s** against the "
