@@ -381,7 +381,7 @@ on the paper case (`u_L2`, which needs h <= 2.5e-4 s only because the error is m
 piecewise-linear interpolant of the output) and both displacement errors on the reduced
 blade. It is not met for the tip temperature (paper case and blade): the θ-method already
 gets the temperature within 1 % at its coarse steps (h = 1e-3 s on the paper case, 1e-4 s on
-the blade: 5 ms), below the exponential stepper's floor (25 ms on the paper case, 13 ms on the
+the blade: 5 ms), below the exponential stepper's floor (23 ms on the paper case, 15 ms on the
 blade). That floor is Python work per contact event (~0.4 ms: the bar's chatter at the start
 of a contact phase gives ~50 events in 0.1 s even at h = 5e-3 s) and per step (~60 µs with the
 recorder); the sub-step flows and the root search themselves are no longer the cost (each
