@@ -149,4 +149,7 @@ def swept_gap(profile: CasingProfile, angles, rotation_speed: float, offset=0.0)
     def gap_rate(t):
         return omega * profile.slope(omega * t + angles)
 
+    # rows at an array of times (m,) in one call: (m, n_c)
+    gap.over_times = lambda t: profile.gap(omega * t[:, None] + angles) + offset
+    gap_rate.over_times = lambda t: omega * profile.slope(omega * t[:, None] + angles)
     return gap, gap_rate

@@ -302,5 +302,9 @@ class Contact:
 
 
 def _over_times(value: Callable, t: np.ndarray, n: int) -> np.ndarray:
-    """``value(t_i)`` (n,) stacked over the times ``t`` (m,): an (m, n) array."""
+    """``value(t_i)`` (n,) stacked over the times ``t`` (m,): an (m, n) array (in one call
+    when ``value`` has a vectorised ``over_times``, e.g. the swept casing gap)."""
+    rows = getattr(value, "over_times", None)
+    if rows is not None:
+        return np.asarray(rows(t), dtype=float).reshape(t.size, n)
     return np.array([value(ti) for ti in t], dtype=float).reshape(t.size, n)

@@ -39,7 +39,8 @@ import numpy as np
 from ..contact.impulses import solve_impulses
 from ..fem.linalg import Factorised
 from .base import Stepper
-from .flows import FlowFamily, first_zero, shift
+from .events import EventLocation
+from .flows import FlowFamily
 
 __all__ = ["ExponentialMoreau", "MAX_COORDINATES"]
 
@@ -51,10 +52,9 @@ MAX_EVENTS = 64
 MAX_PROBES = 512
 #: Impacts of one contact in one step after which it is held (e = 0): a Zeno sequence
 ZENO_HITS = 3
-_XTOL = 1e-10  # relative tolerance (of h) on an event time
 
 
-class ExponentialMoreau(Stepper):
+class ExponentialMoreau(EventLocation, Stepper):
     """Exact-in-time Moreau stepper for moderate-size models (see module docstring).
 
     Parameters
@@ -170,8 +170,11 @@ class ExponentialMoreau(Stepper):
         h, nodes = self.h, self._nodes
         S = np.empty((nodes.size, self._m0 + self._n_a))
         S[0] = self._sk
-        for j in range(1, nodes.size):
-            S[j] = self._signal_values(t + nodes[j] * h)
+        times = t + nodes[1:] * h
+        for k, sig in enumerate(self._signals):
+            S[1:, k] = [sig(tj) for tj in times]
+        if self._n_a:
+            S[1:, self._m0 :] = self.model.contact.rate_at(times)
         self._sk = S[-1]
         b = self._Vinv @ S
         if self._n_a:  # g̈0 = dġ0/dt: the derivative of the rates' interpolant
@@ -245,7 +248,10 @@ class ExponentialMoreau(Stepper):
     def _impact(self, te, X, S, P, forced=None, plastic=None):
         """Newton impulses at time ``te`` (shared LCP); update ``P`` in place; new held set."""
         c = self.model.contact
-        g, gd = c.gap(te, X), c.gap_velocity(te, X)
+        g = c.gap(te, X)
+        if forced is None and not (g <= 0.0).any():  # nothing touches
+            return X, S
+        gd = c.gap_velocity(te, X)
         held = np.zeros(c.n, dtype=bool)
         held[list(S)] = True
         trigger = ~held & (g <= 0.0) & (gd < 0.0)
@@ -270,109 +276,3 @@ class ExponentialMoreau(Stepper):
         tol = 1e-9 * max(float(np.max(np.abs(gd[active]))), 1e-300)
         keep = active & (e == 0.0) & (gdn <= tol)
         return Xn, tuple(np.flatnonzero(keep))
-
-    # -- events --------------------------------------------------------------------------------
-    def _event(self, S, Xa, a, Xe, b):
-        """Earliest closing or release in ``(a, h]``: ``(τ, kind, i, X(τ), P_S(a..τ))``.
-
-        The exact gaps and held multipliers are checked on a grid of spacing ``h / probes``
-        (probe rows on a full step, the cached flow marched on a part step); the first sign
-        change is then bisected on the exact flow (cached dyadic sub-steps).
-        """
-        c, h, t, flows, q = self.model.contact, self.h, self.t, self._flows, self.probes
-        n_s, d = len(S), h / self.probes
-
-        def values(tau, X):
-            lam = flows.multiplier(S, X, self._u(b, tau / h)) if S else np.zeros(0)
-            return np.r_[c.gap(t + tau, X), lam]
-
-        # grid: a, the next multiples of d, h; rows of gaps and multipliers on it
-        grid, rows, states = [a], [values(a, Xa)], {0: (Xa, np.zeros(n_s))}
-        i1 = math.floor(a / d * (1.0 + 1e-12)) + 1  # first grid index after a
-        if i1 < q:
-            g1 = i1 * d
-            if a > 0.0:  # part step: to the grid with cached sub-step flows
-                X1, P1 = flows.advance(S, Xa, a, g1, b, d)
-                grid.append(g1)
-                rows.append(values(g1, X1))
-                states[1] = (X1, P1)
-            else:
-                X1 = Xa
-            k0 = len(grid) - 1  # index of the grid start the probe rows run from
-            if q - i1 > 1 or a == 0.0:
-                Rx, Rb = flows.probe(S, c.GT, q)
-                nj = q - 1 - (i1 if a > 0.0 else 0)  # probe points before h
-                r = Rx.shape[0] // (q - 1)
-                sig0 = grid[k0] / h  # the load polynomial re-expanded at the grid start
-                b1 = b if sig0 == 0.0 else self._Dinv @ shift(b, sig0, 1.0)
-                V = (Rx[: nj * r] @ X1 + Rb[: nj * r] @ b1.ravel()).reshape(nj, r)
-                taus = grid[k0] + d * np.arange(1, nj + 1)
-                if callable(c.gap0):
-                    V[:, : c.n] += np.array([c.gap_at(t + tau) for tau in taus])
-                else:
-                    V[:, : c.n] += c.gap0
-                grid.extend(taus)
-                rows.extend(V)
-        grid.append(h)
-        rows.append(values(h, Xe))
-        V = np.array(rows)
-        gv, lv = V[:, : c.n], V[:, c.n :]
-        held = np.zeros(c.n, dtype=bool)
-        held[list(S)] = True
-        cand = []  # (bracket j, kind, contact, f(τ, X) -> (value, d/dτ))
-        lam, c_n = (flows.generator(S)[2], self.model.n_dofs) if S else (None, 0)
-        # closing: the gap falls below min(g(a), 0) after having been above it
-        f_cl = gv - np.minimum(gv[0], 0.0)
-        for i in np.flatnonzero(~held & np.any(f_cl[1:] < 0.0, axis=0)):
-            ref = min(gv[0, i], 0.0)
-
-            def f(tau, X, i=i, ref=ref):
-                rate = c.rate_at(t + tau)[i] if callable(c.gap_rate) else 0.0
-                dX = flows.rate(S, X, self._u(b, tau / h))
-                return c.gap(t + tau, X)[i] - ref, rate + c.GT[i] @ dX
-
-            cand.append((1 + int(np.argmax(f_cl[1:, i] < 0.0)), "closing", int(i), f))
-        for k in np.flatnonzero(np.any(lv < 0.0, axis=0)):
-            j = int(np.argmax(lv[:, k] < 0.0))
-            if j == 0:  # pulled away already: release now
-                return a, "release", S[k], Xa, np.zeros(n_s)
-
-            def f(tau, X, k=k):
-                u, du = self._u(b, tau / h), self._du(b, tau / h)
-                lx, lu = lam[k, :c_n], lam[k, c_n:]
-                val = lx @ X + (lu @ u if lu.size else 0.0)
-                return val, lx @ flows.rate(S, X, u) + (lu @ du if lu.size else 0.0)
-
-            cand.append((j, "release", S[k], f))
-        if not cand:
-            return None
-        j = min(x[0] for x in cand)
-        lo = grid[j - 1]
-        if j - 1 not in states:  # march the cached flows to the bracket
-            k = max(states)
-            Xk, Pk = states[k]
-            Xj, Pj = flows.advance(S, Xk, grid[k], grid[j - 1], b, d)
-            states[j - 1] = (Xj, Pk + Pj)
-        X0, P0 = states[j - 1]
-        best = None
-        for jj, kind, i, f in cand:
-            if jj != j:
-                continue
-            found = self._root(S, f, lo, grid[j], X0, b)
-            if found is not None and (best is None or found[0] < best[0]):
-                best = (*found, kind, i)
-        if best is None:
-            return None
-        tau, X, Pl, kind, i = best
-        return tau, kind, i, X, P0 + Pl
-
-    def _root(self, S, f, lo, hi, X_lo, b):
-        """First zero of ``f`` in ``(lo, hi]`` on the exact flow from ``(lo, X_lo)``
-        (:func:`~femrub.steppers.flows.first_zero`): ``(τ, X(τ), P_S(lo..τ))`` or ``None``."""
-        h, flows, d = self.h, self._flows, self.h / self.probes
-
-        def at(tau):
-            X, P = flows.advance(S, X_lo, lo, tau, b, d)
-            return X, P, *f(tau, X)
-
-        return first_zero(at, f(lo, X_lo)[0], lo, hi, _XTOL * h)

@@ -35,7 +35,11 @@ import math
 import numpy as np
 import scipy.linalg as sla
 
-__all__ = ["Flow", "FlowFamily", "first_zero", "shift"]
+__all__ = ["Flow", "FlowFamily", "LEVEL_MIN", "first_zero", "shift"]
+
+#: Smallest sub-step flow, ``unit 2^LEVEL_MIN`` (events are located to this resolution).
+LEVEL_MIN = -36
+_FLUSH = 1e-150  # entries of sub-step flows below this are set to zero (no subnormals)
 
 
 def shift(b: np.ndarray, alpha: float, delta: float) -> np.ndarray:
@@ -114,6 +118,7 @@ class FlowFamily:
         self._gen: dict[tuple, tuple] = {}
         self._flows: dict[tuple, Flow] = {}  # (S, τ) -> Flow
         self._probe: dict[tuple, tuple] = {}
+        self._levels: dict[tuple, list] = {}
 
     def generator(self, S: tuple) -> tuple[np.ndarray, np.ndarray, np.ndarray | None]:
         """``(K, E, Λ)`` of held set ``S``; ``Λ = [Λx, Λs]`` gives ``λ_S = Λx X + Λs s``."""
@@ -148,19 +153,72 @@ class FlowFamily:
             self._flows[key] = f
         return f
 
+    def levels(self, S: tuple, unit: float) -> list[np.ndarray]:
+        """Exact flows ``Z_e`` of held set ``S`` over ``unit 2^e``, e = ``LEVEL_MIN`` … ``e_max``
+        (``unit 2^e_max >= h``), on the augmented state ``z = [X; P_S; s, ṡ, …, s^(p)]`` (load
+        derivatives in physical units): ``z(τ + unit 2^e) = Z_e z(τ)`` (cached per ``S``).
+
+        One augmented matrix ``M = [[K, E, 0, …], [0, 0, I, …], …]``; the smallest level from
+        its Taylor series, the others by squaring its increment (``Z = I + D``,
+        ``D_{e+1} = 2 D_e + D_e²``: no cancellation against the identity)."""
+        key = (S, unit)
+        if key not in self._levels:
+            K, E, _ = self.generator(S)
+            nz, m, p = K.shape[0], E.shape[1], self.degree
+            N = nz + (p + 1) * m
+            M = np.zeros((N, N))
+            M[:nz, :nz] = K
+            M[:nz, nz : nz + m] = E
+            for i in range(p):
+                r = nz + i * m
+                M[r : r + m, r + m : r + 2 * m] = np.eye(m)
+            e_max = max(math.ceil(math.log2(self.h / unit)), 0) + 1
+            T = unit * 2.0**LEVEL_MIN * M
+            T[np.abs(T) < _FLUSH] = 0.0
+            if np.linalg.norm(T, 1) < 0.5:  # Taylor series of e^T − I to round-off
+                D, term = T.copy(), T
+                for k in range(2, 40):
+                    term = term @ T / k
+                    term[np.abs(term) < _FLUSH] = 0.0
+                    D += term
+                    if np.max(np.abs(term)) <= 1e-18 * np.max(np.abs(D)):
+                        break
+            else:  # a very stiff model: the exponential itself
+                D = sla.expm(T) - np.eye(N)
+            out, eye = [], np.eye(N)
+            for _ in range(LEVEL_MIN, e_max + 1):
+                D[np.abs(D) < _FLUSH] = 0.0  # no subnormal products (they are slow)
+                out.append(np.ascontiguousarray(eye + D))
+                D = 2.0 * D + D @ D
+            self._levels[key] = out
+        return self._levels[key]
+
+    def chain(self, b, sigma: float) -> np.ndarray:
+        """Load derivatives ``[s, ṡ, …, s^(p)]`` (physical units) at the fraction ``sigma`` of
+        the step, for the step's polynomial ``s = Σ b_i σ^i``."""
+        w = shift(b, sigma, 1.0)  # w_l = d^l s / dσ^l
+        return (w / (self.h ** np.arange(b.shape[0]))[:, None]).ravel()
+
+    def advance_z(self, S: tuple, z, rest: float, unit: float):
+        """Augmented state ``z`` (see :meth:`levels`) advanced by ``rest`` on the flow of ``S``:
+        composed of the flows over ``unit 2^e`` of the binary expansion of ``rest / unit``
+        down to ``2^LEVEL_MIN`` (the remainder, below ``unit 2^LEVEL_MIN``, is dropped)."""
+        Z = self.levels(S, unit)
+        k = int(rest / unit * 2.0**-LEVEL_MIN * (1.0 + 1e-12)) if rest > 0.0 else 0
+        k = min(k, (1 << len(Z)) - 1)
+        while k:
+            e = k.bit_length() - 1
+            z = Z[e] @ z
+            k ^= 1 << e
+        return z
+
     def advance(self, S: tuple, X, tau0: float, tau1: float, b, unit: float):
-        """Flow of ``S`` from ``tau0`` to ``tau1`` in the step, composed of cached flows over
-        ``unit 2^j`` and ``unit / 2^k`` (k <= 36: the remainder, below ``unit 2^-36``, is
-        dropped); ``b``: the step's load polynomial. Returns ``(X, P_S)``."""
-        h, P = self.h, np.zeros(len(S))
-        rest, tau = tau1 - tau0, tau0
-        j = max(int(math.floor(math.log2(max(rest / unit, 1.0)))), 0)
-        pieces = [unit * 2.0**e for e in range(j, -37, -1)]
-        for u in pieces:
-            while rest >= u * (1.0 - 1e-12):
-                X, dP = self.flow(S, u, cache=True)(X, shift(b, tau / h, u / h))
-                P, tau, rest = P + dP, tau + u, rest - u
-        return X, P
+        """Flow of ``S`` from ``tau0`` to ``tau1`` in the step (:meth:`advance_z`); ``b``: the
+        step's load polynomial. Returns ``(X, P_S)``."""
+        n, s = self.L.shape[0], len(S)
+        z = np.concatenate([X, np.zeros(s), self.chain(b, tau0 / self.h)])
+        z = self.advance_z(S, z, tau1 - tau0, unit)
+        return z[:n], z[n : n + s]
 
     def rate(self, S: tuple, X, u) -> np.ndarray:
         """``Ẋ`` (N) of the held-set-``S`` flow at state ``X`` and load signals ``u``."""
@@ -185,39 +243,56 @@ class FlowFamily:
 
         Returns ``(Rx, Rb)``: rows ``[Gᵀ X(τ_j); λ_S(τ_j)]`` stacked over ``j`` equal
         ``Rx X(0) + Rb b`` for the load polynomial ``s(σ) = Σ b_i σ^i`` (σ in units of h)
-        from time 0. Built by recursion on the cached flow over ``h / q`` (cached).
+        from time 0. Built by recursion on the sub-step flow over ``h / q`` (cached).
         """
         if S not in self._probe:
             _, _, lam = self.generator(S)
             n, h, p, m = self.L.shape[0], self.h, self.degree, self.G.shape[1]
-            f = self.flow(S, h / q, cache=True)
-            Phi, Psi = f.Phi[:n], f.Psi[:n]
-            rows = GT if lam is None else np.vstack([GT, lam[:, :n]])
-            nl = 0 if lam is None else lam.shape[0]
-            Rx, Cb, rx, rb = rows, np.zeros((n, (p + 1) * m)), [], []
-            for j in range(1, q):
-                Rx = Rx @ Phi
-                if m:
-                    K = np.kron(shift(np.eye(p + 1), (j - 1) / q, 1.0 / q), np.eye(m))
-                    Cb = Phi @ Cb + Psi @ K
-                Rb = rows @ Cb
-                if nl and m:
-                    Rb[-nl:] += lam[:, n:] @ np.kron((j / q) ** np.arange(p + 1), np.eye(m))
-                rx.append(Rx)
-                rb.append(Rb)
+            Z = self.levels(S, h / q)[-LEVEL_MIN]  # the flow over h / q
+            nz = n + len(S)
+            R = np.zeros((GT.shape[0] + (0 if lam is None else lam.shape[0]), Z.shape[0]))
+            R[: GT.shape[0], :n] = GT
+            if lam is not None:  # λ_S = Λx X + Λs s, s: the chain's first block
+                R[GT.shape[0] :, :n] = lam[:, :n]
+                R[GT.shape[0] :, nz : nz + m] = lam[:, n:]
+            # b -> chain at σ = 0: s^(l) = l! b_l / h^l
+            scale = np.repeat([math.factorial(i) / h**i for i in range(p + 1)], m)
+            rz = []
+            for _ in range(1, q):
+                R = R @ Z
+                rz.append(R)
+            Rz = np.vstack(rz)
             self._probe[S] = (
-                np.ascontiguousarray(np.vstack(rx)),
-                np.ascontiguousarray(np.vstack(rb)),
+                np.ascontiguousarray(Rz[:, :n]),
+                np.ascontiguousarray(Rz[:, nz:] * scale),
             )
         return self._probe[S]
 
 
-def first_zero(at, f_lo: float, lo: float, hi: float, tol: float):
+def _hermite_root(a, fa, dfa, b, fb, dfb) -> float:
+    """First guess of the zero in ``(a, b)``: Newton on the cubic Hermite interpolant of
+    ``f`` from its values and slopes at the ends (``fa > 0 > fb``); NaN if it fails."""
+    d = b - a
+    p0, p1, q0, q1 = fa, d * dfa, fb, d * dfb
+    c2, c3 = 3 * (q0 - p0) - 2 * p1 - q1, 2 * (p0 - q0) + p1 + q1
+    s = fa / (fa - fb)  # secant start
+    for _ in range(8):
+        val = p0 + s * (p1 + s * (c2 + s * c3))
+        der = p1 + s * (2 * c2 + 3 * s * c3)
+        if der == 0.0:
+            return math.nan
+        s = min(max(s - val / der, 0.0), 1.0)
+    return a + s * d
+
+
+def first_zero(at, f_lo: float, lo: float, hi: float, tol: float, df_lo=None):
     """First zero of ``f`` in ``(lo, hi]`` with ``f(hi) < 0``, by safeguarded Newton.
 
     ``at(τ) -> (X, P, f, df/dτ)`` evaluates the exact flow. Newton steps leaving the bracket
     fall back to regula falsi, then bisection. When ``f(lo) <= 0`` (a contact at the surface
     at ``lo``, just released) the bracket is first halved towards ``lo`` until ``f > 0``.
+    With the slope ``df_lo`` the first iterate is the zero of the cubic Hermite interpolant
+    on the bracket (the exact flow is then evaluated near the zero from the start).
     Returns ``(τ, X(τ), P(τ))`` with ``f(τ) <= 0`` within ``tol`` of the zero, or ``None``.
     """
     if f_lo <= 0.0:
@@ -234,9 +309,17 @@ def first_zero(at, f_lo: float, lo: float, hi: float, tol: float):
         a, f_a = lo, f_lo
     x = hi
     X, P, fx, dfx = at(x)
-    best, bh, f_bh = (x, X, P), hi, fx
-    for _ in range(60):
-        x_new = x - fx / dfx if dfx != 0.0 else np.nan
+    best, bh, f_bh, df_bh = (x, X, P), hi, fx, dfx
+    width, slow = bh - a, 0
+    for it in range(60):
+        if it == 0 and df_lo is not None and f_lo > 0.0:
+            x_new = _hermite_root(lo, f_lo, df_lo, x, fx, dfx)
+        elif slow >= 3:  # the bracket stopped shrinking: bisection
+            x_new, slow = 0.5 * (a + bh), 0
+        else:
+            x_new = x - fx / dfx if dfx != 0.0 else np.nan
+            if not (a < x_new < bh) and df_bh != 0.0:  # Newton from the closed side
+                x_new = bh - f_bh / df_bh
         if not (a < x_new < bh):  # outside the bracket: regula falsi, else bisection
             x_new = a - f_a * (bh - a) / (f_bh - f_a)
             if not (a < x_new < bh):
@@ -253,7 +336,9 @@ def first_zero(at, f_lo: float, lo: float, hi: float, tol: float):
         if fx > 0.0:
             a, f_a = x, fx
         else:
-            bh, f_bh, best = x, fx, (x, X, P)
+            bh, f_bh, df_bh, best = x, fx, dfx, (x, X, P)
         if bh - a <= tol:
             break
+        slow = slow + 1 if bh - a > 0.5 * width else 0
+        width = min(width, bh - a) if slow == 0 else width
     return best
