@@ -368,8 +368,20 @@ def render(out: Path, doc: Path) -> Path:
             + _read(out / "exponential_section.md", "benchmarks/exponential.py"),
         ]
     ).replace("performance/", f"{rel.as_posix()}/")
-    doc.write_text(text.rstrip() + "\n")
+    doc.write_text(text.rstrip() + "\n" + _later_sections(doc))
     return doc
+
+
+def _later_sections(doc: Path) -> str:
+    """The sections after §6 of an existing ``doc``, written by other benchmarks (kept)."""
+    if not doc.exists():
+        return ""
+    lines = doc.read_text().splitlines(keepends=True)
+    for i, line in enumerate(lines):
+        head = line.removeprefix("## ").split(".", 1)[0]
+        if line.startswith("## ") and head.isdigit() and int(head) > 6:
+            return "\n" + "".join(lines[i:])
+    return ""
 
 
 def main(argv=None) -> None:
