@@ -1,0 +1,282 @@
+"""Compiled kernels of the Signorini–Coulomb impulse problem (the one implementation).
+
+The problem and its Alart–Curnier form are stated in :mod:`femrub.contact.friction`; this
+module holds the arithmetic, written in the numba-compatible subset of Python (loops over
+contacts, no Python objects) and compiled by :func:`femrub.contact.jit.njit`. Every
+frictional solve of femrub goes through :func:`frictional_solve`
+(:func:`femrub.contact.friction.solve_frictional_contact` and the compiled active-set fixed
+point :func:`femrub.contact.activation.frictional_fixed_point` of the θ-method), so there is
+no second copy of the algebra; with ``NUMBA_DISABLE_JIT=1`` the same functions run as
+Python.
+
+Local rows are contact-major: index ``3 i + (n, t1, t2)``. With ``dA = I − ρ W`` the
+Alart–Curnier function and an element of its generalised Jacobian are::
+
+    F_n = P_n − proj_[0, U](a),  a = P_n − ρ u_n        ∂F_n = ρ W_n  (0 < a < U), else e_n
+    F_t = P_t − proj_B(μ proj(a))(x),  x = P_t − ρ u_t
+        stick (|x| <= r):  ∂F_t = ρ W_t
+        slip:              ∂F_t = e_t − x̂ (μ [0 < a < U] dA_n) − (r / |x|) (I − x̂ x̂ᵀ) dA_t
+
+Status codes returned by the kernels: :data:`SOLVED`, :data:`NOT_SOLVED` (residual above
+``sqrt(tol)``), :data:`NON_POSITIVE` (a diagonal Delassus block is not positive).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from .jit import njit
+
+__all__ = ["SOLVED", "NOT_SOLVED", "NON_POSITIVE", "OPEN", "STICK", "SLIP"]
+
+SOLVED, NOT_SOLVED, NON_POSITIVE = 0, 1, 2
+OPEN, STICK, SLIP = 0, 1, 2
+
+
+@njit
+def newton_law(W, q, e, ub):
+    """``(W_l, q_l)``: Newton's impact law folded into the normal rows.
+
+    ``u_n = (u_n⁺ + e u_n⁻) / (1 + e)``: normal rows of ``W`` and ``q`` scaled by
+    ``1 / (1 + e)``, ``q_n`` shifted by ``e u_n⁻ / (1 + e)``. ``q`` is (n, 3).
+    """
+    n = q.shape[0]
+    Wl = W.copy()
+    ql = q.copy()
+    for i in range(n):
+        s = 1.0 / (1.0 + e[i])
+        for j in range(3 * n):
+            Wl[3 * i, j] = W[3 * i, j] * s
+        ql[i, 0] = q[i, 0] * s + e[i] * ub[i] * s
+    return Wl, ql
+
+
+@njit
+def _residual(P, W, q, mu, rho, U):
+    """Alart–Curnier function ``F(P)`` (m, 3) and what its Jacobian needs."""
+    m = q.shape[0]
+    u = (W @ P.reshape(-1)).reshape(m, 3) + q
+    F = np.empty((m, 3))
+    pos = np.empty(m, dtype=np.bool_)
+    slip = np.empty(m, dtype=np.bool_)
+    r = np.empty(m)
+    x = np.empty((m, 2))
+    nx = np.empty(m)
+    for i in range(m):
+        a = P[i, 0] - rho[i] * u[i, 0]
+        pn = min(max(a, 0.0), U[i])
+        pos[i] = a > 0.0 and a < U[i]  # where the projected normal impulse follows a
+        r[i] = mu[i] * pn
+        x0 = P[i, 1] - rho[i] * u[i, 1]
+        x1 = P[i, 2] - rho[i] * u[i, 2]
+        x[i, 0], x[i, 1] = x0, x1
+        nx[i] = math.hypot(x0, x1)
+        slip[i] = nx[i] > r[i]
+        s = r[i] / nx[i] if slip[i] else 1.0
+        F[i, 0] = P[i, 0] - pn
+        F[i, 1] = P[i, 1] - s * x0
+        F[i, 2] = P[i, 2] - s * x1
+    return F, u, pos, r, x, nx, slip
+
+
+@njit
+def _jacobian(rW, dA, mu, pos, r, x, nx, slip):
+    """An element of the generalised Jacobian of :func:`_residual` (3m, 3m)."""
+    m = pos.size
+    J = rW.copy()
+    for i in range(m):
+        if not pos[i]:  # F_n = P_n
+            J[3 * i, :] = 0.0
+            J[3 * i, 3 * i] = 1.0
+        if slip[i]:
+            xh0, xh1 = x[i, 0] / nx[i], x[i, 1] / nx[i]
+            c = r[i] / nx[i]
+            p00, p01, p11 = 1.0 - xh0 * xh0, -xh0 * xh1, 1.0 - xh1 * xh1
+            for j in range(3 * m):
+                dr = mu[i] * dA[3 * i, j] if pos[i] else 0.0
+                a1, a2 = dA[3 * i + 1, j], dA[3 * i + 2, j]
+                J[3 * i + 1, j] = -xh0 * dr - c * (p00 * a1 + p01 * a2)
+                J[3 * i + 2, j] = -xh1 * dr - c * (p01 * a1 + p11 * a2)
+            J[3 * i + 1, 3 * i + 1] += 1.0
+            J[3 * i + 2, 3 * i + 2] += 1.0
+    return J
+
+
+@njit
+def _newton(P, W, rW, dA, q, mu, rho, U, tol, max_iter):
+    """Semi-smooth Newton with Armijo line search on ``‖F‖²/2``; stops when it stalls.
+
+    Returns ``(P, F, u, iterations)``.
+    """
+    m = q.shape[0]
+    F, u, pos, r, x, nx, slip = _residual(P, W, q, mu, rho, U)
+    merit = 0.5 * np.sum(F**2)
+    it = 0
+    for k in range(1, max_iter + 1):
+        it = k
+        if np.max(np.abs(F)) <= tol:
+            break
+        J = _jacobian(rW, dA, mu, pos, r, x, nx, slip)
+        rhs = -F.reshape(-1)
+        try:
+            d = np.linalg.solve(J, rhs).reshape(m, 3)
+        except Exception:  # singular Jacobian (numba raises a plain exception)
+            break
+        t = 1.0
+        while True:
+            Pn = P + t * d
+            Fn, un, posn, rn, xn, nxn, slipn = _residual(Pn, W, q, mu, rho, U)
+            mn = 0.5 * np.sum(Fn**2)
+            if mn <= (1.0 - 1e-4 * t) * merit:
+                break
+            t *= 0.5
+            if t < 1e-8:
+                return P, F, u, it
+        P, F, u, merit = Pn, Fn, un, mn
+        pos, r, x, nx, slip = posn, rn, xn, nxn, slipn
+    return P, F, u, it
+
+
+@njit
+def _gauss_seidel(P, W, q, mu, rho, U, tol, sweeps):
+    """Projected block Gauss–Seidel on the Alart–Curnier map (robust, linear convergence)."""
+    P = P.copy()
+    m = q.shape[0]
+    for _ in range(sweeps):
+        change = 0.0
+        for i in range(m):
+            u = np.zeros(3)
+            for a in range(3):
+                s = 0.0
+                for j in range(3 * m):
+                    s += W[3 * i + a, j] * P[j // 3, j % 3]
+                u[a] = s + q[i, a]
+            pn = min(max(0.0, P[i, 0] - rho[i] * u[0]), U[i])
+            x0 = P[i, 1] - rho[i] * u[1]
+            x1 = P[i, 2] - rho[i] * u[2]
+            nx = math.hypot(x0, x1)
+            r = mu[i] * pn
+            s = 1.0 if nx <= r else r / nx
+            new = (pn, s * x0, s * x1)
+            for a in range(3):
+                change = max(change, abs(new[a] - P[i, a]))
+                P[i, a] = new[a]
+        if change <= tol:
+            break
+    return P
+
+
+@njit
+def _on_cone(P, u, mu, rho, U):
+    """Exact cone membership; sliding contacts get ``|P_t| = μ P_n`` along ``P_t − ρ u_t``.
+
+    Returns the impulses and the mask of sliding contacts.
+    """
+    P = P.copy()
+    m = P.shape[0]
+    slide = np.zeros(m, dtype=np.bool_)
+    for i in range(m):
+        P[i, 0] = min(max(P[i, 0], 0.0), U[i])
+        bound = mu[i] * P[i, 0]
+        x0 = P[i, 1] - rho[i] * u[i, 1]
+        x1 = P[i, 2] - rho[i] * u[i, 2]
+        nx = math.hypot(x0, x1)
+        if nx > bound and P[i, 0] > 0.0:
+            slide[i] = True
+            P[i, 1], P[i, 2] = bound / nx * x0, bound / nx * x1
+        else:
+            nt = math.hypot(P[i, 1], P[i, 2])
+            if nt > bound:
+                P[i, 1] *= bound / nt
+                P[i, 2] *= bound / nt
+    return P, slide
+
+
+@njit
+def alart_curnier(W, q, mu, U, warm, use_warm, tol, max_iter):
+    """Signorini–Coulomb on ``m`` contacts, ``u = W P + q`` (Newton's law already folded in).
+
+    ``ρ_i = 1 / ‖W_ii‖_F``; Newton from ``warm`` (when ``use_warm`` and not worse than a
+    cold start), projected Gauss–Seidel then Newton again if it stalls, then the exact cone.
+
+    Returns ``(P (m, 3), sliding (m,), relative residual, iterations, status)``.
+    """
+    m = q.shape[0]
+    rho = np.empty(m)
+    for i in range(m):  # Frobenius norm of the diagonal block: no SVD per step
+        s = 0.0
+        for a in range(3):
+            for b in range(3):
+                s += W[3 * i + a, 3 * i + b] ** 2
+        if not (s > 0.0) or W[3 * i, 3 * i] <= 0.0:
+            return np.zeros((m, 3)), np.zeros(m, dtype=np.bool_), np.inf, 0, NON_POSITIVE
+        rho[i] = 1.0 / math.sqrt(s)
+    scale = 1e-300
+    for i in range(m):
+        for a in range(3):
+            scale = max(scale, abs(rho[i] * q[i, a]))
+    rW = W.copy()
+    for i in range(3 * m):
+        rW[i, :] *= rho[i // 3]
+    dA = np.eye(3 * m) - rW
+    P = np.zeros((m, 3))
+    if use_warm:  # a cold start when the warm one is worse
+        F0 = _residual(P, W, q, mu, rho, U)[0]
+        Fw = _residual(warm, W, q, mu, rho, U)[0]
+        if np.sum(Fw**2) <= np.sum(F0**2):
+            P = warm.copy()
+    P, F, u, it = _newton(P, W, rW, dA, q, mu, rho, U, tol * scale, max_iter)
+    if np.max(np.abs(F)) > tol * scale:  # Newton stalled: Gauss-Seidel sweeps, then Newton
+        P = _gauss_seidel(P, W, q, mu, rho, U, tol * scale, 5000)
+        P, F, u, it2 = _newton(P, W, rW, dA, q, mu, rho, U, tol * scale, max_iter)
+        it += it2
+    res = np.max(np.abs(F)) / scale
+    P, slide = _on_cone(P, u, mu, rho, U)
+    status = SOLVED if res <= math.sqrt(tol) else NOT_SOLVED
+    return P, slide, res, it, status
+
+
+@njit
+def frictional_solve(W, q, mu, e, ub, U, active, warm, use_warm, tol, max_iter):
+    """The frictional problem of one step on the ``active`` contacts (of ``n``).
+
+    ``W`` (3n, 3n) and ``q`` (n, 3) as seen by the local velocities after the step; Newton's
+    law with ``e`` (n,) and the pre-step normal velocity ``ub`` (n,); ``U`` (n,) bounds on
+    the normal impulses (``inf``: none); ``warm`` (n, 3) used when ``use_warm``.
+
+    Returns ``(P (n, 3), u = W P + q (n, 3), state (n,), residual, iterations, status)``.
+    """
+    n = q.shape[0]
+    P = np.zeros((n, 3))
+    state = np.zeros(n, dtype=np.int8)
+    idx = np.flatnonzero(active)
+    ma = idx.size
+    if ma == 0:  # nothing to solve (most steps of a rub): no set-up
+        return P, q.copy(), state, 0.0, 0, SOLVED
+    Wl, ql = newton_law(W, q, e, ub)
+    Wa = np.empty((3 * ma, 3 * ma))
+    qa = np.empty((ma, 3))
+    wa = np.empty((ma, 3))
+    mua = np.empty(ma)
+    Ua = np.empty(ma)
+    for a in range(ma):
+        i = idx[a]
+        mua[a], Ua[a] = mu[i], U[i]
+        for c in range(3):
+            qa[a, c] = ql[i, c]
+            wa[a, c] = warm[i, c]
+            for b in range(ma):
+                for d in range(3):
+                    Wa[3 * a + c, 3 * b + d] = Wl[3 * i + c, 3 * idx[b] + d]
+    Pa, slide, res, it, status = alart_curnier(Wa, qa, mua, Ua, wa, use_warm, tol, max_iter)
+    for a in range(ma):
+        for c in range(3):
+            P[idx[a], c] = Pa[a, c]
+    u = (W @ P.reshape(-1)).reshape(n, 3) + q
+    for a in range(ma):
+        i = idx[a]
+        if P[i, 0] > 0.0:
+            state[i] = SLIP if slide[a] or mu[i] == 0.0 else STICK
+    return P, u, state, res, it, status
