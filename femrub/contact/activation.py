@@ -257,3 +257,23 @@ def frictional_fixed_point(
             seen.append(active)
         n_seen += 1
         active = new
+
+
+def compile_kernels() -> None:
+    """Compile :func:`frictional_fixed_point` and the frictional solve for the argument
+    types of a step (or load them from numba's on-disk cache), so that a run's first
+    contact step does not pay for it. Without compilation (``NUMBA_DISABLE_JIT=1``) a no-op.
+    """
+    from .friction import solve_frictional_contact
+    from .jit import compiled
+
+    if not compiled():
+        return
+    one, z, W = np.ones(1), np.zeros(1), np.eye(3)
+    q = np.array([[-1.0, 0.0, 0.0]])
+    for code in (FIXED_POINT, PREDICTED):
+        frictional_fixed_point(
+            code, -one, -one, -one, np.ones((1, 3)), W, q, one * 0.1, z, z.copy(),
+            np.full(1, np.inf), np.zeros((1, 3)), False, 1.0, 0.5, 1e-12, 60,
+        )  # fmt: skip
+    solve_frictional_contact(W, q, 0.1, np.ones(1, dtype=bool))

@@ -36,21 +36,27 @@ OPEN, STICK, SLIP = 0, 1, 2
 
 
 @njit
-def newton_law(W, q, e, ub):
-    """``(W_l, q_l)``: Newton's impact law folded into the normal rows.
+def newton_law(W, q, e, ub, idx):
+    """``(W_a, q_a)`` of the contacts ``idx``, Newton's impact law folded into their rows.
 
-    ``u_n = (u_n⁺ + e u_n⁻) / (1 + e)``: normal rows of ``W`` and ``q`` scaled by
-    ``1 / (1 + e)``, ``q_n`` shifted by ``e u_n⁻ / (1 + e)``. ``q`` is (n, 3).
+    ``u_n = (u_n⁺ + e u_n⁻) / (1 + e)``: the normal rows of ``W`` and ``q`` (n, 3) scaled by
+    ``1 / (1 + e)``, ``q_n`` shifted by ``e u_n⁻ / (1 + e)``; rows and columns of the other
+    contacts dropped.
     """
-    n = q.shape[0]
-    Wl = W.copy()
-    ql = q.copy()
-    for i in range(n):
+    ma = idx.size
+    Wa = np.empty((3 * ma, 3 * ma))
+    qa = np.empty((ma, 3))
+    for a in range(ma):
+        i = idx[a]
         s = 1.0 / (1.0 + e[i])
-        for j in range(3 * n):
-            Wl[3 * i, j] = W[3 * i, j] * s
-        ql[i, 0] = q[i, 0] * s + e[i] * ub[i] * s
-    return Wl, ql
+        for c in range(3):
+            sc = s if c == 0 else 1.0
+            qa[a, c] = q[i, c] * sc
+            for b in range(ma):
+                for d in range(3):
+                    Wa[3 * a + c, 3 * b + d] = W[3 * i + c, 3 * idx[b] + d] * sc
+        qa[a, 0] += e[i] * ub[i] * s
+    return Wa, qa
 
 
 @njit
@@ -255,9 +261,7 @@ def frictional_solve(W, q, mu, e, ub, U, active, warm, use_warm, tol, max_iter):
     ma = idx.size
     if ma == 0:  # nothing to solve (most steps of a rub): no set-up
         return P, q.copy(), state, 0.0, 0, SOLVED
-    Wl, ql = newton_law(W, q, e, ub)
-    Wa = np.empty((3 * ma, 3 * ma))
-    qa = np.empty((ma, 3))
+    Wa, qa = newton_law(W, q, e, ub, idx)
     wa = np.empty((ma, 3))
     mua = np.empty(ma)
     Ua = np.empty(ma)
@@ -265,16 +269,17 @@ def frictional_solve(W, q, mu, e, ub, U, active, warm, use_warm, tol, max_iter):
         i = idx[a]
         mua[a], Ua[a] = mu[i], U[i]
         for c in range(3):
-            qa[a, c] = ql[i, c]
             wa[a, c] = warm[i, c]
-            for b in range(ma):
-                for d in range(3):
-                    Wa[3 * a + c, 3 * b + d] = Wl[3 * i + c, 3 * idx[b] + d]
     Pa, slide, res, it, status = alart_curnier(Wa, qa, mua, Ua, wa, use_warm, tol, max_iter)
+    u = q.copy()  # W P + q over the active columns only
     for a in range(ma):
+        i = idx[a]
         for c in range(3):
-            P[idx[a], c] = Pa[a, c]
-    u = (W @ P.reshape(-1)).reshape(n, 3) + q
+            P[i, c] = Pa[a, c]
+        for r in range(3 * n):
+            u[r // 3, r % 3] += (
+                W[r, 3 * i] * P[i, 0] + W[r, 3 * i + 1] * P[i, 1] + (W[r, 3 * i + 2] * P[i, 2])
+            )
     for a in range(ma):
         i = idx[a]
         if P[i, 0] > 0.0:

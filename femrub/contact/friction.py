@@ -66,13 +66,13 @@ def _as_local(W, n):
     W = np.asarray(W, dtype=float)
     if W.shape != (3 * n, 3 * n):
         raise ValueError(f"Delassus operator must be {(3 * n, 3 * n)}, got {W.shape}")
-    return np.ascontiguousarray(W)
+    return np.array(W, order="C")  # writable and contiguous: one compiled signature
 
 
 def _per_contact(value, n, default=0.0):
     """``value`` broadcast to a writable, contiguous (n,) float array (kernel argument)."""
     v = default if value is None else value
-    return np.ascontiguousarray(np.broadcast_to(np.asarray(v, dtype=float), (n,)), dtype=float)
+    return np.array(np.broadcast_to(np.asarray(v, dtype=float), (n,)), dtype=float)  # a copy
 
 
 def check_status(status: int, residual: float) -> None:
@@ -120,26 +120,27 @@ def solve_frictional_contact(
     FloatingPointError
         No solution within ``sqrt(tol)`` (non-positive Delassus block, divergence).
     """
-    q = np.ascontiguousarray(np.asarray(q, dtype=float).reshape(-1, 3))
+    q = np.array(np.asarray(q, dtype=float).reshape(-1, 3), order="C")
     n = q.shape[0]
     W = _as_local(W, n)
-    active = np.ascontiguousarray(np.broadcast_to(np.asarray(active, dtype=bool), (n,)))
+    active = np.array(np.broadcast_to(np.asarray(active, dtype=bool), (n,)))
     mu, e = _per_contact(mu, n), _per_contact(restitution, n)
     ub, U = _per_contact(u_before, n), _per_contact(upper, n, np.inf)
     if active.any() and not np.any(mu[active] > 0.0):
         # frictionless: the exact LCP on the normal part (pivoting; one-contact closed form)
         idx = np.flatnonzero(active)
-        Wl, ql = newton_law(W, q, e, ub)
-        Wn = Wl[::3, ::3][np.ix_(idx, idx)]
+        Wa, qa = newton_law(W, q, e, ub, idx)
         P = np.zeros((n, 3))
-        P[idx, 0] = solve_impulses(Wn, ql[idx, 0], np.ones(idx.size, dtype=bool), upper=U[idx])
+        P[idx, 0] = solve_impulses(
+            Wa[::3, ::3], qa[:, 0], np.ones(idx.size, dtype=bool), upper=U[idx]
+        )
         u = (W @ P.reshape(-1)).reshape(n, 3) + q
         state = np.where(P[:, 0] > 0.0, SLIP, OPEN).astype(np.int8)
         return FrictionResult(P, u, state, 0.0, 0)
     use_warm = warm is not None
     w = np.zeros((n, 3)) if warm is None else np.asarray(warm, dtype=float).reshape(n, 3)
     P, u, state, res, it, status = frictional_solve(
-        W, q, mu, e, ub, U, active, np.ascontiguousarray(w), use_warm, tol, max_iter
+        W, q, mu, e, ub, U, active, np.array(w, order="C"), use_warm, tol, max_iter
     )
     check_status(status, res)
     return FrictionResult(P, u, state, float(res), int(it))

@@ -45,6 +45,7 @@ from ..contact.activation import (
     DEFAULT_RULE,
     RULES,
     check_rule,
+    compile_kernels,
     frictional_fixed_point,
     impulse_one,
     impulses,
@@ -160,10 +161,11 @@ class ThetaMethod(Stepper):
             self._warm3 = None
             # arguments of the compiled contact step, contiguous and writable once
             self._rule3 = rule_code(self.activation)
-            self._mu3 = np.ascontiguousarray(np.broadcast_to(c.friction, (c.n,)), dtype=float)
-            self._e3 = np.ascontiguousarray(np.broadcast_to(c.restitution, (c.n,)), dtype=float)
+            self._mu3 = np.array(np.broadcast_to(c.friction, (c.n,)), dtype=float)
+            self._e3 = np.array(np.broadcast_to(c.restitution, (c.n,)), dtype=float)
             self._U3 = np.full(c.n, np.inf)
             self._U3zero = np.zeros((c.n, 3))
+            compile_kernels()  # not in the first step's time
             # gap and local velocity rows in one product: [g, ġ, w_t] = S X + casing terms
             self._S = np.vstack([c.GT, c.V3T])
             self._memo = (None, 0.0, None, None)
