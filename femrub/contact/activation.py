@@ -55,9 +55,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from .coulomb import frictional_solve
+from .coulomb import FIXED_POINT, PREDICTED, frictional_fixed_point
 from .impulses import solve_impulses
-from .jit import njit
 
 __all__ = [
     "RULES",
@@ -193,70 +192,9 @@ def _target(g_k, e):
     return np.minimum(g_k, 0.0) + e * np.maximum(g_k, 0.0)
 
 
-#: rule codes of the compiled fixed point: the Moreau–Jean rule, or the "paper" fixed point
-FIXED_POINT, PREDICTED = 0, 1
-
-
 def rule_code(rule: str) -> int:
     """Code of ``rule`` for :func:`frictional_fixed_point` (``"predicted"`` or the rest)."""
     return PREDICTED if check_rule(rule) == "predicted" else FIXED_POINT
-
-
-@njit
-def frictional_fixed_point(
-    code, g_k, gd_k, g_p, GZ3, W, q, mu, e, ub, U, warm, use_warm, h, gamma, tol, max_iter
-):
-    """Active set and solution of a frictional step (compiled; one call per step).
-
-    ``code``: :func:`rule_code`. ``PREDICTED`` is the Moreau–Jean rule
-    ``g_k + γ h ġ_k <= 0``; every other rule uses the ``"paper"`` fixed point (closed at
-    ``t_k`` or closed at ``t_{k+1}`` after the impulse, ``g_p + GZ3 P_flat <= 0``): the
-    position-level rules (``"position"``, ``"capped"``) have no frictional form yet, so
-    with friction the velocity-level Newton law holds on the active contacts. If no
-    consistent set exists the contact is kept active. Each solve is
-    :func:`femrub.contact.coulomb.frictional_solve` of ``(W, q, mu, e, ub, U)`` (see there),
-    warm-started from the previous solve of the step (from ``warm`` for the first);
-    ``GZ3 = ∂g_{k+1}/∂P`` (n_c, 3 n_c).
-
-    Returns ``(active, P, u, state, residual, iterations, status)``.
-    """
-    if code == PREDICTED:
-        active = g_k + gamma * h * gd_k <= 0.0
-        P, u, st, res, it, status = frictional_solve(
-            W, q, mu, e, ub, U, active, warm, use_warm, tol, max_iter
-        )
-        return active, P, u, st, res, it, status
-    closed = g_k <= 0.0
-    active = closed | (g_p <= 0.0)
-    first = True
-    seen = [active]
-    n_seen = 0  # seen[:n_seen] are the sets tried before the current one
-    while True:
-        P, u, st, res, it, status = frictional_solve(
-            W, q, mu, e, ub, U, active, warm, use_warm, tol, max_iter
-        )
-        # an error; or no impulse at the start, so the set is consistent (most steps of a rub)
-        if status != 0 or (first and not active.any()):
-            return active, P, u, st, res, it, status
-        first = False
-        if active.any():  # the next active set starts from here
-            warm, use_warm = P, True
-        new = closed | (g_p + GZ3 @ P.reshape(-1) <= 0.0)
-        if np.array_equal(new, active):
-            return active, P, u, st, res, it, status
-        for j in range(n_seen):
-            if np.array_equal(new, seen[j]):  # no consistent set: keep the impulse
-                active = new | active
-                P, u, st, res, it, status = frictional_solve(
-                    W, q, mu, e, ub, U, active, warm, use_warm, tol, max_iter
-                )
-                return active, P, u, st, res, it, status
-        if n_seen < len(seen):
-            seen[n_seen] = active
-        else:
-            seen.append(active)
-        n_seen += 1
-        active = new
 
 
 def compile_kernels() -> None:

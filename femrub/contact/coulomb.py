@@ -7,7 +7,9 @@ frictional solve of femrub goes through :func:`frictional_solve`
 (:func:`femrub.contact.friction.solve_frictional_contact` and the compiled active-set fixed
 point :func:`femrub.contact.activation.frictional_fixed_point` of the θ-method), so there is
 no second copy of the algebra; with ``NUMBA_DISABLE_JIT=1`` the same functions run as
-Python.
+Python. Every compiled function of the frictional step lives in this one file: numba's
+on-disk cache is invalidated by the source file of the function it compiled, not by the
+files of the functions that one calls.
 
 Local rows are contact-major: index ``3 i + (n, t1, t2)``. With ``dA = I − ρ W`` the
 Alart–Curnier function and an element of its generalised Jacobian are::
@@ -29,7 +31,20 @@ import numpy as np
 
 from .jit import njit
 
-__all__ = ["SOLVED", "NOT_SOLVED", "NON_POSITIVE", "OPEN", "STICK", "SLIP"]
+__all__ = [
+    "SOLVED",
+    "NOT_SOLVED",
+    "NON_POSITIVE",
+    "OPEN",
+    "STICK",
+    "SLIP",
+    "FIXED_POINT",
+    "PREDICTED",
+    "frictional_fixed_point",
+    "frictional_solve",
+    "alart_curnier",
+    "newton_law",
+]
 
 SOLVED, NOT_SOLVED, NON_POSITIVE = 0, 1, 2
 OPEN, STICK, SLIP = 0, 1, 2
@@ -63,7 +78,14 @@ def newton_law(W, q, e, ub, idx):
 def _residual(P, W, q, mu, rho, U):
     """Alart–Curnier function ``F(P)`` (m, 3) and what its Jacobian needs."""
     m = q.shape[0]
-    u = (W @ P.reshape(-1)).reshape(m, 3) + q
+    p = P.reshape(-1)
+    u = q.copy()  # W P + q, by hand: a BLAS call costs more than the product at this size
+    for i in range(m):
+        for c in range(3):
+            s = 0.0
+            for j in range(3 * m):
+                s += W[3 * i + c, j] * p[j]
+            u[i, c] += s
     F = np.empty((m, 3))
     pos = np.empty(m, dtype=np.bool_)
     slip = np.empty(m, dtype=np.bool_)
@@ -88,8 +110,9 @@ def _residual(P, W, q, mu, rho, U):
 
 
 @njit
-def _jacobian(rW, dA, mu, pos, r, x, nx, slip):
-    """An element of the generalised Jacobian of :func:`_residual` (3m, 3m)."""
+def _jacobian(rW, mu, pos, r, x, nx, slip):
+    """An element of the generalised Jacobian of :func:`_residual` (3m, 3m); ``ρ W`` given,
+    ``dA = I − ρ W``."""
     m = pos.size
     J = rW.copy()
     for i in range(m):
@@ -101,8 +124,9 @@ def _jacobian(rW, dA, mu, pos, r, x, nx, slip):
             c = r[i] / nx[i]
             p00, p01, p11 = 1.0 - xh0 * xh0, -xh0 * xh1, 1.0 - xh1 * xh1
             for j in range(3 * m):
-                dr = mu[i] * dA[3 * i, j] if pos[i] else 0.0
-                a1, a2 = dA[3 * i + 1, j], dA[3 * i + 2, j]
+                dr = mu[i] * ((j == 3 * i) - rW[3 * i, j]) if pos[i] else 0.0
+                a1 = (j == 3 * i + 1) - rW[3 * i + 1, j]
+                a2 = (j == 3 * i + 2) - rW[3 * i + 2, j]
                 J[3 * i + 1, j] = -xh0 * dr - c * (p00 * a1 + p01 * a2)
                 J[3 * i + 2, j] = -xh1 * dr - c * (p01 * a1 + p11 * a2)
             J[3 * i + 1, 3 * i + 1] += 1.0
@@ -111,7 +135,7 @@ def _jacobian(rW, dA, mu, pos, r, x, nx, slip):
 
 
 @njit
-def _newton(P, W, rW, dA, q, mu, rho, U, tol, max_iter):
+def _newton(P, W, rW, q, mu, rho, U, tol, max_iter):
     """Semi-smooth Newton with Armijo line search on ``‖F‖²/2``; stops when it stalls.
 
     Returns ``(P, F, u, iterations)``.
@@ -124,7 +148,7 @@ def _newton(P, W, rW, dA, q, mu, rho, U, tol, max_iter):
         it = k
         if np.max(np.abs(F)) <= tol:
             break
-        J = _jacobian(rW, dA, mu, pos, r, x, nx, slip)
+        J = _jacobian(rW, mu, pos, r, x, nx, slip)
         rhs = -F.reshape(-1)
         try:
             d = np.linalg.solve(J, rhs).reshape(m, 3)
@@ -226,17 +250,16 @@ def alart_curnier(W, q, mu, U, warm, use_warm, tol, max_iter):
     rW = W.copy()
     for i in range(3 * m):
         rW[i, :] *= rho[i // 3]
-    dA = np.eye(3 * m) - rW
     P = np.zeros((m, 3))
     if use_warm:  # a cold start when the warm one is worse
         F0 = _residual(P, W, q, mu, rho, U)[0]
         Fw = _residual(warm, W, q, mu, rho, U)[0]
         if np.sum(Fw**2) <= np.sum(F0**2):
             P = warm.copy()
-    P, F, u, it = _newton(P, W, rW, dA, q, mu, rho, U, tol * scale, max_iter)
+    P, F, u, it = _newton(P, W, rW, q, mu, rho, U, tol * scale, max_iter)
     if np.max(np.abs(F)) > tol * scale:  # Newton stalled: Gauss-Seidel sweeps, then Newton
         P = _gauss_seidel(P, W, q, mu, rho, U, tol * scale, 5000)
-        P, F, u, it2 = _newton(P, W, rW, dA, q, mu, rho, U, tol * scale, max_iter)
+        P, F, u, it2 = _newton(P, W, rW, q, mu, rho, U, tol * scale, max_iter)
         it += it2
     res = np.max(np.abs(F)) / scale
     P, slide = _on_cone(P, u, mu, rho, U)
@@ -285,3 +308,65 @@ def frictional_solve(W, q, mu, e, ub, U, active, warm, use_warm, tol, max_iter):
         if P[i, 0] > 0.0:
             state[i] = SLIP if slide[a] or mu[i] == 0.0 else STICK
     return P, u, state, res, it, status
+
+
+#: rule codes of the compiled fixed point: the Moreau–Jean rule, or the "paper" fixed point
+FIXED_POINT, PREDICTED = 0, 1
+
+
+@njit
+def frictional_fixed_point(
+    code, g_k, gd_k, g_p, GZ3, W, q, mu, e, ub, U, warm, use_warm, h, gamma, tol, max_iter
+):
+    """Active set and solution of a frictional step (compiled; one call per step).
+
+    ``code``: :func:`femrub.contact.activation.rule_code` (the rules are described in
+    :mod:`femrub.contact.activation`, which exports this function). ``PREDICTED`` is the
+    Moreau–Jean rule ``g_k + γ h ġ_k <= 0``; every other rule uses the ``"paper"`` fixed
+    point: closed at ``t_k`` or closed at ``t_{k+1}`` after the impulse
+    (``g_p + GZ3 P <= 0``, ``GZ3 = ∂g_{k+1}/∂P`` (n_c, 3 n_c)). The position-level rules
+    (``"position"``, ``"capped"``) have no frictional form yet, so with friction the
+    velocity-level Newton law holds on the active contacts. If no consistent set exists
+    the contact is kept active. Each solve is :func:`frictional_solve` of
+    ``(W, q, mu, e, ub, U)``, warm-started from the previous solve of the step (from
+    ``warm`` for the first, when ``use_warm``).
+
+    Returns ``(active, P, u, state, residual, iterations, status)``.
+    """
+    if code == PREDICTED:
+        active = g_k + gamma * h * gd_k <= 0.0
+        P, u, st, res, it, status = frictional_solve(
+            W, q, mu, e, ub, U, active, warm, use_warm, tol, max_iter
+        )
+        return active, P, u, st, res, it, status
+    closed = g_k <= 0.0
+    active = closed | (g_p <= 0.0)
+    first = True
+    seen = [active]
+    n_seen = 0  # seen[:n_seen] are the sets tried before the current one
+    while True:
+        P, u, st, res, it, status = frictional_solve(
+            W, q, mu, e, ub, U, active, warm, use_warm, tol, max_iter
+        )
+        # an error; or no impulse at the start, so the set is consistent (most steps of a rub)
+        if status != 0 or (first and not active.any()):
+            return active, P, u, st, res, it, status
+        first = False
+        if active.any():  # the next active set starts from here
+            warm, use_warm = P, True
+        new = closed | (g_p + GZ3 @ P.reshape(-1) <= 0.0)
+        if np.array_equal(new, active):
+            return active, P, u, st, res, it, status
+        for j in range(n_seen):
+            if np.array_equal(new, seen[j]):  # no consistent set: keep the impulse
+                active = new | active
+                P, u, st, res, it, status = frictional_solve(
+                    W, q, mu, e, ub, U, active, warm, use_warm, tol, max_iter
+                )
+                return active, P, u, st, res, it, status
+        if n_seen < len(seen):
+            seen[n_seen] = active
+        else:
+            seen.append(active)
+        n_seen += 1
+        active = new
