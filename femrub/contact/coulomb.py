@@ -134,6 +134,48 @@ def _jacobian(rW, mu, pos, r, x, nx, slip):
     return J
 
 
+#: largest Newton system solved by the in-kernel elimination (above it: LAPACK)
+SMALL_SYSTEM = 36
+
+
+@njit
+def _solve(J, b):
+    """``(J⁻¹ b, ok)``: Gaussian elimination with partial pivoting for small systems (a
+    LAPACK call costs more than the arithmetic there), ``numpy.linalg.solve`` above
+    :data:`SMALL_SYSTEM` unknowns; ``ok`` is False for a singular ``J``."""
+    n = b.size
+    if n > SMALL_SYSTEM:
+        try:
+            return np.linalg.solve(J, b), True
+        except Exception:  # singular (numba raises a plain exception)
+            return b, False
+    M = J.copy()
+    x = b.copy()
+    for k in range(n):
+        p, big = k, abs(M[k, k])
+        for i in range(k + 1, n):
+            if abs(M[i, k]) > big:
+                p, big = i, abs(M[i, k])
+        if not big > 0.0:
+            return x, False
+        if p != k:
+            for j in range(k, n):
+                M[k, j], M[p, j] = M[p, j], M[k, j]
+            x[k], x[p] = x[p], x[k]
+        for i in range(k + 1, n):
+            f = M[i, k] / M[k, k]
+            if f != 0.0:
+                for j in range(k + 1, n):
+                    M[i, j] -= f * M[k, j]
+                x[i] -= f * x[k]
+    for k in range(n - 1, -1, -1):
+        s = x[k]
+        for j in range(k + 1, n):
+            s -= M[k, j] * x[j]
+        x[k] = s / M[k, k]
+    return x, True
+
+
 @njit
 def _newton(P, W, rW, q, mu, rho, U, tol, max_iter):
     """Semi-smooth Newton with Armijo line search on ``‖F‖²/2``; stops when it stalls.
@@ -149,11 +191,10 @@ def _newton(P, W, rW, q, mu, rho, U, tol, max_iter):
         if np.max(np.abs(F)) <= tol:
             break
         J = _jacobian(rW, mu, pos, r, x, nx, slip)
-        rhs = -F.reshape(-1)
-        try:
-            d = np.linalg.solve(J, rhs).reshape(m, 3)
-        except Exception:  # singular Jacobian (numba raises a plain exception)
+        d, ok = _solve(J, -F.reshape(-1))
+        if not ok:  # singular Jacobian
             break
+        d = d.reshape(m, 3)
         t = 1.0
         while True:
             Pn = P + t * d

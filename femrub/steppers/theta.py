@@ -168,27 +168,32 @@ class ThetaMethod(Stepper):
             compile_kernels()  # not in the first step's time
             # gap and local velocity rows in one product: [g, ġ, w_t] = S X + casing terms
             self._S = np.vstack([c.GT, c.V3T])
-            self._memo = (None, 0.0, None, None)
+            self._memo = (None, 0.0, None)
+            self._n3 = c.n
 
     def _casing(self, k: int, t: float):
-        """``(g0(t), ġ0(t))`` of the casing at step ``k``: each time is asked for twice
-        (as ``t_{k+1}``, then as ``t_k``), the last one is kept."""
+        """Casing terms of ``[g, ġ, w_t] = S X + o(t)`` at step ``k``: ``o = (g0(t), then
+        per contact ġ0(t), −v_c)`` (4n,). Each time is asked for twice (as ``t_{k+1}``, then
+        as ``t_k``); the last one is kept."""
         memo = self._memo
         if memo[0] != k or abs(memo[1] - t) > 1e-9 * self.h:
             c = self.model.contact
-            self._memo = memo = (k, t, c.gap_at(t), c.rate_at(t))
-        return memo[2], memo[3]
+            n = c.n
+            o = np.empty(4 * n)
+            o[:n] = c.gap_at(t)
+            loc = o[n:].reshape(n, 3)
+            loc[:, 0] = c.rate_at(t)
+            loc[:, 1:] = -c.casing_velocity
+            self._memo = memo = (k, t, o)
+        return memo[2]
 
     def _local(self, k: int, t: float, X):
         """Gap (n,), gap velocity (n,) and ``(ġ, w_t)`` (n, 3) of the state ``X`` at step ``k``."""
-        c = self.model.contact
-        g0, r0 = self._casing(k, t)
+        n = self._n3
         y = self._S @ X
-        n = c.n
+        y += self._casing(k, t)
         loc = y[n:].reshape(n, 3)
-        loc[:, 0] += r0
-        loc[:, 1:] -= c.casing_velocity
-        return g0 + y[:n], loc[:, 0].copy(), loc
+        return y[:n], loc[:, 0].copy(), loc
 
     def _signal_values(self, t):
         return np.array([float(sig(t)) for sig in self._signals])
