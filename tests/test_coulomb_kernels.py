@@ -16,7 +16,7 @@ import numpy as np
 import pytest
 
 from femrub.contact.activation import frictional_fixed_point, rule_code
-from femrub.contact.coulomb import SLIP, STICK
+from femrub.contact.coulomb import NON_POSITIVE, SLIP, SOLVED, STICK
 from femrub.contact.friction import coulomb_check
 from femrub.contact.jit import compiled
 
@@ -30,6 +30,8 @@ def problems(count=60, seed=3):
         n = int(rng.integers(1, 7))
         a = rng.normal(size=(3 * n, 3 * n))
         W = a @ a.T + 0.05 * np.eye(3 * n)
+        if k % 3 == 1:  # non-symmetric (Newton stalls now and then: Gauss–Seidel, then Newton)
+            W += 0.3 * rng.normal(size=W.shape) * np.sqrt(np.outer(np.diag(W), np.diag(W)))
         GZ3 = 0.5 * W[::3] * rng.uniform(0.5, 1.5)
         q = rng.normal(size=(n, 3))
         mu = rng.uniform(0.0, 0.8, n) * (rng.uniform(size=n) > 0.15)
@@ -54,8 +56,17 @@ def solve_all() -> list:
 
 
 def test_fixed_point_solutions_satisfy_signorini_coulomb():
-    for (code, g_k, _, g_p, GZ3, _, _, mu, e, ub, U), r in zip(problems(), solve_all()):
-        assert r["status"] == 0
+    solved = 0
+    for k, ((code, g_k, _, g_p, GZ3, W, _, mu, e, ub, U), r) in enumerate(
+        zip(problems(), solve_all())
+    ):
+        if r["status"] == NON_POSITIVE:  # a perturbed W with a non-positive W_nn
+            assert np.any(np.diag(W)[::3] <= 0.0)
+            continue
+        if k % 3 == 1 and r["status"] != SOLVED:  # non-symmetric: may have no solution
+            continue
+        assert r["status"] == SOLVED
+        solved += 1
         P, u, state = np.array(r["P"]), np.array(r["u"]), np.array(r["state"])
         act = np.array(r["active"])
         un = (u[:, 0] + e * ub) / (1.0 + e)  # Newton's law
@@ -72,6 +83,7 @@ def test_fixed_point_solutions_satisfy_signorini_coulomb():
         if code == rule_code("paper"):  # the set is the fixed point, or kept active
             closed_after = (g_k <= 0.0) | (g_p + GZ3 @ P.reshape(-1) <= 0.0)
             assert np.all(act | ~closed_after)
+    assert solved >= 55
 
 
 @pytest.mark.skipif(not compiled(), reason="kernels not compiled (NUMBA_DISABLE_JIT)")
