@@ -368,9 +368,10 @@ def frictional_fixed_point(
     (``g_p + GZ3 P <= 0``, ``GZ3 = ∂g_{k+1}/∂P`` (n_c, 3 n_c)). The position-level rules
     (``"position"``, ``"capped"``) have no frictional form yet, so with friction the
     velocity-level Newton law holds on the active contacts. If no consistent set exists
-    the contact is kept active. Each solve is :func:`frictional_solve` of
-    ``(W, q, mu, e, ub, U)``, warm-started from the previous solve of the step (from
-    ``warm`` for the first, when ``use_warm``).
+    the contact is kept active (the union of the last two sets; when that union was solved
+    already in this step, its solution is returned, not solved again). Each solve is
+    :func:`frictional_solve` of ``(W, q, mu, e, ub, U)``, warm-started from the previous
+    solve of the step (from ``warm`` for the first, when ``use_warm``).
 
     Returns ``(active, P, u, state, residual, iterations, status)``.
     """
@@ -383,8 +384,9 @@ def frictional_fixed_point(
     closed = g_k <= 0.0
     active = closed | (g_p <= 0.0)
     first = True
-    seen = [active]
-    n_seen = 0  # seen[:n_seen] are the sets tried before the current one
+    # seen[:n_seen]: the sets solved before the current one, with their solutions
+    seen, n_seen = [active], 0
+    s_P, s_u, s_st, s_res, s_it = [warm], [warm], [np.zeros(q.shape[0], np.int8)], [0.0], [0]
     while True:
         P, u, st, res, it, status = frictional_solve(
             W, q, mu, e, ub, U, active, warm, use_warm, tol, max_iter
@@ -400,14 +402,25 @@ def frictional_fixed_point(
             return active, P, u, st, res, it, status
         for j in range(n_seen):
             if np.array_equal(new, seen[j]):  # no consistent set: keep the impulse
-                active = new | active
+                keep = new | active
+                if np.array_equal(keep, active):  # the set just solved
+                    return active, P, u, st, res, it, status
+                for i in range(n_seen):  # a set solved before: the same problem, its solution
+                    if np.array_equal(keep, seen[i]):
+                        return keep, s_P[i], s_u[i], s_st[i], s_res[i], s_it[i], 0
                 P, u, st, res, it, status = frictional_solve(
-                    W, q, mu, e, ub, U, active, warm, use_warm, tol, max_iter
+                    W, q, mu, e, ub, U, keep, warm, use_warm, tol, max_iter
                 )
-                return active, P, u, st, res, it, status
+                return keep, P, u, st, res, it, status
         if n_seen < len(seen):
-            seen[n_seen] = active
+            seen[n_seen], s_P[n_seen], s_u[n_seen], s_st[n_seen] = active, P, u, st
+            s_res[n_seen], s_it[n_seen] = res, it
         else:
             seen.append(active)
+            s_P.append(P)
+            s_u.append(u)
+            s_st.append(st)
+            s_res.append(res)
+            s_it.append(it)
         n_seen += 1
         active = new
