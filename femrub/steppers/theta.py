@@ -164,7 +164,7 @@ class ThetaMethod(Stepper):
             self._mu3 = np.array(np.broadcast_to(c.friction, (c.n,)), dtype=float)
             self._e3 = np.array(np.broadcast_to(c.restitution, (c.n,)), dtype=float)
             self._U3 = np.full(c.n, np.inf)
-            self._U3zero = np.zeros((c.n, 3))
+            self._warm0 = np.zeros((c.n, 3))
             compile_kernels()  # not in the first step's time
             # gap and local velocity rows in one product: [g, ġ, w_t] = S X + casing terms
             self._S = np.vstack([c.GT, c.V3T])
@@ -272,9 +272,9 @@ class ThetaMethod(Stepper):
         gap_p, _, q = self._local(self.k + 1, t1, Xp)
         e = np.where(gdot_k > 0.0, 1.0, self._e3)
         upper = c.impulse_cap(t1, h)
-        U = self._U3 if upper is None else np.asarray(upper, dtype=float)
+        U = self._U3 if upper is None else np.array(upper, dtype=float)  # writable, C
         use_warm = self._warm3 is not None
-        warm = self._warm3 if use_warm else self._U3zero
+        warm = self._warm3 if use_warm else self._warm0
         active, P, u, state, res_, it, status = frictional_fixed_point(
             self._rule3, gap_k, gdot_k, gap_p, GZ, W, q, self._mu3, e, gdot_k, U, warm,
             use_warm, h, self.gamma, 1e-12, 60,
