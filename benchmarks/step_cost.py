@@ -7,7 +7,9 @@ reduced model in seconds), then steps it ``--revolutions`` revolutions without o
 * CPU per step (``time.process_time``), and split between the steps where no contact takes
   an impulse and those where some do (wall time of each ``_advance``, median);
 * the floor: the dense ``T X`` product of the step and one ``numpy.linalg.solve`` of the
-  Delassus block of the contacts active together (the small contact solve), each timed alone.
+  Delassus block of the contacts active together (the small contact solve), each timed alone;
+* what compiling the contact kernels costs (fresh process, empty numba cache) and what
+  loading them from the cache costs (both happen when a stepper is built).
 
 Writes a table between ``<!-- step_cost:begin -->`` and ``<!-- step_cost:end -->`` in
 ``docs/performance.md`` with the machine's load (``os.getloadavg``).
@@ -85,6 +87,27 @@ def _split(model, scheme: dict, opts: dict, t_end: float) -> dict:
     }
 
 
+def _compile_cost() -> dict:
+    """Seconds to compile the contact kernels in a fresh process with an empty numba cache,
+    then to load them from that cache in a second fresh process."""
+    import subprocess
+    import tempfile
+
+    code = (
+        "import time; t = time.perf_counter()\n"
+        "from femrub.contact.activation import compile_kernels\n"
+        "t1 = time.perf_counter(); compile_kernels(); print(time.perf_counter() - t1)"
+    )
+    out = {}
+    with tempfile.TemporaryDirectory() as cache:
+        env = {**os.environ, "NUMBA_CACHE_DIR": cache, "PYTHONPATH": str(ROOT)}
+        for key in ("compile_s", "cached_s"):
+            run = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True,
+                                 text=True, check=True)  # fmt: skip
+            out[key] = float(run.stdout.split()[-1])
+    return out
+
+
 def measure(scene_name: str, revolutions: float) -> dict:
     from femrub.app.cache import ModelCache
     from femrub.app.simulation import _scheme_options, build
@@ -106,6 +129,7 @@ def measure(scene_name: str, revolutions: float) -> dict:
         **_split(m, scene["scheme"], opts, t_end),
     }  # fmt: skip
     row["load"] = [load0, os.getloadavg()[0]]
+    row.update(_compile_cost())
     return row
 
 
@@ -127,6 +151,10 @@ def table(row: dict) -> str:
         f"| floor: `numpy.linalg.solve` of the {row.get('solve_size', 0)}×"
         f"{row.get('solve_size', 0)} Delassus block | {f(row.get('solve_us'))} |\n"
         f"| floor: sum | {floor} |\n"
+        f"\nContact kernels (numba, `femrub.contact.coulomb`): first compilation "
+        f"{row.get('compile_s', float('nan')):.1f} s in a fresh process with an empty cache, "
+        f"{row.get('cached_s', float('nan')):.2f} s to load them from the on-disk cache; done "
+        "when the stepper is built, never inside the steps above.\n"
     )
 
 

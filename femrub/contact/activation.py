@@ -45,8 +45,8 @@ except ``"plain"``:
 Every rule takes an optional bound ``upper`` (n_c,) on the impulses, ``0 <= P <= upper``
 (:func:`femrub.contact.impulses.cap`): an abradable coating yields at ``upper = h F_y``
 (:mod:`femrub.contact.abradable`), and a contact held at its bound may penetrate the worn
-surface by what the coating then loses. :func:`frictional_fixed_point` passes it through
-``solve`` (:func:`femrub.contact.friction.solve_frictional_contact`, ``upper=``).
+surface by what the coating then loses. :func:`frictional_fixed_point` (compiled) passes
+it to each frictional solve (``U``).
 
 Measured accuracy of each on the paper case: ``docs/paper-reproduction.md``.
 """
@@ -55,6 +55,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from .coulomb import FIXED_POINT, PREDICTED, frictional_fixed_point
 from .impulses import solve_impulses
 
 __all__ = [
@@ -62,6 +63,7 @@ __all__ = [
     "DEFAULT_RULE",
     "check_rule",
     "frictional_fixed_point",
+    "rule_code",
     "impulse_one",
     "impulses",
 ]
@@ -190,32 +192,26 @@ def _target(g_k, e):
     return np.minimum(g_k, 0.0) + e * np.maximum(g_k, 0.0)
 
 
-def frictional_fixed_point(rule, g_k, gd_k, g_p, GZ3, solve, h, gamma):
-    """Active set and solution of a frictional step: ``(active, solve(active))``.
+def rule_code(rule: str) -> int:
+    """Code of ``rule`` for :func:`frictional_fixed_point` (``"predicted"`` or the rest)."""
+    return PREDICTED if check_rule(rule) == "predicted" else FIXED_POINT
 
-    ``solve(active)`` solves the Signorini–Coulomb problem on ``active``
-    (:func:`femrub.contact.friction.solve_frictional_contact`), returning ``P`` (n_c, 3);
-    ``GZ3 = ∂g_{k+1}/∂P`` (n_c, 3 n_c). ``"predicted"`` is the Moreau–Jean rule
-    ``g_k + γ h ġ_k <= 0``; every other rule uses the ``"paper"`` fixed point (closed at
-    ``t_k`` or closed at ``t_{k+1}`` after the impulse): the position-level rules
-    (``"position"``, ``"capped"``) have no frictional form yet, so with friction the
-    velocity-level Newton law holds on the active contacts.
+
+def compile_kernels() -> None:
+    """Compile :func:`frictional_fixed_point` and the frictional solve for the argument
+    types of a step (or load them from numba's on-disk cache), so that a run's first
+    contact step does not pay for it. Without compilation (``NUMBA_DISABLE_JIT=1``) a no-op.
     """
-    if rule == "predicted":
-        active = g_k + gamma * h * gd_k <= 0.0
-        return active, solve(active)
-    closed = g_k <= 0.0
-    active = closed | (g_p <= 0.0)
-    if not active.any():  # no impulse, so the set is consistent (most steps of a rub)
-        return active, solve(active)
-    seen = []
-    while True:
-        res = solve(active)
-        new = closed | (g_p + GZ3 @ res.P.reshape(-1) <= 0.0)
-        if np.array_equal(new, active):
-            return active, res
-        if any(np.array_equal(new, a) for a in seen):  # no consistent set: keep impulse
-            active = new | active
-            return active, solve(active)
-        seen.append(active)
-        active = new
+    from .friction import solve_frictional_contact
+    from .jit import compiled
+
+    if not compiled():
+        return
+    one, z, W = np.ones(1), np.zeros(1), np.eye(3)
+    q = np.array([[-1.0, 0.0, 0.0]])
+    for code in (FIXED_POINT, PREDICTED):
+        frictional_fixed_point(
+            code, -one, -one, -one, np.ones((1, 3)), W, q, one * 0.1, z, z.copy(),
+            np.full(1, np.inf), np.zeros((1, 3)), False, 1.0, 0.5, 1e-12, 60,
+        )  # fmt: skip
+    solve_frictional_contact(W, q, 0.1, np.ones(1, dtype=bool))

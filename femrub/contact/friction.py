@@ -36,11 +36,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .coulomb import NON_POSITIVE, OPEN, SLIP, SOLVED, STICK, frictional_solve, newton_law
 from .impulses import solve_impulses
 
 __all__ = ["FrictionResult", "OPEN", "SLIP", "STICK", "coulomb_check", "solve_frictional_contact"]
-
-OPEN, STICK, SLIP = 0, 1, 2
 
 
 @dataclass(frozen=True)
@@ -67,7 +66,21 @@ def _as_local(W, n):
     W = np.asarray(W, dtype=float)
     if W.shape != (3 * n, 3 * n):
         raise ValueError(f"Delassus operator must be {(3 * n, 3 * n)}, got {W.shape}")
-    return W
+    return np.array(W, order="C")  # writable and contiguous: one compiled signature
+
+
+def _per_contact(value, n, default=0.0):
+    """``value`` broadcast to a writable, contiguous (n,) float array (kernel argument)."""
+    v = default if value is None else value
+    return np.array(np.broadcast_to(np.asarray(v, dtype=float), (n,)), dtype=float)  # a copy
+
+
+def check_status(status: int, residual: float) -> None:
+    """Raise the error of a kernel's status code (:mod:`femrub.contact.coulomb`)."""
+    if status == NON_POSITIVE:
+        raise FloatingPointError("non-positive Delassus operator at a contact")
+    if status != SOLVED:
+        raise FloatingPointError(f"frictional contact not solved: residual {residual:.3g}")
 
 
 def solve_frictional_contact(
@@ -107,195 +120,30 @@ def solve_frictional_contact(
     FloatingPointError
         No solution within ``sqrt(tol)`` (non-positive Delassus block, divergence).
     """
-    q = np.asarray(q, dtype=float).reshape(-1, 3)
+    q = np.array(np.asarray(q, dtype=float).reshape(-1, 3), order="C")
     n = q.shape[0]
     W = _as_local(W, n)
-    P = np.zeros((n, 3))
-    idx = np.flatnonzero(active)
-    if idx.size == 0:  # nothing to solve (most steps of a rub): no set-up
-        return FrictionResult(P, q.copy(), np.zeros(n, dtype=np.int8), 0.0, 0)
-    mu = np.broadcast_to(np.asarray(mu, dtype=float), (n,))
-    e = np.broadcast_to(np.asarray(restitution, dtype=float), (n,))
-    ub = np.zeros(n) if u_before is None else np.asarray(u_before, dtype=float)
-    U = np.full(n, np.inf) if upper is None else np.broadcast_to(np.asarray(upper, float), (n,))
-    # Newton's law: scale the normal rows by 1 / (1 + e) and shift by e u_n⁻ / (1 + e)
-    s = np.ones((n, 3))
-    s[:, 0] = 1.0 / (1.0 + e)
-    shift = np.zeros((n, 3))
-    shift[:, 0] = e * ub / (1.0 + e)
-    Wl = W * s.reshape(-1)[:, None]
-    ql = q * s + shift
-    rows = (3 * idx[:, None] + np.arange(3)).ravel()
-    Wa, qa, mua = Wl[np.ix_(rows, rows)], ql[idx], mu[idx]
-    slide = np.zeros(idx.size, dtype=bool)
-    if not np.any(mua > 0.0):  # frictionless: the exact LCP on the normal part
-        Pn = solve_impulses(Wa[::3, ::3], qa[:, 0], np.ones(idx.size, dtype=bool), upper=U[idx])
-        Pa = np.zeros((idx.size, 3))
-        Pa[:, 0] = Pn
-        res, it = 0.0, 0
-    else:
-        w0 = None if warm is None else np.asarray(warm, dtype=float).reshape(-1, 3)[idx]
-        Pa, slide, res, it = _alart_curnier(Wa, qa, mua, U[idx], w0, tol, max_iter)
-    P[idx] = Pa
-    u = (W @ P.reshape(-1)).reshape(n, 3) + q
-    state = np.zeros(n, dtype=np.int8)
-    closed = P[:, 0] > 0.0
-    state[closed] = STICK
-    sliding = np.zeros(n, dtype=bool)
-    sliding[idx] = slide
-    state[closed & (sliding | (mu == 0.0))] = SLIP
-    return FrictionResult(P, u, state, res, it)
-
-
-def _blocks(W, m):
-    """Diagonal 3x3 blocks ``W_ii`` (m, 3, 3)."""
-    r = np.arange(m)
-    return W.reshape(m, 3, m, 3)[r, :, r, :]
-
-
-def _residual(P, W, q, mu, rho, U):
-    """Alart–Curnier function ``F(P)`` (m, 3) and the quantities its Jacobian needs."""
-    u = (W @ P.reshape(-1)).reshape(-1, 3) + q
-    a = P[:, 0] - rho * u[:, 0]
-    pn = np.clip(a, 0.0, U)
-    pos = (a > 0.0) & (a < U)  # where the projected normal impulse follows a
-    r = mu * pn
-    x = P[:, 1:] - rho[:, None] * u[:, 1:]
-    nx = np.hypot(x[:, 0], x[:, 1])
-    slip = nx > r
-    F = np.empty_like(P)
-    F[:, 0] = P[:, 0] - pn
-    scale = np.where(slip, r / np.where(nx > 0.0, nx, 1.0), 1.0)
-    F[:, 1:] = P[:, 1:] - scale[:, None] * x
-    return F, (u, pos, r, x, nx, slip)
-
-
-#: ``(W, ρ, ρ W, I − ρ W)`` of the last :func:`_jacobian` call: constant over the Newton
-#: iterations of a solve (checked by identity; holding W and ρ keeps their ids unique)
-_LAST_DA: list = [None]
-
-
-def _jacobian(W, mu, rho, aux):
-    """An element of the generalised Jacobian of :func:`_residual` (3m, 3m).
-
-    With ``dA = I − ρ W`` (rows contact-major): normal rows ``ρ W_n`` where ``a > 0``, else
-    ``e_n``; stick rows ``e_t − dA_t = ρ W_t``; slip rows
-    ``e_t − x̂ (μ [a > 0] dA_n) − (r / |x|) (I − x̂ x̂ᵀ) dA_t``.
-    """
-    u, pos, r, x, nx, slip = aux
-    m = pos.size
-    last = _LAST_DA[0]
-    if last is None or last[0] is not W or last[1] is not rho:
-        rW = np.repeat(rho, 3)[:, None] * W
-        _LAST_DA[0] = last = (W, rho, rW, np.eye(3 * m) - rW)
-    dA = last[3].reshape(m, 3, 3 * m)
-    J = last[2].reshape(m, 3, 3 * m).copy()
-    off = np.flatnonzero(~pos)
-    if off.size:  # F_n = P_n
-        J[off, 0] = 0.0
-        J[off, 0, 3 * off] = 1.0
-    k = np.flatnonzero(slip)
-    if k.size:
-        xh = x[k] / nx[k, None]
-        proj = np.eye(2)[None] - xh[:, :, None] * xh[:, None, :]  # (s, 2, 2)
-        dr = np.where(pos[k, None], mu[k, None] * dA[k, 0], 0.0)  # (s, 3m)
-        Jk = -xh[:, :, None] * dr[:, None, :] - (r[k] / nx[k])[:, None, None] * np.einsum(
-            "sab,sbj->saj", proj, dA[k, 1:]
+    active = np.array(np.broadcast_to(np.asarray(active, dtype=bool), (n,)))
+    mu, e = _per_contact(mu, n), _per_contact(restitution, n)
+    ub, U = _per_contact(u_before, n), _per_contact(upper, n, np.inf)
+    if active.any() and not np.any(mu[active] > 0.0):
+        # frictionless: the exact LCP on the normal part (pivoting; one-contact closed form)
+        idx = np.flatnonzero(active)
+        Wa, qa = newton_law(W, q, e, ub, idx)
+        P = np.zeros((n, 3))
+        P[idx, 0] = solve_impulses(
+            Wa[::3, ::3], qa[:, 0], np.ones(idx.size, dtype=bool), upper=U[idx]
         )
-        Jk[np.arange(k.size)[:, None], np.arange(2), 3 * k[:, None] + np.arange(1, 3)] += 1.0
-        J[k, 1:] = Jk
-    return J.reshape(3 * m, 3 * m)
-
-
-def _on_cone(P, u, mu, rho, U):
-    """Exact cone membership; sliding contacts get ``|P_t| = μ P_n`` along ``P_t − ρ u_t``.
-
-    Returns the impulses and the mask of sliding contacts.
-    """
-    P = P.copy()
-    P[:, 0] = np.clip(P[:, 0], 0.0, U)
-    bound = mu * P[:, 0]
-    x = P[:, 1:] - rho[:, None] * u[:, 1:]
-    nx = np.hypot(x[:, 0], x[:, 1])
-    slide = (nx > bound) & (P[:, 0] > 0.0)
-    P[slide, 1:] = (bound[slide] / nx[slide])[:, None] * x[slide]
-    nt = np.hypot(P[:, 1], P[:, 2])
-    over = ~slide & (nt > bound)
-    if over.any():
-        P[over, 1:] *= (bound[over] / nt[over])[:, None]
-    return P, slide
-
-
-def _newton(P, W, q, mu, rho, U, tol, max_iter):
-    """Semi-smooth Newton with Armijo line search on ``‖F‖²/2``; stops when it stalls."""
-    m = q.shape[0]
-    F, aux = _residual(P, W, q, mu, rho, U)
-    merit = 0.5 * np.sum(F**2)
-    it = 0
-    for it in range(1, max_iter + 1):
-        if np.max(np.abs(F)) <= tol:
-            break
-        J = _jacobian(W, mu, rho, aux)
-        try:
-            d = np.linalg.solve(J, -F.reshape(-1)).reshape(m, 3)
-        except np.linalg.LinAlgError:
-            break
-        t = 1.0
-        while True:
-            Fn, auxn = _residual(P + t * d, W, q, mu, rho, U)
-            mn = 0.5 * np.sum(Fn**2)
-            if mn <= (1.0 - 1e-4 * t) * merit:
-                break
-            t *= 0.5
-            if t < 1e-8:
-                return P, F, aux, it
-        P, F, aux, merit = P + t * d, Fn, auxn, mn
-    return P, F, aux, it
-
-
-def _gauss_seidel(P, W, q, mu, rho, U, tol, sweeps=5000):
-    """Projected block Gauss–Seidel on the Alart–Curnier map (robust, linear convergence)."""
-    P = P.copy()
-    m = q.shape[0]
-    Wr = W.reshape(m, 3, 3 * m)
-    for _ in range(sweeps):
-        P0 = P.copy()
-        for i in range(m):
-            u = Wr[i] @ P.reshape(-1) + q[i]
-            pn = min(max(0.0, P[i, 0] - rho[i] * u[0]), U[i])
-            x = P[i, 1:] - rho[i] * u[1:]
-            nx = np.linalg.norm(x)
-            r = mu[i] * pn
-            P[i] = (pn, *(x if nx <= r else x * (r / nx)))
-        if np.max(np.abs(P - P0)) <= tol:
-            break
-    return P
-
-
-def _alart_curnier(W, q, mu, U, warm, tol, max_iter):
-    m = q.shape[0]
-    Wd = _blocks(W, m)
-    norm = np.sqrt(np.einsum("mij,mij->m", Wd, Wd))  # Frobenius: no SVD per step
-    if np.any(~(norm > 0.0)) or np.any(Wd[:, 0, 0] <= 0.0):
-        raise FloatingPointError("non-positive Delassus operator at a contact")
-    rho = 1.0 / norm
-    scale = max(float(np.max(np.abs(rho[:, None] * q))), 1e-300)
-    P = np.zeros((m, 3)) if warm is None else warm.copy()
-    if warm is not None:  # a cold start when the warm one is worse
-        F0 = _residual(np.zeros((m, 3)), W, q, mu, rho, U)[0]
-        Fw = _residual(P, W, q, mu, rho, U)[0]
-        if np.sum(Fw**2) > np.sum(F0**2):
-            P = np.zeros((m, 3))
-    P, F, aux, it = _newton(P, W, q, mu, rho, U, tol * scale, max_iter)
-    if np.max(np.abs(F)) > tol * scale:  # Newton stalled: Gauss-Seidel sweeps, then Newton
-        P = _gauss_seidel(P, W, q, mu, rho, U, tol * scale)
-        P, F, aux, it2 = _newton(P, W, q, mu, rho, U, tol * scale, max_iter)
-        it += it2
-    res = float(np.max(np.abs(F)) / scale)
-    if not res <= np.sqrt(tol):
-        raise FloatingPointError(f"frictional contact not solved: residual {res:.3g}")
-    P, slide = _on_cone(P, aux[0], mu, rho, U)
-    return P, slide, res, it
+        u = (W @ P.reshape(-1)).reshape(n, 3) + q
+        state = np.where(P[:, 0] > 0.0, SLIP, OPEN).astype(np.int8)
+        return FrictionResult(P, u, state, 0.0, 0)
+    use_warm = warm is not None
+    w = np.zeros((n, 3)) if warm is None else np.asarray(warm, dtype=float).reshape(n, 3)
+    P, u, state, res, it, status = frictional_solve(
+        W, q, mu, e, ub, U, active, np.array(w, order="C"), use_warm, tol, max_iter
+    )
+    check_status(status, res)
+    return FrictionResult(P, u, state, float(res), int(it))
 
 
 def coulomb_check(normal_force, friction_force, slip_velocity, state, mu) -> dict:

@@ -45,11 +45,13 @@ from ..contact.activation import (
     DEFAULT_RULE,
     RULES,
     check_rule,
+    compile_kernels,
     frictional_fixed_point,
     impulse_one,
     impulses,
+    rule_code,
 )
-from ..contact.friction import solve_frictional_contact
+from ..contact.friction import check_status, solve_frictional_contact
 from ..fem.linalg import Factorised, compact
 from .base import Stepper
 
@@ -157,29 +159,41 @@ class ThetaMethod(Stepper):
             self._GZ3 = c.GT @ self._Z3
             self._GZt = c.GT @ self._Zt
             self._warm3 = None
+            # arguments of the compiled contact step, contiguous and writable once
+            self._rule3 = rule_code(self.activation)
+            self._mu3 = np.array(np.broadcast_to(c.friction, (c.n,)), dtype=float)
+            self._e3 = np.array(np.broadcast_to(c.restitution, (c.n,)), dtype=float)
+            self._U3 = np.full(c.n, np.inf)
+            self._warm0 = np.zeros((c.n, 3))
+            compile_kernels()  # not in the first step's time
             # gap and local velocity rows in one product: [g, ġ, w_t] = S X + casing terms
             self._S = np.vstack([c.GT, c.V3T])
-            self._memo = (None, 0.0, None, None)
+            self._memo = (None, 0.0, None)
+            self._n3 = c.n
 
     def _casing(self, k: int, t: float):
-        """``(g0(t), ġ0(t))`` of the casing at step ``k``: each time is asked for twice
-        (as ``t_{k+1}``, then as ``t_k``), the last one is kept."""
+        """Casing terms of ``[g, ġ, w_t] = S X + o(t)`` at step ``k``: ``o = (g0(t), then
+        per contact ġ0(t), −v_c)`` (4n,). Each time is asked for twice (as ``t_{k+1}``, then
+        as ``t_k``); the last one is kept."""
         memo = self._memo
         if memo[0] != k or abs(memo[1] - t) > 1e-9 * self.h:
             c = self.model.contact
-            self._memo = memo = (k, t, c.gap_at(t), c.rate_at(t))
-        return memo[2], memo[3]
+            n = c.n
+            o = np.empty(4 * n)
+            o[:n] = c.gap_at(t)
+            loc = o[n:].reshape(n, 3)
+            loc[:, 0] = c.rate_at(t)
+            loc[:, 1:] = -c.casing_velocity
+            self._memo = memo = (k, t, o)
+        return memo[2]
 
     def _local(self, k: int, t: float, X):
         """Gap (n,), gap velocity (n,) and ``(ġ, w_t)`` (n, 3) of the state ``X`` at step ``k``."""
-        c = self.model.contact
-        g0, r0 = self._casing(k, t)
+        n = self._n3
         y = self._S @ X
-        n = c.n
+        y += self._casing(k, t)
         loc = y[n:].reshape(n, 3)
-        loc[:, 0] += r0
-        loc[:, 1:] -= c.casing_velocity
-        return g0 + y[:n], loc[:, 0].copy(), loc
+        return y[:n], loc[:, 0].copy(), loc
 
     def _signal_values(self, t):
         return np.array([float(sig(t)) for sig in self._signals])
@@ -243,7 +257,8 @@ class ThetaMethod(Stepper):
         return Xp + Z @ P, P
 
     def _step_friction(self, Xk, Xp, t1):
-        """Signorini–Coulomb step (active set: ``contact.activation.frictional_fixed_point``)."""
+        """Signorini–Coulomb step: the compiled active-set fixed point
+        (``contact.activation.frictional_fixed_point``) in one call."""
         c, h = self.model.contact, self.h
         n = c.n
         alpha = c.alpha_at(t1) if c.heat_law == "alpha" else np.zeros(n)
@@ -255,22 +270,17 @@ class ThetaMethod(Stepper):
             GZ[:, ::3] += self._GZt * alpha
         gap_k, gdot_k, _ = self._local(self.k, self.t, Xk)
         gap_p, _, q = self._local(self.k + 1, t1, Xp)
-        e = np.where(gdot_k > 0.0, 1.0, c.restitution)
+        e = np.where(gdot_k > 0.0, 1.0, self._e3)
         upper = c.impulse_cap(t1, h)
-
-        def solve(active, shift=0.0):
-            res = solve_frictional_contact(
-                W, q + shift, c.friction, active, restitution=e, u_before=gdot_k,
-                warm=self._warm3, upper=upper,
-            )  # fmt: skip
-            if active.any():  # the next active set of the fixed point starts from here
-                self._warm3 = res.P
-            return res
-
-        active, res = frictional_fixed_point(
-            self.activation, gap_k, gdot_k, gap_p, GZ, solve, h, self.gamma
-        )
-        heat = alpha * res.P[:, 0]  # the α λ heat is already in Z's normal columns
+        U = self._U3 if upper is None else np.array(upper, dtype=float)  # writable, C
+        use_warm = self._warm3 is not None
+        warm = self._warm3 if use_warm else self._warm0
+        active, P, u, state, res_, it, status = frictional_fixed_point(
+            self._rule3, gap_k, gdot_k, gap_p, GZ, W, q, self._mu3, e, gdot_k, U, warm,
+            use_warm, h, self.gamma, 1e-12, 60,
+        )  # fmt: skip
+        check_status(status, res_)
+        heat = alpha * P[:, 0]  # the α λ heat is already in Z's normal columns
         power = c.heat_law == "power" and self.model.layout.n_t > 0
         if power:
             # the heat η (−P_t · w_t,mid) moves the step's velocities through the thermal
@@ -278,16 +288,19 @@ class ThetaMethod(Stepper):
             w_k = c.slip_velocity(Xk)
             heat = np.zeros(n)
             for _ in range(MAX_HEAT_ITERATIONS):
-                w_mid = 0.5 * (w_k + res.u[:, 1:])
-                new = c.heat_partition * -np.einsum("ij,ij->i", res.P[:, 1:], w_mid)
+                w_mid = 0.5 * (w_k + u[:, 1:])
+                new = c.heat_partition * -np.einsum("ij,ij->i", P[:, 1:], w_mid)
                 if np.max(np.abs(new - heat), initial=0.0) <= 1e-12 * np.max(np.abs(new)):
                     break
                 heat = new
-                res = solve(active, (self._W3t @ heat).reshape(n, 3))
+                res = solve_frictional_contact(
+                    W, q + (self._W3t @ heat).reshape(n, 3), c.friction, active,
+                    restitution=e, u_before=gdot_k, warm=P, upper=upper,
+                )  # fmt: skip
+                P, u, state = res.P, res.u, res.state
             heat = new
-        P = res.P
         self._warm3 = P
         X = Xp + Z @ P.reshape(-1) if active.any() else Xp
         if power:
             X = X + self._Zt @ heat
-        return X, P[:, 0].copy(), {"friction_impulse": P[:, 1:], "heat": heat, "state": res.state}
+        return X, P[:, 0].copy(), {"friction_impulse": P[:, 1:], "heat": heat, "state": state}
