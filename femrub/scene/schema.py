@@ -296,6 +296,12 @@ PHYSICS = {
         choices=("auto", "row-sum", "hrz", "consistent"),
         doc="mass lumping (auto: row-sum for P1, HRZ for P2)",
     ),
+    "conduction": Spec(
+        C,
+        "auto",
+        choices=("auto", "monotone", "galerkin"),
+        doc="heat conduction matrix (auto: monotone in 3D, Galerkin on the 1D bar)",
+    ),
 }
 
 SCHEME = Variant(

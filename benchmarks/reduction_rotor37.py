@@ -1,0 +1,155 @@
+"""Rotor 37 reduced model against 2x and 4x larger reduced models (issue 11).
+
+``python benchmarks/reduction_convergence_3d.py --rotor37 [--scene NAME] [--set K=V]``
+(run it under ``flock /tmp/femrub-heavy.lock``). The full Rotor 37 model (194,276 state
+dofs) cannot be stepped on a 2-core / 24 GB machine (factorising its iteration matrix took
+more than 13 GB and 13 min, docs/reduction_3d.md), so the scene's reduced model is judged
+against reduced models 2x and 4x larger, all sub-bases of one reductor built at the 4x
+sizes with the scene's projection and thermal reduction. The full model is built without a
+stepper (:func:`femrub.app.simulation.build` with ``stepper=False``), through the model
+cache. Every model is stepped over one lobe passage (``t_end = 2π / (2 Ω)``) with the
+scene's scheme and step; differences (:func:`femrub.reduction.estimate.compare`, fields
+reconstructed on the mesh ``y = R X̄``) of the default and 2x models to the 4x one, and of
+the default to the 2x one: convergence shows as ``‖2x − 4x‖ ≪ ‖default − 4x‖``.
+"""
+
+from __future__ import annotations
+
+import os
+import resource
+import time
+
+import numpy as np
+
+from femrub.app.cache import ModelCache
+from femrub.app.cli import _changes
+from femrub.app.simulation import _bare_stepper, build
+from femrub.reduction import ThermoelasticCraigBampton
+from femrub.reduction.estimate import compare, field_norms
+from femrub.reduction.sizes import lobe_passage
+from femrub.scene.scene import load_scene
+
+#: stored states per run (fields are compared at these times)
+STORED = 50
+#: size factors of the models compared (1 = the scene's sizes)
+FACTORS = (1, 2, 4)
+
+
+def _peak_gib() -> float:
+    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 2**20
+
+
+def measure(name: str, sets: list[str], log=print) -> dict:
+    """Step the scene's reduced model and its 2x, 4x enlargements; differences to 4x and 2x."""
+    changes = {"outputs.vtk_stride": 0, **_changes(type("A", (), {"set": sets}))}
+    scene = load_scene(name, changes)
+    if scene["reduction"]["method"] != "craig-bampton":
+        raise SystemExit(f"{name}: reduction.method must be 'craig-bampton' (fixed sizes)")
+    window = lobe_passage(scene)
+    if "scheme.t_end" not in changes:
+        scene = load_scene(name, {**changes, "scheme.t_end": window})
+    t_end, opts = scene["scheme"]["t_end"], scene["reduction"]
+    base = (opts["n_uv"], opts["n_theta"])
+    sizes = [(f * base[0], f * base[1]) for f in FACTORS]
+    load0 = os.getloadavg()
+    t0 = time.perf_counter()
+    bare = {k: v for k, v in changes.items() if not k.startswith("reduction.")}
+    fsim = build(load_scene(name, {**bare, "scheme.t_end": t_end, "reduction.method": "none"}),
+                 cache=ModelCache(), stepper=False, log=log)  # fmt: skip
+    full = fsim.model
+    t_full = time.perf_counter() - t0
+    log(f"full model {full.n_dofs} state dofs built in {t_full:.0f} s; reductor at {sizes[-1]}")
+    t0, c0 = time.perf_counter(), time.process_time()
+    red = ThermoelasticCraigBampton(
+        full, *sizes[-1], projection=opts["projection"], thermal=opts["thermal"]
+    )
+    red.solver.free()
+    t_red, c_red = time.perf_counter() - t0, time.process_time() - c0
+    log(f"reductor built in {t_red:.0f} s (CPU {c_red:.0f} s), peak {_peak_gib():.1f} GiB")
+    norms = field_norms(full)
+    runs = []
+    for s in sizes:
+        model = red.reduce(*s)
+        st = _bare_stepper(scene, model)
+        c0 = time.process_time()
+        res = st.run(t_end, store_every=max(1, st.steps_to(t_end) // STORED))
+        cpu = time.process_time() - c0
+        X = red.reconstruct(res.states, *s)
+        tmin = float(X[:, full.layout.t].min()) if full.layout.n_t else 0.0
+        impulse = float(np.abs(res.impulse).sum())
+        runs.append(dict(sizes=s, n=model.n_dofs, n_bt=model.info["n_boundary_theta"], res=res,
+                         X=X, cpu=cpu, tmin=tmin, energy=res.energy_error(),
+                         heat=res.heat_error(), status=res.status, impulse=impulse))  # fmt: skip
+        log(f"{s}: {model.n_dofs} dofs stepped in {cpu:.1f} s CPU, status {res.status}")
+    ref, mid = runs[-1], runs[-2]
+    diff = lambda a, b: compare(a["res"], b["res"], a["X"], b["X"], norms, window)  # noqa: E731
+    for r in runs[:-1]:
+        r["vs_4x"] = diff(r, ref)
+    runs[0]["vs_2x"] = diff(runs[0], mid)
+    for r in runs:
+        r.pop("X")
+    return dict(scene=name, sets=sets, t_end=t_end, h=scene["scheme"]["h"], window=window,
+                n_full=full.n_dofs, n_contacts=full.n_contacts, runs=runs,
+                projection=opts["projection"], thermal=opts["thermal"],
+                conduction=getattr(full.blocks, "info", {}).get("conduction", "?"),
+                times=dict(full=t_full, reductor=t_red, reductor_cpu=c_red),
+                peak=_peak_gib(), load=(load0, os.getloadavg()))  # fmt: skip
+
+
+ROWS = (
+    ("contact force impulse per lobe passage", "contact_force"),
+    ("contact temperature history", "contact_temperature"),
+    ("displacement field, max over t (L2_M)", "displacement"),
+    ("displacement field at t_end (L2_M)", "displacement_end"),
+    ("temperature field, max over t (L2_C)", "temperature"),
+    ("temperature field at t_end (L2_C)", "temperature_end"),
+)
+
+
+def table(r: dict) -> str:
+    pct = lambda x: "–" if x is None else f"{100 * x:.2f} %"  # noqa: E731
+    d, m, b = r["runs"]
+    f = lambda s: f"({s[0]}, {s[1]})"  # noqa: E731
+    t, ld = r["times"], r["load"]
+    lines = [
+        f"### {r['scene']}: default reduction vs 2× and 4× reduced models",
+        "",
+        "`flock /tmp/femrub-heavy.lock python benchmarks/reduction_convergence_3d.py --rotor37"
+        + "".join(f" --set {s}" for s in r["sets"])
+        + f"`: built-in `{r['scene']}` (projection `{r['projection']}`, thermal "
+        f"`{r['thermal']}`, conduction `{r['conduction']}`), one lobe passage t_end = "
+        f"{r['t_end']:.4g} s, h = {r['h']:g} s. The full model ({r['n_full']} state dofs, "
+        f"{r['n_contacts']} contacts) cannot be stepped on this machine, so the default sizes "
+        f"{f(d['sizes'])} are compared with {f(m['sizes'])} (2×) and {f(b['sizes'])} (4×), "
+        f"sub-bases of one reductor built at the 4× sizes ({t['reductor']:.0f} s wall, "
+        f"{t['reductor_cpu']:.0f} s CPU; full model assembly {t['full']:.0f} s; process peak "
+        f"{r['peak']:.1f} GiB); load average {ld[0][0]:.1f} → {ld[1][0]:.1f} (2 cores).",
+        "",
+        f"| quantity | default {f(d['sizes'])} vs 4× | 2× {f(m['sizes'])} vs 4× | default vs 2× |",
+        "|---|---|---|---|",
+    ]
+    for label, k in ROWS:
+        lines.append(f"| {label} | {pct(d['vs_4x'].get(k))} | {pct(m['vs_4x'].get(k))} | "
+                     f"{pct(d['vs_2x'].get(k))} |")  # fmt: skip
+    lines += [
+        "",
+        "| model | (n_uv, n_θ) | reduced dofs | θ boundary coords | total contact impulse (N s) "
+        "| energy bal. | heat bal. | T min (K) | CPU (s) | status |",
+        "|---|---|---|---|---|---|---|---|---|---|",
+    ]
+    for lab, x in zip(("default", "2×", "4×"), r["runs"]):
+        lines.append(
+            f"| {lab} | {f(x['sizes'])} | {x['n']} | {x['n_bt']} | {x['impulse']:.4g} | "
+            f"{x['energy']:.1e} | {x['heat']:.1e} | {x['tmin']:.3f} | {x['cpu']:.1f} | "
+            f"{x['status']} |"
+        )
+    return "\n".join(lines) + "\n"
+
+
+def run_rotor37(name, sets, doc, write_section):
+    """Measure, print and write the subsection into ``doc`` (``write_section``)."""
+    r = measure(name, sets)
+    text = table(r)
+    print(text)
+    write_section(doc, {"heading": f"### {name}: default reduction vs 2×"}, text)
+    return r
