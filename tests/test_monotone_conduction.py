@@ -1,5 +1,6 @@
 """Monotone conduction operator (femrub.fem.monotone, issue 11): no temperature below
-ambient without a sink on the twisted NACA mesh, the paper bar's matrix unchanged."""
+ambient without a sink on the twisted NACA mesh (the built-in scene's choice), the Galerkin
+default and the paper bar's matrix unchanged."""
 
 import numpy as np
 import pytest
@@ -49,21 +50,24 @@ def test_operator_is_a_conservative_symmetric_m_matrix(naca):
         conduction_operator(K, "upwind")
 
 
-def test_default_3d_heat_has_no_undershoot(naca):
-    """The default (auto → monotone) stays >= 0; the Galerkin matrix of the same mesh goes
-    below ambient with a lumped capacity and backward Euler (not the time scheme)."""
+def test_twisted_naca_heat_has_no_undershoot(naca):
+    """The built-in scene's monotone conduction stays >= 0; the Galerkin matrix (the
+    default) of the same mesh goes below ambient with a lumped capacity and backward Euler
+    (so not the time scheme)."""
     disc, material = naca
-    default = assemble(disc, material)
-    assert default.info["conduction"] == "monotone"
-    low, high = _heated(disc, default)
+    assert load_scene("twisted-naca")["physics"]["conduction"] == "monotone"
+    mono = assemble(disc, material, conduction="monotone")
+    low, high = _heated(disc, mono)
     assert low >= -1e-12 * high
-    low_g, high_g = _heated(disc, assemble(disc, material, conduction="galerkin"))
+    galerkin = assemble(disc, material)
+    assert galerkin.info["conduction"] == "galerkin"
+    low_g, high_g = _heated(disc, galerkin)
     assert low_g < -1e-4 * high_g
     assert abs(high - high_g) < 0.05 * high_g  # hottest vertex barely moves
 
 
 def test_paper_bar_conduction_unchanged():
-    """The 1D bar keeps the Galerkin matrix (an M-matrix already: monotone is identical)."""
+    """The 1D bar keeps the Galerkin matrix (an M-matrix already: monotone would be identical)."""
     disc, mats = _bar_parts(PAPER)[:2]
     assert mats.info["conduction"] == "galerkin"
     assert positive_couplings(mats.Ktt) == 0

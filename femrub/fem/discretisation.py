@@ -113,22 +113,13 @@ def default_lumping(order: int) -> str:
     return "hrz" if order == 2 else "row-sum"
 
 
-def default_conduction(dim: int) -> str:
-    """Conduction operator of a mesh dimension: monotone in 3D, Galerkin on the 1D bar.
-
-    Tetrahedral meshes of blades have obtuse angles (no discrete maximum principle of the
-    Galerkin matrix, :mod:`femrub.fem.monotone`); the 1D P1 matrix is an M-matrix already.
-    """
-    return "monotone" if dim == 3 else "galerkin"
-
-
 def assemble(
     disc: Discretisation,
     material: Material,
     *,
     area: float = 1.0,
     lumping: str = "auto",
-    conduction: str = "auto",
+    conduction: str = "galerkin",
     coupling: str = "physical",
     beta: float | None = None,
     strain_heating: bool = False,
@@ -144,12 +135,10 @@ def assemble(
     the ``(a, b)`` used. ``prestress`` (a :class:`~femrub.fem.prestress.Prestress` of
     ``disc``) replaces ``K^uu`` by its prestressed tangent (material + geometric stiffness −
     spin softening) before the damping is set, so the blade vibrates about its spinning
-    equilibrium; ``info["prestress_speed"]`` holds its Ω. ``conduction = "auto"`` is
-    :func:`default_conduction` of the mesh dimension.
+    equilibrium; ``info["prestress_speed"]`` holds its Ω. ``conduction``: ``"galerkin"``
+    or ``"monotone"`` (:mod:`femrub.fem.monotone`).
     """
     lumping = default_lumping(disc.order) if lumping == "auto" else lumping
-    if conduction == "auto":
-        conduction = default_conduction(disc.basis_t.mesh.dim())
     mats = assemble_thermoelastic(
         disc.basis_u,
         disc.basis_t,

@@ -17,8 +17,10 @@ Discrete upwinding (Kuzmin, Shashkov & Svyatskiy, J. Comput. Phys. 228 (2009) 34
 ``K^θθ`` (a uniform temperature still carries no flux: conservative), so with a lumped
 (diagonal, positive) ``C^θθ`` every θ-method step with ``Γ h`` large enough — backward Euler
 for any step — maps non-negative data to non-negative temperatures. ``D`` is positive
-semi-definite: the operator is more diffusive than Galerkin, by a perturbation that vanishes
-on meshes without obtuse angles (then ``K_mono = K^θθ``; always so for the 1D bar).
+semi-definite: the operator conducts more than Galerkin, by a first-order perturbation that
+vanishes on meshes without obtuse angles (then ``K_mono = K^θθ``; always so for the 1D bar)
+but costs accuracy where conduction carries heat over many elements, hence an option
+(``physics.conduction``), not the default (docs/theory.md §1).
 """
 
 from __future__ import annotations
@@ -28,7 +30,7 @@ import scipy.sparse as sp
 
 __all__ = ["CONDUCTIONS", "monotone", "positive_couplings", "conduction_operator"]
 
-#: ``physics.conduction`` choices (``"auto"`` is resolved by the mesh dimension).
+#: ``physics.conduction`` choices (the first is the default).
 CONDUCTIONS = ("galerkin", "monotone")
 
 

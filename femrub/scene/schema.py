@@ -298,9 +298,9 @@ PHYSICS = {
     ),
     "conduction": Spec(
         C,
-        "auto",
-        choices=("auto", "monotone", "galerkin"),
-        doc="heat conduction matrix (auto: monotone in 3D, Galerkin on the 1D bar)",
+        "galerkin",
+        choices=("galerkin", "monotone"),
+        doc="heat conduction matrix (monotone: M-matrix by discrete upwinding, no undershoot)",
     ),
 }
 
