@@ -169,6 +169,7 @@ def plot(st, path):
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--rotor37", action="store_true")
+    ap.add_argument("--factors", default="1,2,4", help="--rotor37: size factors compared")
     ap.add_argument("--quick", action="store_true")
     ap.add_argument("--thermal", default="inputs", choices=("inputs", "boundary"))
     ap.add_argument("--projection", default="static-mass", choices=PROJECTIONS)
@@ -184,7 +185,8 @@ def main(argv=None):
         from reduction_rotor37 import run_rotor37
 
         scene = "rotor37-thermal" if a.scene == "twisted-naca" else a.scene
-        return run_rotor37(scene, a.set, DOCS / "reduction_3d.md", write_section)
+        factors = tuple(int(x) for x in a.factors.split(","))
+        return run_rotor37(scene, a.set, DOCS / "reduction_3d.md", write_section, factors)
     name, changes = "twisted-naca", {}
     sizes = [(4, 4), (8, 8), (16, 16), (40, 40), (80, 80), (160, 80)]
     if a.quick:

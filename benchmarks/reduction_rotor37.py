@@ -31,7 +31,7 @@ from femrub.scene.scene import load_scene
 
 #: stored states per run (fields are compared at these times)
 STORED = 50
-#: size factors of the models compared (1 = the scene's sizes)
+#: size factors of the models compared (1 = the scene's sizes; ``--factors``)
 FACTORS = (1, 2, 4)
 
 
@@ -39,8 +39,9 @@ def _peak_gib() -> float:
     return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 2**20
 
 
-def measure(name: str, sets: list[str], log=print) -> dict:
-    """Step the scene's reduced model and its 2x, 4x enlargements; differences to 4x and 2x."""
+def measure(name: str, sets: list[str], factors=FACTORS, log=print) -> dict:
+    """Step the scene's reduced model and its enlargements by ``factors``; the differences of
+    every pair (``runs[i]["vs"][j]``: model ``i`` against the larger model ``j``)."""
     changes = {"outputs.vtk_stride": 0, **_changes(type("A", (), {"set": sets}))}
     scene = load_scene(name, changes)
     if scene["reduction"]["method"] != "craig-bampton":
@@ -50,7 +51,7 @@ def measure(name: str, sets: list[str], log=print) -> dict:
         scene = load_scene(name, {**changes, "scheme.t_end": window})
     t_end, opts = scene["scheme"]["t_end"], scene["reduction"]
     base = (opts["n_uv"], opts["n_theta"])
-    sizes = [(f * base[0], f * base[1]) for f in FACTORS]
+    sizes = [(f * base[0], f * base[1]) for f in factors]
     load0 = os.getloadavg()
     t0 = time.perf_counter()
     bare = {k: v for k, v in changes.items() if not k.startswith("reduction.")}
@@ -81,11 +82,10 @@ def measure(name: str, sets: list[str], log=print) -> dict:
                          X=X, cpu=cpu, tmin=tmin, energy=res.energy_error(),
                          heat=res.heat_error(), status=res.status, impulse=impulse))  # fmt: skip
         log(f"{s}: {model.n_dofs} dofs stepped in {cpu:.1f} s CPU, status {res.status}")
-    ref, mid = runs[-1], runs[-2]
     diff = lambda a, b: compare(a["res"], b["res"], a["X"], b["X"], norms, window)  # noqa: E731
-    for r in runs[:-1]:
-        r["vs_4x"] = diff(r, ref)
-    runs[0]["vs_2x"] = diff(runs[0], mid)
+    for i, r in enumerate(runs):
+        r["factor"] = factors[i]
+        r["vs"] = {j: diff(r, runs[j]) for j in range(i + 1, len(runs))}
     for r in runs:
         r.pop("X")
     return dict(scene=name, sets=sets, t_end=t_end, h=scene["scheme"]["h"], window=window,
@@ -106,49 +106,66 @@ ROWS = (
 )
 
 
+def _name(run) -> str:
+    return "default" if run["factor"] == 1 else f"{run['factor']}×"
+
+
 def table(r: dict) -> str:
     pct = lambda x: "–" if x is None else f"{100 * x:.2f} %"  # noqa: E731
-    d, m, b = r["runs"]
+    runs = r["runs"]
     f = lambda s: f"({s[0]}, {s[1]})"  # noqa: E731
+    pairs = sorted(((i, j) for i in range(len(runs)) for j in runs[i]["vs"]),
+                   key=lambda p: (-p[1], p[0]))  # fmt: skip
     t, ld = r["times"], r["load"]
+    big = runs[-1]
+    others = ", ".join(f"{f(x['sizes'])} ({_name(x)})" for x in runs[1:])
     lines = [
-        f"### {r['scene']}: default reduction vs 2× and 4× reduced models",
+        f"### {r['scene']}: default reduction vs "
+        + " and ".join(", ".join(_name(x) for x in runs[1:]).rsplit(", ", 1))
+        + " reduced models",
         "",
         "`flock /tmp/femrub-heavy.lock python benchmarks/reduction_convergence_3d.py --rotor37"
         + "".join(f" --set {s}" for s in r["sets"])
+        + (
+            ""
+            if tuple(x["factor"] for x in runs) == FACTORS
+            else " --factors " + ",".join(str(x["factor"]) for x in runs)
+        )
         + f"`: built-in `{r['scene']}` (projection `{r['projection']}`, thermal "
         f"`{r['thermal']}`, conduction `{r['conduction']}`), one lobe passage t_end = "
         f"{r['t_end']:.4g} s, h = {r['h']:g} s. The full model ({r['n_full']} state dofs, "
         f"{r['n_contacts']} contacts) cannot be stepped on this machine, so the default sizes "
-        f"{f(d['sizes'])} are compared with {f(m['sizes'])} (2×) and {f(b['sizes'])} (4×), "
-        f"sub-bases of one reductor built at the 4× sizes ({t['reductor']:.0f} s wall, "
-        f"{t['reductor_cpu']:.0f} s CPU; full model assembly {t['full']:.0f} s; process peak "
-        f"{r['peak']:.1f} GiB); load average {ld[0][0]:.1f} → {ld[1][0]:.1f} (2 cores).",
+        f"{f(runs[0]['sizes'])} are compared with {others}, sub-bases of one reductor built at "
+        f"the {_name(big)} sizes ({t['reductor']:.0f} s wall, {t['reductor_cpu']:.0f} s CPU; "
+        f"full model assembly {t['full']:.0f} s; process peak {r['peak']:.1f} GiB); load "
+        f"average {ld[0][0]:.1f} → {ld[1][0]:.1f} (2 cores).",
         "",
-        f"| quantity | default {f(d['sizes'])} vs 4× | 2× {f(m['sizes'])} vs 4× | default vs 2× |",
-        "|---|---|---|---|",
+        "| quantity | "
+        + " | ".join(f"{_name(runs[i])} vs {_name(runs[j])}" for i, j in pairs)
+        + " |",
+        "|---|" + "---|" * len(pairs),
     ]
     for label, k in ROWS:
-        lines.append(f"| {label} | {pct(d['vs_4x'].get(k))} | {pct(m['vs_4x'].get(k))} | "
-                     f"{pct(d['vs_2x'].get(k))} |")  # fmt: skip
+        cells = " | ".join(pct(runs[i]["vs"][j].get(k)) for i, j in pairs)
+        lines.append(f"| {label} | {cells} |")
     lines += [
         "",
         "| model | (n_uv, n_θ) | reduced dofs | θ boundary coords | total contact impulse (N s) "
         "| energy bal. | heat bal. | T min (K) | CPU (s) | status |",
         "|---|---|---|---|---|---|---|---|---|---|",
     ]
-    for lab, x in zip(("default", "2×", "4×"), r["runs"]):
+    for x in runs:
         lines.append(
-            f"| {lab} | {f(x['sizes'])} | {x['n']} | {x['n_bt']} | {x['impulse']:.4g} | "
+            f"| {_name(x)} | {f(x['sizes'])} | {x['n']} | {x['n_bt']} | {x['impulse']:.4g} | "
             f"{x['energy']:.1e} | {x['heat']:.1e} | {x['tmin']:.3f} | {x['cpu']:.1f} | "
             f"{x['status']} |"
         )
     return "\n".join(lines) + "\n"
 
 
-def run_rotor37(name, sets, doc, write_section):
+def run_rotor37(name, sets, doc, write_section, factors=FACTORS):
     """Measure, print and write the subsection into ``doc`` (``write_section``)."""
-    r = measure(name, sets)
+    r = measure(name, sets, factors)
     text = table(r)
     print(text)
     write_section(doc, {"heading": f"### {name}: default reduction vs 2×"}, text)
