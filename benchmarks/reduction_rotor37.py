@@ -10,11 +10,17 @@ stepper (:func:`femrub.app.simulation.build` with ``stepper=False``), through th
 cache. Every model is stepped over one lobe passage (``t_end = 2π / (2 Ω)``) with the
 scene's scheme and step; differences (:func:`femrub.reduction.estimate.compare`, fields
 reconstructed on the mesh ``y = R X̄``) of the default and 2x models to the 4x one, and of
-the default to the 2x one: convergence shows as ``‖2x − 4x‖ ≪ ‖default − 4x‖``.
+the default to the 2x one: convergence shows as ``‖2x − 4x‖ ≪ ‖default − 4x‖``. The
+largest model is also stepped with its initial displacement perturbed by
+:data:`~femrub.reduction.estimate.PERTURBATION` (``estimate.twin``): the difference of these
+twins is the sensitivity of the nonsmooth response, the floor below which no two models can
+be told apart; and at half the step (signals of every other step, impulses summed): the
+time-discretisation error of the largest model, for scale.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import os
 import resource
 import time
@@ -23,16 +29,26 @@ import numpy as np
 
 from femrub.app.cache import ModelCache
 from femrub.app.cli import _changes
-from femrub.app.simulation import _bare_stepper, build
+from femrub.app.simulation import _bare_stepper, _scheme_options, build
 from femrub.reduction import ThermoelasticCraigBampton
-from femrub.reduction.estimate import compare, field_norms
+from femrub.reduction.estimate import PERTURBATION, compare, field_norms, twin
 from femrub.reduction.sizes import lobe_passage
 from femrub.scene.scene import load_scene
+from femrub.steppers import make_stepper
 
 #: stored states per run (fields are compared at these times)
 STORED = 50
 #: size factors of the models compared (1 = the scene's sizes; ``--factors``)
 FACTORS = (1, 2, 4)
+
+
+def _coarsen(res, f: int):
+    """``res`` (step h/f) seen at every f-th step: signals sampled, impulses summed."""
+    n = (len(res.t) - 1) // f
+    imp = res.impulse
+    coarse = np.vstack([imp[:1], imp[1 : 1 + n * f].reshape(n, f, -1).sum(axis=1)])
+    sig = {k: v[: 1 + n * f : f] for k, v in res.signals.items()}
+    return dataclasses.replace(res, t=res.t[: 1 + n * f : f], impulse=coarse, signals=sig)
 
 
 def _peak_gib() -> float:
@@ -86,10 +102,22 @@ def measure(name: str, sets: list[str], factors=FACTORS, log=print) -> dict:
     for i, r in enumerate(runs):
         r["factor"] = factors[i]
         r["vs"] = {j: diff(r, runs[j]) for j in range(i + 1, len(runs))}
+    # the noise floor: the largest model against itself with u0 perturbed by 1e-15 m
+    tw = twin(red, sizes[-1], lambda m: _bare_stepper(scene, m), t_end, checkpoints=STORED)
+    twin_diff = compare(tw[0], runs[-1]["res"], tw[1], runs[-1]["X"], norms, window)
+    log(f"twin of {sizes[-1]} stepped")
+    # the time-step floor: the largest model at h / 2 against itself at h
+    s = scene["scheme"]
+    st = make_stepper(s["name"], red.reduce(*sizes[-1]), s["h"] / 2, **_scheme_options(scene))
+    half = st.run(t_end, store_every=2 * max(1, st.steps_to(t_end) // (2 * STORED)))
+    Xh = red.reconstruct(half.states, *sizes[-1])
+    half_diff = compare(runs[-1]["res"], _coarsen(half, 2), runs[-1]["X"], Xh, norms, window)
+    log(f"{sizes[-1]} at h/2 stepped")
     for r in runs:
         r.pop("X")
     return dict(scene=name, sets=sets, t_end=t_end, h=scene["scheme"]["h"], window=window,
-                n_full=full.n_dofs, n_contacts=full.n_contacts, runs=runs,
+                n_full=full.n_dofs, n_contacts=full.n_contacts, runs=runs, twin=twin_diff,
+                half=half_diff,
                 projection=opts["projection"], thermal=opts["thermal"],
                 conduction=getattr(full.blocks, "info", {}).get("conduction", "?"),
                 times=dict(full=t_full, reductor=t_red, reductor_cpu=c_red),
@@ -142,12 +170,12 @@ def table(r: dict) -> str:
         "",
         "| quantity | "
         + " | ".join(f"{_name(runs[i])} vs {_name(runs[j])}" for i, j in pairs)
-        + " |",
-        "|---|" + "---|" * len(pairs),
+        + f" | {_name(big)} vs its twin (u0 + {PERTURBATION:g} m) | {_name(big)} at h vs h/2 |",
+        "|---|" + "---|" * (len(pairs) + 2),
     ]
     for label, k in ROWS:
         cells = " | ".join(pct(runs[i]["vs"][j].get(k)) for i, j in pairs)
-        lines.append(f"| {label} | {cells} |")
+        lines.append(f"| {label} | {cells} | {pct(r['twin'].get(k))} | {pct(r['half'].get(k))} |")
     lines += [
         "",
         "| model | (n_uv, n_θ) | reduced dofs | θ boundary coords | total contact impulse (N s) "
