@@ -142,4 +142,10 @@ def test_default_reduction_matches_full_twisted_naca():
     for k in ("displacement_end", "temperature_end", "contact_temperature", "displacement"):
         assert e[k] < 0.05, (k, e)
     assert res.energy_error() < 0.01 and res.heat_error() < 0.01
-    assert X[:, fsim.full.layout.t].min() >= ref.states[:, fsim.full.layout.t].min() - 0.05
+    T, T_full = X[:, fsim.full.layout.t], ref.states[:, fsim.full.layout.t]
+    assert T.min() >= T_full.min() - 0.05
+    # no temperature below ambient without a sink (the root is held at ambient): the
+    # monotone conduction of the scene keeps the full model to round-off (Galerkin on
+    # this mesh reached -0.12 K by 4 ms, -1.0 K by 10 ms), the reduced model within 0.5 K
+    assert T_full.min() >= -1e-9 * T_full.max()
+    assert T.min() >= -0.5

@@ -117,10 +117,14 @@ class Simulation:
         return explain(self.report)
 
     @classmethod
-    def from_scene(cls, scene, *, log=None, modes: int = 0, cache=None) -> Simulation:
+    def from_scene(
+        cls, scene, *, log=None, modes: int = 0, cache=None, stepper: bool = True
+    ) -> Simulation:
         """Build ``scene``; ``modes``: natural frequencies to report; ``cache``: a
         :class:`~femrub.app.cache.ModelCache` for the assembled and reduced models
-        (:mod:`femrub.app.cached`), ``None`` to build everything.
+        (:mod:`femrub.app.cached`), ``None`` to build everything; ``stepper=False``: no
+        stepper (``None``; e.g. a full Rotor 37 model to reduce, whose iteration matrix
+        would not be factorised on a small machine).
 
         Raises
         ------
@@ -129,12 +133,12 @@ class Simulation:
             the stability limit, ...).
         """
         with progress.reporting(log):  # factorisations, eigen-solves, reduction phases
-            return _build(scene, log, modes, Stages(cache, log))
+            return _build(scene, log, modes, Stages(cache, log), stepper)
 
 
-def build(scene, *, log=None, modes: int = 0, cache=None) -> Simulation:
+def build(scene, *, log=None, modes: int = 0, cache=None, stepper: bool = True) -> Simulation:
     """:meth:`Simulation.from_scene`."""
-    return Simulation.from_scene(scene, log=log, modes=modes, cache=cache)
+    return Simulation.from_scene(scene, log=log, modes=modes, cache=cache, stepper=stepper)
 
 
 class _Clock:
@@ -166,7 +170,7 @@ def _scheme_options(scene) -> dict:
     return {}
 
 
-def _build(scene, log, modes, stages) -> Simulation:
+def _build(scene, log, modes, stages, with_stepper=True) -> Simulation:
     scene.check_files()
     clock = _Clock(log)
     c, p = scene["contact"], scene["physics"]
@@ -197,6 +201,7 @@ def _build(scene, log, modes, stages) -> Simulation:
         prestress = _prestress(scene, disc, material, omega, log, stages)
         mats = stages.assemble(
             disc, material, area=tr.area_of(scene), lumping=p["lumping"],
+            conduction=p["conduction"],
             coupling=tr.coupling_of(scene), beta=p["beta"], strain_heating=p["strain_heating"],
             rayleigh=tuple(p["rayleigh"]), damping_ratio=p["damping_ratio"],
             damping_modes=tuple(p["damping_modes"]), prestress=prestress,
@@ -259,7 +264,7 @@ def _build(scene, log, modes, stages) -> Simulation:
     reduced, reductor, report["reduction"] = stages.reduce(model, scene, log, make, limits)
     clock.done("reduction", f"{reduced.n_dofs} dofs")
     report["model"] = {"n_dofs": reduced.n_dofs, **_layout(reduced)}
-    stepper = _stepper(scene, reduced, report)
+    stepper = _stepper(scene, reduced, report) if with_stepper else None
     report["outputs"] = {
         "vtk_stride": scene["outputs"]["vtk_stride"],
         "plots": scene["outputs"]["plots"],

@@ -22,6 +22,7 @@ from .. import progress
 from . import forms
 from .lumping import lump
 from .material import Material, check_finite_positive
+from .monotone import conduction_operator
 
 __all__ = ["ThermoelasticMatrices", "assemble_thermoelastic", "COUPLINGS"]
 
@@ -127,6 +128,7 @@ def assemble_thermoelastic(
     area: float = 1.0,
     lumping: str = "row-sum",
     heat_lumping: str | None = None,
+    conduction: str = "galerkin",
     coupling: str = "physical",
     beta: float | None = None,
     strain_heating: bool = False,
@@ -148,6 +150,10 @@ def assemble_thermoelastic(
     lumping
         Mass lumping: ``"consistent"``, ``"row-sum"`` (P1) or ``"hrz"`` (P2, required to keep
         masses positive); ``heat_lumping`` defaults to ``lumping`` (scalar field).
+    conduction
+        ``"galerkin"`` (the P1 matrix ``K^θθ = ∫ k ∇θ·∇w``) or ``"monotone"`` (the same made
+        an M-matrix by discrete upwinding, :mod:`femrub.fem.monotone`: no temperature below
+        ambient without a sink on meshes with obtuse tetrahedra).
     coupling
         ``"none"`` (K^uθ = 0), ``"physical"`` (K^uθ = −∫ b θ div v, b = (dλ + 2μ) α_th) or
         ``"paper"`` (K^uθ = β K^uu, the paper's Sec. 4.1 model, which needs u and θ on the
@@ -179,6 +185,7 @@ def assemble_thermoelastic(
         Ctt = forms.heat_capacity.assemble(basis_t, rho_c=material.rho_c, area=area)
         Ctt = lump(Ctt, heat_lumping or lumping, 1)
         Ktt = forms.conductivity.assemble(basis_t, k=material.conductivity, area=area)
+        Ktt = conduction_operator(Ktt, conduction)
 
     b = (dim * lam + 2.0 * mu) * material.expansion
     if coupling == "physical":
@@ -222,5 +229,12 @@ def assemble_thermoelastic(
         n_t_all=basis_t.N,
         basis_u=basis_u,
         basis_t=basis_t,
-        info={"dim": dim, "lumping": lumping, "coupling": coupling, "area": area, "beta": beta},
+        info={
+            "dim": dim,
+            "lumping": lumping,
+            "coupling": coupling,
+            "area": area,
+            "beta": beta,
+            "conduction": conduction,
+        },
     )

@@ -119,6 +119,7 @@ def assemble(
     *,
     area: float = 1.0,
     lumping: str = "auto",
+    conduction: str = "galerkin",
     coupling: str = "physical",
     beta: float | None = None,
     strain_heating: bool = False,
@@ -134,7 +135,8 @@ def assemble(
     the ``(a, b)`` used. ``prestress`` (a :class:`~femrub.fem.prestress.Prestress` of
     ``disc``) replaces ``K^uu`` by its prestressed tangent (material + geometric stiffness −
     spin softening) before the damping is set, so the blade vibrates about its spinning
-    equilibrium; ``info["prestress_speed"]`` holds its Ω.
+    equilibrium; ``info["prestress_speed"]`` holds its Ω. ``conduction``: ``"galerkin"``
+    or ``"monotone"`` (:mod:`femrub.fem.monotone`).
     """
     lumping = default_lumping(disc.order) if lumping == "auto" else lumping
     mats = assemble_thermoelastic(
@@ -144,6 +146,7 @@ def assemble(
         area=area,
         lumping=lumping,
         heat_lumping="row-sum" if lumping == "hrz" else lumping,
+        conduction=conduction,
         coupling=coupling,
         beta=beta,
         strain_heating=strain_heating,

@@ -296,6 +296,12 @@ PHYSICS = {
         choices=("auto", "row-sum", "hrz", "consistent"),
         doc="mass lumping (auto: row-sum for P1, HRZ for P2)",
     ),
+    "conduction": Spec(
+        C,
+        "galerkin",
+        choices=("galerkin", "monotone"),
+        doc="heat conduction matrix (monotone: M-matrix by discrete upwinding, no undershoot)",
+    ),
 }
 
 SCHEME = Variant(
