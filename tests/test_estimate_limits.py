@@ -3,20 +3,13 @@ runs stop at the scene's stop limits, as the run does (a runaway is not judged p
 
 from __future__ import annotations
 
+from test_cache import SMALL as COARSE
+
 from femrub.app.simulation import build
 from femrub.scene import load_scene
 
-# a coarse twisted blade reduced with fixed sizes, long enough for the tip to reach the casing
-SMALL = {
-    "loads.centrifugal": "off",
-    "geometry.h": 0.03,
-    "geometry.n_sections": 2,
-    "contact.reach": "all",
-    "reduction.method": "craig-bampton",
-    "reduction.n_uv": 8,
-    "reduction.n_theta": 4,
-    "scheme.t_end": 4e-4,
-}
+# the coarse twisted blade of the cache tests, long enough for the tip to reach the casing
+SMALL = {**COARSE, "scheme.t_end": 4e-4}
 
 
 def test_estimate_runs_stop_where_the_run_stops():
