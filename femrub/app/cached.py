@@ -137,8 +137,9 @@ class Stages:
         if opts["method"] == "none":
             return reduce_model(model, scene, log, make_stepper, limits=limits)  # nothing stored
         t_end = scene["scheme"]["t_end"] if opts["method"] == "auto" else None
-        run = [dict(scene[k]) for k in ("scheme", "loads", "contact")] if make_stepper else None
-        run = run and run + [dict(limits or {})]
+        run = None  # what the estimate's runs depend on
+        if make_stepper:
+            run = [dict(scene[k]) for k in ("scheme", "loads", "contact")] + [dict(limits or {})]
         key = self._model_key(model, "reduction", opts, t_end, run)
         hit = self._fetch("reduction", key)
         if hit is not None:
