@@ -191,15 +191,43 @@ def test_frictional_blade_cuts_the_coating_at_the_yield_force(tmp_path):
 
 
 def test_worn_surface_rate_enters_the_gap_rate():
-    """A contact moving from a worn cell into an unworn one meets the coating approaching
-    (ġ0 = −w / h over that step), so a velocity-level law stops it there and it cuts."""
+    """The worn surface is linear between cell centres: a contact sliding towards a less worn
+    centre meets the coating approaching at ``Ω ∂w/∂ψ`` (any step inside the segment)."""
     grid = CasingGrid([0.0], [0.0], 0.3, 100.0, n_angle=4, n_axial=1)
     wear = Abradable(1e-3, 10.0, grid)
     wear.reset(h=1e-3)
-    wear.depth[0, 0] = 2e-4  # first quarter worn
-    t_cross = (math.pi / 2) / 100.0  # the contact enters the second cell
-    assert wear.rate_at(t_cross + 0.5e-3) == pytest.approx([-2e-4 / 1e-3])
-    assert wear.rate_at(t_cross - 0.5e-3) == pytest.approx([0.0])
+    wear.depth[0, 0] = 2e-4  # centre at 45 deg worn, the others not
+    slope = -2e-4 / (math.pi / 2)  # ∂w/∂ψ between the centres at 45 and 135 deg
+    t = (math.pi / 2) / 100.0  # the contact at 90 deg, half way
+    assert wear.rate_at(t) == pytest.approx([100.0 * slope])
+    assert wear.depth_at(t) == pytest.approx([1e-4])
+    assert wear.rate_at(math.pi / 100.0) == pytest.approx([0.0], abs=1e-12)  # 135-225 deg
     c = Contact(G=[[1.0]], Gv=[[1.0]], Hm=[[1.0]], Ht=[[0.0]], gap0=0.0, wear=wear)
-    assert c.rate_at(t_cross + 0.5e-3) == pytest.approx([-0.2])
-    assert c.gap_at(t_cross - 0.5e-3) == pytest.approx([2e-4])
+    assert c.rate_at(t) == pytest.approx([100.0 * slope])
+    assert c.gap_at(t) == pytest.approx([1e-4])
+
+
+@pytest.mark.parametrize("n_angle", [36, 360, 3600])
+def test_a_sweep_cuts_every_centre_it_crosses(n_angle):
+    """A contact that yields at a constant reach over a quarter turn wears the same volume
+    whatever the number of cells it crosses per step, and ends on its own cut (g >= 0)."""
+    omega, h, reach = 100.0, 1e-3, 3e-5  # 0.1 rad per step
+    grid = CasingGrid([0.0], [0.0], 0.3, omega, n_angle=n_angle, n_axial=1)
+    wear = Abradable(1e-4, 10.0, grid)
+    wear.reset(h=h)
+    steps = int(round((math.pi / 2) / (omega * h)))
+    wear.update(0.0, np.array([-reach]), np.array([False]))  # the sweep starts at 0 rad
+    for k in range(1, steps + 1):
+        t = k * h
+        gap = wear.depth_at(t) - reach
+        wear.update(t, gap, np.array([True]))
+        assert wear.depth_at(t) - reach >= -1e-18  # on the new surface
+    d = wear.depth[:, 0]
+    assert d.max() == pytest.approx(reach) and d.min() == 0.0
+    swept = steps * omega * h  # rad
+    n_cut = np.count_nonzero(d)  # every centre swept, and the bracketing ones at each end
+    assert swept / (2 * math.pi / n_angle) - 1 <= n_cut <= swept / (2 * math.pi / n_angle) + 3
+    width = grid.z_edges[1] - grid.z_edges[0]
+    assert wear.worn_volume == pytest.approx(
+        reach * 0.3 * swept * width, rel=3.0 / (swept / (2 * math.pi / n_angle))
+    )

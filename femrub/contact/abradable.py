@@ -1,9 +1,12 @@
 """Abradable coating on the casing: a wear map that deepens where the blade cuts it.
 
 The coating (thickness ``e``) lines the casing. Its current wear depth ``w(ψ, z) ∈ [0, e]``
-is stored on a grid of casing angle ``ψ`` (``n_angle`` cells over a revolution) × axial
-position ``z`` (``n_axial`` cells over the contacts' axial extent). Contact ``i`` (angle
-``φ_i``, axial position ``z_i``) meets the worn surface, so its gap is::
+is stored at the centres of a grid of casing angle ``ψ`` (``n_angle`` cells over a
+revolution) × axial position ``z`` (``n_axial`` cells over the contacts' axial extent), and
+read between centres by periodic linear interpolation in ``ψ`` (so the worn surface a contact
+slides on is continuous, and its rate ``Ω ∂w/∂ψ`` is finite: the time step does not decide
+how hard a contact meets the edge of a cell). Contact ``i`` (angle ``φ_i``, axial position
+``z_i``) meets the worn surface, so its gap is::
 
     g_i(t, X) = g0_i(t) + w(Ω t + φ_i, z_i) − n_i · u(p_i)
 
@@ -12,12 +15,18 @@ of Batailly & Legrand): the coating carries at most the yield force ``F_y`` per 
 impulse of a step is bounded, ``0 <= P_i <= h F_y`` (:func:`femrub.contact.impulses.cap`),
 and below that bound contact complementarity holds on the worn surface. When the bound is
 reached the coating yields: the blade penetrates the current surface and the material it
-penetrates is removed permanently (after each step, :meth:`Abradable.update`)::
+penetrates is removed permanently (after each step, :meth:`Abradable.update`). With the
+blade's reach into the coating ``r_i = w(ψ_i) − g_i``, every cell centre the contact swept
+over the step (from ``ψ_i(t − h)`` to ``ψ_i(t)``, and the centre just beyond) is cut to the
+reach interpolated linearly along the sweep::
 
-    w(ψ_i, z_i) <- min(e, w(ψ_i, z_i) + max(0, −g_i))     for contacts at the bound
+    w(ψ_k, z_i) <- min(e, max(w(ψ_k, z_i), r_i(t − h) + s_k (r_i(t) − r_i(t − h))))
 
-Once a cell is worn through (``w = e``) the rigid casing behind it takes any force. Wear
-is monotone, never negative and never deeper than ``e``.
+``s_k ∈ [0, 1]`` the fraction of the sweep at centre ``k`` (1 beyond its end), so that
+after the update ``g_i(t) >= 0`` on the new surface. A contact that crosses several cells in
+a step cuts all of them: the worn volume does not depend on how the time step compares with
+the cell size. Once the surface is worn through (``w = e``) the rigid casing behind it takes
+any force. Wear is monotone, never negative and never deeper than ``e``.
 
 The wear map is casing state that evolves during a run: a stepper calls :meth:`reset` when
 it starts. ``history`` keeps ``(t, max depth)`` at every step that removed material.
@@ -69,6 +78,25 @@ class CasingGrid:
         j = np.minimum((psi * self.n_angle / (2 * math.pi)).astype(int), self.n_angle - 1)
         return j * self.n_axial + self.axial_cell
 
+    def position(self, t: float) -> np.ndarray:
+        """Contacts' positions in cell-centre units, ``ψ n_angle / 2π − 1/2`` (unwrapped:
+        centre ``k`` is at ``k``, taken modulo ``n_angle``)."""
+        return (self.omega * t + self.angles) * (self.n_angle / (2 * math.pi)) - 0.5
+
+    def flat(self, k: np.ndarray, axial_cell: np.ndarray) -> np.ndarray:
+        """Flat indices of centres ``k`` (any integers, periodic) in rows ``axial_cell``."""
+        return np.mod(k, self.n_angle) * self.n_axial + axial_cell
+
+    def interpolate(self, values: np.ndarray, t: float) -> np.ndarray:
+        """``values`` (flat, per cell) at the contacts at ``t``, linear between centres."""
+        x = self.position(t)
+        k = np.floor(x)
+        s = x - k
+        k = k.astype(np.int64)
+        return (1.0 - s) * values[self.flat(k, self.axial_cell)] + s * values[
+            self.flat(k + 1, self.axial_cell)
+        ]
+
     @property
     def cell_area(self) -> np.ndarray:
         """(n_axial,) area of a cell of each axial row (m²)."""
@@ -106,23 +134,26 @@ class Abradable:
         self.depth = np.zeros((self.n_angle, self.n_axial))
         self.history = [(0.0, 0.0)]
         self.h = h
+        self._last = None  # (t, reach) of the previous update: the start of the next sweep
 
     def cells(self, t: float) -> np.ndarray:
         return self.grid.cells(t)
 
     def depth_at(self, t: float) -> np.ndarray:
-        """Wear depth under each contact at ``t`` (m): what the worn surface adds to the gap."""
-        return self.depth.ravel()[self.cells(t)]
+        """Wear depth under each contact at ``t`` (m): what the worn surface adds to the gap
+        (linear between cell centres)."""
+        return self.grid.interpolate(self.depth.ravel(), t)
 
     def rate_at(self, t: float) -> np.ndarray | float:
         """Rate of the worn surface under each contact, ``(w(t) − w(t − h)) / h`` (m/s).
 
-        The map is piecewise constant in the casing angle: a contact moving from a worn cell
-        into a less worn one meets the coating as a surface approaching it. This rate enters
-        ``ġ0`` (:meth:`~femrub.contact.gap.Contact.rate_at`) so a velocity-level contact law
-        stops the blade there and the coating yields (as the casing profile's own rate does
-        on a continuous lobe); without it, the blade would cross the unworn coating with no
-        force and no wear wherever the profile recedes.
+        A contact sliding towards a less worn part of the map meets the coating as a surface
+        approaching it. This rate enters ``ġ0``
+        (:meth:`~femrub.contact.gap.Contact.rate_at`) so a velocity-level contact law stops
+        the blade there and the coating yields (as the casing profile's own rate does on a
+        continuous lobe); without it, the blade would cross the unworn coating with no force
+        and no wear wherever the profile recedes. The map is linear between cell centres, so
+        the rate tends to ``Ω ∂w/∂ψ`` as ``h → 0``.
         """
         if not self.h:
             return 0.0
@@ -134,18 +165,42 @@ class Abradable:
         return np.where(worn, math.inf, h * self.yield_force)
 
     def update(self, t: float, gap: np.ndarray, yielded: np.ndarray) -> None:
-        """Remove the coating the blade penetrates at contacts that ``yielded`` (module doc).
+        """Cut the coating swept by contacts that ``yielded`` over the step ending at ``t``
+        (module doc); call it after every step.
 
-        ``gap`` is the gap on the current worn surface at ``t`` (m).
+        ``gap`` is the gap on the current worn surface at ``t`` (m): the contacts' reach into
+        the coating is ``r = w − gap``. The sweep starts where the previous call left the
+        contacts (at the start of a run: where they are now).
         """
-        pen = np.where(yielded, np.maximum(0.0, -np.asarray(gap, dtype=float)), 0.0)
-        if not np.any(pen > 0.0):
+        reach = self.depth_at(t) - np.asarray(gap, dtype=float)
+        last, self._last = self._last, (float(t), reach)
+        cut = np.asarray(yielded, dtype=bool) & (reach > self.depth_at(t))
+        if not np.any(cut):
             return
+        g = self.grid
+        i = np.flatnonzero(cut)
+        r1 = reach[i]
+        x1 = g.position(t)[i]
+        if last is None or not t > last[0]:
+            x0, r0 = x1, r1
+        else:
+            x0, r0 = g.position(last[0])[i], last[1][i]
+        lo = np.floor(np.minimum(x0, x1)).astype(np.int64)
+        hi = np.floor(np.maximum(x0, x1)).astype(np.int64) + 1
+        span = int(np.max(hi - lo)) + 1
+        k = lo[:, None] + np.arange(span)[None, :]  # centres swept (and the two bracketing)
+        inside = k <= hi[:, None]
+        dx = x1 - x0
+        frac = np.where(
+            np.abs(dx)[:, None] > 0.0,
+            np.clip((k - x0[:, None]) / np.where(dx == 0.0, 1.0, dx)[:, None], 0.0, 1.0),
+            1.0,
+        )
+        level = np.minimum(self.thickness, r0[:, None] + frac * (r1 - r0)[:, None])
+        cells = g.flat(k, g.axial_cell[i][:, None])
         flat = self.depth.ravel()
-        cells = self.cells(t)
-        # several contacts in one cell: the deepest cut counts
-        new = np.minimum(self.thickness, flat[cells] + pen)
-        np.maximum.at(flat, cells, new)
+        # several contacts (or sweeps) over one centre: the deepest cut counts
+        np.maximum.at(flat, cells[inside], level[inside])
         self.history.append((float(t), float(flat.max())))
 
     # -- results ------------------------------------------------------------------------

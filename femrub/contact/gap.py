@@ -186,8 +186,7 @@ class Contact:
         if self.wear is None:
             return
         yielded = impulse >= (1.0 - 1e-9) * self.wear.impulse_cap(t, h)
-        if np.any(yielded):
-            self.wear.update(t, self.gap(t, X), yielded)
+        self.wear.update(t, self.gap(t, X), yielded)  # every step: the next sweep starts here
 
     def rate_at(self, t) -> np.ndarray | float:
         """``ġ0(t) = dg0/dt`` (m/s); the scalar 0 for a fixed obstacle. With a coating it
