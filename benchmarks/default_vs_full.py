@@ -20,7 +20,8 @@ import os
 import time
 
 from femrub.app.cli import _changes
-from femrub.app.simulation import _bare_stepper, build
+from femrub.app.scheme import bare_stepper
+from femrub.app.simulation import build
 from femrub.reduction.estimate import QUANTITIES, compare, field_norms
 from femrub.reduction.sizes import lobe_passage, reduce_model
 from femrub.scene.scene import load_scene
@@ -51,7 +52,7 @@ def measure(name: str, sets: list[str]) -> dict:
     fsim = build(load_scene(name, {**changes, "reduction.method": "none"}))
     t_build_full = time.perf_counter() - t0
     t0 = time.perf_counter()
-    make = lambda m: _bare_stepper(scene, m)  # noqa: E731
+    make = lambda m: bare_stepper(scene, m)  # noqa: E731
     model, red, rep = reduce_model(fsim.model, scene, make_stepper=make)
     t_build_red = time.perf_counter() - t0
     res_r, wall_r, cpu_r = _run(make(model), t_end)

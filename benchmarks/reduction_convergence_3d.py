@@ -106,9 +106,9 @@ def _heading(st) -> str:
 
 
 def _opts(sim):
-    from femrub.app.simulation import _scheme_options
+    from femrub.app.scheme import scheme_options
 
-    return {k: v for k, v in _scheme_options(sim.scene).items() if v is not None}
+    return {k: v for k, v in scheme_options(sim.scene).items() if v is not None}
 
 
 def table(st) -> str:

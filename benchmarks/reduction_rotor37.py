@@ -29,7 +29,8 @@ import numpy as np
 
 from femrub.app.cache import ModelCache
 from femrub.app.cli import _changes
-from femrub.app.simulation import _bare_stepper, _scheme_options, build
+from femrub.app.scheme import bare_stepper, scheme_options
+from femrub.app.simulation import build
 from femrub.reduction import ThermoelasticCraigBampton
 from femrub.reduction.estimate import PERTURBATION, compare, field_norms, twin
 from femrub.reduction.sizes import lobe_passage
@@ -87,7 +88,7 @@ def measure(name: str, sets: list[str], factors=FACTORS, log=print) -> dict:
     runs = []
     for s in sizes:
         model = red.reduce(*s)
-        st = _bare_stepper(scene, model)
+        st = bare_stepper(scene, model)
         c0 = time.process_time()
         res = st.run(t_end, store_every=max(1, st.steps_to(t_end) // STORED))
         cpu = time.process_time() - c0
@@ -103,12 +104,12 @@ def measure(name: str, sets: list[str], factors=FACTORS, log=print) -> dict:
         r["factor"] = factors[i]
         r["vs"] = {j: diff(r, runs[j]) for j in range(i + 1, len(runs))}
     # the noise floor: the largest model against itself with u0 perturbed by 1e-15 m
-    tw = twin(red, sizes[-1], lambda m: _bare_stepper(scene, m), t_end, checkpoints=STORED)
+    tw = twin(red, sizes[-1], lambda m: bare_stepper(scene, m), t_end, checkpoints=STORED)
     twin_diff = compare(tw[0], runs[-1]["res"], tw[1], runs[-1]["X"], norms, window)
     log(f"twin of {sizes[-1]} stepped")
     # the time-step floor: the largest model at h / 2 against itself at h
     s = scene["scheme"]
-    st = make_stepper(s["name"], red.reduce(*sizes[-1]), s["h"] / 2, **_scheme_options(scene))
+    st = make_stepper(s["name"], red.reduce(*sizes[-1]), s["h"] / 2, **scheme_options(scene))
     half = st.run(t_end, store_every=2 * max(1, st.steps_to(t_end) // (2 * STORED)))
     Xh = red.reconstruct(half.states, *sizes[-1])
     half_diff = compare(runs[-1]["res"], _coarsen(half, 2), runs[-1]["X"], Xh, norms, window)

@@ -110,7 +110,8 @@ def _compile_cost() -> dict:
 
 def measure(scene_name: str, revolutions: float) -> dict:
     from femrub.app.cache import ModelCache
-    from femrub.app.simulation import _scheme_options, build
+    from femrub.app.scheme import scheme_options
+    from femrub.app.simulation import build
     from femrub.scene import load_scene
 
     scene = load_scene(scene_name)
@@ -120,7 +121,7 @@ def measure(scene_name: str, revolutions: float) -> dict:
     build_s = time.perf_counter() - t0
     omega = scene["loads"]["rotation_speed"]
     t_end = revolutions * 2 * math.pi / omega if omega else scene["scheme"]["t_end"]
-    opts = _scheme_options(scene)
+    opts = scheme_options(scene)
     m = sim.model
     row = {
         "scene": scene_name, "n_dofs": m.n_dofs, "contacts": m.contact.n, "t_end": t_end,

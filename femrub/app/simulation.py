@@ -20,7 +20,6 @@ through the same path.
 
 from __future__ import annotations
 
-import math
 import time
 import warnings
 from dataclasses import dataclass, field
@@ -28,19 +27,18 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .. import progress
-from ..contact.abradable import Abradable, CasingGrid
-from ..contact.casing_heat import CasingHeat
 from ..contact.heat import heat_coefficients
 from ..contact.points import locate_contacts
 from ..contact.reach import contact_reach, normal_deflection
 from ..fem.discretisation import discretise
 from ..model.rub import rub_model, tip_load
 from ..scene.spec import SceneError, fail
-from ..steppers import make_stepper
 from . import translate as tr
 from .blade import load_blade
 from .cached import Stages
+from .casing import abradable_of, casing_grid, casing_heat_of
 from .explain import explain
+from .scheme import bare_stepper, stepper_of
 
 __all__ = [
     "MAX_CLEARANCE_RATIO",
@@ -155,21 +153,6 @@ class _Clock:
             self.log(f"{stage} done in {self.timings[stage]:.2f} s: {result}")
 
 
-def _scheme_options(scene) -> dict:
-    s = scene["scheme"]
-    if s["name"] == "theta":
-        return {
-            "gamma": s["gamma"],
-            "gamma_thermal": s.get("gamma_thermal"),
-            "activation": s["activation"],
-        }
-    if s["name"] == "penalty":
-        return {"stiffness": s["stiffness"], "damping": s["damping"], "method": s["method"]}
-    if s["name"] == "exponential":
-        return {"events": s["events"]}
-    return {}
-
-
 def _build(scene, log, modes, stages, with_stepper=True) -> Simulation:
     scene.check_files()
     clock = _Clock(log)
@@ -231,15 +214,15 @@ def _build(scene, log, modes, stages, with_stepper=True) -> Simulation:
             alpha = heat_coefficients(points.radii, "alpha", alpha=c["heat_coefficient"],
                                       heat_partition=eta)  # fmt: skip
             heated = bool(np.any(alpha > 0))
-        grid = _grid(scene, blade, points, omega, growth[reach.keep])
+        grid = casing_grid(scene, blade, points, omega, growth[reach.keep])
         keep_t, report["thermal"] = tr.thermal_choice(scene, heated, points.n > 0)
         full, fields = rub_model(
             disc, mats, points, material, casing=casing, rotation_speed=omega, alpha=alpha,
             restitution=c["restitution"], offset=reach.offset[reach.keep], loads=loads,
             thermal=keep_t, observe_at=points if points.n else candidates,
             friction=mu, heat_law="power" if law == "power" else "alpha",
-            heat_partition=eta, wear=_abradable(scene, grid),
-            casing_heat=_casing_heat(scene, grid, eta, alpha, mu if law == "power" else 0.0),
+            heat_partition=eta, wear=abradable_of(scene, grid),
+            casing_heat=casing_heat_of(scene, grid, eta, alpha, mu if law == "power" else 0.0),
         )  # fmt: skip
         report["friction"] = {"mu": mu, "heat_law": law, "heat_partition": eta}
         _initial_penetration(full, report, log)
@@ -260,11 +243,11 @@ def _build(scene, log, modes, stages, with_stepper=True) -> Simulation:
     model, limits = _select_signals(scene, full, report, size)
     if modes:
         report["natural_frequencies_hz"] = stages.frequencies(model, modes).tolist()
-    make = lambda m: _bare_stepper(scene, m)  # noqa: E731  (the reduction error estimate)
+    make = lambda m: bare_stepper(scene, m)  # noqa: E731  (the reduction error estimate)
     reduced, reductor, report["reduction"] = stages.reduce(model, scene, log, make, limits)
     clock.done("reduction", f"{reduced.n_dofs} dofs")
     report["model"] = {"n_dofs": reduced.n_dofs, **_layout(reduced)}
-    stepper = _stepper(scene, reduced, report) if with_stepper else None
+    stepper = stepper_of(scene, reduced, report) if with_stepper else None
     report["outputs"] = {
         "vtk_stride": scene["outputs"]["vtk_stride"],
         "plots": scene["outputs"]["plots"],
@@ -275,14 +258,6 @@ def _build(scene, log, modes, stages, with_stepper=True) -> Simulation:
     )
 
 
-def _bare_stepper(scene, model):
-    s = scene["scheme"]
-    try:
-        return make_stepper(s["name"], model, s["h"], **_scheme_options(scene))
-    except ValueError as exc:
-        raise SceneError(f"scheme ({s['name']}): {exc}") from None
-
-
 def _prestress(scene, disc, material, omega, log, stages):
     """The scene's centrifugal prestress (:mod:`femrub.fem.prestress`), or ``None``."""
     method = tr.centrifugal_of(scene)
@@ -291,43 +266,6 @@ def _prestress(scene, disc, material, omega, log, stages):
     if log:
         log(f"centrifugal prestress ({method}) at {omega:g} rad/s ...")
     return stages.prestress(disc, material, omega, method)
-
-
-def _grid(scene, blade, points, omega, growth):
-    """Casing cells swept by the kept contacts (wear map, casing heat), or ``None``."""
-    c = scene["contact"]
-    a, h = c["abradable"], c["casing_heat"]
-    if points.n == 0 or (a["thickness"] <= 0.0 and h["thickness"] <= 0.0):
-        return None
-    n = a if a["thickness"] > 0.0 else h
-    axial = blade.axis @ points.points if blade.dim == 3 else np.zeros(points.n)
-    return CasingGrid(points.angles, axial, float(np.max(points.radii + growth)), omega,
-                      n_angle=n["n_angle"], n_axial=n["n_axial"])  # fmt: skip
-
-
-def _abradable(scene, grid):
-    """The coating of ``contact.abradable`` over the kept contacts, or ``None``."""
-    a = scene["contact"]["abradable"]
-    if grid is None or a["thickness"] <= 0.0:
-        return None
-    return Abradable(a["thickness"], a["yield"], grid)
-
-
-def _casing_heat(scene, grid, eta, alpha, mu):
-    """The lumped casing thermal model of ``contact.casing_heat``, or ``None``; ``mu``: the
-    Coulomb coefficient of the ``"power"`` heat law (0 with the ``"alpha"`` law)."""
-    h = scene["contact"]["casing_heat"]
-    if grid is None or h["thickness"] <= 0.0:
-        return None
-    if not 0.0 < eta < 1.0 or not (mu > 0.0 or np.any(alpha > 0)):
-        fail(
-            "contact.casing_heat.thickness",
-            h["thickness"],
-            f"no frictional heat reaches the casing (heat_partition {eta:g}, no heat "
-            "coefficient); set contact.friction / heat_coefficient and heat_partition < 1",
-        )
-    return CasingHeat(grid, h["thickness"], h["density"], h["specific_heat"], h["conductivity"],
-                      h["expansion"], eta, alpha)  # fmt: skip
 
 
 def _centrifugal_report(scene, prestress, growth, reach) -> dict:
@@ -349,31 +287,6 @@ def _centrifugal_report(scene, prestress, growth, reach) -> dict:
         "min_gap": float(reach.min_gap.min()) if g.size else 0.0,
         "max_min_gap": float(reach.min_gap.max()) if g.size else 0.0,
     }  # fmt: skip
-
-
-def _stepper(scene, model, report):
-    s = scene["scheme"]
-    options = _scheme_options(scene)
-    stepper = _bare_stepper(scene, model)
-    report["scheme"] = {
-        "name": s["name"],
-        "h": s["h"],
-        "t_end": s["t_end"],
-        "steps": stepper.steps_to(s["t_end"]),
-        **{k: v for k, v in options.items() if v is not None},
-    }
-    if s["name"] == "carpenter":
-        limit = stepper.stability_limit()
-        report["scheme"]["stability_limit"] = limit
-        if s["h"] > limit:
-            fail(
-                "scheme.h",
-                s["h"],
-                f"exceeds the stability limit {limit:.3g} s of Carpenter's "
-                f"explicit scheme for this model; use scheme.h <= {_floor(limit)} or "
-                "scheme.name = 'theta'",
-            )
-    return stepper
 
 
 def _select_signals(scene, model, report, size):
@@ -440,9 +353,3 @@ def _contacts_report(points, reach) -> dict:
 def _layout(model) -> dict:
     L = model.layout
     return {"n_u": L.n_u, "n_v": L.n_v, "n_theta": L.n_t, "n_contacts": model.n_contacts}
-
-
-def _floor(x: float) -> str:
-    """``x`` rounded down to 2 significant digits, as text."""
-    e = math.floor(math.log10(x))
-    return f"{math.floor(x / 10**e * 10) / 10 * 10**e:.2g}"
