@@ -140,8 +140,16 @@ class Recorder:
         self.buf = np.empty((self.chunk + 1, N))
 
     # -- the run ---------------------------------------------------------------------------
-    def record(self, start: State, advance: Callable, *, progress: bool = False) -> Results:
+    def record(
+        self, start: State, advance: Callable, *, progress: bool = False, block=None
+    ) -> Results:
         """Record ``start`` and ``n_steps`` calls of ``advance() -> (t, X, impulse, extra)``.
+
+        ``block`` (optional) replaces ``advance`` by whole blocks of steps:
+        ``block(m, X, t, P, Pt, heat, state) -> (steps done, friction rows written, error)``
+        writes ``m`` steps into the given rows of the recorder (states, times, impulses and
+        the friction rows of :meth:`_friction_rows`); ``error``, an exception or ``None``,
+        ends the run as ``advance`` raising it would.
 
         ``extra`` (a dict or ``None``) may hold the step's friction quantities
         (``friction_impulse``, ``heat``, ``state``: see ``Stepper._step``) and
@@ -164,22 +172,37 @@ class Recorder:
         ):
             try:
                 self._start(start)
-                for i in range(1, n + 1):
-                    try:
-                        ti, X, P, *more = advance()
-                    except (FloatingPointError, ArithmeticError) as exc:
-                        i_end = self._flush(i0, j)
-                        raise _Stop("unstable", f"{type(exc).__name__}: {exc}", i_end) from None
-                    j += 1
-                    buf[j], t[i] = X, ti
-                    if nc:
-                        imp[i] = P
-                    info = more[0] if more else None
-                    if info:
-                        if "contact_work" in info:  # the scheme's own contact work
-                            self._work_rows()[i] = info["contact_work"]
-                        if "state" in info:
-                            self._friction_rows(i, info)
+                i = 0
+                while i < n:
+                    if block is not None:  # a block of steps in one call, into the rows
+                        m = min(self.chunk - j, n - i)
+                        r = slice(i + 1, i + 1 + m)
+                        done, friction, err = block(
+                            m, buf[j + 1 : j + 1 + m], t[r], imp[r], self.imp_t[r],
+                            self.heat[r], self.cstate[r],
+                        )  # fmt: skip
+                        self.has_friction |= friction
+                        i, j = i + done, j + done
+                        if err is not None:
+                            i_end = self._flush(i0, j)
+                            raise _Stop("unstable", f"{type(err).__name__}: {err}", i_end)
+                    else:
+                        i += 1
+                        try:
+                            ti, X, P, *more = advance()
+                        except (FloatingPointError, ArithmeticError) as exc:
+                            i_end = self._flush(i0, j)
+                            raise _Stop("unstable", f"{type(exc).__name__}: {exc}", i_end) from None
+                        j += 1
+                        buf[j], t[i] = X, ti
+                        if nc:
+                            imp[i] = P
+                        info = more[0] if more else None
+                        if info:
+                            if "contact_work" in info:  # the scheme's own contact work
+                                self._work_rows()[i] = info["contact_work"]
+                            if "state" in info:
+                                self._friction_rows(i, info)
                     if j == self.chunk or i == n:
                         i_end = self._flush(i0, j)
                         self._deliver(i0, i_end)
