@@ -90,8 +90,10 @@ def one_contact_block(X, T, Y1, Y0, sig, code, g0, gr, gv, z, w, gz, e, h, gamma
 
 
 @njit
-def friction_block(X, T, Y1, Y0, sig, S, off, Z, W, GZ, code, mu, e3, U, warm, use_warm, h,
-                   gamma, alpha, tol, max_iter, Xout, Pout, Ptout, heat_out, state_out):  # fmt: skip
+def friction_block(
+    X, T, Y1, Y0, sig, S, off, Z, W, GZ, code, mu, e3, U, warm, use_warm, h, gamma, alpha, tol,
+    max_iter, Xout, Pout, Ptout, heat_out, state_out,
+):  # fmt: skip
     """``Xout.shape[0]`` frictional steps (``off`` (m + 1, 4 n_c): the casing terms at
     ``t_k`` and at each step's end). Returns ``(steps done, status, residual, warm)``: a
     step whose solve failed (status ≠ 0) is not written, and the block stops there."""
