@@ -134,3 +134,48 @@ def test_blocks_run_as_python_without_jit():
     _close(np.array(py["bar"]), np.array(jit["bar"]), 1e-12)
     _close(np.array(py["P"]), np.array(jit["P"]), 1e-9)
     _close(np.array(py["Pt"]), np.array(jit["Pt"]), 1e-9)
+
+
+def test_a_block_interrupted_or_failing_keeps_the_checked_rows(monkeypatch):
+    """Ctrl-C or an exception inside a block: the rows of the blocks before it are kept."""
+    import femrub.steppers.theta_blocks as tb
+
+    real, calls, error = tb.one_contact_block, [0], [None]
+
+    def block(*args):
+        calls[0] += 1
+        if calls[0] == 3:
+            raise error[0]
+        return real(*args)
+
+    monkeypatch.setattr(tb, "one_contact_block", block)
+    monkeypatch.setattr("femrub.output.recorder.CHUNK_STEPS", 64)
+    for what, status in ((KeyboardInterrupt(), "interrupted"), (RuntimeError("x"), "failed")):
+        calls[0], error[0] = 0, what
+        res = fr.ThetaMethod(bar_model(), 1e-4).run(0.05)
+        assert res.status == status and 64 <= res.steps <= 128, (res.status, res.steps)
+
+
+def test_a_failed_frictional_solve_in_a_block_ends_the_run_unstable(naca, monkeypatch):
+    """A contact solve that fails inside a block: the steps before it are checked and kept,
+    the run ends ``unstable`` with the solver's message (as step by step)."""
+    import femrub.steppers.theta_blocks as tb
+    from femrub.app.simulation import _scheme_options
+    from femrub.steppers import make_stepper
+
+    real = tb.friction_block
+
+    def block(*args):
+        args = list(args)
+        for i in range(-5, 0):
+            args[i] = args[i][:10]
+        done, status, res, warm = real(*args)
+        return done, 1, 0.5, warm  # NOT_SOLVED after 10 steps
+
+    monkeypatch.setattr(tb, "friction_block", block)
+    sim, scene = naca
+    s = scene["scheme"]
+    st = make_stepper(s["name"], sim.model, s["h"], **_scheme_options(scene))
+    res = st.run(s["t_end"])
+    assert res.status == "unstable" and "not solved" in res.message
+    assert res.steps == 10 and st.k == 10
