@@ -33,6 +33,8 @@ from tqdm.auto import tqdm
 from ..fem.linalg import compact
 from ..model.first_order import FirstOrderModel
 from .energy import EnergyMeter
+from .limits import limit_hit as _limit_hit
+from .limits import limit_index as _limit_index
 from .results import Results
 
 __all__ = ["CHUNK_STEPS", "CHUNK_VALUES", "Recorder", "State"]
@@ -389,27 +391,3 @@ class Recorder:
             info={"label": self.label, "stability_limit": self.h_lim, "n_dofs": self.model.n_dofs},
             extra={k: v[:m].copy() for k, v in self.extra.items()},
         )
-
-
-def _limit_index(limits, names, sizes):
-    """Columns of each observed signal in the observation rows; checks the limit names."""
-    idx, col = {}, 0
-    for name, size in zip(names, sizes):
-        idx[name] = slice(col, col + size)
-        col += size
-    for key in limits:
-        if key != "contact_force" and key not in idx:
-            raise ValueError(f"stop limit on unknown signal {key!r}; use one of {names}")
-    return idx
-
-
-def _limit_hit(limits, idx, rows, force):
-    """First ``(row, message)`` where a stop limit is exceeded in a block, or ``None``."""
-    first = None
-    for key, bound in limits.items():
-        vals = force if key == "contact_force" else rows[:, idx[key]]
-        if vals.size:
-            over = np.any(np.abs(vals) > bound, axis=1)
-            if over.any() and (first is None or np.argmax(over) < first[0]):
-                first = (int(np.argmax(over)), f"{key} exceeded {bound:g}")
-    return first

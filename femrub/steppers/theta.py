@@ -34,6 +34,11 @@ With the ``"power"`` heat law the blade then receives ``η (−P_t · w_t,m)`` p
 heat input of the same step; its effect on the step's velocities through the thermal
 coupling is fed back into the contact solve by a fixed point (contact solve, heat, contact
 solve with the heat's velocity shift ``W_θ Q``, ...) until the heat repeats to 1e-12.
+
+``run()`` on a dense model whose contacts carry no history (no wear, no casing heat,
+constant α, no ``"power"`` heat with a thermal field) advances whole chunks of steps in one
+compiled call (:mod:`femrub.steppers.theta_blocks`): the same step, the same contact
+algebra, written into the recorder's rows. ``step()`` and ``iterate()`` go step by step.
 """
 
 from __future__ import annotations
