@@ -36,18 +36,71 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
 
-def _per_step(model, scheme: dict, opts: dict, t_end: float, energy: bool) -> dict:
+def _per_step(model, scheme: dict, opts: dict, t_end: float, energy: bool, blocks=True,
+              on_state=None) -> dict:  # fmt: skip
+    """CPU per step of ``run()`` (``blocks``: the compiled blocks of steps, else step by
+    step; ``on_state``: an output callback, e.g. a VTK series)."""
     from femrub.steppers import make_stepper
 
     st = make_stepper(scheme["name"], model, scheme["h"], **opts)
+    st.block_steps = blocks
     c0 = time.process_time()
-    res = st.run(t_end, energy=energy)
+    res = st.run(t_end, energy=energy, on_state=on_state)
     cpu = time.process_time() - c0
-    return {"steps": res.steps, "us": 1e6 * cpu / res.steps, "status": res.status}
+    return {"steps": res.steps, "us": 1e6 * cpu / res.steps, "status": res.status,
+            "energy_error": float(np.max(np.abs(res.energy["energy_error"])))
+            if "energy_error" in res.energy else None}  # fmt: skip
+
+
+def _bare_blocks(model, scheme: dict, opts: dict, t_end: float) -> dict:
+    """CPU per step of the compiled blocks alone (chunks of 512 steps into preallocated
+    rows, no recorder): the kernel's cost with the casing terms and signals of each block."""
+    from femrub.output.recorder import CHUNK_STEPS
+    from femrub.steppers import make_stepper
+    from femrub.steppers.theta_blocks import advance_block
+
+    st = make_stepper(scheme["name"], model, scheme["h"], **opts)
+    if not getattr(st, "_block_kind", None):
+        return {}
+    n, N, nc = st.steps_to(t_end), model.n_dofs, model.n_contacts
+    m = CHUNK_STEPS
+    X, t, P = np.empty((m, N)), np.empty(m), np.empty((m, nc))
+    Pt, heat, state = np.empty((m, nc, 2)), np.empty((m, nc)), np.empty((m, nc), np.int8)
+    done = 0
+    with threadpool_limits(limits=1, user_api="blas"):
+        c0 = time.process_time()
+        while done < n:
+            k = min(m, n - done)
+            advance_block(st, k, X[:k], t[:k], P[:k], Pt[:k], heat[:k], state[:k])
+            done += k
+        cpu = time.process_time() - c0
+    return {"bare_us": 1e6 * cpu / n}
+
+
+def _vtk(sim, scheme: dict, opts: dict, stride: int, frames: int) -> dict:
+    """CPU per step with a VTK series at ``stride`` over ``frames`` frames, and per frame."""
+    import tempfile
+
+    from femrub.output.vtk import VTKSeries
+
+    if sim.fields is None or sim.model.to_full is None:
+        return {}
+    t_end = stride * frames * scheme["h"]
+    with tempfile.TemporaryDirectory() as d:
+        series = VTKSeries(d, sim.model, sim.fields, h=scheme["h"], stride=stride)
+        row = _per_step(sim.model, scheme, opts, t_end, False, on_state=series)
+        plain = _per_step(sim.model, scheme, opts, t_end, False)
+    return {
+        "vtk_stride": stride,
+        "vtk_us": row["us"],
+        "vtk_plain_us": plain["us"],
+        "vtk_frame_s": (row["us"] - plain["us"]) * row["steps"] / 1e6 / (frames + 1),
+    }
 
 
 def _split(model, scheme: dict, opts: dict, t_end: float) -> dict:
-    """Median wall time of a step without / with an impulse, and the contacts active."""
+    """Median wall time of a step without / with an impulse (the per-step path,
+    ``_advance``), and the contacts active."""
     from femrub.steppers import make_stepper
 
     st = make_stepper(scheme["name"], model, scheme["h"], **opts)
@@ -108,7 +161,7 @@ def _compile_cost() -> dict:
     return out
 
 
-def measure(scene_name: str, revolutions: float) -> dict:
+def measure(scene_name: str, revolutions: float, vtk_frames: int = 10) -> dict:
     from femrub.app.cache import ModelCache
     from femrub.app.scheme import scheme_options
     from femrub.app.simulation import build
@@ -127,8 +180,12 @@ def measure(scene_name: str, revolutions: float) -> dict:
         "scene": scene_name, "n_dofs": m.n_dofs, "contacts": m.contact.n, "t_end": t_end,
         "build_s": build_s, "no_energy": _per_step(m, scene["scheme"], opts, t_end, False),
         "energy": _per_step(m, scene["scheme"], opts, t_end, True),
+        "steps_path": _per_step(m, scene["scheme"], opts, t_end, False, blocks=False),
+        **_bare_blocks(m, scene["scheme"], opts, t_end),
         **_split(m, scene["scheme"], opts, t_end),
     }  # fmt: skip
+    if vtk_frames:
+        row.update(_vtk(sim, scene["scheme"], opts, 50, vtk_frames))
     row["load"] = [load0, os.getloadavg()[0]]
     row.update(_compile_cost())
     return row
@@ -142,20 +199,33 @@ def table(row: dict) -> str:
         f"contacts), θ-method, {row['no_energy']['steps']} steps, one process; load "
         f"{row['load'][0]:.2f}–{row['load'][1]:.2f} (1-minute average).\n\n"
         "| quantity | µs per step |\n|---|---|\n"
-        f"| CPU per step, no output, `run(energy=False)` | {f(row['no_energy']['us'])} |\n"
+        f"| CPU per step, no output, `run(energy=False)` (compiled blocks of steps) | "
+        f"{f(row['no_energy']['us'])} |\n"
         f"| CPU per step, energy balance on (default `run()`) | {f(row['energy']['us'])} |\n"
-        f"| step without impulse (median wall, {100 * (1 - row['contact_share']):.0f} % of "
-        f"the steps) | {f(row['quiet_us'])} |\n"
-        f"| step with impulses (median wall, {100 * row['contact_share']:.0f} % of the steps, "
-        f"{row['active_mean']:.1f} contacts active on average) | {f(row['contact_us'])} |\n"
+        f"| CPU per step, the compiled blocks alone (no recorder) | {f(row.get('bare_us'))} |\n"
+        f"| CPU per step, `run(energy=False)` step by step (`block_steps = False`) | "
+        f"{f(row['steps_path']['us'])} |\n"
+        f"| per-step path: step without impulse (median wall, "
+        f"{100 * (1 - row['contact_share']):.0f} % of the steps) | {f(row['quiet_us'])} |\n"
+        f"| per-step path: step with impulses (median wall, {100 * row['contact_share']:.0f} % "
+        f"of the steps, {row['active_mean']:.1f} contacts active on average) | "
+        f"{f(row['contact_us'])} |\n"
         f"| floor: dense `T X` ({row['n_dofs']}²) | {f(row.get('matvec_us'))} |\n"
         f"| floor: `numpy.linalg.solve` of the {row.get('solve_size', 0)}×"
         f"{row.get('solve_size', 0)} Delassus block | {f(row.get('solve_us'))} |\n"
         f"| floor: sum | {floor} |\n"
-        f"\nContact kernels (numba, `femrub.contact.coulomb`): first compilation "
+        + (
+            f"| VTK at stride {row['vtk_stride']}: CPU per step (same run without it: "
+            f"{f(row['vtk_plain_us'])}); one frame {row['vtk_frame_s']:.2f} s | "
+            f"{f(row['vtk_us'])} |\n"
+            if "vtk_us" in row
+            else ""
+        )
+        + f"\nContact kernels (numba, `femrub.contact.coulomb`): first compilation "
         f"{row.get('compile_s', float('nan')):.1f} s in a fresh process with an empty cache, "
         f"{row.get('cached_s', float('nan')):.2f} s to load them from the on-disk cache; done "
-        "when the stepper is built, never inside the steps above.\n"
+        "when the stepper is built, never inside the steps above. Blocks: chunks of the "
+        "recorder's rows advanced in one compiled call (`femrub.steppers.theta_blocks`).\n"
     )
 
 
@@ -176,10 +246,11 @@ def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--scene", default="rotor37")
     ap.add_argument("--revolutions", type=float, default=5.0)
+    ap.add_argument("--vtk-frames", type=int, default=10, help="frames of the VTK row (0: none)")
     ap.add_argument("--no-write", action="store_true", help="print, do not edit the docs")
     args = ap.parse_args(argv)
     try:
-        row = measure(args.scene, args.revolutions)
+        row = measure(args.scene, args.revolutions, args.vtk_frames)
     except (FileNotFoundError, SceneError) as exc:
         print(f"skipped: {exc}")
         return 0

@@ -76,6 +76,9 @@ def test_interrupted_run_keeps_partial_results(tiny, tmp_path, capsys, monkeypat
         return real_step(self)
 
     monkeypatch.setattr(ThetaMethod, "_step", step)
+    monkeypatch.setattr(
+        ThetaMethod, "block_steps", False
+    )  # step by step (blocks: test_theta_blocks)
     assert main(["run", str(tiny), "-o", str(out), "-q"]) == 130
     err = capsys.readouterr().err
     assert "interrupted at t = " in err and str(out) in err and "partial results kept" in err
@@ -102,6 +105,9 @@ def test_failed_run_keeps_partial_results(tiny, tmp_path, capsys, monkeypatch):
         return real_step(self)
 
     monkeypatch.setattr(ThetaMethod, "_step", step)
+    monkeypatch.setattr(
+        ThetaMethod, "block_steps", False
+    )  # step by step (blocks: test_theta_blocks)
     assert main(["run", str(tiny), "-o", str(out), "-q"]) == 1
     err = capsys.readouterr().err
     assert "run failed" in err and "solver exploded" in err and str(out) in err

@@ -119,6 +119,7 @@ def test_history_is_streamed_in_checked_blocks(tiny, tmp_path, monkeypatch):
 
     monkeypatch.setattr("femrub.output.recorder.CHUNK_STEPS", 64)
     monkeypatch.setattr(ThetaMethod, "_step", step)
+    monkeypatch.setattr(ThetaMethod, "block_steps", False)  # step by step, to look inside
     assert main(["run", str(tiny), "-o", str(out), "-q"]) == 0
     assert seen == [129]  # rows 0..128: two checked blocks of 64 steps, flushed
     rows = _rows(out / "history.csv")
@@ -174,6 +175,9 @@ def test_paper_honours_ctrl_c(tmp_path, capsys, monkeypatch):
         return real_step(self)
 
     monkeypatch.setattr(ThetaMethod, "_step", step)
+    monkeypatch.setattr(
+        ThetaMethod, "block_steps", False
+    )  # step by step (blocks: test_theta_blocks)
     out = tmp_path / "paper"
     assert main(["paper", "--out", str(out), "--figures", "fig2,fig3", "--t-end", "0.02"]) == 130
     assert "interrupted" in capsys.readouterr().err

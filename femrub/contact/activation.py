@@ -57,6 +57,7 @@ import numpy as np
 
 from .coulomb import FIXED_POINT, PREDICTED, frictional_fixed_point
 from .impulses import solve_impulses
+from .theta_block import ONE_RULES, impulse_one_code
 
 __all__ = [
     "RULES",
@@ -66,6 +67,8 @@ __all__ = [
     "rule_code",
     "impulse_one",
     "impulses",
+    "compile_kernels",
+    "compile_blocks",
 ]
 
 RULES = ("position", "capped", "paper", "plain", "predicted")
@@ -83,28 +86,13 @@ def impulse_one(rule, g_k, gd_k, g_p, gd_p, w, gz, e, h, gamma, upper=np.inf) ->
     """Impulse of a single contact (scalar closed form of :func:`impulses`).
 
     ``w = ∂ġ_{k+1}/∂P > 0`` and ``gz = ∂g_{k+1}/∂P > 0``; ``upper``: bound on the impulse.
+    The arithmetic is :func:`femrub.contact.theta_block.impulse_one_code` (compiled).
     """
-    return min(_impulse_one(rule, g_k, gd_k, g_p, gd_p, w, gz, e, h, gamma), upper)
-
-
-def _impulse_one(rule, g_k, gd_k, g_p, gd_p, w, gz, e, h, gamma) -> float:
-    if rule in ("capped", "position"):
-        if g_k > 0.0 and g_p >= 0.0:  # open, and the free step does not reach the casing
-            return 0.0
-        p_cap = (min(g_k, 0.0) + e * max(g_k, 0.0) - g_p) / gz  # _target, on floats
-        if rule == "position":
-            return max(0.0, p_cap)
-        return max(0.0, min(-(gd_p + e * gd_k) / w, p_cap))
-    if rule == "plain":
-        return max(0.0, -(gd_p + e * gd_k) / w) if g_p <= 0.0 else 0.0
-    if rule == "predicted":
-        active = g_k + gamma * h * gd_k <= 0.0
-    else:  # paper: the fixed point for one contact is "closed at t_k or predicted closed"
-        active = g_k <= 0.0 or g_p <= 0.0
-    if not active:
-        return 0.0
-    e = 1.0 if gd_k > 0.0 else e
-    return max(0.0, -(gd_p + e * gd_k) / w)
+    P = impulse_one_code(
+        ONE_RULES[rule], float(g_k), float(gd_k), float(g_p), float(gd_p), float(w), float(gz),
+        float(e), float(h), float(gamma),
+    )  # fmt: skip
+    return min(P, upper)
 
 
 def impulses(rule, g_k, gd_k, g_p, gd_p, W, GZ, e, h, gamma, warm=None, upper=None):
@@ -215,3 +203,24 @@ def compile_kernels() -> None:
             np.full(1, np.inf), np.zeros((1, 3)), False, 1.0, 0.5, 1e-12, 60,
         )  # fmt: skip
     solve_frictional_contact(W, q, 0.1, np.ones(1, dtype=bool))
+    compile_blocks()
+
+
+def compile_blocks() -> None:
+    """Compile (or load) the θ-method's block kernels of :mod:`femrub.contact.theta_block`
+    for the argument types of a run (no step is taken: blocks of zero rows)."""
+    from .jit import compiled
+    from .theta_block import friction_block, one_contact_block
+
+    if not compiled():
+        return
+    N, E, one = 2, np.empty, np.ones(1)
+    T, Y, sig = np.eye(N), np.zeros((N, 0)), np.zeros((1, 0))
+    one_contact_block(np.zeros(N), T, Y, Y, sig, 0, 1.0, np.ones(N), np.ones(N), np.ones(N),
+                      1.0, 1.0, 0.0, 1.0, 0.5, np.inf, E((0, N)), E((0, 1)))  # fmt: skip
+    friction_block(
+        np.zeros(N), T, Y, Y, sig, np.zeros((4, N)), np.zeros((1, 4)), np.zeros((N, 3)),
+        np.eye(3), np.zeros((1, 3)), FIXED_POINT, one, one * 0.0, one * np.inf,
+        np.zeros((1, 3)), False, 1.0, 0.5, one * 0.0, 1e-12, 60, E((0, N)), E((0, 1)),
+        E((0, 1, 2)), E((0, 1)), E((0, 1), dtype=np.int8),
+    )  # fmt: skip

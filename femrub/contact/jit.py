@@ -5,6 +5,11 @@ numpy (``numba.njit(cache=True)``: the machine code is cached next to the module
 the first call on a machine pays the compilation). With ``NUMBA_DISABLE_JIT=1``, or without
 numba, the same function runs as plain Python: there is one implementation, and the tests
 exercise it both ways.
+
+numba stamps a cached function with its own source file only, so a kernel cached in one
+file would keep a stale copy of a callee changed in another. The kernel files of
+:data:`KERNEL_FILES` are therefore stamped together (a change to any of them recompiles
+all of their kernels), through a cache locator registered with numba below.
 """
 
 from __future__ import annotations
@@ -14,7 +19,59 @@ try:  # numba is a dependency; the fallback keeps a broken install importable
 except ImportError:  # pragma: no cover
     numba = None
 
-__all__ = ["njit", "compiled"]
+import hashlib
+import os
+
+__all__ = ["njit", "compiled", "KERNEL_FILES"]
+
+_HERE = os.path.dirname(os.path.abspath(__file__))
+#: the source files of compiled functions that call each other (one cache stamp)
+KERNEL_FILES = tuple(os.path.join(_HERE, f) for f in ("coulomb.py", "theta_block.py"))
+
+
+def _stamp() -> bytes:
+    h = hashlib.sha256()
+    for path in KERNEL_FILES:
+        with open(path, "rb") as f:
+            h.update(f.read())
+    return h.digest()
+
+
+def _register_locator() -> None:
+    """Put a locator stamping :data:`KERNEL_FILES` together first in numba's list (in
+    ``__pycache__`` next to them, or under ``NUMBA_CACHE_DIR`` when set, as numba's own
+    locators)."""
+    from numba.core import caching, config
+
+    impl = getattr(caching, "CacheImpl", None) or getattr(caching, "_CacheImpl", None)
+    base = getattr(caching, "InTreeCacheLocator", None) or getattr(
+        caching, "_InTreeCacheLocator", None
+    )
+    if impl is None or base is None:  # pragma: no cover - another numba layout
+        return
+
+    class KernelFilesLocator(base):
+        def __init__(self, py_func, py_file):
+            super().__init__(py_func, py_file)
+            if config.CACHE_DIR:  # NUMBA_CACHE_DIR, as numba's own first locator
+                sub = self.get_suitable_cache_subpath(py_file)
+                self._cache_path = os.path.join(config.CACHE_DIR, sub)
+
+        def get_source_stamp(self):
+            return _stamp()
+
+        @classmethod
+        def from_function(cls, py_func, py_file):
+            if os.path.abspath(py_file) not in KERNEL_FILES:
+                return None
+            return super().from_function(py_func, py_file)
+
+    if not any(c.__name__ == "KernelFilesLocator" for c in impl._locator_classes):
+        impl._locator_classes.insert(0, KernelFilesLocator)
+
+
+if numba is not None:
+    _register_locator()
 
 
 def njit(fn):

@@ -68,15 +68,21 @@ class EnergyMeter:
         self._heats = np.array([term.heat for term in model.loads])
         self.contact = model.contact
         self.data = {k: np.zeros(capacity) for k in ENERGY_KEYS}
+        self._support: dict[int, tuple] = {}
         self._E0 = self._Q0 = 0.0
         self.scale = 0.0
         self.heat_scale = 0.0
 
-    @staticmethod
-    def _quad(Q, X):
-        """Row-wise ``x_iᵀ Q x_i`` for the rows ``x_i`` of ``X``."""
-        QX = X @ Q.T if isinstance(Q, np.ndarray) else (Q @ X.T).T  # X @ Q.T: fast BLAS path
-        return np.einsum("ij,ij->i", X, np.asarray(QX))
+    def _quad(self, Q, X):
+        """Row-wise ``x_iᵀ Q x_i`` for the rows ``x_i`` of ``X``; a dense ``Q`` on the rows and
+        columns where it is nonzero (an energy form acts on one block of the state)."""
+        if not isinstance(Q, np.ndarray):
+            return np.einsum("ij,ij->i", X, np.asarray((Q @ X.T).T))
+        sub = self._support.get(id(Q))
+        if sub is None:
+            sub = self._support[id(Q)] = _support(Q)
+        Qs, r, c = sub
+        return np.einsum("ij,ij->i", X[:, r], X[:, c] @ Qs.T)  # X @ Q.T: fast BLAS path
 
     def start(self, X0: np.ndarray) -> None:
         f, d = self.forms, self.data
@@ -164,3 +170,19 @@ class EnergyMeter:
 
     def arrays(self, n: int) -> dict[str, np.ndarray]:
         return {k: v[:n].copy() for k, v in self.data.items()}
+
+
+def _support(Q: np.ndarray) -> tuple:
+    """``(Q[r][:, c], r, c)``: the rows ``r`` and columns ``c`` where ``Q`` is nonzero, as
+    slices when they are ranges (no copy of the states' columns)."""
+
+    def part(mask):
+        idx = np.flatnonzero(mask)
+        if idx.size == 0:
+            return slice(0, 0)
+        if idx[-1] - idx[0] + 1 == idx.size:
+            return slice(int(idx[0]), int(idx[-1]) + 1)
+        return idx
+
+    r, c = part(np.any(Q != 0.0, axis=1)), part(np.any(Q != 0.0, axis=0))
+    return np.ascontiguousarray(Q[r][:, c]), r, c

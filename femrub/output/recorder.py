@@ -33,6 +33,8 @@ from tqdm.auto import tqdm
 from ..fem.linalg import compact
 from ..model.first_order import FirstOrderModel
 from .energy import EnergyMeter
+from .limits import limit_hit as _limit_hit
+from .limits import limit_index as _limit_index
 from .results import Results
 
 __all__ = ["CHUNK_STEPS", "CHUNK_VALUES", "Recorder", "State"]
@@ -140,8 +142,16 @@ class Recorder:
         self.buf = np.empty((self.chunk + 1, N))
 
     # -- the run ---------------------------------------------------------------------------
-    def record(self, start: State, advance: Callable, *, progress: bool = False) -> Results:
+    def record(
+        self, start: State, advance: Callable, *, progress: bool = False, block=None
+    ) -> Results:
         """Record ``start`` and ``n_steps`` calls of ``advance() -> (t, X, impulse, extra)``.
+
+        ``block`` (optional) replaces ``advance`` by whole blocks of steps:
+        ``block(m, X, t, P, Pt, heat, state) -> (steps done, friction rows written, error)``
+        writes ``m`` steps into the given rows of the recorder (states, times, impulses and
+        the friction rows of :meth:`_friction_rows`); ``error``, an exception or ``None``,
+        ends the run as ``advance`` raising it would.
 
         ``extra`` (a dict or ``None``) may hold the step's friction quantities
         (``friction_impulse``, ``heat``, ``state``: see ``Stepper._step``) and
@@ -164,22 +174,37 @@ class Recorder:
         ):
             try:
                 self._start(start)
-                for i in range(1, n + 1):
-                    try:
-                        ti, X, P, *more = advance()
-                    except (FloatingPointError, ArithmeticError) as exc:
-                        i_end = self._flush(i0, j)
-                        raise _Stop("unstable", f"{type(exc).__name__}: {exc}", i_end) from None
-                    j += 1
-                    buf[j], t[i] = X, ti
-                    if nc:
-                        imp[i] = P
-                    info = more[0] if more else None
-                    if info:
-                        if "contact_work" in info:  # the scheme's own contact work
-                            self._work_rows()[i] = info["contact_work"]
-                        if "state" in info:
-                            self._friction_rows(i, info)
+                i = 0
+                while i < n:
+                    if block is not None:  # a block of steps in one call, into the rows
+                        m = min(self.chunk - j, n - i)
+                        r = slice(i + 1, i + 1 + m)
+                        done, friction, err = block(
+                            m, buf[j + 1 : j + 1 + m], t[r], imp[r], self.imp_t[r],
+                            self.heat[r], self.cstate[r],
+                        )  # fmt: skip
+                        self.has_friction |= friction
+                        i, j = i + done, j + done
+                        if err is not None:
+                            i_end = self._flush(i0, j)
+                            raise _Stop("unstable", f"{type(err).__name__}: {err}", i_end)
+                    else:
+                        i += 1
+                        try:
+                            ti, X, P, *more = advance()
+                        except (FloatingPointError, ArithmeticError) as exc:
+                            i_end = self._flush(i0, j)
+                            raise _Stop("unstable", f"{type(exc).__name__}: {exc}", i_end) from None
+                        j += 1
+                        buf[j], t[i] = X, ti
+                        if nc:
+                            imp[i] = P
+                        info = more[0] if more else None
+                        if info:
+                            if "contact_work" in info:  # the scheme's own contact work
+                                self._work_rows()[i] = info["contact_work"]
+                            if "state" in info:
+                                self._friction_rows(i, info)
                     if j == self.chunk or i == n:
                         i_end = self._flush(i0, j)
                         self._deliver(i0, i_end)
@@ -366,27 +391,3 @@ class Recorder:
             info={"label": self.label, "stability_limit": self.h_lim, "n_dofs": self.model.n_dofs},
             extra={k: v[:m].copy() for k, v in self.extra.items()},
         )
-
-
-def _limit_index(limits, names, sizes):
-    """Columns of each observed signal in the observation rows; checks the limit names."""
-    idx, col = {}, 0
-    for name, size in zip(names, sizes):
-        idx[name] = slice(col, col + size)
-        col += size
-    for key in limits:
-        if key != "contact_force" and key not in idx:
-            raise ValueError(f"stop limit on unknown signal {key!r}; use one of {names}")
-    return idx
-
-
-def _limit_hit(limits, idx, rows, force):
-    """First ``(row, message)`` where a stop limit is exceeded in a block, or ``None``."""
-    first = None
-    for key, bound in limits.items():
-        vals = force if key == "contact_force" else rows[:, idx[key]]
-        if vals.size:
-            over = np.any(np.abs(vals) > bound, axis=1)
-            if over.any() and (first is None or np.argmax(over) < first[0]):
-                first = (int(np.argmax(over)), f"{key} exceeded {bound:g}")
-    return first

@@ -116,6 +116,11 @@ class Stepper:
         (n_c, 2), the blade's ``heat`` (n_c,) (J) and the contact ``state`` (n_c,) of the step."""
         raise NotImplementedError
 
+    def _block_writer(self):
+        """A writer of whole blocks of steps for :meth:`Recorder.record` (``block``), or
+        ``None``: ``run()`` then advances step by step."""
+        return None
+
     def _stability_limit(self) -> float:
         """Largest stable step (s); ``inf`` for unconditionally stable schemes."""
         return math.inf
@@ -216,7 +221,9 @@ class Stepper:
             label=label,
             blowup_check=self.blowup_check,
         )
-        res = recorder.record(self.state, self._advance, progress=progress)
+        res = recorder.record(
+            self.state, self._advance, progress=progress, block=self._block_writer()
+        )
         if self.locates_events:
             merge_time = None
         return assess(res, tolerances=tolerances, merge_time=merge_time)

@@ -34,6 +34,11 @@ With the ``"power"`` heat law the blade then receives ``η (−P_t · w_t,m)`` p
 heat input of the same step; its effect on the step's velocities through the thermal
 coupling is fed back into the contact solve by a fixed point (contact solve, heat, contact
 solve with the heat's velocity shift ``W_θ Q``, ...) until the heat repeats to 1e-12.
+
+``run()`` on a dense model whose contacts carry no history (no wear, no casing heat,
+constant α, no ``"power"`` heat with a thermal field) advances whole chunks of steps in one
+compiled call (:mod:`femrub.steppers.theta_blocks`): the same step, the same contact
+algebra, written into the recorder's rows. ``step()`` and ``iterate()`` go step by step.
 """
 
 from __future__ import annotations
@@ -54,6 +59,7 @@ from ..contact.activation import (
 from ..contact.friction import check_status, solve_frictional_contact
 from ..fem.linalg import Factorised, compact
 from .base import Stepper
+from .theta_blocks import advance_block, prepare
 
 __all__ = ["ThetaMethod", "ACTIVATION_RULES"]
 
@@ -80,6 +86,9 @@ class ThetaMethod(Stepper):
 
     name = "theta"
     supports_wear = True
+    #: ``run()`` advances dense models with history-free contacts in compiled blocks of
+    #: steps (:mod:`femrub.steppers.theta_blocks`); ``False``: step by step (same results)
+    block_steps = True
 
     def __init__(
         self,
@@ -170,6 +179,12 @@ class ThetaMethod(Stepper):
             self._S = np.vstack([c.GT, c.V3T])
             self._memo = (None, 0.0, None)
             self._n3 = c.n
+        prepare(self)
+
+    def _block_writer(self):
+        if not (self.block_steps and self._block_kind):
+            return None
+        return lambda *rows: advance_block(self, *rows)
 
     def _casing(self, k: int, t: float):
         """Casing terms of ``[g, ġ, w_t] = S X + o(t)`` at step ``k``: ``o = (g0(t), then
