@@ -68,13 +68,13 @@ def naca():
 
 
 def test_frictional_blocks_equal_the_steps(naca):
-    from femrub.app.simulation import _scheme_options
+    from femrub.app.scheme import scheme_options
     from femrub.steppers import make_stepper
 
     sim, scene = naca
     s = scene["scheme"]
     (a, sa), (b, sb) = _both(
-        lambda: make_stepper(s["name"], sim.model, s["h"], **_scheme_options(scene)), s["t_end"]
+        lambda: make_stepper(s["name"], sim.model, s["h"], **scheme_options(scene)), s["t_end"]
     )
     assert sa._block_kind == "friction" and a.status == b.status == "ok", a.message
     assert int((a.contact_state > 0).any(axis=1).sum()) > 50  # rubs, several contacts
@@ -104,7 +104,7 @@ _CHILD = """
 import json, numpy as np, femrub as fr
 from femrub.cases.bar import bar_model
 from femrub.app import build
-from femrub.app.simulation import _scheme_options
+from femrub.app.scheme import scheme_options
 from femrub.scene import load_scene
 from femrub.steppers import make_stepper
 from femrub.contact.jit import compiled
@@ -112,7 +112,7 @@ r = fr.ThetaMethod(bar_model(), 1e-4, activation="paper").run(0.05)
 scene = load_scene("twisted-naca", json.loads(%r))
 sim = build(scene, log=lambda s: None)
 s = scene["scheme"]
-st = make_stepper(s["name"], sim.model, s["h"], **_scheme_options(scene))
+st = make_stepper(s["name"], sim.model, s["h"], **scheme_options(scene))
 f = st.run(s["t_end"])
 print(json.dumps({"jit": compiled(), "kind": st._block_kind, "bar": r.impulse.tolist(),
                   "P": f.impulse.tolist(), "Pt": f.friction_force.tolist()}))
@@ -160,7 +160,7 @@ def test_a_failed_frictional_solve_in_a_block_ends_the_run_unstable(naca, monkey
     """A contact solve that fails inside a block: the steps before it are checked and kept,
     the run ends ``unstable`` with the solver's message (as step by step)."""
     import femrub.steppers.theta_blocks as tb
-    from femrub.app.simulation import _scheme_options
+    from femrub.app.scheme import scheme_options
     from femrub.steppers import make_stepper
 
     real = tb.friction_block
@@ -175,7 +175,7 @@ def test_a_failed_frictional_solve_in_a_block_ends_the_run_unstable(naca, monkey
     monkeypatch.setattr(tb, "friction_block", block)
     sim, scene = naca
     s = scene["scheme"]
-    st = make_stepper(s["name"], sim.model, s["h"], **_scheme_options(scene))
+    st = make_stepper(s["name"], sim.model, s["h"], **scheme_options(scene))
     res = st.run(s["t_end"])
     assert res.status == "unstable" and "not solved" in res.message
     assert res.steps == 10 and st.k == 10
