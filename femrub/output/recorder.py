@@ -32,7 +32,7 @@ from tqdm.auto import tqdm
 
 from ..fem.linalg import compact
 from ..model.first_order import FirstOrderModel
-from .energy import EnergyMeter
+from .energy import SCHEME_INTEGRALS, EnergyMeter
 from .results import Results
 
 __all__ = ["CHUNK_STEPS", "CHUNK_VALUES", "Recorder", "State"]
@@ -83,8 +83,8 @@ class Recorder:
     on_rows : callback ``f(arrays)`` fed each checked block of rows, ``{name: array}`` as
         :meth:`per_step` gives them (row 0 comes with the first block).
     label : name of the run (progress bar and ``Results.info``).
-    blowup_check : stop on energy created from nothing (off for schemes whose step is exact
-        between events: the meter's trapezoidal work integrals are then the only error).
+    blowup_check : stop on energy created from nothing (a scheme may turn it off when the
+        meter's quadratures, not the scheme, would open its balance).
     """
 
     def __init__(
@@ -135,7 +135,7 @@ class Recorder:
             self.message = (
                 f"h = {h:.3g} s exceeds the stability limit {stability_limit:.3g} s of {scheme}"
             )
-        self._work = None
+        self._work: dict[str, np.ndarray] = {}
         self.chunk = int(max(1, min(CHUNK_STEPS, CHUNK_VALUES // max(N, 1))))
         self.buf = np.empty((self.chunk + 1, N))
 
@@ -145,8 +145,9 @@ class Recorder:
 
         ``extra`` (a dict or ``None``) may hold the step's friction quantities
         (``friction_impulse``, ``heat``, ``state``: see ``Stepper._step``) and
-        ``contact_work``, the contact work of the step (J) as the scheme computed it
-        (impulses inside the step); the energy balance then uses it.
+        any of :data:`~femrub.output.energy.SCHEME_INTEGRALS` (``contact_work``,
+        ``external_work``, ... in J), the step's work or heat as the scheme computed it
+        (impulses inside the step, exact flight); the energy balance then uses it.
         """
         n, buf, t, imp = self.n, self.buf, self.t, self.imp
         nc = self.model.n_contacts
@@ -176,8 +177,8 @@ class Recorder:
                         imp[i] = P
                     info = more[0] if more else None
                     if info:
-                        if "contact_work" in info:  # the scheme's own contact work
-                            self._work_rows()[i] = info["contact_work"]
+                        for k in SCHEME_INTEGRALS.intersection(info):  # the scheme's own
+                            self._work_rows(k)[i] = info[k]
                         if "state" in info:
                             self._friction_rows(i, info)
                     if j == self.chunk or i == n:
@@ -208,11 +209,11 @@ class Recorder:
                 bar.close()
         return self._results(i_end, time.process_time() - cpu0)
 
-    def _work_rows(self) -> np.ndarray:
-        """Per-step contact work reported by the scheme (allocated on first use)."""
-        if self._work is None:
-            self._work = np.zeros(self.n + 1)
-        return self._work
+    def _work_rows(self, key: str) -> np.ndarray:
+        """Per-step work or heat ``key`` reported by the scheme (allocated on first use)."""
+        if key not in self._work:
+            self._work[key] = np.zeros(self.n + 1)
+        return self._work[key]
 
     def _friction_rows(self, i: int, extra: dict) -> None:
         """Friction quantities of step ``i`` (see :meth:`Stepper._step`)."""
@@ -276,7 +277,7 @@ class Recorder:
         if self.meter is not None and m:
             friction = (self.imp_t[rows], self.heat[rows]) if self.has_friction else None
             with np.errstate(all="ignore"):
-                work = None if self._work is None else self._work[rows]
+                work = {k: v[rows] for k, v in self._work.items()} or None
                 self.meter.update(i0, X, self.imp[rows], t[i0 : rows.stop], h, work, friction)
             bad = self.meter.blown_up(rows) if self.blowup_check else None
             if bad is not None:
