@@ -154,22 +154,26 @@ class WorkIntegrals:
         for the rest. With ``state``: ``(z(rest), integrals)``, ``z`` composed exactly as
         :meth:`~.flows.FlowFamily.advance_z` does."""
         Y, lo, act, A, B = self.levels(S, unit)
-        N, k_q = z.size, act.size
-        wq, wl = np.zeros(k_q), np.zeros(2)
+        N, kn = z.size, act.size * z.size
         k = int(rest / unit * 2.0**-LEVEL_MIN * (1.0 + 1e-12)) if rest > 0.0 else 0
         k = min(k, (1 << (lo + len(Y))) - 1)
+        ys, zs = [], []  # per level: [Γ_e z; C J_e z; Z_e z] and z (one product each)
         while k >> lo:
             e = k.bit_length() - 1
-            y = Y[e - lo] @ z
-            wq += y[: k_q * N].reshape(k_q, N) @ z
-            wl += y[k_q * N : k_q * N + 2]
-            z = y[k_q * N + 2 :]
+            zs.append(z)
+            ys.append(Y[e - lo] @ z)
+            z = ys[-1][kn + 2 :]
             k ^= 1 << e
+        wq, wl = np.zeros(act.size), np.zeros(2)
+        if ys:
+            ys, zs = np.array(ys), np.array(zs)
+            wq = np.einsum("bkn,bn->k", ys[:, :kn].reshape(len(zs), -1, N), zs)
+            wl = ys[:, kn : kn + 2].sum(axis=0)
         if k:
             d = k * unit * 2.0**LEVEL_MIN
             c = d ** np.arange(1, _TERMS + 1) / _FACTORIALS
-            wq += c @ ((A @ z) @ z)
-            wl += c @ (B @ z)
+            wq = wq + c @ ((A @ z) @ z)
+            wl = wl + c @ (B @ z)
         w = np.zeros(6)
         w[act], w[4:] = wq, wl
         if not state:
