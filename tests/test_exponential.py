@@ -97,9 +97,10 @@ def test_energy_balance_closes_with_heat_entering_inside_steps(h):
     assert res.status == "ok"
     assert res.energy_error() < 1e-9 and res.heat_error() < 1e-9
     assert res.energy["thermal_work"][-1] != 0.0 and res.energy["external_work"][-1] != 0.0
-    # without the balance the works are not integrated, and the flight is the same
+    # without the balance the works are not integrated; the flight is the same to round-off
     quiet = fr.ExponentialMoreau(_two_contact_bar(), h).run(0.1, energy=False)
-    assert np.array_equal(quiet.impulse, res.impulse)
+    assert quiet.impulse.sum(axis=0) == pytest.approx(res.impulse.sum(axis=0), rel=1e-9)
+    assert quiet.energy == {} and np.abs(quiet.gap - res.gap).max() < 1e-9 * np.abs(res.gap).max()
 
 
 def test_paper_case_coarse_step_and_first_contact():

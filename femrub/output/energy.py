@@ -37,8 +37,13 @@ from .results import ENERGY_KEYS
 __all__ = ["BLOWUP_FACTOR", "EnergyMeter", "SCHEME_INTEGRALS"]
 
 #: per-step works and heats a scheme may compute itself (exactly) instead of the quadrature
-SCHEME_INTEGRALS = frozenset(
-    ("contact_work", "external_work", "thermal_work", "damping_work", "heat_load", "heat_outflow")
+SCHEME_INTEGRALS = (
+    "contact_work",
+    "external_work",
+    "thermal_work",
+    "damping_work",
+    "heat_load",
+    "heat_outflow",
 )
 
 # a balance residual this many times the energy exchanged so far is created from nothing

@@ -135,7 +135,7 @@ class Recorder:
             self.message = (
                 f"h = {h:.3g} s exceeds the stability limit {stability_limit:.3g} s of {scheme}"
             )
-        self._work: dict[str, np.ndarray] = {}
+        self._work, self._n_work = None, 0
         self.chunk = int(max(1, min(CHUNK_STEPS, CHUNK_VALUES // max(N, 1))))
         self.buf = np.empty((self.chunk + 1, N))
 
@@ -145,9 +145,10 @@ class Recorder:
 
         ``extra`` (a dict or ``None``) may hold the step's friction quantities
         (``friction_impulse``, ``heat``, ``state``: see ``Stepper._step``) and
-        any of :data:`~femrub.output.energy.SCHEME_INTEGRALS` (``contact_work``,
-        ``external_work``, ... in J), the step's work or heat as the scheme computed it
-        (impulses inside the step, exact flight); the energy balance then uses it.
+        ``contact_work`` (J), the step's contact work as the scheme computed it (impulses
+        inside the step), or ``works``, the step's works and heats (J) of
+        :data:`~femrub.output.energy.SCHEME_INTEGRALS` in that order (exact flight); the
+        energy balance then uses them.
         """
         n, buf, t, imp = self.n, self.buf, self.t, self.imp
         nc = self.model.n_contacts
@@ -177,8 +178,10 @@ class Recorder:
                         imp[i] = P
                     info = more[0] if more else None
                     if info:
-                        for k in SCHEME_INTEGRALS.intersection(info):  # the scheme's own
-                            self._work_rows(k)[i] = info[k]
+                        if "works" in info:  # the scheme's own works and heats
+                            self._work_rows(len(SCHEME_INTEGRALS))[i] = info["works"]
+                        elif "contact_work" in info:  # its own contact work
+                            self._work_rows(1)[i, 0] = info["contact_work"]
                         if "state" in info:
                             self._friction_rows(i, info)
                     if j == self.chunk or i == n:
@@ -209,11 +212,13 @@ class Recorder:
                 bar.close()
         return self._results(i_end, time.process_time() - cpu0)
 
-    def _work_rows(self, key: str) -> np.ndarray:
-        """Per-step work or heat ``key`` reported by the scheme (allocated on first use)."""
-        if key not in self._work:
-            self._work[key] = np.zeros(self.n + 1)
-        return self._work[key]
+    def _work_rows(self, k: int) -> np.ndarray:
+        """Per-step works and heats reported by the scheme (the first ``k`` of
+        :data:`~femrub.output.energy.SCHEME_INTEGRALS`; allocated on first use)."""
+        if self._work is None:
+            self._work = np.zeros((self.n + 1, len(SCHEME_INTEGRALS)))
+        self._n_work = max(self._n_work, k)
+        return self._work
 
     def _friction_rows(self, i: int, extra: dict) -> None:
         """Friction quantities of step ``i`` (see :meth:`Stepper._step`)."""
@@ -277,7 +282,10 @@ class Recorder:
         if self.meter is not None and m:
             friction = (self.imp_t[rows], self.heat[rows]) if self.has_friction else None
             with np.errstate(all="ignore"):
-                work = {k: v[rows] for k, v in self._work.items()} or None
+                work = None
+                if self._work is not None:
+                    keys = SCHEME_INTEGRALS[: self._n_work]
+                    work = {k: self._work[rows, j] for j, k in enumerate(keys)}
                 self.meter.update(i0, X, self.imp[rows], t[i0 : rows.stop], h, work, friction)
             bad = self.meter.blown_up(rows) if self.blowup_check else None
             if bad is not None:

@@ -42,7 +42,7 @@ from ..fem.linalg import Factorised
 from .base import Stepper
 from .events import EventLocation
 from .flows import FlowFamily
-from .work import LINEAR, QUADRATIC, WorkIntegrals
+from .work import WorkIntegrals
 
 __all__ = ["ExponentialMoreau", "MAX_COORDINATES"]
 
@@ -167,7 +167,7 @@ class ExponentialMoreau(EventLocation, Stepper):
             heats = [term.heat for term in m.loads]
             self._integrals = WorkIntegrals(self._flows, m.energy, powers, heats, GvT)
             self._Wth = None if m.energy.Wth is None else self._integrals.Wth
-        self._measure = self._integrals is not None
+        self._measure = False  # step() / iterate(): no meter to hand them to
 
     def _signal_values(self, t):
         """Load signals, then the casing's gap rates ``ġ0`` (moving casing, held contacts)."""
@@ -212,15 +212,14 @@ class ExponentialMoreau(EventLocation, Stepper):
         try:
             return super().run(t_end, energy=energy, **kwargs)
         finally:
-            self._measure = self._integrals is not None
+            self._measure = False
 
     def _advance(self):
         t, X, P, extra = super()._advance()
         out = {**(extra or {}), "contact_work": self._work}
         if self._measure:  # the scheme's exact integrals replace the meter's quadrature
-            w = self._w
-            out.update(zip(QUADRATIC + LINEAR, w.tolist()))
-            out["contact_work"] = self._work + w[3]
+            out["works"] = self._w  # SCHEME_INTEGRALS order, impulses' work added below
+            out["works"][0] += self._work
         return t, X, P, out
 
     def _step(self):
@@ -233,14 +232,18 @@ class ExponentialMoreau(EventLocation, Stepper):
         self._w = np.zeros(6)
         for n_events in range(MAX_EVENTS + 1):
             rest = None  # the integrals of the flight to the step end, when known
-            if a == 0.0:
+            if a == 0.0 and self._measure:  # the whole step and its integrals at once
+                Xe, PS, rest = self._integrals.flight(
+                    S, X, self._T01 @ b, self.probes, h / self.probes
+                )
+            elif a == 0.0:
                 Xe, PS = self._flows.flow(S, h)(X, self._T01 @ b)
             elif self._measure:  # after an event: the flight and its integrals at once
                 Xe, PS, rest = self._integrate(S, X, a, h, b, state=True)
             else:  # after an event: cached sub-step flows
                 Xe, PS = self._flows.advance(S, X, a, h, b, h / self.probes)
             if c is None:
-                self._w += self._integrate(S, X, a, h, b)
+                self._w += self._integrate(S, X, a, h, b) if rest is None else rest
                 return Xe, P
             ev = None
             if self.events and n_events < MAX_EVENTS:
@@ -287,13 +290,14 @@ class ExponentialMoreau(EventLocation, Stepper):
     def _impact(self, te, X, S, P, forced=None, plastic=None):
         """Newton impulses at time ``te`` (shared LCP); update ``P`` in place; new held set."""
         c = self.model.contact
-        g = c.gap(te, X)
-        if forced is None and not (g <= 0.0).any():  # nothing touches
+        touch = c.gap(te, X) <= 0.0
+        touch[list(S)] = False
+        if forced is None and not touch.any():  # no free contact touches
             return X, S
         gd = c.gap_velocity(te, X)
         held = np.zeros(c.n, dtype=bool)
         held[list(S)] = True
-        trigger = ~held & (g <= 0.0) & (gd < 0.0)
+        trigger = touch & (gd < 0.0)
         if forced is not None:
             trigger[forced] = gd[forced] < 0.0
         if not trigger.any():
@@ -309,7 +313,7 @@ class ExponentialMoreau(EventLocation, Stepper):
         Xn = X + (self._Zm + self._Zt * alpha) @ Pi
         self._work += float(Pi @ (c.structure_velocity(X) + c.structure_velocity(Xn))) / 2
         if self._measure and self._Wth is not None:  # a reduced model's expansion shapes jump
-            self._w[1] += float((Xn - X) @ self._Wth @ (Xn + X)) / 2
+            self._w[2] += float((Xn - X) @ self._Wth @ (Xn + X)) / 2
         P += Pi
         if not self._hold:
             return Xn, ()

@@ -248,6 +248,20 @@ class FlowFamily:
             out += lam[:, n:] @ u
         return out
 
+    def end_rows(self, S: tuple, GT: np.ndarray) -> tuple[np.ndarray, np.ndarray | None]:
+        """``(Ex, Eu)``: ``[Gᵀ X; λ_S] = Ex X + Eu u`` at a state ``X`` and load signals ``u``
+        (``Eu`` is ``None`` without held contacts or loads; cached)."""
+        key = ("ends", S)
+        if key not in self._probe:
+            _, _, lam = self.generator(S)
+            if lam is None:
+                self._probe[key] = (GT, None)
+            else:
+                n = self.L.shape[0]
+                Eu = np.vstack([np.zeros((GT.shape[0], lam.shape[1] - n)), lam[:, n:]])
+                self._probe[key] = (np.vstack([GT, lam[:, :n]]), Eu if Eu.shape[1] else None)
+        return self._probe[key]
+
     def probe(self, S: tuple, GT: np.ndarray, q: int) -> tuple[np.ndarray, np.ndarray]:
         """Gaps ``Gᵀ X`` and held multipliers ``λ_S`` at ``τ_j = j h / q``, j = 1 .. q − 1.
 

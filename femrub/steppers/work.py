@@ -35,7 +35,7 @@ from .flows import _FLUSH, LEVEL_MIN
 __all__ = ["QUADRATIC", "LINEAR", "WorkIntegrals"]
 
 #: the quadratic (works, J) and linear (heats, J) integrals, in this order
-QUADRATIC = ("external_work", "thermal_work", "damping_work", "contact_work")
+QUADRATIC = ("contact_work", "external_work", "thermal_work", "damping_work")
 LINEAR = ("heat_load", "heat_outflow")
 _TERMS = 8  # terms of the Taylor series of the integrals over short durations
 _FACTORIALS = np.array([math.factorial(k + 1) for k in range(_TERMS)], dtype=float)
@@ -67,6 +67,7 @@ class WorkIntegrals:
         self.outflow = np.asarray(energy.heat_outflow, dtype=float)
         self._levels: dict[tuple, tuple] = {}
         self._full: dict[tuple, tuple] = {}
+        self._flight: dict[tuple, tuple] = {}
 
     # -- forms on the augmented state -----------------------------------------------------------
     def forms(self, S: tuple, M: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -75,20 +76,20 @@ class WorkIntegrals:
         n, s, m0 = self.Pth.shape[0], len(S), self.powers.shape[1]
         N, nz = M.shape[0], n + s
         Q, C = np.zeros((4, N, N)), np.zeros((2, N))
-        if m0:
-            Q[0, :n, nz : nz + m0] = self.powers
-            C[0, nz : nz + m0] = self.heats
-        if self.Wth is None:
-            Q[1, :n, :n] = self.Pth
-        else:  # Ẋ = M[:n] z: the work on the state's rate
-            Q[1, :, :n] = M[:n].T @ self.Wth
-        Q[2, :n, :n] = self.Pd
         if S:  # λ_S = Λ z, structure velocity Gv_Sᵀ X
             _, _, lam = self.flows.generator(S)
             Lz = np.zeros((s, N))
             Lz[:, :n] = lam[:, :n]
             Lz[:, nz : nz + lam.shape[1] - n] = lam[:, n:]
-            Q[3, :, :n] = Lz.T @ self.GvT[list(S)]
+            Q[0, :, :n] = Lz.T @ self.GvT[list(S)]
+        if m0:
+            Q[1, :n, nz : nz + m0] = self.powers
+            C[0, nz : nz + m0] = self.heats
+        if self.Wth is None:
+            Q[2, :n, :n] = self.Pth
+        else:  # Ẋ = M[:n] z: the work on the state's rate
+            Q[2, :, :n] = M[:n].T @ self.Wth
+        Q[3, :n, :n] = self.Pd
         C[1, :n] = self.outflow
         return 0.5 * (Q + Q.transpose(0, 2, 1)), C
 
@@ -108,8 +109,9 @@ class WorkIntegrals:
             # Γ(τ) = Σ τ^{k+1}/(k+1)! A_k, A_{k+1} = Mᵀ A_k + A_k M
             # C J(τ) = Σ τ^{k+1}/(k+1)! C M^k
             A, B = [Q], [C]
-            for _ in range(_TERMS - 1):
-                A.append(M.T @ A[-1] + A[-1] @ M)
+            for _ in range(_TERMS - 1):  # A_k symmetric: Mᵀ A_k = (A_k M)ᵀ
+                AM = A[-1] @ M
+                A.append(AM + AM.transpose(0, 2, 1))
                 B.append(B[-1] @ M)
             A, B = np.stack(A), np.stack(B)
             size = np.array(
@@ -122,12 +124,15 @@ class WorkIntegrals:
             Y = []
             if lo < len(Z):  # the first level after the series' range, then doubling
                 g, j = self._van_loan(M, Q, C, tau[0]) if lo == 0 else _series(A, B, tau[lo])
-                N = M.shape[0]
+                N, kn = M.shape[0], Q.shape[0] * M.shape[0]
+                g = g.reshape(kn, N)  # the forms stacked: [Γ_1; Γ_2; …]
                 for Zi in Z[lo:]:
-                    y = np.vstack([g.reshape(-1, N), j, Zi])
+                    y = np.vstack([g, j, Zi])
                     y[np.abs(y) < _FLUSH] = 0.0  # no subnormal products (they are slow)
                     Y.append(y)
-                    g = g + Zi.T @ g @ Zi  # [0, 2τ] = [0, τ] and [τ, 2τ]
+                    # [0, 2τ] = [0, τ] and [τ, 2τ]: Γ + Zᵀ Γ Z, Zᵀ Γ Z = (Γ Z)ᵀ Z (Γ symmetric)
+                    gz = (g @ Zi).reshape(-1, N, N).transpose(0, 2, 1).reshape(kn, N)
+                    g = g + gz @ Zi
                     j = j + j @ Zi
             self._levels[key] = (Y, lo, act, A, B)
         return self._levels[key]
@@ -187,6 +192,14 @@ class WorkIntegrals:
 
     def step(self, S: tuple, z, q: int, unit: float) -> np.ndarray:
         """The integrals (6,) over a whole step ``h = q unit`` from ``z`` (one form each)."""
+        Y, act = self._step_forms(S, q, unit)
+        y, k_q = Y @ z, act.size
+        w = np.zeros(6)
+        w[act], w[4:] = y[: k_q * z.size].reshape(k_q, z.size) @ z, y[k_q * z.size :]
+        return w
+
+    def _step_forms(self, S: tuple, q: int, unit: float) -> tuple[np.ndarray, np.ndarray]:
+        """``[Γ(h) (non-zero forms); C J(h)]`` stacked, and the forms' indices (cached)."""
         key = (S, unit)
         if key not in self._full:
             Y, lo, act, A, B = self.levels(S, unit)
@@ -206,11 +219,34 @@ class WorkIntegrals:
                     j += je @ P
                     P = Z[i] @ P
             self._full[key] = (np.vstack([g.reshape(-1, N), j]), act)
-        Y, act = self._full[key]
-        y, k_q = Y @ z, act.size
-        w = np.zeros(6)
-        w[act], w[4:] = y[: k_q * z.size].reshape(k_q, z.size) @ z, y[k_q * z.size :]
-        return w
+        return self._full[key]
+
+    def flight(self, S: tuple, X, w, q: int, unit: float):
+        """A whole step ``h = q unit`` of held set ``S`` and its integrals in one product:
+        ``(X(h), P_S, integrals (6,))`` for the flow's inputs ``(X, w)``
+        (:class:`~.flows.Flow`; ``w_l = h^l s^(l)``)."""
+        key = (S, unit)
+        if key not in self._flight:
+            f = self.flows.flow(S, self.flows.h)
+            Y, act = self._step_forms(S, q, unit)
+            N, n, nz = Y.shape[1], f.n, f.Phi.shape[0]
+            n_in = n + f.Psi.shape[1]
+            E = np.zeros((N, n_in))  # z = E [X; w]: chain s^(l) = w_l / h^l, P_S = 0
+            E[:n, :n] = np.eye(n)
+            p1 = self.flows.degree + 1
+            scale = np.repeat(self.flows.h ** -np.arange(p1), f.Psi.shape[1] // p1)
+            E[nz:, n:] = np.diag(scale)
+            kn = act.size * N
+            gam = E.T @ Y[:kn].reshape(-1, N, N) @ E
+            big = np.vstack([np.hstack([f.Phi, f.Psi]), gam.reshape(-1, n_in), Y[kn:] @ E])
+            self._flight[key] = (big, act, n, nz)
+        big, act, n, nz = self._flight[key]
+        u = np.concatenate([X, w.ravel()])
+        y = big @ u
+        kn = act.size * u.size
+        out = np.zeros(6)
+        out[act], out[4:] = y[nz : nz + kn].reshape(-1, u.size) @ u, y[nz + kn :]
+        return y[:n], y[n:nz], out
 
 
 def _series(A, B, tau):
