@@ -34,7 +34,17 @@ from ..fem.linalg import compact
 from ..model.first_order import EnergyForms, FirstOrderModel
 from .results import ENERGY_KEYS
 
-__all__ = ["BLOWUP_FACTOR", "EnergyMeter"]
+__all__ = ["BLOWUP_FACTOR", "EnergyMeter", "SCHEME_INTEGRALS"]
+
+#: per-step works and heats a scheme may compute itself (exactly) instead of the quadrature
+SCHEME_INTEGRALS = (
+    "contact_work",
+    "external_work",
+    "thermal_work",
+    "damping_work",
+    "heat_load",
+    "heat_outflow",
+)
 
 # a balance residual this many times the energy exchanged so far is created from nothing
 # (a physical runaway keeps the balance closed): numerical blow-up
@@ -97,8 +107,9 @@ class EnergyMeter:
     def update(self, i0, X, impulse, t, h, work=None, friction=None) -> None:
         """Fill rows ``i0 + 1 .. i0 + m`` from a block of states (see class docstring).
 
-        ``work`` (m,): the contact work of each step as the scheme computed it (impulses
-        given inside the step, e.g. the exponential stepper); default ``Pᵀ Gvᵀ X_m``.
+        ``work``: ``{key: (m,)}``, the works and heats (:data:`SCHEME_INTEGRALS`) of each
+        step as the scheme computed them (impulses given inside the step, exact flight: the
+        exponential stepper); the others by the quadratures above (contact: ``Pᵀ Gvᵀ X_m``).
         ``friction``: ``(P_t (m, n_c, 2), blade heat (m, n_c))`` of the steps, or ``None``.
         """
         f, d = self.forms, self.data
@@ -118,9 +129,12 @@ class EnergyMeter:
             WX = Xm @ f.Wth.T if isinstance(f.Wth, np.ndarray) else (f.Wth @ Xm.T).T
             inc["thermal_work"] = np.einsum("ij,ij->i", dX, np.asarray(WX))
         inc["damping_work"] = h * self._quad(f.Pd, Xm)
+        own = work or {}
         c = self.contact
         if c is not None:
-            dwc = np.einsum("ij,ij->i", impulse, c.structure_velocity(Xm)) if work is None else work
+            dwc = own.get("contact_work")
+            if dwc is None:
+                dwc = np.einsum("ij,ij->i", impulse, c.structure_velocity(Xm))
             inc["contact_work"] = dwc
             inc["impact_dissipation"] = -dwc
             alpha = np.broadcast_to(c.alpha_at(t[1:]), impulse.shape)
@@ -138,6 +152,9 @@ class EnergyMeter:
                 if c.heat_law == "power":
                     inc["heat_to_casing"] = inc.get("friction_work", 0.0) - inc["friction_heat"]
         inc["heat_outflow"] = h * (Xm @ f.heat_outflow)
+        for k in ("external_work", "thermal_work", "damping_work", "heat_load", "heat_outflow"):
+            if k in own:
+                inc[k] = own[k]
         for k, v in inc.items():
             d[k][rows] = d[k][i0] + np.cumsum(v)
         d["kinetic"][rows] = 0.5 * self._quad(f.Qk, X[1:])

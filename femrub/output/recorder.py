@@ -32,7 +32,7 @@ from tqdm.auto import tqdm
 
 from ..fem.linalg import compact
 from ..model.first_order import FirstOrderModel
-from .energy import EnergyMeter
+from .energy import SCHEME_INTEGRALS, EnergyMeter
 from .limits import limit_hit as _limit_hit
 from .limits import limit_index as _limit_index
 from .results import Results
@@ -85,8 +85,8 @@ class Recorder:
     on_rows : callback ``f(arrays)`` fed each checked block of rows, ``{name: array}`` as
         :meth:`per_step` gives them (row 0 comes with the first block).
     label : name of the run (progress bar and ``Results.info``).
-    blowup_check : stop on energy created from nothing (off for schemes whose step is exact
-        between events: the meter's trapezoidal work integrals are then the only error).
+    blowup_check : stop on energy created from nothing (a scheme may turn it off when the
+        meter's quadratures, not the scheme, would open its balance).
     """
 
     def __init__(
@@ -137,7 +137,7 @@ class Recorder:
             self.message = (
                 f"h = {h:.3g} s exceeds the stability limit {stability_limit:.3g} s of {scheme}"
             )
-        self._work = None
+        self._work, self._n_work = None, 0
         self.chunk = int(max(1, min(CHUNK_STEPS, CHUNK_VALUES // max(N, 1))))
         self.buf = np.empty((self.chunk + 1, N))
 
@@ -153,10 +153,10 @@ class Recorder:
         the friction rows of :meth:`_friction_rows`); ``error``, an exception or ``None``,
         ends the run as ``advance`` raising it would.
 
-        ``extra`` (a dict or ``None``) may hold the step's friction quantities
-        (``friction_impulse``, ``heat``, ``state``: see ``Stepper._step``) and
-        ``contact_work``, the contact work of the step (J) as the scheme computed it
-        (impulses inside the step); the energy balance then uses it.
+        ``extra`` (dict or ``None``): the step's friction quantities (``friction_impulse``,
+        ``heat``, ``state``: ``Stepper._step``) and ``contact_work`` (J, impulses inside the
+        step) or ``works`` (J, :data:`~femrub.output.energy.SCHEME_INTEGRALS` in order, exact
+        flight) as the scheme computed them; the energy balance then uses them.
         """
         n, buf, t, imp = self.n, self.buf, self.t, self.imp
         nc = self.model.n_contacts
@@ -201,8 +201,10 @@ class Recorder:
                             imp[i] = P
                         info = more[0] if more else None
                         if info:
-                            if "contact_work" in info:  # the scheme's own contact work
-                                self._work_rows()[i] = info["contact_work"]
+                            if "works" in info:  # the scheme's own works and heats
+                                self._work_rows(len(SCHEME_INTEGRALS))[i] = info["works"]
+                            elif "contact_work" in info:  # its own contact work
+                                self._work_rows(1)[i, 0] = info["contact_work"]
                             if "state" in info:
                                 self._friction_rows(i, info)
                     if j == self.chunk or i == n:
@@ -233,10 +235,12 @@ class Recorder:
                 bar.close()
         return self._results(i_end, time.process_time() - cpu0)
 
-    def _work_rows(self) -> np.ndarray:
-        """Per-step contact work reported by the scheme (allocated on first use)."""
+    def _work_rows(self, k: int) -> np.ndarray:
+        """Per-step works and heats reported by the scheme (the first ``k`` of
+        :data:`~femrub.output.energy.SCHEME_INTEGRALS`; allocated on first use)."""
         if self._work is None:
-            self._work = np.zeros(self.n + 1)
+            self._work = np.zeros((self.n + 1, len(SCHEME_INTEGRALS)))
+        self._n_work = max(self._n_work, k)
         return self._work
 
     def _friction_rows(self, i: int, extra: dict) -> None:
@@ -301,7 +305,10 @@ class Recorder:
         if self.meter is not None and m:
             friction = (self.imp_t[rows], self.heat[rows]) if self.has_friction else None
             with np.errstate(all="ignore"):
-                work = None if self._work is None else self._work[rows]
+                work = None
+                if self._work is not None:
+                    keys = SCHEME_INTEGRALS[: self._n_work]
+                    work = {k: self._work[rows, j] for j, k in enumerate(keys)}
                 self.meter.update(i0, X, self.imp[rows], t[i0 : rows.stop], h, work, friction)
             bad = self.meter.blown_up(rows) if self.blowup_check else None
             if bad is not None:

@@ -128,35 +128,30 @@ class EventLocation:
 
     def _quiet(self, S, Xa, Xe, b) -> bool:
         """A whole step without event: no free gap falls below ``min(g(0), 0)`` and no held
-        multiplier is negative on the probe grid (the common case, checked with one product
-        of the probe rows)."""
+        multiplier is negative on the probe grid and at the step's ends (the common case,
+        checked with one product of the probe rows and one of the end rows)."""
         c, t, h, q, flows = self.model.contact, self.t, self.h, self.probes, self._flows
-        g0, g1 = c.gap(t, Xa), c.gap(t + h, Xe)
-        ref = np.minimum(g0, 0.0)
-        free = np.ones(c.n, dtype=bool)
-        if S:
-            idx = list(S)
-            free[idx] = False
-            ref[idx] = -np.inf
-            if (flows.multiplier(S, Xa, b[0]) < 0.0).any():
-                return False
-            if (flows.multiplier(S, Xe, b.sum(axis=0)) < 0.0).any():
-                return False
-        if (g1 < ref).any():
-            return False
-        if q == 1:
-            return True
-        Rx, Rb = flows.probe(S, c.GT, q)
-        V = Rx @ Xa
-        if Rb.shape[1]:
-            V += Rb @ b.ravel()
-        V = V.reshape(q - 1, -1)
+        Ex, Eu = flows.end_rows(S, c.GT)
+        ends = np.vstack([Xa, Xe]) @ Ex.T  # [gaps; multipliers] at 0 and h, gap0 aside
+        if Eu is not None:
+            ends += np.vstack([b[0], b.sum(axis=0)]) @ Eu.T
+        if q > 1:
+            Rx, Rb = flows.probe(S, c.GT, q)
+            V = Rx @ Xa
+            if Rb.shape[1]:
+                V += Rb @ b.ravel()
+            V = np.vstack([ends[:1], V.reshape(q - 1, -1), ends[1:]])
+        else:
+            V = ends
         gv = V[:, : c.n]
         if callable(c.gap0):
-            gv += c.gap_at(t + (h / q) * np.arange(1, q))
+            gv += c.gap_at(t + (h / q) * np.arange(q + 1))
         else:
             gv += c.gap0
-        return not ((gv < ref).any() or (V[:, c.n :] < 0.0).any())
+        ref = np.minimum(gv[0], 0.0)
+        if S:
+            ref[list(S)] = -np.inf
+        return not ((gv[1:] < ref).any() or (V[:, c.n :] < 0.0).any())
 
     def _root(self, S, f, lo, hi, X_lo, b):
         """First zero of ``f`` in ``(lo, hi]`` on the exact flow from ``(lo, X_lo)``

@@ -16,7 +16,8 @@ impulses solve the θ-method's LCP with the same shared solve
 
 The kinetic energy changes by ``Pᵀ (ġ⁻ + ġ⁺) / 2 = −(1 − e) / (2 (1 + e)) Pᵀ W P <= 0``
 (fixed obstacle) and the exact flight neither creates nor dissipates energy: no step creates
-energy for e <= 1. This contact work is handed to the energy meter.
+energy for e <= 1. This contact work, and the works and heats of the flights integrated
+exactly on them (:mod:`~.work`), are handed to the energy meter.
 
 Events (``events=True``): exact gaps and held multipliers are checked at ``probes`` points
 per step; at the first sign change the time is found on the exact flow
@@ -41,6 +42,7 @@ from ..fem.linalg import Factorised
 from .base import Stepper
 from .events import EventLocation
 from .flows import FlowFamily
+from .work import WorkIntegrals
 
 __all__ = ["ExponentialMoreau", "MAX_COORDINATES"]
 
@@ -73,9 +75,6 @@ class ExponentialMoreau(EventLocation, Stepper):
     """
 
     name = "exponential"
-    # exact between events: nothing to blow up; over steps longer than the structure's
-    # periods the meter's trapezoidal work integrals (not the scheme) open the balance
-    blowup_check = False
     locates_events = True
 
     def __init__(
@@ -157,6 +156,18 @@ class ExponentialMoreau(EventLocation, Stepper):
         self._S: tuple = ()  # held contacts
         self._warm = None
         self._work = 0.0
+        # exact works and heats of the energy balance (with run(energy=True))
+        self._integrals = self._Wth = None
+        if m.energy is not None:
+            powers = (
+                np.column_stack([term.power for term in m.loads])
+                if m.loads
+                else np.zeros((m.n_dofs, 0))
+            )
+            heats = [term.heat for term in m.loads]
+            self._integrals = WorkIntegrals(self._flows, m.energy, powers, heats, GvT)
+            self._Wth = None if m.energy.Wth is None else self._integrals.Wth
+        self._measure = False  # step() / iterate(): no meter to hand them to
 
     def _signal_values(self, t):
         """Load signals, then the casing's gap rates ``ġ0`` (moving casing, held contacts)."""
@@ -194,9 +205,22 @@ class ExponentialMoreau(EventLocation, Stepper):
         return ((i * sigma ** (i - 1)) @ b[1:]) / self.h
 
     # -- one step ------------------------------------------------------------------------------
+    def run(self, t_end, *, energy: bool = True, **kwargs):
+        """:meth:`Stepper.run <femrub.steppers.base.Stepper.run>`; the exact works and heats
+        of the energy balance are integrated only when it is kept (``energy``)."""
+        self._measure = energy and self._integrals is not None
+        try:
+            return super().run(t_end, energy=energy, **kwargs)
+        finally:
+            self._measure = False
+
     def _advance(self):
         t, X, P, extra = super()._advance()
-        return t, X, P, {**(extra or {}), "contact_work": self._work}
+        out = {**(extra or {}), "contact_work": self._work}
+        if self._measure:  # the scheme's exact integrals replace the meter's quadrature
+            out["works"] = self._w  # SCHEME_INTEGRALS order, impulses' work added below
+            out["works"][0] += self._work
+        return t, X, P, out
 
     def _step(self):
         h, t, c = self.h, self.t, self.model.contact
@@ -205,28 +229,37 @@ class ExponentialMoreau(EventLocation, Stepper):
         P = np.zeros(self.model.n_contacts)
         hits = np.zeros(self.model.n_contacts, dtype=int)
         self._work = 0.0
+        self._w = np.zeros(6)
         for n_events in range(MAX_EVENTS + 1):
-            if a == 0.0:
+            rest = None  # the integrals of the flight to the step end, when known
+            if a == 0.0 and self._measure:  # the whole step and its integrals at once
+                Xe, PS, rest = self._integrals.flight(
+                    S, X, self._T01 @ b, self.probes, h / self.probes
+                )
+            elif a == 0.0:
                 Xe, PS = self._flows.flow(S, h)(X, self._T01 @ b)
+            elif self._measure:  # after an event: the flight and its integrals at once
+                Xe, PS, rest = self._integrate(S, X, a, h, b, state=True)
             else:  # after an event: cached sub-step flows
                 Xe, PS = self._flows.advance(S, X, a, h, b, h / self.probes)
             if c is None:
+                self._w += self._integrate(S, X, a, h, b) if rest is None else rest
                 return Xe, P
             ev = None
             if self.events and n_events < MAX_EVENTS:
                 ev = self._event(S, X, a, Xe, b)
             if ev is None:
                 break
-            a, kind, i, Xn, PSa = ev
-            self._held_work(S, PSa, X, Xn)
-            X = Xn
+            tau, kind, i, Xn, PSa = ev
+            self._w += self._integrate(S, X, a, tau, b)
+            a, X = tau, Xn
             P[list(S)] += PSa
             if kind == "release":
                 S = tuple(j for j in S if j != i)
             else:  # a third bounce of one contact in a step: Zeno, end it plastically
                 hits[i] += 1
                 X, S = self._impact(t + a, X, S, P, forced=i, plastic=hits >= ZENO_HITS)
-        self._held_work(S, PS, X, Xe)
+        self._w += self._integrate(S, X, a, h, b) if rest is None else rest
         X = Xe
         P[list(S)] += PS
         if S and not self.events:  # releases at step ends
@@ -236,25 +269,35 @@ class ExponentialMoreau(EventLocation, Stepper):
         self._S = S
         return X, P
 
-    def _held_work(self, S, PS, X0, X1):
-        """Work of the held contacts' impulse on the structure (moving casing: not zero),
-        with their mean structure velocity over the segment."""
-        if S:
-            c, idx = self.model.contact, list(S)
-            v = c.structure_velocity(X0)[idx] + c.structure_velocity(X1)[idx]
-            self._work += float(PS @ v) / 2
+    def _integrate(self, S, X, a, tau, b, state=False):
+        """The exact works and heats (6,) of the flight of ``S`` from ``(a, X)`` to ``tau``
+        (:class:`~.work.WorkIntegrals`; held contacts' work included); with ``state`` also
+        the flight itself, ``(X(τ), P_S, integrals)`` (composed as
+        :meth:`~.flows.FlowFamily.advance`)."""
+        z = np.concatenate([X, np.zeros(len(S)), self._flows.chain(b, a / self.h)])
+        unit = self.h / self.probes
+        if state:
+            z, w = self._integrals.over(S, z, tau - a, unit, state=True)
+            n = self.model.n_dofs
+            return z[:n], z[n : n + len(S)], w
+        if not self._measure or tau <= a:
+            return 0.0
+        if a == 0.0 and tau == self.h:
+            return self._integrals.step(S, z, self.probes, unit)
+        return self._integrals.over(S, z, tau - a, unit)
 
     # -- impulses ------------------------------------------------------------------------------
     def _impact(self, te, X, S, P, forced=None, plastic=None):
         """Newton impulses at time ``te`` (shared LCP); update ``P`` in place; new held set."""
         c = self.model.contact
-        g = c.gap(te, X)
-        if forced is None and not (g <= 0.0).any():  # nothing touches
+        touch = c.gap(te, X) <= 0.0
+        touch[list(S)] = False
+        if forced is None and not touch.any():  # no free contact touches
             return X, S
         gd = c.gap_velocity(te, X)
         held = np.zeros(c.n, dtype=bool)
         held[list(S)] = True
-        trigger = ~held & (g <= 0.0) & (gd < 0.0)
+        trigger = touch & (gd < 0.0)
         if forced is not None:
             trigger[forced] = gd[forced] < 0.0
         if not trigger.any():
@@ -269,6 +312,8 @@ class ExponentialMoreau(EventLocation, Stepper):
         self._warm = Pi > 0.0
         Xn = X + (self._Zm + self._Zt * alpha) @ Pi
         self._work += float(Pi @ (c.structure_velocity(X) + c.structure_velocity(Xn))) / 2
+        if self._measure and self._Wth is not None:  # a reduced model's expansion shapes jump
+            self._w[2] += float((Xn - X) @ self._Wth @ (Xn + X)) / 2
         P += Pi
         if not self._hold:
             return Xn, ()

@@ -49,8 +49,9 @@ def shift(b: np.ndarray, alpha: float, delta: float) -> np.ndarray:
     """
     p = b.shape[0] - 1
     C, E = _binomials(p)
-    T = C * np.where(E >= 0, float(alpha) ** np.maximum(E, 0), 0.0)
-    T *= (float(delta) ** np.arange(p + 1))[:, None]
+    T = C * (float(alpha) ** np.arange(p + 1))[E]  # C = 0 where i < l
+    if delta != 1.0:
+        T *= (float(delta) ** np.arange(p + 1))[:, None]
     return T @ b
 
 
@@ -58,7 +59,7 @@ _BINOMIALS: dict[int, tuple] = {}
 
 
 def _binomials(p: int) -> tuple[np.ndarray, np.ndarray]:
-    """``C[l, i] = C(i, l) l!`` and the exponents ``E[l, i] = i − l``."""
+    """``C[l, i] = C(i, l) l!`` and the exponents ``E[l, i] = max(i − l, 0)``."""
     if p not in _BINOMIALS:
         i, j = np.meshgrid(np.arange(p + 1), np.arange(p + 1))
         C = np.array(
@@ -68,7 +69,7 @@ def _binomials(p: int) -> tuple[np.ndarray, np.ndarray]:
             ],
             dtype=float,
         )
-        _BINOMIALS[p] = (C, i - j)
+        _BINOMIALS[p] = (C, np.maximum(i - j, 0))
     return _BINOMIALS[p]
 
 
@@ -115,6 +116,7 @@ class FlowFamily:
     def __init__(self, L, G, AinvH, GvT, h, degree, n_acc=0):
         self.L, self.G, self.AinvH, self.GvT, self.n_acc = L, G, AinvH, GvT, n_acc
         self.h, self.degree = h, degree
+        self._chain0 = np.array([math.factorial(i) / h**i for i in range(degree + 1)])
         self._gen: dict[tuple, tuple] = {}
         self._flows: dict[tuple, Flow] = {}  # (S, τ) -> Flow
         self._probe: dict[tuple, tuple] = {}
@@ -163,15 +165,8 @@ class FlowFamily:
         ``D_{e+1} = 2 D_e + D_e²``: no cancellation against the identity)."""
         key = (S, unit)
         if key not in self._levels:
-            K, E, _ = self.generator(S)
-            nz, m, p = K.shape[0], E.shape[1], self.degree
-            N = nz + (p + 1) * m
-            M = np.zeros((N, N))
-            M[:nz, :nz] = K
-            M[:nz, nz : nz + m] = E
-            for i in range(p):
-                r = nz + i * m
-                M[r : r + m, r + m : r + 2 * m] = np.eye(m)
+            M = self.generator_z(S)
+            N = M.shape[0]
             e_max = max(math.ceil(math.log2(self.h / unit)), 0) + 1
             T = unit * 2.0**LEVEL_MIN * M
             T[np.abs(T) < _FLUSH] = 0.0
@@ -193,9 +188,24 @@ class FlowFamily:
             self._levels[key] = out
         return self._levels[key]
 
+    def generator_z(self, S: tuple) -> np.ndarray:
+        """``M`` of the augmented state ``z = [X; P_S; s, ṡ, …, s^(p)]``: ``ż = M z``."""
+        K, E, _ = self.generator(S)
+        nz, m, p = K.shape[0], E.shape[1], self.degree
+        N = nz + (p + 1) * m
+        M = np.zeros((N, N))
+        M[:nz, :nz] = K
+        M[:nz, nz : nz + m] = E
+        for i in range(p):
+            r = nz + i * m
+            M[r : r + m, r + m : r + 2 * m] = np.eye(m)
+        return M
+
     def chain(self, b, sigma: float) -> np.ndarray:
         """Load derivatives ``[s, ṡ, …, s^(p)]`` (physical units) at the fraction ``sigma`` of
         the step, for the step's polynomial ``s = Σ b_i σ^i``."""
+        if sigma == 0.0:  # s^(l)(0) = l! b_l / h^l
+            return (b * self._chain0[: b.shape[0], None]).ravel()
         w = shift(b, sigma, 1.0)  # w_l = d^l s / dσ^l
         return (w / (self.h ** np.arange(b.shape[0]))[:, None]).ravel()
 
@@ -237,6 +247,20 @@ class FlowFamily:
         if lam.shape[1] > n:
             out += lam[:, n:] @ u
         return out
+
+    def end_rows(self, S: tuple, GT: np.ndarray) -> tuple[np.ndarray, np.ndarray | None]:
+        """``(Ex, Eu)``: ``[Gᵀ X; λ_S] = Ex X + Eu u`` at a state ``X`` and load signals ``u``
+        (``Eu`` is ``None`` without held contacts or loads; cached)."""
+        key = ("ends", S)
+        if key not in self._probe:
+            _, _, lam = self.generator(S)
+            if lam is None:
+                self._probe[key] = (GT, None)
+            else:
+                n = self.L.shape[0]
+                Eu = np.vstack([np.zeros((GT.shape[0], lam.shape[1] - n)), lam[:, n:]])
+                self._probe[key] = (np.vstack([GT, lam[:, :n]]), Eu if Eu.shape[1] else None)
+        return self._probe[key]
 
     def probe(self, S: tuple, GT: np.ndarray, q: int) -> tuple[np.ndarray, np.ndarray]:
         """Gaps ``Gᵀ X`` and held multipliers ``λ_S`` at ``τ_j = j h / q``, j = 1 .. q − 1.

@@ -1,0 +1,255 @@
+"""Exact work and heat integrals along the exact flows of :mod:`~.flows`.
+
+Between events the augmented state ``z = [X; P_S; s, ṡ, …, s^(p)]`` of a held set ``S`` obeys
+``ż = M z`` (:meth:`~.flows.FlowFamily.levels`). Every power of the energy balance
+(:mod:`femrub.output.energy`) is a quadratic form of ``z`` and every heat rate a linear one::
+
+    external   Σ_j s_j p_jᵀ X               thermal   Xᵀ P_th X   (or Ẋᵀ W_th X, reduced)
+    damping    Xᵀ P_d X                     held contacts  λ_Sᵀ Gv_Sᵀ X   (λ_S = Λ z)
+    heat load  Σ_j s_j q_j                  heat outflow   rᵀ X
+
+so their integrals over ``[0, τ]`` are exact (Van Loan)::
+
+    ∫ zᵀ Q z = z(0)ᵀ Γ(τ) z(0),   Γ(τ) = ∫_0^τ e^{Mᵀσ} Q e^{Mσ} dσ,
+    ∫ cᵀ z   = cᵀ J(τ) z(0),      J(τ) = ∫_0^τ e^{Mσ} dσ,
+
+on the same dyadic levels ``τ_e = unit 2^e`` as the flows: ``Γ_{e+1} = Γ_e + Z_eᵀ Γ_e Z_e``,
+``J_{e+1} = J_e + J_e Z_e``, from the first level beyond the range where their Taylor series
+(eight terms) is exact to round-off; shorter durations use the series directly (a model too
+stiff for it at the smallest level starts from Van Loan's exponential there). A
+segment of any length is composed like its state (:meth:`WorkIntegrals.over`). The exact
+flight then closes the balance: the meter's midpoint rule does not see the structure's
+oscillation inside a step, nor heat entering at an event inside it.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import scipy.linalg as sla
+import scipy.sparse as sp
+
+from .flows import _FLUSH, LEVEL_MIN
+
+__all__ = ["QUADRATIC", "LINEAR", "WorkIntegrals"]
+
+#: the quadratic (works, J) and linear (heats, J) integrals, in this order
+QUADRATIC = ("contact_work", "external_work", "thermal_work", "damping_work")
+LINEAR = ("heat_load", "heat_outflow")
+_TERMS = 8  # terms of the Taylor series of the integrals over short durations
+_FACTORIALS = np.array([math.factorial(k + 1) for k in range(_TERMS)], dtype=float)
+
+
+def _dense(Q):
+    return np.asarray(Q.toarray() if sp.issparse(Q) else Q, dtype=float)
+
+
+class WorkIntegrals:
+    """Exact integrals of the energy balance's powers and heat rates on the flows of a
+    :class:`~.flows.FlowFamily` (see module docstring).
+
+    Parameters
+    ----------
+    flows : the stepper's :class:`~.flows.FlowFamily`.
+    energy : the model's :class:`~femrub.model.first_order.EnergyForms`.
+    powers : (N, m0) load power vectors ``p_j``; ``heats`` (m0,) their heat ``q_j``.
+    GvT : (n_c, N) gap-velocity rows (held contacts' work), or ``None``.
+    """
+
+    def __init__(self, flows, energy, powers, heats, GvT=None):
+        self.flows, self.GvT = flows, GvT
+        self.Pth = _dense(energy.Pth)
+        self.Wth = None if energy.Wth is None else _dense(energy.Wth)
+        self.Pd = _dense(energy.Pd)
+        self.damped = bool(np.any(self.Pd))
+        self.powers, self.heats = powers, np.asarray(heats, dtype=float)
+        self.outflow = np.asarray(energy.heat_outflow, dtype=float)
+        self._levels: dict[tuple, tuple] = {}
+        self._full: dict[tuple, tuple] = {}
+        self._flight: dict[tuple, tuple] = {}
+
+    # -- forms on the augmented state -----------------------------------------------------------
+    def forms(self, S: tuple, M: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """``(Q (4, N, N), C (2, N))``: the powers and heat rates of :data:`QUADRATIC` and
+        :data:`LINEAR` on ``z`` of held set ``S`` (``M``: its generator)."""
+        n, s, m0 = self.Pth.shape[0], len(S), self.powers.shape[1]
+        N, nz = M.shape[0], n + s
+        Q, C = np.zeros((4, N, N)), np.zeros((2, N))
+        if S:  # λ_S = Λ z, structure velocity Gv_Sᵀ X
+            _, _, lam = self.flows.generator(S)
+            Lz = np.zeros((s, N))
+            Lz[:, :n] = lam[:, :n]
+            Lz[:, nz : nz + lam.shape[1] - n] = lam[:, n:]
+            Q[0, :, :n] = Lz.T @ self.GvT[list(S)]
+        if m0:
+            Q[1, :n, nz : nz + m0] = self.powers
+            C[0, nz : nz + m0] = self.heats
+        if self.Wth is None:
+            Q[2, :n, :n] = self.Pth
+        else:  # Ẋ = M[:n] z: the work on the state's rate
+            Q[2, :, :n] = M[:n].T @ self.Wth
+        Q[3, :n, :n] = self.Pd
+        C[1, :n] = self.outflow
+        return 0.5 * (Q + Q.transpose(0, 2, 1)), C
+
+    def levels(self, S: tuple, unit: float) -> tuple:
+        """``(Y, lo, forms, A, B)`` of held set ``S`` (cached): per level ``e >= lo`` of
+        :meth:`~.flows.FlowFamily.levels` the stacked ``[Γ_e; C J_e; Z_e]`` (one product per
+        level in :meth:`over`; ``Γ`` of the non-zero ``forms`` only), and the Taylor
+        coefficients ``A_k, C M^k`` (k < :data:`_TERMS`) that give the integrals over any
+        duration below ``unit 2^lo`` to round-off."""
+        key = (S, unit)
+        if key not in self._levels:
+            Z = self.flows.levels(S, unit)
+            M = self.flows.generator_z(S)
+            Q, C = self.forms(S, M)
+            act = np.flatnonzero(np.any(Q, axis=(1, 2)))  # forms that are not zero
+            Q = Q[act]
+            # Γ(τ) = Σ τ^{k+1}/(k+1)! A_k, A_{k+1} = Mᵀ A_k + A_k M
+            # C J(τ) = Σ τ^{k+1}/(k+1)! C M^k
+            A, B = [Q], [C]
+            for _ in range(_TERMS - 1):  # A_k symmetric: Mᵀ A_k = (A_k M)ᵀ
+                AM = A[-1] @ M
+                A.append(AM + AM.transpose(0, 2, 1))
+                B.append(B[-1] @ M)
+            A, B = np.stack(A), np.stack(B)
+            size = np.array(
+                [max(np.max(np.abs(a), initial=0.0), np.max(np.abs(b))) for a, b in zip(A, B)]
+            )
+            tau = unit * 2.0 ** np.arange(LEVEL_MIN, LEVEL_MIN + len(Z))
+            # the series' last term is round-off against its first up to level lo - 1
+            ok = tau ** (_TERMS - 1) / _FACTORIALS[-1] * size[-1] <= 1e-16 * size[0]
+            lo = len(Z) if ok.all() else int(np.argmin(ok))
+            Y = []
+            if lo < len(Z):  # the first level after the series' range, then doubling
+                g, j = self._van_loan(M, Q, C, tau[0]) if lo == 0 else _series(A, B, tau[lo])
+                N, kn = M.shape[0], Q.shape[0] * M.shape[0]
+                g = g.reshape(kn, N)  # the forms stacked: [Γ_1; Γ_2; …]
+                for Zi in Z[lo:]:
+                    y = np.vstack([g, j, Zi])
+                    y[np.abs(y) < _FLUSH] = 0.0  # no subnormal products (they are slow)
+                    Y.append(y)
+                    # [0, 2τ] = [0, τ] and [τ, 2τ]: Γ + Zᵀ Γ Z, Zᵀ Γ Z = (Γ Z)ᵀ Z (Γ symmetric)
+                    gz = (g @ Zi).reshape(-1, N, N).transpose(0, 2, 1).reshape(kn, N)
+                    g = g + gz @ Zi
+                    j = j + j @ Zi
+            self._levels[key] = (Y, lo, act, A, B)
+        return self._levels[key]
+
+    @staticmethod
+    def _van_loan(M, Q, C, tau):
+        """``Γ(τ)`` (per form) and ``C J(τ)`` by the exponentials of block matrices."""
+        N = M.shape[0]
+        E = sla.expm(tau * M)
+        gam = np.empty_like(Q)
+        for k, Qk in enumerate(Q):
+            big = np.zeros((2 * N, 2 * N))
+            big[:N, :N], big[:N, N:], big[N:, N:] = -tau * M.T, tau * Qk, tau * M
+            gam[k] = E.T @ sla.expm(big)[:N, N:]
+        big = np.zeros((2 * N, 2 * N))
+        big[:N, :N], big[:N, N:] = tau * M, tau * np.eye(N)
+        return 0.5 * (gam + gam.transpose(0, 2, 1)), C @ sla.expm(big)[:N, N:]
+
+    # -- integrals over segments ----------------------------------------------------------------
+    def over(self, S: tuple, z, rest: float, unit: float, state: bool = False):
+        """The integrals (6,) of :data:`QUADRATIC` + :data:`LINEAR` over ``rest`` from ``z``,
+        on the segments of :meth:`~.flows.FlowFamily.advance_z` (binary expansion of
+        ``rest / unit`` down to ``2^LEVEL_MIN``): its levels from ``lo`` up, then the series
+        for the rest. With ``state``: ``(z(rest), integrals)``, ``z`` composed exactly as
+        :meth:`~.flows.FlowFamily.advance_z` does."""
+        Y, lo, act, A, B = self.levels(S, unit)
+        N, kn = z.size, act.size * z.size
+        k = int(rest / unit * 2.0**-LEVEL_MIN * (1.0 + 1e-12)) if rest > 0.0 else 0
+        k = min(k, (1 << (lo + len(Y))) - 1)
+        ys, zs = [], []  # per level: [Γ_e z; C J_e z; Z_e z] and z (one product each)
+        while k >> lo:
+            e = k.bit_length() - 1
+            zs.append(z)
+            ys.append(Y[e - lo] @ z)
+            z = ys[-1][kn + 2 :]
+            k ^= 1 << e
+        wq, wl = np.zeros(act.size), np.zeros(2)
+        if ys:
+            ys, zs = np.array(ys), np.array(zs)
+            wq = np.einsum("bkn,bn->k", ys[:, :kn].reshape(len(zs), -1, N), zs)
+            wl = ys[:, kn : kn + 2].sum(axis=0)
+        if k:
+            d = k * unit * 2.0**LEVEL_MIN
+            c = d ** np.arange(1, _TERMS + 1) / _FACTORIALS
+            wq = wq + c @ ((A @ z) @ z)
+            wl = wl + c @ (B @ z)
+        w = np.zeros(6)
+        w[act], w[4:] = wq, wl
+        if not state:
+            return w
+        Z = self.flows.levels(S, unit)
+        while k:
+            e = k.bit_length() - 1
+            z = Z[e] @ z
+            k ^= 1 << e
+        return z, w
+
+    def step(self, S: tuple, z, q: int, unit: float) -> np.ndarray:
+        """The integrals (6,) over a whole step ``h = q unit`` from ``z`` (one form each)."""
+        Y, act = self._step_forms(S, q, unit)
+        y, k_q = Y @ z, act.size
+        w = np.zeros(6)
+        w[act], w[4:] = y[: k_q * z.size].reshape(k_q, z.size) @ z, y[k_q * z.size :]
+        return w
+
+    def _step_forms(self, S: tuple, q: int, unit: float) -> tuple[np.ndarray, np.ndarray]:
+        """``[Γ(h) (non-zero forms); C J(h)]`` stacked, and the forms' indices (cached)."""
+        key = (S, unit)
+        if key not in self._full:
+            Y, lo, act, A, B = self.levels(S, unit)
+            Z = self.flows.levels(S, unit)
+            N, k_q = Z[0].shape[0], act.size
+            g, j = np.zeros((k_q, N, N)), np.zeros((2, N))
+            P = np.eye(N)  # the flow over the part composed so far
+            for e in range(q.bit_length() - 1, -1, -1):
+                if q >> e & 1:
+                    i = e - LEVEL_MIN
+                    if i >= lo:
+                        ge = Y[i - lo][: k_q * N].reshape(k_q, N, N)
+                        je = Y[i - lo][k_q * N : k_q * N + 2]
+                    else:
+                        ge, je = _series(A, B, unit * 2.0**e)
+                    g += P.T @ ge @ P
+                    j += je @ P
+                    P = Z[i] @ P
+            self._full[key] = (np.vstack([g.reshape(-1, N), j]), act)
+        return self._full[key]
+
+    def flight(self, S: tuple, X, w, q: int, unit: float):
+        """A whole step ``h = q unit`` of held set ``S`` and its integrals in one product:
+        ``(X(h), P_S, integrals (6,))`` for the flow's inputs ``(X, w)``
+        (:class:`~.flows.Flow`; ``w_l = h^l s^(l)``)."""
+        key = (S, unit)
+        if key not in self._flight:
+            f = self.flows.flow(S, self.flows.h)
+            Y, act = self._step_forms(S, q, unit)
+            N, n, nz = Y.shape[1], f.n, f.Phi.shape[0]
+            n_in = n + f.Psi.shape[1]
+            E = np.zeros((N, n_in))  # z = E [X; w]: chain s^(l) = w_l / h^l, P_S = 0
+            E[:n, :n] = np.eye(n)
+            p1 = self.flows.degree + 1
+            scale = np.repeat(self.flows.h ** -np.arange(p1), f.Psi.shape[1] // p1)
+            E[nz:, n:] = np.diag(scale)
+            kn = act.size * N
+            gam = E.T @ Y[:kn].reshape(-1, N, N) @ E
+            big = np.vstack([np.hstack([f.Phi, f.Psi]), gam.reshape(-1, n_in), Y[kn:] @ E])
+            self._flight[key] = (big, act, n, nz)
+        big, act, n, nz = self._flight[key]
+        u = np.concatenate([X, w.ravel()])
+        y = big @ u
+        kn = act.size * u.size
+        out = np.zeros(6)
+        out[act], out[4:] = y[nz : nz + kn].reshape(-1, u.size) @ u, y[nz + kn :]
+        return y[:n], y[n:nz], out
+
+
+def _series(A, B, tau):
+    """``Γ(τ)``, ``C J(τ)`` from their Taylor coefficients (see :meth:`WorkIntegrals.levels`)."""
+    c = tau ** np.arange(1, _TERMS + 1) / _FACTORIALS
+    return np.tensordot(c, A, 1), np.tensordot(c, B, 1)

@@ -1,0 +1,73 @@
+"""Exact works and heats of the exponential stepper's flights (steppers/work.py)."""
+
+import math
+
+import numpy as np
+import pytest
+import scipy.linalg as sla
+
+import femrub as fr
+from femrub.steppers.flows import LEVEL_MIN
+from femrub.steppers.work import LINEAR, QUADRATIC
+
+
+def _setup(h=2e-3):
+    st = fr.ExponentialMoreau(fr.bar_model(alpha=3.0), h)
+    return st, st._integrals, h / st.probes
+
+
+def _quadrature(M, Q, C, z0, tau, pieces=64, nodes=8):
+    """``∫ zᵀQz`` and ``∫ Cz`` on ``z(s) = e^{sM} z0`` by composite Gauss–Legendre, and the
+    integrals of their absolute values (the scale of round-off in cancelling integrals)."""
+    x, wts = np.polynomial.legendre.leggauss(nodes)
+    d = tau / pieces
+    at = [sla.expm(0.5 * (xi + 1.0) * d * M) for xi in x]  # the nodes of one piece
+    step = sla.expm(d * M)
+    w, scale, za = np.zeros(Q.shape[0] + C.shape[0]), np.zeros(Q.shape[0] + C.shape[0]), z0
+    for _ in range(pieces):
+        for E, wi in zip(at, wts):
+            z = E @ za
+            f = np.r_[np.einsum("i,kij,j->k", z, Q, z), C @ z]
+            w += 0.5 * d * wi * f
+            scale += 0.5 * d * wi * np.abs(f)
+        za = step @ za
+    return w, scale
+
+
+@pytest.mark.parametrize("S", [(), (0,)])
+def test_integrals_match_quadrature_on_the_exact_flow(S):
+    st, W, unit = _setup()
+    flows, h = st._flows, st.h
+    M = flows.generator_z(S)
+    Q, C = W.forms(S, M)
+    rng = np.random.default_rng(3)
+    n, s = st.model.n_dofs, len(S)
+    z0 = np.r_[rng.standard_normal(n) * 1e-6, np.zeros(s), rng.standard_normal(M.shape[0] - n - s)]
+    z0[st.model.layout.t] = 50.0 + 10.0 * rng.random(st.model.layout.n_t)
+    for tau in (3e-9, 0.37 * unit, 2.3 * unit, 0.61 * h):
+        # the segment composed of flows over unit 2^e, down to e = LEVEL_MIN
+        composed = math.floor(tau / unit * 2.0**-LEVEL_MIN) * unit * 2.0**LEVEL_MIN
+        ref, scale = _quadrature(M, Q, C, z0, composed)
+        w = W.over(S, z0, tau, unit)
+        assert np.all(np.abs(w - ref) <= 1e-11 * scale), (tau, w, ref)
+    ref, scale = _quadrature(M, Q, C, z0, h, pieces=128)
+    assert np.all(np.abs(W.step(S, z0, st.probes, unit) - ref) <= 1e-11 * scale)
+    # the state composed with the integrals is the composed flow
+    z1, _ = W.over(S, z0, 0.61 * h, unit, state=True)
+    assert np.allclose(
+        z1, flows.advance_z(S, z0, 0.61 * h, unit), rtol=0, atol=1e-14 * np.abs(z1).max()
+    )
+
+
+def test_integral_keys_are_the_meter_keys():
+    from femrub.output.energy import SCHEME_INTEGRALS
+
+    assert QUADRATIC + LINEAR == SCHEME_INTEGRALS  # the stepper hands them in this order
+
+
+@pytest.mark.parametrize("h", [5e-3, 5e-4])
+def test_paper_case_balance_closes_at_coarse_steps(h):
+    res = fr.ExponentialMoreau(fr.bar_model(alpha=3.0), h).run(0.1)
+    assert res.status == "ok"
+    assert res.energy_error() < 1e-9 and res.heat_error() < 1e-9
+    assert np.all(np.diff(res.energy["contact_work"]) <= 1e-15)
