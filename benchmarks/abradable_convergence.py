@@ -41,7 +41,8 @@ NACA = {
     "reduction.n_theta": 16,
     "outputs.vtk_stride": 0,
 }
-ROTOR37 = {"outputs.vtk_stride": 0}  # stepped over one lobe passage (the model as the scene)
+# stepped over one lobe passage from the published 1000 steps per revolution down
+ROTOR37 = {"outputs.vtk_stride": 0, "scheme.h": 4.675e-6}
 
 
 def study(scene, t_end: float, factors) -> list[dict]:
