@@ -392,7 +392,8 @@ class ThermoelasticCraigBampton:
         L = m.layout
         Rz = self._elastic_basis(R, layout)
         forms = m.energy.project(R)
-        forms.Qe = sp.csr_matrix(project(Rz, m.energy.Qe, Rz))
+        if Rz is not R:  # else the projected Qe is already the elastic energy's
+            forms.Qe = sp.csr_matrix(project(Rz, m.energy.Qe, Rz))
         if L.n_t:
             P = sp.csr_matrix(m.energy.Pth)
             P_u = sp.vstack([P[L.v], P[L.u], P[L.t]], format="csr")  # v-rows moved to u-rows
