@@ -65,6 +65,7 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.linalg import eigh
 
+from .. import progress
 from ..fem.eigen import lowest_modes, normalise_columns
 from ..fem.linalg import project
 from ..model.first_order import FirstOrderModel, Layout, LoadTerm
@@ -285,8 +286,8 @@ class ThermoelasticCraigBampton:
         n_uv, n_theta, cols, layout = self._columns(n_uv, n_theta)
         t0 = time.perf_counter()
         m = self.fom
-        if self._largest is None and (cols.size == self.R.shape[1] or self._nested()):
-            self._largest = self._project(np.arange(self.R.shape[1]), self.layout)
+        if cols.size == self.R.shape[1] or self._nested():
+            t0 -= self.project()  # this call's projection time includes the largest's
         if self._largest is not None and (cols.size == self.R.shape[1] or self._nested()):
             parts = self._slice(cols, layout)
         else:
@@ -312,6 +313,18 @@ class ThermoelasticCraigBampton:
         return FirstOrderModel(
             A=sp.csc_matrix(A), B=sp.csc_matrix(B), layout=layout, x0=x0, info=info, **parts
         )
+
+    def project(self) -> float:
+        """Project the largest reduced operators (once); return the seconds it took (0 when
+        already done). :meth:`reduce` calls it; a caller may call it first to time it."""
+        if self._largest is not None:
+            return 0.0
+        t0 = time.perf_counter()
+        n, r = self.R.shape
+        with progress.phase(f"projecting the operators on the bases ({n} -> {r} dofs)"):
+            self._largest = self._project(np.arange(r), self.layout)
+        self.timings["projection"] = time.perf_counter() - t0
+        return self.timings["projection"]
 
     def _nested(self) -> bool:
         """Whether every size's elastic-energy basis is ``R`` itself (no displacement part in

@@ -250,9 +250,11 @@ def reduce_model(model, scene, log=None, make_stepper=None, reductor=None, limit
     else:
         n_uv, n_theta = want
     red.solver.free()  # no more interior solves: release the factorisations' memory
+    projection = red.project()  # once; every size is then a block of it (or projected)
     if make_stepper is not None:
         n_uv, n_theta = _checked(red, model, want, make_stepper, scene, report, log, limits)
     reduced = red.reduce(n_uv, n_theta)
+    reduced.info["timings"]["projection"] += projection
     if "error" in report:  # energy the reduced dynamics can create (verdict rule ``reduction``)
         report["error"]["energy_growth_rate"] = reduced.info["energy_growth_rate"]
     report.update(
