@@ -111,6 +111,8 @@ class ThermoelasticCraigBampton:
         :func:`~femrub.reduction.thermal_inputs.input_basis`, ``2 m + 1`` input shapes for
         ``m`` heat distributions plus ``max_n_theta`` modes of the whole blade, Galerkin
         projection of the heat equation; ``docs/reduction.md`` section 8).
+    keep_solver : keep the interior factorisations for later solves (``solver``); ``False``
+        releases them before the dense bases are allocated (lower peak memory).
 
     Attributes
     ----------
@@ -139,6 +141,7 @@ class ThermoelasticCraigBampton:
         projection="petrov-galerkin",
         boundary=None,
         thermal="boundary",
+        keep_solver=True,
     ):
         if projection not in PROJECTIONS:
             raise ValueError(f"unknown projection {projection!r}; use one of {PROJECTIONS}")
@@ -205,10 +208,8 @@ class ThermoelasticCraigBampton:
         t0 = time.perf_counter()
         self._idx = (mb, mi, tb, ti)
         self.layout = self._layout(self.n_uv, self.n_theta)
-        self.R = self._assemble(psi, phi[:, : self.n_qu], phi, chi, phi_ut)
-        if projection in ("galerkin", "second-order"):
-            self.left = self.R
-        else:  # left (adjoint) modes; boundary columns: adjoint static shapes or unit vectors
+        left = None  # (left) adjoint modes; boundary columns: adjoint static shapes or unit vectors
+        if projection not in ("galerkin", "second-order"):
             if projection == "adjoint":
                 psi_l = solver.solve_transposed(-B[self._bnd][:, self._int].T)
             elif projection == "static-mass":  # momentum rows of v_b on [1; Ψ_uu]
@@ -217,7 +218,11 @@ class ThermoelasticCraigBampton:
             else:  # boundary equations kept as in the full model: no static shapes
                 psi_l = None
             mphi = _orient(normalise_columns(solver.M @ phi[:, : self.n_qu]))
-            self.left = self._assemble(psi_l, mphi, phi, chi, solver.Ctu.T @ chi)
+            left = (psi_l, mphi, phi, chi, solver.Ctu.T @ chi)
+        if not keep_solver:  # no more solves: the factorisations' memory before the bases'
+            solver.free()
+        self.R = self._assemble(psi, phi[:, : self.n_qu], phi, chi, phi_ut)
+        self.left = self.R if left is None else self._assemble(*left)
         self.timings["bases"] = time.perf_counter() - t0
 
     # -- bases -----------------------------------------------------------------------------

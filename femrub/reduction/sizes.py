@@ -236,8 +236,9 @@ def reduce_model(model, scene, log=None, make_stepper=None, reductor=None, limit
             report["bases"] = "reused (same matrices and reduction options)"
         else:
             red = ThermoelasticCraigBampton(
-                model, n_uv, n_theta, projection=opts["projection"], thermal=opts["thermal"]
-            )
+                model, n_uv, n_theta, projection=opts["projection"], thermal=opts["thermal"],
+                keep_solver=method == "auto",  # only "auto" solves again (_auto_sizes)
+            )  # fmt: skip
     except ValueError as exc:
         text = str(exc)
         key = next((f"reduction.{k}" for k in ("n_theta", "n_uv") if k in text), None)
