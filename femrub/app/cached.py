@@ -30,8 +30,9 @@ carries what the run needs, including its map to the mesh).
 
 A reduced model missing from the cache but whose bases this process already built (the
 next point of a speed sweep on a dask worker: same matrices, same ``reduction`` options,
-given sizes) reuses that reductor (:data:`_REDUCTORS`, the last one only): the reduction
-error estimate and the projection run again, the static shapes and modes do not.
+given sizes) reuses that reductor (:data:`_REDUCTORS`, the last one only) with the reduced
+operators it projected (:mod:`femrub.reduction.truncation`): only the reduction error
+estimate runs again; the static shapes, modes and projection do not.
 """
 
 from __future__ import annotations
