@@ -151,7 +151,7 @@ class Stages:
         )
         if bases is not None:
             _REDUCTORS.clear()
-            _REDUCTORS[bases] = reductor
+            _REDUCTORS[bases] = reductor.detached()  # not the model of this point
         _say_phases(self._say, reduced.info.get("timings", {}))
         self._keep("reduction", key, _detach(reduced, report), f"{reduced.n_dofs} dofs")
         return reduced, reductor, report

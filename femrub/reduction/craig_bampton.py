@@ -156,6 +156,7 @@ class ThermoelasticCraigBampton:
                 "carries its blocks); reduce the full model"
             )
         self.fom, self.projection = fom, projection
+        self._signature = (fom.layout, fom.A.shape, fom.B.shape)  # what for_model checks
         blocks, L = fom.blocks, fom.layout
         nu, nt = L.n_u, L.n_t
         if boundary is None and fom.boundary is None:
@@ -494,11 +495,18 @@ class ThermoelasticCraigBampton:
         are shared, not copied. The caller vouches for the matrices (the model cache keys
         them, :mod:`femrub.app.cached`); the layout and the operators' shapes are checked.
         """
-        old = self.fom
-        if fom.layout != old.layout or fom.A.shape != old.A.shape or fom.B.shape != old.B.shape:
+        if (fom.layout, fom.A.shape, fom.B.shape) != self._signature:
             raise ValueError("for_model: the model's layout or operators differ from the bases'")
         new = copy.copy(self)
         new.fom, new.timings = fom, {}  # nothing built: the reduced model's info says so
+        return new
+
+    def detached(self) -> ThermoelasticCraigBampton:
+        """This reductor without its full model (``fom = None``), to keep for
+        :meth:`for_model` without holding the model it was built for (about 1 GB for a
+        Rotor 37 blade); its factorisations must be released (:meth:`InteriorSolver.free`)."""
+        new = copy.copy(self)
+        new.fom = None
         return new
 
 

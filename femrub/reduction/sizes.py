@@ -199,9 +199,9 @@ def reduce_model(model, scene, log=None, make_stepper=None, reductor=None, limit
     the sizes from that estimate. ``reductor``: one built by an earlier call for a model with
     the same matrices and the same ``reduction`` options (a point of a speed sweep): its
     bases are reused (:meth:`~femrub.reduction.craig_bampton.ThermoelasticCraigBampton.for_model`)
-    with the operators projected on them, and only the estimate runs again. ``limits``: the run's stop limits
-    (``Stepper.run``), applied to the estimate's runs: they compare the models over the
-    part of the run that the run itself can reach.
+    with the operators projected on them, and only the estimate runs again. ``limits``: the
+    run's stop limits (``Stepper.run``), applied to the estimate's runs: they compare the
+    models over the part of the run that the run itself can reach.
     """
     opts = scene["reduction"]
     method = opts["method"]
