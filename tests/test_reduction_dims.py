@@ -5,6 +5,8 @@ reductor built directly with those sizes gives (round-off for dense eigen-solves
 tolerance for the 3D blade), and the ``"auto"`` scene reduction must reuse its one reductor.
 """
 
+import dataclasses
+
 import numpy as np
 import pytest
 import scipy.sparse as sp
@@ -168,3 +170,35 @@ def test_interior_solves_by_blocks_and_free(blade, monkeypatch):
     # the bases are kept: reduce and reconstruct still work without the factorisations
     Xr = np.ones(red.reduce(2, 1).n_dofs)
     assert red.reconstruct(Xr, 2, 1).shape == (blade.n_dofs,)
+
+
+@pytest.mark.parametrize("projection", PROJECTIONS)
+def test_smaller_sizes_are_blocks_of_the_largest_projection(paper, projection, monkeypatch):
+    """Once the largest model is projected, a smaller size is sliced from it (no projection
+    over the full state) when its elastic-energy basis is ``R`` (``_nested``), and equals the
+    model projected at that size; otherwise that size is projected."""
+    red = ThermoelasticCraigBampton(paper, 20, 12, projection=projection)
+    red.reduce()
+    calls = []
+    real = red._project
+    monkeypatch.setattr(red, "_project", lambda *a: calls.append(a) or real(*a))
+    rom = red.reduce(6, 4)
+    *_, cols, layout = red._columns(6, 4)
+    assert bool(calls) == (not red._nested())
+    ref = real(cols, layout)
+    assert _rel(rom.A.toarray(), ref["A"]) < TOL_DENSE
+    assert _rel(rom.energy.Pd.toarray(), ref["energy"].Pd.toarray()) < 1e-10
+    assert _rel(rom.energy.Pth.toarray(), ref["energy"].Pth.toarray()) < 1e-10
+    growth = rom.info["energy_growth_rate"]
+    assert abs(growth - ref["growth"]) <= 1e-9 * max(1.0, abs(ref["growth"]))
+
+
+def test_sliced_models_take_the_gap_functions_of_the_reductors_model(paper):
+    """``for_model`` shares the projected operators; the gap and load functions are the new
+    model's (a point of a speed sweep)."""
+    red = ThermoelasticCraigBampton(paper, 8, 6, projection="second-order")
+    red.reduce()
+    other = paper.with_(contact=dataclasses.replace(paper.contact, gap0=paper.contact.gap0 * 2))
+    rom = red.for_model(other).reduce(4, 3)
+    assert np.allclose(rom.contact.gap0, 2 * paper.contact.gap0)
+    assert _rel(rom.contact.G, red.reduce(4, 3).contact.G) == 0.0

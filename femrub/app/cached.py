@@ -30,8 +30,9 @@ carries what the run needs, including its map to the mesh).
 
 A reduced model missing from the cache but whose bases this process already built (the
 next point of a speed sweep on a dask worker: same matrices, same ``reduction`` options,
-given sizes) reuses that reductor (:data:`_REDUCTORS`, the last one only): the reduction
-error estimate and the projection run again, the static shapes and modes do not.
+given sizes) reuses that reductor (:data:`_REDUCTORS`, the last one only) with the reduced
+operators it projected (:mod:`femrub.reduction.truncation`): only the reduction error
+estimate runs again; the static shapes, modes and projection do not.
 """
 
 from __future__ import annotations
@@ -150,7 +151,7 @@ class Stages:
         )
         if bases is not None:
             _REDUCTORS.clear()
-            _REDUCTORS[bases] = reductor
+            _REDUCTORS[bases] = reductor.detached()  # not the model of this point
         _say_phases(self._say, reduced.info.get("timings", {}))
         self._keep("reduction", key, _detach(reduced, report), f"{reduced.n_dofs} dofs")
         return reduced, reductor, report

@@ -194,6 +194,7 @@ def project(left: np.ndarray, Q, right: np.ndarray, chunk: int = 8192) -> np.nda
         return left.T @ np.asarray(Q @ right)
     Q = sp.csr_matrix(Q)
     out = np.zeros((left.shape[1], right.shape[1]))
+    nonzero = right != 0.0  # one boolean pattern: a chunk copies only the block it needs
     for s in range(0, Q.shape[0], chunk):
         Qs = Q[s : s + chunk]
         if Qs.nnz == 0:
@@ -201,10 +202,9 @@ def project(left: np.ndarray, Q, right: np.ndarray, chunk: int = 8192) -> np.nda
         Ls = left[s : s + chunk]
         lc = np.flatnonzero(np.any(Ls != 0.0, axis=0))
         cols = np.unique(Qs.indices)
-        Rq = right[cols]
-        rc = np.flatnonzero(np.any(Rq != 0.0, axis=0))
+        rc = np.flatnonzero(np.any(nonzero[cols], axis=0))
         if lc.size and rc.size:
-            QR = Qs[:, cols] @ np.ascontiguousarray(Rq[:, rc])
+            QR = Qs[:, cols] @ right[np.ix_(cols, rc)]
             out[np.ix_(lc, rc)] += Ls[:, lc].T @ QR
     return out
 

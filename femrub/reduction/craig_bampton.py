@@ -65,11 +65,13 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.linalg import eigh
 
+from .. import progress
 from ..fem.eigen import lowest_modes, normalise_columns
 from ..fem.linalg import project
 from ..model.first_order import FirstOrderModel, Layout, LoadTerm
 from .interior import InteriorSolver
 from .thermal_inputs import input_basis, input_distributions
+from .truncation import sliced_contact, sliced_energy, sliced_loads
 
 __all__ = ["PROJECTIONS", "ThermoelasticCraigBampton", "craig_bampton_thermal"]
 
@@ -109,6 +111,8 @@ class ThermoelasticCraigBampton:
         :func:`~femrub.reduction.thermal_inputs.input_basis`, ``2 m + 1`` input shapes for
         ``m`` heat distributions plus ``max_n_theta`` modes of the whole blade, Galerkin
         projection of the heat equation; ``docs/reduction.md`` section 8).
+    keep_solver : keep the interior factorisations for later solves (``solver``); ``False``
+        releases them before the dense bases are allocated (lower peak memory).
 
     Attributes
     ----------
@@ -137,6 +141,7 @@ class ThermoelasticCraigBampton:
         projection="petrov-galerkin",
         boundary=None,
         thermal="boundary",
+        keep_solver=True,
     ):
         if projection not in PROJECTIONS:
             raise ValueError(f"unknown projection {projection!r}; use one of {PROJECTIONS}")
@@ -151,6 +156,7 @@ class ThermoelasticCraigBampton:
                 "carries its blocks); reduce the full model"
             )
         self.fom, self.projection = fom, projection
+        self._signature = (fom.layout, fom.A.shape, fom.B.shape)  # what for_model checks
         blocks, L = fom.blocks, fom.layout
         nu, nt = L.n_u, L.n_t
         if boundary is None and fom.boundary is None:
@@ -170,6 +176,7 @@ class ThermoelasticCraigBampton:
                 stacklevel=2,
             )
         self.timings = {}
+        self._largest = None  # the largest reduced operators, projected on first use
         t0 = time.perf_counter()
         self.solver = solver = InteriorSolver(blocks, mi, ti)
         self._bnd = np.r_[mb, nu + mb, 2 * nu + tb].astype(int)
@@ -202,10 +209,8 @@ class ThermoelasticCraigBampton:
         t0 = time.perf_counter()
         self._idx = (mb, mi, tb, ti)
         self.layout = self._layout(self.n_uv, self.n_theta)
-        self.R = self._assemble(psi, phi[:, : self.n_qu], phi, chi, phi_ut)
-        if projection in ("galerkin", "second-order"):
-            self.left = self.R
-        else:  # left (adjoint) modes; boundary columns: adjoint static shapes or unit vectors
+        left = None  # (left) adjoint modes; boundary columns: adjoint static shapes or unit vectors
+        if projection not in ("galerkin", "second-order"):
             if projection == "adjoint":
                 psi_l = solver.solve_transposed(-B[self._bnd][:, self._int].T)
             elif projection == "static-mass":  # momentum rows of v_b on [1; Ψ_uu]
@@ -214,7 +219,11 @@ class ThermoelasticCraigBampton:
             else:  # boundary equations kept as in the full model: no static shapes
                 psi_l = None
             mphi = _orient(normalise_columns(solver.M @ phi[:, : self.n_qu]))
-            self.left = self._assemble(psi_l, mphi, phi, chi, solver.Ctu.T @ chi)
+            left = (psi_l, mphi, phi, chi, solver.Ctu.T @ chi)
+        if not keep_solver:  # no more solves: the factorisations' memory before the bases'
+            solver.free()
+        self.R = self._assemble(psi, phi[:, : self.n_qu], phi, chi, phi_ut)
+        self.left = self.R if left is None else self._assemble(*left)
         self.timings["bases"] = time.perf_counter() - t0
 
     # -- bases -----------------------------------------------------------------------------
@@ -275,25 +284,20 @@ class ThermoelasticCraigBampton:
         """The reduced model of Eqs. (14)–(15) with ``n_uv`` shapes and ``n_theta`` modes.
 
         ``None`` gives the largest sizes of the reductor; smaller sizes truncate its bases
-        (class docstring), so this only projects: ``Ā = R̃ᵀ A R``, ``B̄ = R̃ᵀ B R``.
+        (class docstring), so this only projects: ``Ā = R̃ᵀ A R``, ``B̄ = R̃ᵀ B R``. The
+        largest model is projected once (on the first call) and every size is then a block
+        of it (:mod:`femrub.reduction.truncation`), unless its elastic-energy basis depends
+        on the size (then that size is projected).
         """
         n_uv, n_theta, cols, layout = self._columns(n_uv, n_theta)
         t0 = time.perf_counter()
         m = self.fom
-        every = cols.size == self.R.shape[1]  # the largest sizes: the bases, no copies
-        R = self.R if every else np.take(self.R, cols, axis=1)  # C-ordered, as self.R
-        Lt = self.left if every else np.take(self.left, cols, axis=1)
-        Lt = R if self.projection in ("galerkin", "second-order") else Lt
-        Ar = project(Lt, m.A, R)
-        Br = project(Lt, m.B, R)
-        loads = [
-            LoadTerm(Lt.T @ t.vector, t.signal, power=R.T @ t.power, heat=t.heat, name=t.name)
-            for t in m.loads
-        ]
-        contact = None if m.contact is None else m.contact.project(Lt, R)
-        obs = {k: np.asarray(O @ R) for k, O in m.observations.items()}
-        energy = None if m.energy is None else self._energy(R, Ar, Br, layout)
-        to_full = None if m.to_full is None else np.asarray(m.to_full @ R)
+        if cols.size == self.R.shape[1] or self._nested():
+            t0 -= self.project()  # this call's projection time includes the largest's
+        if self._largest is not None and (cols.size == self.R.shape[1] or self._nested()):
+            parts = self._slice(cols, layout)
+        else:
+            parts = self._project(cols, layout)
         x0 = self.restrict(m.x0, n_uv, n_theta)
         info = {
             "reduction": "thermoelastic Craig-Bampton (paper Sec. 2)",
@@ -305,24 +309,80 @@ class ThermoelasticCraigBampton:
             "n_boundary_u": int(self.boundary["u"].size),
             "n_boundary_theta": int(self.n_theta_b),
             "thermal": self.thermal,
-            "energy_growth_rate": self.energy_growth_rate if m.energy is not None else 0.0,
+            "energy_growth_rate": parts.pop("growth"),
             "n_full": m.n_dofs,
             "n_reduced": layout.n,
             "timings": dict(self.timings, projection=time.perf_counter() - t0),
             "full_info": dict(m.info),
         }
+        A, B = parts.pop("A"), parts.pop("B")
         return FirstOrderModel(
-            A=sp.csc_matrix(Ar),
-            B=sp.csc_matrix(Br),
-            layout=layout,
-            loads=loads,
-            contact=contact,
-            observations=obs,
-            energy=energy,
-            to_full=to_full,
-            x0=x0,
-            info=info,
+            A=sp.csc_matrix(A), B=sp.csc_matrix(B), layout=layout, x0=x0, info=info, **parts
         )
+
+    def project(self) -> float:
+        """Project the largest reduced operators (once); return the seconds it took (0 when
+        already done). :meth:`reduce` calls it; a caller may call it first to time it."""
+        if self._largest is not None:
+            return 0.0
+        t0 = time.perf_counter()
+        n, r = self.R.shape
+        with progress.phase(f"projecting the operators on the bases ({n} -> {r} dofs)"):
+            self._largest = self._project(np.arange(r), self.layout)
+        self.timings["projection"] = time.perf_counter() - t0
+        return self.timings["projection"]
+
+    def _nested(self) -> bool:
+        """Whether every size's elastic-energy basis is ``R`` itself (no displacement part in
+        the boundary velocity shapes, :meth:`_elastic_basis`): then a size is a block."""
+        L, Lr, nb = self.fom.layout, self.layout, self.boundary["u"].size
+        return not np.any(self.R[L.u, Lr.v.start : Lr.v.start + nb])
+
+    def _project(self, cols, layout) -> dict:
+        """The operators of the sizes of ``cols`` projected over the full state."""
+        m = self.fom
+        every = cols.size == self.R.shape[1]  # the largest sizes: the bases, no copies
+        R = self.R if every else np.take(self.R, cols, axis=1)  # C-ordered, as self.R
+        Lt = self.left if every else np.take(self.left, cols, axis=1)
+        Lt = R if self.projection in ("galerkin", "second-order") else Lt
+        Ar = project(Lt, m.A, R)
+        Br = project(Lt, m.B, R)
+        loads = [
+            LoadTerm(Lt.T @ t.vector, t.signal, power=R.T @ t.power, heat=t.heat, name=t.name)
+            for t in m.loads
+        ]
+        energy, growth = None, 0.0
+        if m.energy is not None:
+            energy, growth = self._energy(R, Ar, Br, layout)
+        return {
+            "A": Ar,
+            "B": Br,
+            "loads": loads,
+            "contact": None if m.contact is None else m.contact.project(Lt, R),
+            "observations": {k: np.asarray(O @ R) for k, O in m.observations.items()},
+            "energy": energy,
+            "growth": growth,
+            "to_full": None if m.to_full is None else np.asarray(m.to_full @ R),
+        }
+
+    def _slice(self, cols, layout) -> dict:
+        """The operators of the sizes of ``cols`` as blocks of the largest projected ones,
+        with the full model's gap, heat and load functions (:meth:`for_model`)."""
+        big, m = self._largest, self.fom
+        A, B = big["A"][np.ix_(cols, cols)], big["B"][np.ix_(cols, cols)]
+        energy, growth = None, 0.0
+        if big["energy"] is not None:
+            energy, growth = self._rates(sliced_energy(big["energy"], cols), A, B, layout)
+        return {
+            "A": A,
+            "B": B,
+            "loads": sliced_loads(big["loads"], m.loads, cols),
+            "contact": sliced_contact(big["contact"], m.contact, cols),
+            "observations": {k: O[:, cols] for k, O in big["observations"].items()},
+            "energy": energy,
+            "growth": growth,
+            "to_full": None if big["to_full"] is None else big["to_full"][:, cols],
+        }
 
     def _energy(self, R, Ar, Br, layout):
         """Energy forms of the reduced model: the energy its own dynamics conserves.
@@ -351,16 +411,23 @@ class ThermoelasticCraigBampton:
         L = m.layout
         Rz = self._elastic_basis(R, layout)
         forms = m.energy.project(R)
-        forms.Qe = sp.csr_matrix(project(Rz, m.energy.Qe, Rz))
-        damped = sp.csr_matrix(m.energy.Pd).count_nonzero() > 0
-        if L.n_t or damped:  # Ẋ̄ = Ā⁻¹ B̄ X̄ without loads and impulses
-            rate = np.linalg.solve(Ar, Br)
+        if Rz is not R:  # else the projected Qe is already the elastic energy's
+            forms.Qe = sp.csr_matrix(project(Rz, m.energy.Qe, Rz))
         if L.n_t:
             P = sp.csr_matrix(m.energy.Pth)
             P_u = sp.vstack([P[L.v], P[L.u], P[L.t]], format="csr")  # v-rows moved to u-rows
-            W = np.asarray(project(Rz, P_u, R))
-            forms.Pth = sp.csr_matrix(rate.T @ W)
-            forms.Wth = sp.csr_matrix(W)
+            forms.Wth = sp.csr_matrix(np.asarray(project(Rz, P_u, R)))
+        return self._rates(forms, Ar, Br, layout)
+
+    def _rates(self, forms, Ar, Br, layout):
+        """``(forms, growth rate)``: the forms of :meth:`_energy` built on ``Ā⁻¹ B̄`` (``Pth``,
+        ``Pd``, the energy growth rate) from the projected ``Qk``, ``Qe`` and ``Wth``."""
+        L = self.fom.layout
+        damped = sp.csr_matrix(self.fom.energy.Pd).count_nonzero() > 0
+        if L.n_t or damped:  # Ẋ̄ = Ā⁻¹ B̄ X̄ without loads and impulses
+            rate = np.linalg.solve(Ar, Br)
+        if L.n_t:
+            forms.Pth = sp.csr_matrix(rate.T @ forms.Wth.toarray())
         self.energy_growth_rate = 0.0
         if damped:
             mech = np.r_[np.arange(layout.n_u), layout.v.start + np.arange(layout.n_v)]
@@ -372,7 +439,7 @@ class ThermoelasticCraigBampton:
             forms.Pd = sp.csr_matrix(Pd)
             # fastest relative growth d ln E / dt the damped reduced dynamics allows (1/s)
             self.energy_growth_rate = float(eigh(D, Q, eigvals_only=True)[-1])
-        return forms
+        return forms, self.energy_growth_rate
 
     def _elastic_basis(self, R, layout):
         """``R`` with the boundary-velocity static shapes' displacement projected on the kept
@@ -428,11 +495,18 @@ class ThermoelasticCraigBampton:
         are shared, not copied. The caller vouches for the matrices (the model cache keys
         them, :mod:`femrub.app.cached`); the layout and the operators' shapes are checked.
         """
-        old = self.fom
-        if fom.layout != old.layout or fom.A.shape != old.A.shape or fom.B.shape != old.B.shape:
+        if (fom.layout, fom.A.shape, fom.B.shape) != self._signature:
             raise ValueError("for_model: the model's layout or operators differ from the bases'")
         new = copy.copy(self)
         new.fom, new.timings = fom, {}  # nothing built: the reduced model's info says so
+        return new
+
+    def detached(self) -> ThermoelasticCraigBampton:
+        """This reductor without its full model (``fom = None``), to keep for
+        :meth:`for_model` without holding the model it was built for (about 1 GB for a
+        Rotor 37 blade); its factorisations must be released (:meth:`InteriorSolver.free`)."""
+        new = copy.copy(self)
+        new.fom = None
         return new
 
 

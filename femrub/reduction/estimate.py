@@ -47,6 +47,8 @@ from __future__ import annotations
 import numpy as np
 import scipy.sparse as sp
 
+from ..progress import phase
+
 __all__ = [
     "QUANTITIES",
     "compare",
@@ -154,7 +156,16 @@ def simulate(reductor, sizes, make_stepper, t_end, checkpoints=5, limits=None, p
     over what the run itself can reach, not past a physical stop. ``perturb``: random
     displacement (m) added to the initial state (:func:`twin`).
     """
-    m = reductor.reduce(*sizes)
+    what = "twin" if perturb else "run"
+    with phase(f"reduction error estimate: {what} of sizes {list(sizes)} to {t_end:g} s") as p:
+        m = reductor.reduce(*sizes)
+        res, states = _simulate(m, reductor, sizes, make_stepper, t_end, checkpoints, limits,
+                                perturb)  # fmt: skip
+        p["detail"] = f"{res.steps} steps, {m.n_dofs} coordinates"
+    return res, states
+
+
+def _simulate(m, reductor, sizes, make_stepper, t_end, checkpoints, limits, perturb):
     if perturb:
         x0 = np.array(m.x0, dtype=float)
         x0[m.layout.u] += perturb * np.random.default_rng(0).standard_normal(m.layout.n_u)

@@ -199,9 +199,9 @@ def reduce_model(model, scene, log=None, make_stepper=None, reductor=None, limit
     the sizes from that estimate. ``reductor``: one built by an earlier call for a model with
     the same matrices and the same ``reduction`` options (a point of a speed sweep): its
     bases are reused (:meth:`~femrub.reduction.craig_bampton.ThermoelasticCraigBampton.for_model`)
-    and only the estimate and the projection run again. ``limits``: the run's stop limits
-    (``Stepper.run``), applied to the estimate's runs: they compare the models over the
-    part of the run that the run itself can reach.
+    with the operators projected on them, and only the estimate runs again. ``limits``: the
+    run's stop limits (``Stepper.run``), applied to the estimate's runs: they compare the
+    models over the part of the run that the run itself can reach.
     """
     opts = scene["reduction"]
     method = opts["method"]
@@ -236,8 +236,9 @@ def reduce_model(model, scene, log=None, make_stepper=None, reductor=None, limit
             report["bases"] = "reused (same matrices and reduction options)"
         else:
             red = ThermoelasticCraigBampton(
-                model, n_uv, n_theta, projection=opts["projection"], thermal=opts["thermal"]
-            )
+                model, n_uv, n_theta, projection=opts["projection"], thermal=opts["thermal"],
+                keep_solver=method == "auto",  # only "auto" solves again (_auto_sizes)
+            )  # fmt: skip
     except ValueError as exc:
         text = str(exc)
         key = next((f"reduction.{k}" for k in ("n_theta", "n_uv") if k in text), None)
@@ -250,9 +251,11 @@ def reduce_model(model, scene, log=None, make_stepper=None, reductor=None, limit
     else:
         n_uv, n_theta = want
     red.solver.free()  # no more interior solves: release the factorisations' memory
+    projection = red.project()  # once; every size is then a block of it (or projected)
     if make_stepper is not None:
         n_uv, n_theta = _checked(red, model, want, make_stepper, scene, report, log, limits)
     reduced = red.reduce(n_uv, n_theta)
+    reduced.info["timings"]["projection"] += projection
     if "error" in report:  # energy the reduced dynamics can create (verdict rule ``reduction``)
         report["error"]["energy_growth_rate"] = reduced.info["energy_growth_rate"]
     report.update(
