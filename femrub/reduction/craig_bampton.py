@@ -63,12 +63,12 @@ import warnings
 
 import numpy as np
 import scipy.sparse as sp
-from scipy.linalg import eigh
 
 from .. import progress
 from ..fem.eigen import lowest_modes, normalise_columns
 from ..fem.linalg import project
 from ..model.first_order import FirstOrderModel, Layout, LoadTerm
+from .energy_forms import energy_rates, reduced_energy
 from .interior import InteriorSolver
 from .thermal_inputs import input_basis, input_distributions
 from .truncation import sliced_contact, sliced_energy, sliced_loads
@@ -334,7 +334,8 @@ class ThermoelasticCraigBampton:
 
     def _nested(self) -> bool:
         """Whether every size's elastic-energy basis is ``R`` itself (no displacement part in
-        the boundary velocity shapes, :meth:`_elastic_basis`): then a size is a block."""
+        the boundary velocity shapes, :func:`.energy_forms.elastic_basis`): then a size is a
+        block."""
         L, Lr, nb = self.fom.layout, self.layout, self.boundary["u"].size
         return not np.any(self.R[L.u, Lr.v.start : Lr.v.start + nb])
 
@@ -353,7 +354,7 @@ class ThermoelasticCraigBampton:
         ]
         energy, growth = None, 0.0
         if m.energy is not None:
-            energy, growth = self._energy(R, Ar, Br, layout)
+            energy, growth = reduced_energy(m, self.boundary["u"].size, R, Ar, Br, layout)
         return {
             "A": Ar,
             "B": Br,
@@ -372,7 +373,7 @@ class ThermoelasticCraigBampton:
         A, B = big["A"][np.ix_(cols, cols)], big["B"][np.ix_(cols, cols)]
         energy, growth = None, 0.0
         if big["energy"] is not None:
-            energy, growth = self._rates(sliced_energy(big["energy"], cols), A, B, layout)
+            energy, growth = energy_rates(m, sliced_energy(big["energy"], cols), A, B, layout)
         return {
             "A": A,
             "B": B,
@@ -383,80 +384,6 @@ class ThermoelasticCraigBampton:
             "growth": growth,
             "to_full": None if big["to_full"] is None else big["to_full"][:, cols],
         }
-
-    def _energy(self, R, Ar, Br, layout):
-        """Energy forms of the reduced model: the energy its own dynamics conserves.
-
-        * kinetic ``½ (R_v X̄)ᵀ M (R_v X̄)``, as projected;
-        * elastic ``½ (R_z X̄)ᵀ K (R_z X̄)`` on the displacement the reduced kinematics
-          integrates: ``R_z = R`` except that the displacement part of each boundary-velocity
-          static shape, ``Γ = −K_ii⁻¹ C_ib`` (a damped model's quasi-static response to a
-          boundary velocity), is replaced by its M-orthogonal projection on the kept modes
-          ``Φ (Φᵀ M_ii Φ)⁻¹ Φᵀ M_ii Γ``
-          (the interior kinematic rows, projected on ``M_ii Φ``, only integrate that part);
-        * damping power: the rate of that energy along the homogeneous reduced dynamics,
-          ``P_d = sym(Q Ā⁻¹ B̄)`` on the mechanical coordinates (``Q`` kinetic + elastic);
-          with a lumped boundary mass and ``C = a M + b K`` this is negative semi-definite,
-          a positive part is energy the reduction creates, reported as the largest relative growth
-          rate ``max λ: P_d x = λ Q x`` (``info["energy_growth_rate"]``, 1/s);
-        * thermal-stress work on ``u̇``, not ``v``: the full model's power ``vᵀ(−K^uθ θ)``
-          equals ``u̇ᵀ(−K^uθ θ)`` because ``u̇ = v``; a reduced model only keeps
-          ``u̇_b = v_b`` (its interior ``u̇`` is the rate of ``R_u X̄``, which holds
-          thermal-expansion shapes that ``v`` lacks), so the power of the thermal stresses is
-          ``(R_u Ā⁻¹ B̄ X̄)ᵀ(−K^uθ)(R_θ X̄)`` (``Pth``) and the work over a step, impulses
-          included, ``ΔW_th = (R_u ΔX̄)ᵀ(−K^uθ)(R_θ X̄_m)`` (``Wth``: a heat impulse moves
-          the expansion shapes at once; docs/reduction.md section 8).
-        """
-        m = self.fom
-        L = m.layout
-        Rz = self._elastic_basis(R, layout)
-        forms = m.energy.project(R)
-        if Rz is not R:  # else the projected Qe is already the elastic energy's
-            forms.Qe = sp.csr_matrix(project(Rz, m.energy.Qe, Rz))
-        if L.n_t:
-            P = sp.csr_matrix(m.energy.Pth)
-            P_u = sp.vstack([P[L.v], P[L.u], P[L.t]], format="csr")  # v-rows moved to u-rows
-            forms.Wth = sp.csr_matrix(np.asarray(project(Rz, P_u, R)))
-        return self._rates(forms, Ar, Br, layout)
-
-    def _rates(self, forms, Ar, Br, layout):
-        """``(forms, growth rate)``: the forms of :meth:`_energy` built on ``Ā⁻¹ B̄`` (``Pth``,
-        ``Pd``, the energy growth rate) from the projected ``Qk``, ``Qe`` and ``Wth``."""
-        L = self.fom.layout
-        damped = sp.csr_matrix(self.fom.energy.Pd).count_nonzero() > 0
-        if L.n_t or damped:  # Ẋ̄ = Ā⁻¹ B̄ X̄ without loads and impulses
-            rate = np.linalg.solve(Ar, Br)
-        if L.n_t:
-            forms.Pth = sp.csr_matrix(rate.T @ forms.Wth.toarray())
-        self.energy_growth_rate = 0.0
-        if damped:
-            mech = np.r_[np.arange(layout.n_u), layout.v.start + np.arange(layout.n_v)]
-            Q = (forms.Qk + forms.Qe).toarray()[np.ix_(mech, mech)]
-            D = Q @ rate[np.ix_(mech, mech)]
-            D = 0.5 * (D + D.T)
-            Pd = np.zeros((layout.n, layout.n))
-            Pd[np.ix_(mech, mech)] = D
-            forms.Pd = sp.csr_matrix(Pd)
-            # fastest relative growth d ln E / dt the damped reduced dynamics allows (1/s)
-            self.energy_growth_rate = float(eigh(D, Q, eigvals_only=True)[-1])
-        return forms, self.energy_growth_rate
-
-    def _elastic_basis(self, R, layout):
-        """``R`` with the boundary-velocity static shapes' displacement projected on the kept
-        modes (see :meth:`_energy`)."""
-        m = self.fom
-        L = m.layout
-        nb = self.boundary["u"].size
-        n_qu = layout.n_u - nb
-        cv_b = layout.v.start + np.arange(nb)
-        G = R[L.u][:, cv_b]
-        if not np.any(G):
-            return R
-        Phi = R[L.u][:, nb : nb + n_qu]
-        Rz = R.copy()
-        MPhi = m.blocks.M @ Phi
-        Rz[L.u, cv_b[0] : cv_b[-1] + 1] = Phi @ np.linalg.solve(Phi.T @ MPhi, MPhi.T @ G)
-        return Rz
 
     def reconstruct(self, Xr: np.ndarray, n_uv=None, n_theta=None) -> np.ndarray:
         """Full state ``R X̄`` of a reduced state (r,) or of the rows of an (m, r) array.
