@@ -172,9 +172,10 @@ class Abradable:
         the coating is ``r = w − gap``. The sweep starts where the previous call left the
         contacts (at the start of a run: where they are now).
         """
-        reach = self.depth_at(t) - np.asarray(gap, dtype=float)
+        depth = self.depth_at(t)
+        reach = depth - np.asarray(gap, dtype=float)
         last, self._last = self._last, (float(t), reach)
-        cut = np.asarray(yielded, dtype=bool) & (reach > self.depth_at(t))
+        cut = np.asarray(yielded, dtype=bool) & (reach > depth)
         if not np.any(cut):
             return
         g = self.grid
