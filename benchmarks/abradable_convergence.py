@@ -17,6 +17,7 @@ section "Time-step convergence of the coated rub" of ``docs/abradable.md``.
 from __future__ import annotations
 
 import argparse
+import os
 import sys
 import time
 from pathlib import Path
@@ -142,7 +143,7 @@ def main(argv=None) -> int:
     rigid = []
     if not a.no_rigid:
         rigid = study(scene.with_changes({"contact.abradable.thickness": 0.0}), t_end, factors[::2])
-    load = ", ".join(f"{x:.1f}" for x in __import__("os").getloadavg())
+    load = ", ".join(f"{x:.1f}" for x in os.getloadavg())
     write(name, table(rows, rigid), load)
     return 0
 

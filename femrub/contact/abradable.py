@@ -191,12 +191,9 @@ class Abradable:
         span = int(np.max(hi - lo)) + 1
         k = lo[:, None] + np.arange(span)[None, :]  # centres swept (and the two bracketing)
         inside = k <= hi[:, None]
-        dx = x1 - x0
-        frac = np.where(
-            np.abs(dx)[:, None] > 0.0,
-            np.clip((k - x0[:, None]) / np.where(dx == 0.0, 1.0, dx)[:, None], 0.0, 1.0),
-            1.0,
-        )
+        dx = (x1 - x0)[:, None]
+        still = dx == 0.0  # no sweep (first call): the reach at the end everywhere
+        frac = np.where(still, 1.0, np.clip((k - x0[:, None]) / np.where(still, 1.0, dx), 0, 1))
         level = np.minimum(self.thickness, r0[:, None] + frac * (r1 - r0)[:, None])
         cells = g.flat(k, g.axial_cell[i][:, None])
         flat = self.depth.ravel()
