@@ -32,6 +32,7 @@ __all__ = [
     "lowest_modes",
     "natural_frequencies",
     "normalise_columns",
+    "orient_columns",
 ]
 
 #: Problem sizes below which dense LAPACK solvers replace ARPACK.
@@ -53,6 +54,22 @@ def normalise_columns(V: np.ndarray) -> np.ndarray:
     peak = V[idx, np.arange(V.shape[1])]
     peak[peak == 0.0] = 1.0
     return V / peak
+
+
+def orient_columns(V: np.ndarray, tie: float = 1e-8) -> np.ndarray:
+    """Shapes with the first of their largest entries (ties within ``tie``) positive.
+
+    :func:`normalise_columns` makes the largest entry positive; when two entries tie (a
+    mirror-symmetric mode), round-off picks one, and it changes with the number of modes
+    solved for. This sign is the same for any number of modes, so a basis truncated to its
+    leading columns equals one computed at that size (the Craig–Bampton reductor's
+    ``reduce(dims)``).
+    """
+    if V.size == 0:
+        return V
+    mag = np.abs(V)
+    first = np.argmax(mag >= (1.0 - tie) * mag.max(axis=0), axis=0)
+    return V * np.where(V[first, np.arange(V.shape[1])] < 0.0, -1.0, 1.0)
 
 
 def lowest_modes(K, M, k: int, solve=None, *, tol: float = 1e-12, vectors: bool = True):

@@ -9,31 +9,24 @@ any number of contacts) and builds
   their static shapes ``Ψ = −B_ii⁻¹ B_ib`` (Eq. 11), ``n_uv`` first-order mechanical shapes
   (clamped modes ``φ_j`` used as displacement and as velocity shapes) and ``n_θ`` thermal
   modes ``χ_k`` with the coupling correction ``Φ^uθ = −K_ii⁻¹ K^uθ_ii χ`` (after Eq. 11);
-* the left basis ``R̃`` of Eq. (14), chosen by ``projection``:
+* the left basis ``R̃`` of Eq. (14), chosen by ``projection`` (derived and compared in
+  ``docs/reduction.md``):
 
-  - ``"petrov-galerkin"`` (default): the boundary equations are kept as in the full model
-    (unit left vectors on ``u_b, v_b, θ_b``: mass and heat capacity stay lumped on the
-    contact dofs) and the interior equations are projected on the left eigenvectors of the
-    clamped uncoupled problem (``M_ii φ_j`` for the kinematic rows, ``φ_j`` for the momentum
-    rows, ``χ_k`` with the adjoint correction ``C^θu_iiᵀ χ_k`` for the heat rows);
-  - ``"static-mass"``: as ``"petrov-galerkin"``, but the boundary velocities move the
-    interior with their displacement static shapes (``v_i = Ψ_uu v_b + Φ q_v``) and the
-    boundary momentum rows are projected on the same shapes, so the contact dofs carry the
-    Craig–Bampton mass of their static shapes, ``m_b + Ψ_uuᵀ M_ii Ψ_uu``, coupled to the
-    modes by ``Ψ_uuᵀ M_ii Φ`` (Galerkin on the momentum rows; the kinematic and heat rows
-    as ``"petrov-galerkin"``). The Petrov–Galerkin model leaves the interior mass that the
-    modes miss out of the contact dynamics (``docs/reduction.md`` section 10);
+  - ``"petrov-galerkin"``: the boundary equations kept as in the full model (unit left
+    vectors on ``u_b, v_b, θ_b``), the interior ones projected on the left eigenvectors of
+    the clamped uncoupled problem (``M_ii φ_j``, ``φ_j``, ``χ_k`` with the adjoint correction
+    ``C^θu_iiᵀ χ_k``);
+  - ``"static-mass"`` (the scenes' default): as ``"petrov-galerkin"``, but the boundary
+    velocities move the interior with their displacement static shapes
+    (``v_i = Ψ_uu v_b + Φ q_v``) and their momentum rows are projected on them, so the contact
+    dofs carry the Craig–Bampton mass ``m_b + Ψ_uuᵀ M_ii Ψ_uu`` (``docs/reduction.md`` §10);
   - ``"galerkin"``: ``R̃ = R``;
-  - ``"second-order"``: the classical second-order Craig–Bampton model of the mechanics
-    (Galerkin, ``R̃ = R``, with the boundary velocity shapes equal to the displacement ones,
-    ``v = [I, 0; Ψ, Φ] v̄``, instead of the first-order static shapes of Eq. 11): the reduced
-    mass ``TᵀMT`` keeps the static shapes' inertia, the model is symmetric and conserves
-    its energy, and its contact impulses converge much faster with the number of modes
-    (``docs/reduction.md`` section 8);
+  - ``"second-order"``: the classical, symmetric second-order Craig–Bampton model of the
+    mechanics (Galerkin, boundary velocity shapes equal to the displacement ones), whose
+    impulses converge fastest with the number of modes (``docs/reduction.md`` §8);
   - ``"adjoint"``: the Craig–Bampton basis of the adjoint problem, static shapes
     ``−B_ii⁻ᵀ B_biᵀ`` and the same left modes (two-sided moment matching at s = 0);
 
-  ``docs/reduction.md`` derives them and compares them on the paper case;
 * the reduced model ``Ā = R̃ᵀ A R``, ``B̄ = R̃ᵀ B R`` (Eqs. 14–15), a
   :class:`~femrub.model.first_order.FirstOrderModel` that every stepper runs unchanged.
 
@@ -65,21 +58,18 @@ import numpy as np
 import scipy.sparse as sp
 
 from .. import progress
-from ..fem.eigen import lowest_modes, normalise_columns
-from ..fem.linalg import project
-from ..model.first_order import FirstOrderModel, Layout, LoadTerm
-from .energy_forms import energy_rates, reduced_energy
+from ..fem.eigen import lowest_modes, normalise_columns, orient_columns
+from ..model.first_order import FirstOrderModel, Layout
+from .basis import assemble_basis
 from .interior import InteriorSolver
+from .operators import projected, sliced
 from .thermal_inputs import input_basis, input_distributions
-from .truncation import sliced_contact, sliced_energy, sliced_loads
 
 __all__ = ["PROJECTIONS", "ThermoelasticCraigBampton", "craig_bampton_thermal"]
 
 PROJECTIONS = ("petrov-galerkin", "static-mass", "galerkin", "adjoint", "second-order")
 #: Thermal reductions: the paper's boundary temperature dofs, or one input distribution each.
 THERMAL = ("inputs", "boundary")
-#: Relative gap within which entries of a shape tie for its largest (mirror-symmetric modes).
-PEAK_TIE = 1e-8
 
 
 class ThermoelasticCraigBampton:
@@ -202,8 +192,8 @@ class ThermoelasticCraigBampton:
             self.n_inputs = Q.shape[1]
         else:
             self.mu, chi = lowest_modes(solver.Ktt, solver.Ctt, self.n_theta, solver.solve_T)
-            chi, self.n_theta_b, self.n_inputs = _orient(chi), tb.size, tb.size
-        phi = _orient(phi)
+            chi, self.n_theta_b, self.n_inputs = orient_columns(chi), tb.size, tb.size
+        phi = orient_columns(phi)
         phi_ut = -solver.solve_K(solver.Kut @ chi)  # K_ii Φ^uθ = −K^uθ_ii Φ^θθ
         self.timings["modes"] = time.perf_counter() - t0
         t0 = time.perf_counter()
@@ -218,12 +208,13 @@ class ThermoelasticCraigBampton:
                 psi_l[n_i : 2 * n_i, mb.size : 2 * mb.size] = psi[:n_i, : mb.size]
             else:  # boundary equations kept as in the full model: no static shapes
                 psi_l = None
-            mphi = _orient(normalise_columns(solver.M @ phi[:, : self.n_qu]))
+            mphi = orient_columns(normalise_columns(solver.M @ phi[:, : self.n_qu]))
             left = (psi_l, mphi, phi, chi, solver.Ctu.T @ chi)
         if not keep_solver:  # no more solves: the factorisations' memory before the bases'
             solver.free()
-        self.R = self._assemble(psi, phi[:, : self.n_qu], phi, chi, phi_ut)
-        self.left = self.R if left is None else self._assemble(*left)
+        at = (self._idx, self._int, nu, fom.n_dofs, self.layout)  # where each shape goes
+        self.R = assemble_basis(*at, psi, phi[:, : self.n_qu], phi, chi, phi_ut)
+        self.left = self.R if left is None else assemble_basis(*at, *left)
         self.timings["bases"] = time.perf_counter() - t0
 
     # -- bases -----------------------------------------------------------------------------
@@ -231,29 +222,6 @@ class ThermoelasticCraigBampton:
         """Reduced layout ``(n_b + n_qu, n_b + n_qv, n_θb + n_θ)`` of the sizes given."""
         nb = self.boundary["u"].size
         return Layout(nb + n_uv // 2, nb + (n_uv + 1) // 2, self.n_theta_b + n_theta)
-
-    def _assemble(self, psi, u_shapes, v_shapes, chi, chi_u) -> np.ndarray:
-        """A basis in the full state order with the reduced column order of the layout."""
-        mb, mi, tb, ti = self._idx
-        nu, N, Lr = self.fom.layout.n_u, self.fom.n_dofs, self.layout
-        nb = mb.size
-        V = np.zeros((N, Lr.n))
-        cu_b = np.arange(0, nb)
-        cv_b = Lr.v.start + np.arange(nb)
-        ct_b = Lr.t.start + np.arange(tb.size)
-        for k, (rows, cols) in enumerate(
-            [(mb, cu_b), (nu + mb, cv_b), (2 * nu + tb, ct_b)]
-        ):  # boundary dofs kept (Eq. 12) with their static shapes (Eq. 11)
-            V[rows, cols] = 1.0
-            first = [0, nb, 2 * nb][k]
-            if psi is not None:  # None: zero static shapes (unit left vectors)
-                V[self._int[:, None], cols[None, :]] = psi[:, first : first + cols.size]
-        V[mi[:, None], np.arange(nb, nb + self.n_qu)[None, :]] = u_shapes
-        V[(nu + mi)[:, None], (Lr.v.start + nb + np.arange(self.n_qv))[None, :]] = v_shapes
-        cq_t = Lr.t.start + tb.size + np.arange(chi.shape[1])
-        V[(2 * nu + ti)[:, None], cq_t[None, :]] = chi
-        V[mi[:, None], cq_t[None, :]] = chi_u
-        return V
 
     def _columns(self, n_uv, n_theta) -> tuple[int, int, np.ndarray, Layout]:
         """Sizes (``None``: the largest), columns of ``R`` they keep and their layout.
@@ -341,49 +309,16 @@ class ThermoelasticCraigBampton:
 
     def _project(self, cols, layout) -> dict:
         """The operators of the sizes of ``cols`` projected over the full state."""
-        m = self.fom
         every = cols.size == self.R.shape[1]  # the largest sizes: the bases, no copies
         R = self.R if every else np.take(self.R, cols, axis=1)  # C-ordered, as self.R
         Lt = self.left if every else np.take(self.left, cols, axis=1)
         Lt = R if self.projection in ("galerkin", "second-order") else Lt
-        Ar = project(Lt, m.A, R)
-        Br = project(Lt, m.B, R)
-        loads = [
-            LoadTerm(Lt.T @ t.vector, t.signal, power=R.T @ t.power, heat=t.heat, name=t.name)
-            for t in m.loads
-        ]
-        energy, growth = None, 0.0
-        if m.energy is not None:
-            energy, growth = reduced_energy(m, self.boundary["u"].size, R, Ar, Br, layout)
-        return {
-            "A": Ar,
-            "B": Br,
-            "loads": loads,
-            "contact": None if m.contact is None else m.contact.project(Lt, R),
-            "observations": {k: np.asarray(O @ R) for k, O in m.observations.items()},
-            "energy": energy,
-            "growth": growth,
-            "to_full": None if m.to_full is None else np.asarray(m.to_full @ R),
-        }
+        return projected(self.fom, R, Lt, layout, self.boundary["u"].size)
 
     def _slice(self, cols, layout) -> dict:
         """The operators of the sizes of ``cols`` as blocks of the largest projected ones,
         with the full model's gap, heat and load functions (:meth:`for_model`)."""
-        big, m = self._largest, self.fom
-        A, B = big["A"][np.ix_(cols, cols)], big["B"][np.ix_(cols, cols)]
-        energy, growth = None, 0.0
-        if big["energy"] is not None:
-            energy, growth = energy_rates(m, sliced_energy(big["energy"], cols), A, B, layout)
-        return {
-            "A": A,
-            "B": B,
-            "loads": sliced_loads(big["loads"], m.loads, cols),
-            "contact": sliced_contact(big["contact"], m.contact, cols),
-            "observations": {k: O[:, cols] for k, O in big["observations"].items()},
-            "energy": energy,
-            "growth": growth,
-            "to_full": None if big["to_full"] is None else big["to_full"][:, cols],
-        }
+        return sliced(self._largest, self.fom, cols, layout)
 
     def reconstruct(self, Xr: np.ndarray, n_uv=None, n_theta=None) -> np.ndarray:
         """Full state ``R X̄`` of a reduced state (r,) or of the rows of an (m, r) array.
@@ -445,21 +380,6 @@ def craig_bampton_thermal(model, n_uv=None, n_theta=None, **kw):
     """
     red = ThermoelasticCraigBampton(model, n_uv, n_theta, **kw)
     return red.reduce(), red
-
-
-def _orient(V: np.ndarray) -> np.ndarray:
-    """Shapes with the first of their largest entries (ties within :data:`PEAK_TIE`) positive.
-
-    :func:`~femrub.fem.eigen.normalise_columns` makes the largest entry positive; when two
-    entries tie (a mirror-symmetric mode), round-off picks one, and it changes with the
-    number of modes solved for. This sign is the same for any number of modes, so a basis
-    truncated by :meth:`ThermoelasticCraigBampton.reduce` equals one computed at that size.
-    """
-    if V.size == 0:
-        return V
-    mag = np.abs(V)
-    first = np.argmax(mag >= (1.0 - PEAK_TIE) * mag.max(axis=0), axis=0)
-    return V * np.where(V[first, np.arange(V.shape[1])] < 0.0, -1.0, 1.0)
 
 
 def _count(name, value, most) -> int:

@@ -1,0 +1,58 @@
+"""A Craig–Bampton basis assembled in the reduced state's order (paper Eqs. 12–13).
+
+The reduced state is ``X̄ = [u_b, q_u | v_b, q_v | θ_b, q_θ]`` (the blocks the steppers
+expect); the rows of a basis are the full state's ``[u | v | θ]``. :func:`assemble_basis`
+puts each family of shapes in its place::
+
+        u_b   q_u     v_b   q_v     θ_b   q_θ
+    u_b [ I                                  ]
+    u_i [ Ψ    Φ_u    Ψ             Ψ    Φ^uθ ]
+    v_b [             I                      ]
+    v_i [ Ψ           Ψ    Φ_v      Ψ        ]
+    θ_b [                           I        ]
+    θ_i [ Ψ           Ψ             Ψ    χ    ]
+
+(``Ψ``: the columns of the static shapes of Eq. 11 on the interior rows, zero where the
+projection has none). The same function assembles the right basis ``R`` and the left basis
+``R̃`` from their own shapes.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+__all__ = ["assemble_basis"]
+
+
+def assemble_basis(index, interior, n_u: int, n_full: int, layout, psi, u_shapes, v_shapes,
+                   chi, chi_u) -> np.ndarray:  # fmt: skip
+    """The (n_full, layout.n) basis of the diagram above.
+
+    Parameters
+    ----------
+    index : ``(mb, mi, tb, ti)``: boundary and interior positions in the u- and θ-blocks.
+    interior : full-state rows of the interior dofs ``[mi, n_u + mi, 2 n_u + ti]``.
+    n_u, n_full : size of the full u-block and of the full state.
+    layout : the reduced :class:`~femrub.model.first_order.Layout`.
+    psi : (interior, 2 n_b + n_θb) static shapes of the boundary dofs, or ``None`` (zero).
+    u_shapes, v_shapes : displacement and velocity shapes on the mechanical interior.
+    chi, chi_u : thermal shapes on the thermal interior and their displacement coupling
+        correction on the mechanical interior.
+    """
+    mb, mi, tb, ti = index
+    nb = mb.size
+    V = np.zeros((n_full, layout.n))
+    cu_b = np.arange(0, nb)
+    cv_b = layout.v.start + np.arange(nb)
+    ct_b = layout.t.start + np.arange(tb.size)
+    for k, (rows, cols) in enumerate([(mb, cu_b), (n_u + mb, cv_b), (2 * n_u + tb, ct_b)]):
+        V[rows, cols] = 1.0  # boundary dofs kept (Eq. 12) with their static shapes (Eq. 11)
+        first = [0, nb, 2 * nb][k]
+        if psi is not None:
+            V[interior[:, None], cols[None, :]] = psi[:, first : first + cols.size]
+    V[mi[:, None], np.arange(nb, nb + u_shapes.shape[1])[None, :]] = u_shapes
+    V[(n_u + mi)[:, None], (layout.v.start + nb + np.arange(v_shapes.shape[1]))[None, :]] = v_shapes
+    cq_t = layout.t.start + tb.size + np.arange(chi.shape[1])
+    V[(2 * n_u + ti)[:, None], cq_t[None, :]] = chi
+    V[mi[:, None], cq_t[None, :]] = chi_u
+    return V

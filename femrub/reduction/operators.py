@@ -1,0 +1,70 @@
+"""The reduced operators of a Craig–Bampton reductor's bases (paper Eqs. 14–15).
+
+Two ways to the same operators of a reduced model of the columns ``c`` of the bases:
+
+* :func:`projected`: the projection over the full state, ``Ā = R̃_cᵀ A R_c``,
+  ``B̄ = R̃_cᵀ B R_c``, the loads ``R̃_cᵀ F``, the contact rows (``Contact.project``), the
+  observations ``O R_c``, the energy forms (:func:`~.energy_forms.reduced_energy`) and the
+  map to the mesh ``to_full R_c``;
+* :func:`sliced`: the same as blocks of the largest model's projected operators
+  (:mod:`femrub.reduction.truncation`), with the full model's gap, heat and load functions;
+  only the energy rates, which are not projections, are recomputed.
+
+Both return ``{"A", "B", "loads", "contact", "observations", "energy", "growth",
+"to_full"}`` (``growth``: the largest energy growth rate of the reduced model,
+:func:`~.energy_forms.reduced_energy`).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..fem.linalg import project
+from ..model.first_order import LoadTerm
+from .energy_forms import energy_rates, reduced_energy
+from .truncation import sliced_contact, sliced_energy, sliced_loads
+
+__all__ = ["projected", "sliced"]
+
+
+def projected(fom, R, left, layout, n_boundary_u: int) -> dict:
+    """Operators of ``fom`` projected on the right basis ``R`` and left basis ``left``
+    (``R̃``; ``R`` itself for a Galerkin projection), of reduced ``layout``."""
+    Ar = project(left, fom.A, R)
+    Br = project(left, fom.B, R)
+    loads = [
+        LoadTerm(left.T @ t.vector, t.signal, power=R.T @ t.power, heat=t.heat, name=t.name)
+        for t in fom.loads
+    ]
+    energy, growth = None, 0.0
+    if fom.energy is not None:
+        energy, growth = reduced_energy(fom, n_boundary_u, R, Ar, Br, layout)
+    return {
+        "A": Ar,
+        "B": Br,
+        "loads": loads,
+        "contact": None if fom.contact is None else fom.contact.project(left, R),
+        "observations": {k: np.asarray(O @ R) for k, O in fom.observations.items()},
+        "energy": energy,
+        "growth": growth,
+        "to_full": None if fom.to_full is None else np.asarray(fom.to_full @ R),
+    }
+
+
+def sliced(largest: dict, fom, cols, layout) -> dict:
+    """The operators of the columns ``cols`` as blocks of the ``largest`` model's
+    (:func:`projected` on every column), with ``fom``'s gap, heat and load functions."""
+    A, B = largest["A"][np.ix_(cols, cols)], largest["B"][np.ix_(cols, cols)]
+    energy, growth = None, 0.0
+    if largest["energy"] is not None:
+        energy, growth = energy_rates(fom, sliced_energy(largest["energy"], cols), A, B, layout)
+    return {
+        "A": A,
+        "B": B,
+        "loads": sliced_loads(largest["loads"], fom.loads, cols),
+        "contact": sliced_contact(largest["contact"], fom.contact, cols),
+        "observations": {k: O[:, cols] for k, O in largest["observations"].items()},
+        "energy": energy,
+        "growth": growth,
+        "to_full": None if largest["to_full"] is None else largest["to_full"][:, cols],
+    }
