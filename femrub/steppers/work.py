@@ -225,6 +225,15 @@ class WorkIntegrals:
         """A whole step ``h = q unit`` of held set ``S`` and its integrals in one product:
         ``(X(h), P_S, integrals (6,))`` for the flow's inputs ``(X, w)``
         (:class:`~.flows.Flow`; ``w_l = h^l s^(l)``)."""
+        big, _, n, nz = self.flight_matrix(S, q, unit)
+        u = np.concatenate([X, w.ravel()])
+        y = big @ u
+        return y[:n], y[n:nz], self.flight_integrals(S, q, unit, y, u)
+
+    def flight_matrix(self, S: tuple, q: int, unit: float) -> tuple:
+        """``(F, act, n, nz)``: ``y = F u`` on the flow's inputs ``u = [X; w]`` stacks the
+        state ``[X(h); P_S]`` (``nz`` rows), ``E ᵀ Γ(h) E u`` per non-zero form ``act`` and
+        ``C J(h) E u`` (``E``: the inputs to ``z``; see :meth:`flight_integrals`; cached)."""
         key = (S, unit)
         if key not in self._flight:
             f = self.flows.flow(S, self.flows.h)
@@ -240,13 +249,17 @@ class WorkIntegrals:
             gam = E.T @ Y[:kn].reshape(-1, N, N) @ E
             big = np.vstack([np.hstack([f.Phi, f.Psi]), gam.reshape(-1, n_in), Y[kn:] @ E])
             self._flight[key] = (big, act, n, nz)
-        big, act, n, nz = self._flight[key]
-        u = np.concatenate([X, w.ravel()])
-        y = big @ u
+        return self._flight[key]
+
+    def flight_integrals(self, S: tuple, q: int, unit: float, y, u) -> np.ndarray:
+        """The integrals (6,) of a whole step from ``y = F u`` (:meth:`flight_matrix`; rows
+        of ``y`` past ``F``'s are ignored): the forms ``uᵀ (EᵀΓE) u``, the heats as read."""
+        _, act, _, nz = self._flight[(S, unit)]
         kn = act.size * u.size
         out = np.zeros(6)
-        out[act], out[4:] = y[nz : nz + kn].reshape(-1, u.size) @ u, y[nz + kn :]
-        return y[:n], y[n:nz], out
+        out[act] = y[nz : nz + kn].reshape(-1, u.size) @ u
+        out[4:] = y[nz + kn : nz + kn + 2]
+        return out
 
 
 def _series(A, B, tau):
