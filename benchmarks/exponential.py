@@ -517,19 +517,20 @@ of a matrix stacked once per held set: the exact flight, its work integrals and 
 gaps and held multipliers on the event check grid (`_flight`, `events._grid_rows`).
 
 The 3x target is met on the reduced blade's displacement errors, where θ and Carpenter must
-refine to about 1e-6 s while the exponential stepper needs 1e-5 s. It is not met on the paper
-case, against a θ-method that advances dense models in compiled blocks of steps
-(`steppers/theta_blocks.py`, a few µs per step): no exponential run, at any step, is within 3x
-of it, and the cost-floor table says why, per error. The tip temperature: the exponential
+refine to about 1e-6 s while the exponential stepper needs 1e-5 s. It is not met on the
+paper case, against a θ-method that advances dense models in compiled blocks of steps
+(`steppers/theta_blocks.py`, a few µs per step): no exponential run, at any step, is within
+3x of it, and the cost-floor table says why, per error. The tip temperature: the exponential
 stepper reaches 1 % at its coarsest step (its error does not depend on h: event location,
-not the step, sets it; without events it is wrong by ~50 %), but there its fixed cost alone
-(constructor; per held set the sub-step flows, probe rows and work integrals) exceeds a
-third of θ's whole 1 % run, before any step or event. The paper `u_L2` (which needs
-h <= 2.5e-4 s only because the error is measured on the piecewise-linear interpolant of
-the output): the cost of its event steps alone (27 events: root search on composed dyadic
-flows, impulses, the integrals of the two part flights) exceeds the 3x target, so a
-compiled path for the steps without event, whose total is the column "steps without event",
-cannot reach it either ("run − steps without event" is the run with such steps free).
+not the step, sets it; without events it is off by 12 % at h = 1e-4 s and by 0.6–2x at
+coarser steps), but there its fixed cost alone (constructor; per held set the sub-step
+flows, probe rows and work integrals) exceeds a third of θ's whole 1 % run, before any step
+or event. The paper `u_L2` (which needs h <= 2.5e-4 s only because the error is measured on
+the piecewise-linear interpolant of the output): the cost of its event steps alone (27
+events: root search on composed dyadic flows, impulses, the integrals of the two part
+flights) exceeds the 3x target, so a compiled path for the steps without event, whose total
+is the column "steps without event", cannot reach it either ("run − steps without event" is
+the run with such steps free).
 Without event location (`events = false`) the same stepper is cheap but wrong: an
 end-of-step impulse only stops the tip mass while the rest of the bar flies through the
 casing for a whole step; event location and held contacts are therefore kept. On the free
