@@ -126,10 +126,12 @@ class WorkIntegrals:
                 g, j = self._van_loan(M, Q, C, tau[0]) if lo == 0 else _series(A, B, tau[lo])
                 N, kn = M.shape[0], Q.shape[0] * M.shape[0]
                 g = g.reshape(kn, N)  # the forms stacked: [Γ_1; Γ_2; …]
-                for Zi in Z[lo:]:
+                for i, Zi in enumerate(Z[lo:], start=lo + 1):
                     y = np.vstack([g, j, Zi])
                     y[np.abs(y) < _FLUSH] = 0.0  # no subnormal products (they are slow)
                     Y.append(y)
+                    if i == len(Z):  # the last level: no next one
+                        break
                     # [0, 2τ] = [0, τ] and [τ, 2τ]: Γ + Zᵀ Γ Z, Zᵀ Γ Z = (Γ Z)ᵀ Z (Γ symmetric)
                     gz = (g @ Zi).reshape(-1, N, N).transpose(0, 2, 1).reshape(kn, N)
                     g = g + gz @ Zi
