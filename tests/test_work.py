@@ -71,3 +71,39 @@ def test_paper_case_balance_closes_at_coarse_steps(h):
     assert res.status == "ok"
     assert res.energy_error() < 1e-9 and res.heat_error() < 1e-9
     assert np.all(np.diff(res.energy["contact_work"]) <= 1e-15)
+
+
+@pytest.mark.parametrize("h", [1e-4, 5e-3])
+@pytest.mark.parametrize("measure", [False, True])
+@pytest.mark.parametrize("S", [(), (0,)])
+def test_whole_step_product_matches_the_matrix_exponential(S, measure, h):
+    """One product per step (`_flight`): end state, held impulse, integrals and the event
+    check grid ``[g; λ_S]`` at ``j h / q`` equal the augmented flow's ``expm`` to round-off."""
+    st, W, unit = _setup(h)
+    st._measure = measure
+    flows, q, c = st._flows, st.probes, st.model.contact
+    n, s = st.model.n_dofs, len(S)
+    M = flows.generator_z(S)
+    rng = np.random.default_rng(5)
+    X = rng.standard_normal(n) * 1e-6
+    X[st.model.layout.t] = 50.0 + 10.0 * rng.random(st.model.layout.n_t)
+    b = rng.standard_normal((flows.degree + 1, flows.G.shape[1]))
+    Xe, PS, rest, V = st._flight(S, X, b)
+    z0 = np.r_[X, np.zeros(s), flows.chain(b, 0.0)]
+    lam = flows.generator(S)[2]
+    ref = []
+    for j in range(q + 1):
+        zj = sla.expm(j * h / q * M) @ z0
+        u = (j / q) ** np.arange(b.shape[0]) @ b
+        row = c.gap(st.t + j * h / q, zj[:n])
+        ref.append(row if not S else np.r_[row, lam[:, :n] @ zj[:n] + lam[:, n:] @ u])
+        if j == q:
+            assert np.allclose(Xe, zj[:n], rtol=0, atol=1e-12 * np.abs(zj[:n]).max())
+            assert np.allclose(PS, zj[n : n + s], rtol=1e-10, atol=1e-14)
+    ref = np.array(ref)
+    assert V.shape == ref.shape
+    assert np.allclose(V, ref, rtol=0, atol=1e-10 * np.abs(ref).max())
+    if measure:
+        assert np.allclose(rest, W.step(S, z0, q, unit), rtol=1e-10, atol=1e-16)
+    else:
+        assert rest is None

@@ -27,52 +27,22 @@ class EventLocation:
     reads the stepper's model, ``h``, ``t``, ``probes``, flows and load polynomial helpers)."""
 
     # -- events --------------------------------------------------------------------------------
-    def _event(self, S, Xa, a, Xe, b):
+    def _event(self, S, Xa, a, Xe, b, V=None):
         """Earliest closing or release in ``(a, h]``: ``(τ, kind, i, X(τ), P_S(a..τ))``.
 
         The exact gaps and held multipliers are checked on a grid of spacing ``h / probes``
-        (probe rows on a full step, the cached flow marched on a part step); the first sign
-        change is then located on the exact flow (cached sub-step flows over ``h / probes × 2^e``).
+        (at a step start: the rows ``V`` of :meth:`_grid_values`, computed with the flight;
+        on a part step: probe rows and cached sub-step flows); the first sign change is then
+        located on the exact flow (cached sub-step flows over ``h / probes × 2^e``).
         """
         c, h, t, flows, q = self.model.contact, self.h, self.t, self._flows, self.probes
         n_s, d = len(S), h / self.probes
-        if a == 0.0 and self._quiet(S, Xa, Xe, b):
-            return None
-
-        def values(tau, X):
-            g = c.gap(t + tau, X)
-            return np.concatenate([g, flows.multiplier(S, X, self._u(b, tau / h))]) if S else g
-
-        # grid: a, the next multiples of d, h; rows of gaps and multipliers on it (blocks)
-        grid, rows, states = [[a]], [values(a, Xa)[None]], {0: (Xa, np.zeros(n_s))}
-        i1 = math.floor(a / d * (1.0 + 1e-12)) + 1  # first grid index after a
-        if i1 < q:
-            g1 = i1 * d
-            if a > 0.0:  # part step: to the grid with cached sub-step flows
-                X1, P1 = flows.advance(S, Xa, a, g1, b, d)
-                grid.append([g1])
-                rows.append(values(g1, X1)[None])
-                states[1] = (X1, P1)
-            else:
-                X1 = Xa
-            start = g1 if a > 0.0 else 0.0  # the grid start the probe rows run from
-            if q - i1 > 1 or a == 0.0:
-                Rx, Rb = flows.probe(S, c.GT, q)
-                nj = q - 1 - (i1 if a > 0.0 else 0)  # probe points before h
-                r = Rx.shape[0] // (q - 1)
-                sig0 = start / h  # the load polynomial re-expanded at the grid start
-                b1 = b if sig0 == 0.0 else self._Dinv @ shift(b, sig0, 1.0)
-                V = Rx[: nj * r] @ X1
-                if Rb.shape[1]:
-                    V += Rb[: nj * r] @ b1.ravel()
-                V = V.reshape(nj, r)
-                taus = start + d * np.arange(1, nj + 1)
-                V[:, : c.n] += c.gap_at(t + taus) if callable(c.gap0) else c.gap0
-                grid.append(taus)
-                rows.append(V)
-        grid.append([h])
-        rows.append(values(h, Xe)[None])
-        grid, V = np.concatenate(grid), np.concatenate(rows)
+        if a == 0.0 and V is not None:  # the whole step's grid, read off the flight
+            if self._quiet(S, V):
+                return None
+            grid, states = np.append(d * np.arange(q), h), {0: (Xa, np.zeros(n_s))}
+        else:
+            grid, V, states = self._part_grid(S, Xa, a, Xe, b)
         gv, lv = V[:, : c.n], V[:, c.n :]
         # closing: the gap falls below min(g(a), 0) after having been above it
         f_cl = gv - np.minimum(gv[0], 0.0)
@@ -126,32 +96,96 @@ class EventLocation:
         tau, X, Pl, kind, i = best
         return tau, kind, i, X, P0 + Pl
 
-    def _quiet(self, S, Xa, Xe, b) -> bool:
-        """A whole step without event: no free gap falls below ``min(g(0), 0)`` and no held
-        multiplier is negative on the probe grid and at the step's ends (the common case,
-        checked with one product of the probe rows and one of the end rows)."""
-        c, t, h, q, flows = self.model.contact, self.t, self.h, self.probes, self._flows
-        Ex, Eu = flows.end_rows(S, c.GT)
-        ends = np.vstack([Xa, Xe]) @ Ex.T  # [gaps; multipliers] at 0 and h, gap0 aside
-        if Eu is not None:
-            ends += np.vstack([b[0], b.sum(axis=0)]) @ Eu.T
-        if q > 1:
-            Rx, Rb = flows.probe(S, c.GT, q)
-            V = Rx @ Xa
-            if Rb.shape[1]:
-                V += Rb @ b.ravel()
-            V = np.vstack([ends[:1], V.reshape(q - 1, -1), ends[1:]])
-        else:
-            V = ends
-        gv = V[:, : c.n]
+    def _part_grid(self, S, Xa, a, Xe, b):
+        """The check grid of a part step ``(a, h]``: ``(grid, V, states)``, ``V`` the rows
+        ``[g; λ_S]`` at ``grid`` (probe rows from the first multiple of ``h / probes``,
+        reached with cached sub-step flows), ``states`` the states known on it."""
+        c, h, t, flows, q = self.model.contact, self.h, self.t, self._flows, self.probes
+        n_s, d = len(S), h / self.probes
+
+        def values(tau, X):
+            g = c.gap(t + tau, X)
+            return np.concatenate([g, flows.multiplier(S, X, self._u(b, tau / h))]) if S else g
+
+        # grid: a, the next multiples of d, h; rows of gaps and multipliers on it (blocks)
+        grid, rows, states = [[a]], [values(a, Xa)[None]], {0: (Xa, np.zeros(n_s))}
+        i1 = math.floor(a / d * (1.0 + 1e-12)) + 1  # first grid index after a
+        if i1 < q:
+            g1 = i1 * d
+            if a > 0.0:  # part step: to the grid with cached sub-step flows
+                X1, P1 = flows.advance(S, Xa, a, g1, b, d)
+                grid.append([g1])
+                rows.append(values(g1, X1)[None])
+                states[1] = (X1, P1)
+            else:
+                X1 = Xa
+            start = g1 if a > 0.0 else 0.0  # the grid start the probe rows run from
+            if q - i1 > 1 or a == 0.0:
+                Rx, Rb = flows.probe(S, c.GT, q)
+                nj = q - 1 - (i1 if a > 0.0 else 0)  # probe points before h
+                r = Rx.shape[0] // (q - 1)
+                sig0 = start / h  # the load polynomial re-expanded at the grid start
+                b1 = b if sig0 == 0.0 else self._Dinv @ shift(b, sig0, 1.0)
+                V = Rx[: nj * r] @ X1
+                if Rb.shape[1]:
+                    V += Rb[: nj * r] @ b1.ravel()
+                V = V.reshape(nj, r)
+                taus = start + d * np.arange(1, nj + 1)
+                V[:, : c.n] += c.gap_at(t + taus) if callable(c.gap0) else c.gap0
+                grid.append(taus)
+                rows.append(V)
+        grid.append([h])
+        rows.append(values(h, Xe)[None])
+        return np.concatenate(grid), np.concatenate(rows), states
+
+    def _grid_rows(self, S, flow) -> np.ndarray:
+        """``R`` (cached per held set): ``R u`` are the rows ``[Gᵀ X; λ_S]`` at
+        ``τ_j = j h / q``, j = 0 … q (``q = probes``), for the inputs ``u = [X; w]`` of the
+        step's exact flight ``flow`` (``w_l = l! b_l``, :class:`~.flows.Flow`): end rows at
+        both ends (the end state ``X(h) = [Φ Ψ]_X u``), probe rows between
+        (:meth:`~.flows.FlowFamily.probe`, load coefficients ``b_l = w_l / l!``)."""
+        key = ("grid", S)
+        if key not in self._probe_rows:
+            c, flows, q = self.model.contact, self._flows, self.probes
+            n = self.model.n_dofs
+            Ex, Eu = flows.end_rows(S, c.GT)
+            r, n_in = Ex.shape[0], n + flow.Psi.shape[1]
+            R = np.zeros((q + 1, r, n_in))
+            R[0, :, :n] = Ex
+            R[q] = Ex @ np.hstack([flow.Phi[:n], flow.Psi[:n]])
+            m, p1 = flows.G.shape[1], flows.degree + 1
+            inv = np.repeat([1.0 / math.factorial(j) for j in range(p1)], m)  # b = w / l!
+            if Eu is not None:  # λ_S's load terms: s(0) = w_0, s(h) = Σ w_l / l!
+                R[0, :, n : n + m] += Eu
+                R[q, :, n:] += np.tile(Eu, p1) * inv
+            if q > 1:
+                Rx, Rb = flows.probe(S, c.GT, q)
+                R[1:q, :, :n] = Rx.reshape(q - 1, r, n)
+                if Rb.shape[1]:
+                    R[1:q, :, n:] = (Rb * inv).reshape(q - 1, r, -1)
+            self._probe_rows[key] = R.reshape((q + 1) * r, n_in)
+        return self._probe_rows[key]
+
+    def _grid_values(self, S, y) -> np.ndarray:
+        """``V`` (q + 1, r): the rows ``y = R u`` of :meth:`_grid_rows` with the casing's
+        gaps ``g0`` added at ``t + j h / q``."""
+        c, q = self.model.contact, self.probes
+        V = y.reshape(q + 1, -1)
         if callable(c.gap0):
-            gv += c.gap_at(t + (h / q) * np.arange(q + 1))
+            V[:, : c.n] += c.gap_at(self.t + (self.h / q) * np.arange(q + 1))
         else:
-            gv += c.gap0
+            V[:, : c.n] += c.gap0
+        return V
+
+    def _quiet(self, S, V) -> bool:
+        """A whole step without event: on the grid ``V`` (:meth:`_grid_values`) no free gap
+        falls below ``min(g(0), 0)`` and no held multiplier is negative (the common case)."""
+        n = self.model.contact.n
+        gv = V[:, :n]
         ref = np.minimum(gv[0], 0.0)
         if S:
             ref[list(S)] = -np.inf
-        return not ((gv[1:] < ref).any() or (V[:, c.n :] < 0.0).any())
+        return not ((gv[1:] < ref).any() or (V[:, n:] < 0.0).any())
 
     def _root(self, S, f, lo, hi, X_lo, b):
         """First zero of ``f`` in ``(lo, hi]`` on the exact flow from ``(lo, X_lo)``

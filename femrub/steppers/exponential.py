@@ -168,6 +168,8 @@ class ExponentialMoreau(EventLocation, Stepper):
             self._integrals = WorkIntegrals(self._flows, m.energy, powers, heats, GvT)
             self._Wth = None if m.energy.Wth is None else self._integrals.Wth
         self._measure = False  # step() / iterate(): no meter to hand them to
+        self._fused: dict[tuple, tuple] = {}  # (S, measure) -> whole-step matrix (_flight)
+        self._probe_rows: dict[tuple, np.ndarray] = {}  # the check grids' rows (events)
 
     def _signal_values(self, t):
         """Load signals, then the casing's gap rates ``ġ0`` (moving casing, held contacts)."""
@@ -231,13 +233,9 @@ class ExponentialMoreau(EventLocation, Stepper):
         self._work = 0.0
         self._w = np.zeros(6)
         for n_events in range(MAX_EVENTS + 1):
-            rest = None  # the integrals of the flight to the step end, when known
-            if a == 0.0 and self._measure:  # the whole step and its integrals at once
-                Xe, PS, rest = self._integrals.flight(
-                    S, X, self._T01 @ b, self.probes, h / self.probes
-                )
-            elif a == 0.0:
-                Xe, PS = self._flows.flow(S, h)(X, self._T01 @ b)
+            rest = V = None  # the flight's integrals to the step end and its check grid
+            if a == 0.0:  # the whole step, its integrals and check grid in one product
+                Xe, PS, rest, V = self._flight(S, X, b)
             elif self._measure:  # after an event: the flight and its integrals at once
                 Xe, PS, rest = self._integrate(S, X, a, h, b, state=True)
             else:  # after an event: cached sub-step flows
@@ -247,7 +245,7 @@ class ExponentialMoreau(EventLocation, Stepper):
                 return Xe, P
             ev = None
             if self.events and n_events < MAX_EVENTS:
-                ev = self._event(S, X, a, Xe, b)
+                ev = self._event(S, X, a, Xe, b, V)
             if ev is None:
                 break
             tau, kind, i, Xn, PSa = ev
@@ -268,6 +266,33 @@ class ExponentialMoreau(EventLocation, Stepper):
         X, S = self._impact(t + h, X, S, P)
         self._S = S
         return X, P
+
+    def _flight(self, S, X, b):
+        """The exact flight of ``S`` over the whole step from ``X`` with the load polynomial
+        ``b``, in one product of a matrix stacked once per held set: ``(X(h), P_S,
+        integrals, V)``, the integrals (:meth:`~.work.WorkIntegrals.flight_matrix`) with
+        ``run(energy=True)`` and the event check grid ``V`` (:meth:`_grid_rows`) when events
+        are located (else ``None``)."""
+        key = (S, self._measure)
+        q, n, nz = self.probes, self.model.n_dofs, self.model.n_dofs + len(S)
+        if key not in self._fused:
+            f = self._flows.flow(S, self.h)
+            if self._measure:
+                F = self._integrals.flight_matrix(S, q, self.h / q)[0]
+            else:
+                F = np.hstack([f.Phi, f.Psi])
+            k = F.shape[0]  # the rows past k: the check grid
+            if self.events and self.model.contact is not None:
+                F = np.vstack([F, self._grid_rows(S, f)])
+            self._fused[key] = (F, k)
+        F, k = self._fused[key]
+        u = np.concatenate([X, (self._T01 @ b).ravel()])
+        y = F @ u
+        rest = None
+        if self._measure:
+            rest = self._integrals.flight_integrals(S, q, self.h / q, y, u)
+        V = self._grid_values(S, y[k:]) if k < y.size else None
+        return y[:n], y[n:nz], rest, V
 
     def _integrate(self, S, X, a, tau, b, state=False):
         """The exact works and heats (6,) of the flight of ``S`` from ``(a, X)`` to ``tau``

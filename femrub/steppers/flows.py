@@ -167,7 +167,7 @@ class FlowFamily:
         if key not in self._levels:
             M = self.generator_z(S)
             N = M.shape[0]
-            e_max = max(math.ceil(math.log2(self.h / unit)), 0) + 1
+            e_max = max(math.ceil(math.log2(self.h / unit)), 0)
             T = unit * 2.0**LEVEL_MIN * M
             T[np.abs(T) < _FLUSH] = 0.0
             if np.linalg.norm(T, 1) < 0.5:  # Taylor series of e^T − I to round-off
@@ -181,10 +181,11 @@ class FlowFamily:
             else:  # a very stiff model: the exponential itself
                 D = sla.expm(T) - np.eye(N)
             out, eye = [], np.eye(N)
-            for _ in range(LEVEL_MIN, e_max + 1):
+            for e in range(LEVEL_MIN, e_max + 1):
                 D[np.abs(D) < _FLUSH] = 0.0  # no subnormal products (they are slow)
                 out.append(np.ascontiguousarray(eye + D))
-                D = 2.0 * D + D @ D
+                if e < e_max:
+                    D = 2.0 * D + D @ D
             self._levels[key] = out
         return self._levels[key]
 

@@ -126,10 +126,12 @@ class WorkIntegrals:
                 g, j = self._van_loan(M, Q, C, tau[0]) if lo == 0 else _series(A, B, tau[lo])
                 N, kn = M.shape[0], Q.shape[0] * M.shape[0]
                 g = g.reshape(kn, N)  # the forms stacked: [Γ_1; Γ_2; …]
-                for Zi in Z[lo:]:
+                for i, Zi in enumerate(Z[lo:], start=lo + 1):
                     y = np.vstack([g, j, Zi])
                     y[np.abs(y) < _FLUSH] = 0.0  # no subnormal products (they are slow)
                     Y.append(y)
+                    if i == len(Z):  # the last level: no next one
+                        break
                     # [0, 2τ] = [0, τ] and [τ, 2τ]: Γ + Zᵀ Γ Z, Zᵀ Γ Z = (Γ Z)ᵀ Z (Γ symmetric)
                     gz = (g @ Zi).reshape(-1, N, N).transpose(0, 2, 1).reshape(kn, N)
                     g = g + gz @ Zi
@@ -225,6 +227,15 @@ class WorkIntegrals:
         """A whole step ``h = q unit`` of held set ``S`` and its integrals in one product:
         ``(X(h), P_S, integrals (6,))`` for the flow's inputs ``(X, w)``
         (:class:`~.flows.Flow`; ``w_l = h^l s^(l)``)."""
+        big, _, n, nz = self.flight_matrix(S, q, unit)
+        u = np.concatenate([X, w.ravel()])
+        y = big @ u
+        return y[:n], y[n:nz], self.flight_integrals(S, q, unit, y, u)
+
+    def flight_matrix(self, S: tuple, q: int, unit: float) -> tuple:
+        """``(F, act, n, nz)``: ``y = F u`` on the flow's inputs ``u = [X; w]`` stacks the
+        state ``[X(h); P_S]`` (``nz`` rows), ``E ᵀ Γ(h) E u`` per non-zero form ``act`` and
+        ``C J(h) E u`` (``E``: the inputs to ``z``; see :meth:`flight_integrals`; cached)."""
         key = (S, unit)
         if key not in self._flight:
             f = self.flows.flow(S, self.flows.h)
@@ -240,13 +251,17 @@ class WorkIntegrals:
             gam = E.T @ Y[:kn].reshape(-1, N, N) @ E
             big = np.vstack([np.hstack([f.Phi, f.Psi]), gam.reshape(-1, n_in), Y[kn:] @ E])
             self._flight[key] = (big, act, n, nz)
-        big, act, n, nz = self._flight[key]
-        u = np.concatenate([X, w.ravel()])
-        y = big @ u
+        return self._flight[key]
+
+    def flight_integrals(self, S: tuple, q: int, unit: float, y, u) -> np.ndarray:
+        """The integrals (6,) of a whole step from ``y = F u`` (:meth:`flight_matrix`; rows
+        of ``y`` past ``F``'s are ignored): the forms ``uᵀ (EᵀΓE) u``, the heats as read."""
+        _, act, _, nz = self._flight[(S, unit)]
         kn = act.size * u.size
         out = np.zeros(6)
-        out[act], out[4:] = y[nz : nz + kn].reshape(-1, u.size) @ u, y[nz + kn :]
-        return y[:n], y[n:nz], out
+        out[act] = y[nz : nz + kn].reshape(-1, u.size) @ u
+        out[4:] = y[nz + kn : nz + kn + 2]
+        return out
 
 
 def _series(A, B, tau):
