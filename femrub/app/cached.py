@@ -123,20 +123,22 @@ class Stages:
             model.observations, model.energy, model.to_full, *extra,
         )  # fmt: skip
 
-    def reduce(self, model, scene, log=None, make_stepper=None, limits=None):
+    def reduce(self, model, scene, log=None, make_stepper=None, limits=None, on_run=None):
         """:func:`~femrub.reduction.sizes.reduce_model`: ``(reduced, reductor, report)``.
 
         ``make_stepper`` (for the reduction error estimate, which steps the run itself)
         puts the scene's ``scheme``, ``loads`` and ``contact`` and the stop ``limits`` it
-        applies to its runs into the key.
+        applies to its runs into the key. ``on_run``: see ``reduce_model`` (not called on a
+        cache hit: nothing is stepped).
         """
+        kw = {"limits": limits, "on_run": on_run}
         if self.cache is None or self._mats_key is None:
-            out = reduce_model(model, scene, log, make_stepper, limits=limits)
+            out = reduce_model(model, scene, log, make_stepper, **kw)
             _say_phases(self._say, out[0].info.get("timings", {}))
             return out
         opts = dict(scene["reduction"])
         if opts["method"] == "none":
-            return reduce_model(model, scene, log, make_stepper, limits=limits)  # nothing stored
+            return reduce_model(model, scene, log, make_stepper, **kw)  # nothing stored
         t_end = scene["scheme"]["t_end"] if opts["method"] == "auto" else None
         run = None  # what the estimate's runs depend on
         if make_stepper:
@@ -147,7 +149,7 @@ class Stages:
             return _attach(hit, model), None, dict(hit["report"], cache="hit")
         bases = self._model_key(model, "bases", opts) if opts["method"] != "auto" else None
         reduced, reductor, report = reduce_model(
-            model, scene, log, make_stepper, reductor=_REDUCTORS.get(bases), limits=limits
+            model, scene, log, make_stepper, reductor=_REDUCTORS.get(bases), **kw
         )
         if bases is not None:
             _REDUCTORS.clear()

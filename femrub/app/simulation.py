@@ -48,6 +48,7 @@ __all__ = [
     "blade_size",
     "build",
     "default_limits",
+    "reusable_run",
 ]
 
 #: default stop limit on temperature signals (K above ambient; titanium melts ~1650 K above)
@@ -109,6 +110,9 @@ class Simulation:
     limits: dict
     report: dict = field(default_factory=dict)
     timings: dict = field(default_factory=dict)
+    #: ``(results, wall seconds)`` of the scene's run of ``model`` to ``scheme.t_end``, stepped
+    #: by the reduction error estimate (:func:`reusable_run`), else ``None``
+    ran: tuple | None = None
 
     def explain(self) -> str:
         """What was built and why, as text (``femrub run SCENE --explain``)."""
@@ -144,6 +148,10 @@ class _Clock:
 
     def __init__(self, log):
         self.log, self.timings, self._t = log, {}, time.perf_counter()
+
+    def exclude(self, seconds: float) -> None:
+        """Leave ``seconds`` of the current stage out of its time (a run stepped inside it)."""
+        self._t += seconds
 
     def done(self, stage: str, result: str) -> None:
         now = time.perf_counter()
@@ -244,7 +252,14 @@ def _build(scene, log, modes, stages, with_stepper=True) -> Simulation:
     if modes:
         report["natural_frequencies_hz"] = stages.frequencies(model, modes).tolist()
     make = lambda m: bare_stepper(scene, m)  # noqa: E731  (the reduction error estimate)
-    reduced, reductor, report["reduction"] = stages.reduce(model, scene, log, make, limits)
+    ran = []
+    keep = ran.append if reusable_run(model) else None
+    reduced, reductor, report["reduction"] = stages.reduce(
+        model, scene, log, make, limits, on_run=keep and (lambda *r: keep(r))
+    )
+    ran = ran[0] if ran else None
+    if ran is not None:  # the run itself: its time is the run's ``stepping``
+        clock.exclude(ran[1])
     clock.done("reduction", f"{reduced.n_dofs} dofs")
     report["model"] = {"n_dofs": reduced.n_dofs, **_layout(reduced)}
     stepper = stepper_of(scene, reduced, report) if with_stepper else None
@@ -254,8 +269,19 @@ def _build(scene, log, modes, stages, with_stepper=True) -> Simulation:
     }
     report["timings"] = clock.timings
     return Simulation(
-        scene, reduced, full, fields, reductor, stepper, limits, report, clock.timings
+        scene, reduced, full, fields, reductor, stepper, limits, report, clock.timings, ran
     )
+
+
+def reusable_run(model) -> bool:
+    """Whether the reduction error estimate's run of the chosen sizes can be the run.
+
+    It is the same model, stepper, initial state, end time and stop limits; its results are
+    kept unless the contact carries state across runs that a later run of the estimate (its
+    reference's twin) would overwrite: an abradable coating's wear or the casing's heat.
+    """
+    c = model.contact
+    return c is None or (c.wear is None and c.casing_heat is None)
 
 
 def _prestress(scene, disc, material, omega, log, stages):
