@@ -28,6 +28,10 @@ functions and signals from the full model built in this run. Every key also hold
 On a hit ``Simulation.reductor`` is ``None`` (the bases are not stored: the reduced model
 carries what the run needs, including its map to the mesh).
 
+A sweep worker keeps the last assembly it built or loaded (:func:`keep_assemblies`): the
+next point of a speed sweep on the same dask worker takes it from memory instead of the
+cache folder.
+
 A reduced model missing from the cache but whose bases this process already built (the
 next point of a speed sweep on a dask worker: same matrices, same ``reduction`` options,
 given sizes) reuses that reductor (:data:`_REDUCTORS`, the last one only) with the reduced
@@ -47,10 +51,21 @@ from ..fem.prestress import centrifugal_prestress
 from ..reduction.sizes import natural_frequencies, reduce_model
 from .cache import content_key
 
-__all__ = ["Stages"]
+__all__ = ["Stages", "keep_assemblies"]
 
 #: the last reductor this process built, ``{key: reductor}`` (its bases are speed-free)
 _REDUCTORS: dict = {}
+#: the last assembly this process built or loaded, ``{key: blocks without their bases}``,
+#: once :func:`keep_assemblies` is called (``None``: not kept)
+_ASSEMBLED: dict | None = None
+
+
+def keep_assemblies() -> None:
+    """Keep the last assembly in this process from now on (a sweep worker: every point on
+    the blade has the same blocks; they are then neither loaded nor assembled again)."""
+    global _ASSEMBLED
+    if _ASSEMBLED is None:
+        _ASSEMBLED = {}
 
 
 class Stages:
@@ -91,13 +106,20 @@ class Stages:
             disc.fixed_u, disc.fixed_t, material, kw,
         )  # fmt: skip
         self._mats_key = key
-        mats = self._fetch("assembly", key)
+        mats = _ASSEMBLED.get(key) if _ASSEMBLED is not None else None
         if mats is not None:
-            return dataclasses.replace(mats, basis_u=disc.basis_u, basis_t=disc.basis_t)
-        mats = assemble(disc, material, **kw)
-        bare = dataclasses.replace(mats, basis_u=None, basis_t=None)
-        self._keep("assembly", key, bare, f"{mats.n_u} + {mats.n_t} FE dofs")
-        return mats
+            self.hits["assembly"] = True
+            self._say(f"cache: assembly kept by this process ({key[:12]})")
+        else:
+            mats = self._fetch("assembly", key)
+        if mats is None:
+            mats = assemble(disc, material, **kw)
+            mats = dataclasses.replace(mats, basis_u=None, basis_t=None)
+            self._keep("assembly", key, mats, f"{mats.n_u} + {mats.n_t} FE dofs")
+        if _ASSEMBLED is not None:  # the next point of a sweep on this worker: same blocks
+            _ASSEMBLED.clear()
+            _ASSEMBLED[key] = mats
+        return dataclasses.replace(mats, basis_u=disc.basis_u, basis_t=disc.basis_t)
 
     def prestress(self, disc, material, omega: float, method: str):
         """:func:`~femrub.fem.prestress.centrifugal_prestress` of ``disc``, through the cache."""

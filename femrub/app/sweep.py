@@ -31,6 +31,7 @@ from ..output.folder import FINISHED, FolderError, claim, folder_status
 from ..output.jsonfile import write_json
 from ..scene import SceneError, parse_value, resolve_key
 from ..scene.scene import Scene
+from .cached import keep_assemblies
 from .run import run_scene, scene_hash
 
 __all__ = ["parse_param", "grid", "run_point", "point_metrics", "run_sweep"]
@@ -119,6 +120,7 @@ def run_point(
     """Run one point (in a worker); never raises: failures come back as a row.
 
     ``cache``: a :class:`~femrub.app.cache.ModelCache` shared by the points."""
+    keep_assemblies()  # the worker's next points load nothing the blade's blocks already hold
     try:
         scene = Scene(scene_data, source, Path(base_dir)).with_changes(changes)
         run_scene(scene, out, overwrite=True, modes=N_MODES, cache=cache)
