@@ -88,3 +88,23 @@ def test_run_scene_steps_once(tmp_path, monkeypatch):
     assert len(calls) in (2, 3) and all(c > 0 for c in calls)
     assert s["timings"]["stepping"] == pytest.approx(built.ran[1])
     assert s["reduction_error"]["sizes"] == [8, 4] and s["status"] == res.status
+
+
+def test_a_sweep_worker_keeps_the_assembly(tmp_path, monkeypatch):
+    """After ``keep_assemblies`` the next build on the blade reads no assembly from disk."""
+    from femrub.app import cached
+    from femrub.app.cache import ModelCache
+
+    monkeypatch.setattr(cached, "_ASSEMBLED", None)
+    cache, notes = ModelCache(tmp_path / "cache"), []
+    scene = load_scene("twisted-naca", {**SMALL, "scheme.t_end": 2e-5})
+    first = build(scene, cache=cache)
+    cached.keep_assemblies()
+    build(scene.with_changes({"loads.rotation_speed": 1400.0}), cache=cache, log=notes.append)
+    assert any("assembly loaded" in n for n in notes)  # from the cache folder, then kept
+    notes.clear()
+    again = build(scene.with_changes({"loads.rotation_speed": 1300.0}), cache=cache,
+                  log=notes.append)  # fmt: skip
+    assert any("assembly kept by this process" in n for n in notes)
+    assert not any("assembly loaded" in n or "assembly stored" in n for n in notes)
+    np.testing.assert_array_equal(again.full.A.toarray(), first.full.A.toarray())
