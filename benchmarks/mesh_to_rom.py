@@ -79,7 +79,8 @@ def row(r: dict) -> str:
         f"{r['peak_mib']:.0f} ({r['peak_mib'] * 1.048576 / 1000:.2f} GB) | "
         f"{r['timings'].get('assembly', 0):.1f} | {r['timings'].get('reduction', 0):.1f} "
         f"({ph}; estimate {est:.1f}, of which the run itself {run:.1f}, kept as the run; "
-        f"wall without it {r['wall'] - run:.1f}) | {100 * (r['estimate'] or 0):.2f} % ({verdict}) | "
+        f"wall without it {r['wall'] - run:.1f}) | "
+        f"{100 * (r['estimate'] or 0):.2f} % ({verdict}) | "
         f"{r['n_dofs']} | {r['load'][0]}–{r['load'][1]} |"
     )
 
