@@ -14,8 +14,10 @@ for the signals the scene does not limit (:func:`default_limits`: a temperature 
 :data:`MAX_TEMPERATURE_RISE` K, a displacement of :data:`MAX_DISPLACEMENT_RATIO` times the
 blade's size), so a runaway is reported as ``diverged-physically``, never as ``ok``.
 ``report`` says what was built and why (``femrub run SCENE --explain``); ``timings`` holds
-the seconds spent meshing, assembling and reducing. The paper's bar and a 3D blade go
-through the same path.
+the seconds spent meshing, assembling and reducing. The reduction error estimate steps the
+reduced model of the chosen sizes to ``scheme.t_end`` with the scene's stepper: those results
+are the run's (``ran``), and :func:`femrub.app.run.run_scene` writes them instead of stepping
+the model a second time. The paper's bar and a 3D blade go through the same path.
 """
 
 from __future__ import annotations
