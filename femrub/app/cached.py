@@ -28,6 +28,10 @@ functions and signals from the full model built in this run. Every key also hold
 On a hit ``Simulation.reductor`` is ``None`` (the bases are not stored: the reduced model
 carries what the run needs, including its map to the mesh).
 
+A sweep worker keeps the last assembly it built or loaded (:func:`keep_assemblies`): the
+next point of a speed sweep on the same dask worker takes it from memory instead of the
+cache folder.
+
 A reduced model missing from the cache but whose bases this process already built (the
 next point of a speed sweep on a dask worker: same matrices, same ``reduction`` options,
 given sizes) reuses that reductor (:data:`_REDUCTORS`, the last one only) with the reduced
@@ -47,10 +51,21 @@ from ..fem.prestress import centrifugal_prestress
 from ..reduction.sizes import natural_frequencies, reduce_model
 from .cache import content_key
 
-__all__ = ["Stages"]
+__all__ = ["Stages", "keep_assemblies"]
 
 #: the last reductor this process built, ``{key: reductor}`` (its bases are speed-free)
 _REDUCTORS: dict = {}
+#: the last assembly this process built or loaded, ``{key: blocks without their bases}``,
+#: once :func:`keep_assemblies` is called (``None``: not kept)
+_ASSEMBLED: dict | None = None
+
+
+def keep_assemblies() -> None:
+    """Keep the last assembly in this process from now on (a sweep worker: every point on
+    the blade has the same blocks; they are then neither loaded nor assembled again)."""
+    global _ASSEMBLED
+    if _ASSEMBLED is None:
+        _ASSEMBLED = {}
 
 
 class Stages:
@@ -91,13 +106,20 @@ class Stages:
             disc.fixed_u, disc.fixed_t, material, kw,
         )  # fmt: skip
         self._mats_key = key
-        mats = self._fetch("assembly", key)
+        mats = _ASSEMBLED.get(key) if _ASSEMBLED is not None else None
         if mats is not None:
-            return dataclasses.replace(mats, basis_u=disc.basis_u, basis_t=disc.basis_t)
-        mats = assemble(disc, material, **kw)
-        bare = dataclasses.replace(mats, basis_u=None, basis_t=None)
-        self._keep("assembly", key, bare, f"{mats.n_u} + {mats.n_t} FE dofs")
-        return mats
+            self.hits["assembly"] = True
+            self._say(f"cache: assembly kept by this process ({key[:12]})")
+        else:
+            mats = self._fetch("assembly", key)
+        if mats is None:
+            mats = assemble(disc, material, **kw)
+            mats = dataclasses.replace(mats, basis_u=None, basis_t=None)
+            self._keep("assembly", key, mats, f"{mats.n_u} + {mats.n_t} FE dofs")
+        if _ASSEMBLED is not None:  # the next point of a sweep on this worker: same blocks
+            _ASSEMBLED.clear()
+            _ASSEMBLED[key] = mats
+        return dataclasses.replace(mats, basis_u=disc.basis_u, basis_t=disc.basis_t)
 
     def prestress(self, disc, material, omega: float, method: str):
         """:func:`~femrub.fem.prestress.centrifugal_prestress` of ``disc``, through the cache."""
@@ -123,20 +145,22 @@ class Stages:
             model.observations, model.energy, model.to_full, *extra,
         )  # fmt: skip
 
-    def reduce(self, model, scene, log=None, make_stepper=None, limits=None):
+    def reduce(self, model, scene, log=None, make_stepper=None, limits=None, on_run=None):
         """:func:`~femrub.reduction.sizes.reduce_model`: ``(reduced, reductor, report)``.
 
         ``make_stepper`` (for the reduction error estimate, which steps the run itself)
         puts the scene's ``scheme``, ``loads`` and ``contact`` and the stop ``limits`` it
-        applies to its runs into the key.
+        applies to its runs into the key. ``on_run``: see ``reduce_model`` (not called on a
+        cache hit: nothing is stepped).
         """
+        kw = {"limits": limits, "on_run": on_run}
         if self.cache is None or self._mats_key is None:
-            out = reduce_model(model, scene, log, make_stepper, limits=limits)
+            out = reduce_model(model, scene, log, make_stepper, **kw)
             _say_phases(self._say, out[0].info.get("timings", {}))
             return out
         opts = dict(scene["reduction"])
         if opts["method"] == "none":
-            return reduce_model(model, scene, log, make_stepper, limits=limits)  # nothing stored
+            return reduce_model(model, scene, log, make_stepper, **kw)  # nothing stored
         t_end = scene["scheme"]["t_end"] if opts["method"] == "auto" else None
         run = None  # what the estimate's runs depend on
         if make_stepper:
@@ -147,7 +171,7 @@ class Stages:
             return _attach(hit, model), None, dict(hit["report"], cache="hit")
         bases = self._model_key(model, "bases", opts) if opts["method"] != "auto" else None
         reduced, reductor, report = reduce_model(
-            model, scene, log, make_stepper, reductor=_REDUCTORS.get(bases), limits=limits
+            model, scene, log, make_stepper, reductor=_REDUCTORS.get(bases), **kw
         )
         if bases is not None:
             _REDUCTORS.clear()

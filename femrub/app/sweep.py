@@ -31,6 +31,7 @@ from ..output.folder import FINISHED, FolderError, claim, folder_status
 from ..output.jsonfile import write_json
 from ..scene import SceneError, parse_value, resolve_key
 from ..scene.scene import Scene
+from .cached import keep_assemblies
 from .run import run_scene, scene_hash
 
 __all__ = ["parse_param", "grid", "run_point", "point_metrics", "run_sweep"]
@@ -38,6 +39,8 @@ __all__ = ["parse_param", "grid", "run_point", "point_metrics", "run_sweep"]
 _RANGE = re.compile(r"^\s*([^:]+):([^:]+):([^:]+?)\s*([A-Za-zµμ/^]+[A-Za-z0-9µμ/^]*)?\s*$")
 #: natural frequencies computed for the Campbell diagram
 N_MODES = 4
+#: a local cluster of more workers than this runs the sweep's first point alone (memory)
+SERIAL_FIRST_ABOVE = 2
 
 
 def _number(text: str, what: str) -> float:
@@ -119,6 +122,7 @@ def run_point(
     """Run one point (in a worker); never raises: failures come back as a row.
 
     ``cache``: a :class:`~femrub.app.cache.ModelCache` shared by the points."""
+    keep_assemblies()  # the worker's next points load nothing the blade's blocks already hold
     try:
         scene = Scene(scene_data, source, Path(base_dir)).with_changes(changes)
         run_scene(scene, out, overwrite=True, modes=N_MODES, cache=cache)
@@ -169,8 +173,11 @@ def run_sweep(
     scheduler : address of a dask scheduler; ``None``: a ``LocalCluster`` of ``workers``.
     overwrite : rerun points that already have a finished result.
     cache : a :class:`~femrub.app.cache.ModelCache` (its folder must be shared with the
-        workers): the first point runs alone and stores its models, the others then load
-        the models they share with it.
+        workers): on a cluster (``scheduler``) or more than :data:`SERIAL_FIRST_ABOVE` local
+        workers the first point runs alone and stores its models, the others then load the
+        models they share with it; on fewer local workers every worker starts at once (each
+        builds its reduction bases on its first point anyway, so one point alone would only
+        spare the others an assembly, at the price of idle workers meanwhile).
     """
     out = Path(out)
     if scheduler is None and (isinstance(workers, bool) or not isinstance(workers, int)
@@ -239,6 +246,7 @@ def _compute(scene, todo, scheduler, workers, progress, cache=None) -> None:
     try:
         bar = tqdm(total=len(todo), disable=not progress, unit="point", desc="sweep")
         first = cache is not None and len(todo) > 1
+        first = first and (scheduler is not None or workers > SERIAL_FIRST_ABOVE)
         batches = [todo[:1], todo[1:]] if first else [todo]  # the first point fills the cache
         for batch in batches:
             _collect(submit(batch), bar)

@@ -31,6 +31,7 @@ from .history_file import HistoryCSV
 from .interrupts import deferred, interruptible
 from .jsonfile import write_json as _write_json
 from .plots import savefig, tip_panels
+from .verdict import assess
 
 __all__ = ["STAGES", "run_to_folder", "ResultExists"]
 
@@ -94,6 +95,7 @@ def run_to_folder(
     merge_time: float | None = None,
     claimed: bool = False,
     reduction_error: dict | None = None,
+    ran=None,
 ):
     """Run ``stepper`` to ``t_end`` and write the results folder ``out`` (module docstring).
 
@@ -106,20 +108,37 @@ def run_to_folder(
     :func:`~femrub.output.folder.claim` on ``out``. ``reduction_error``: the estimate of a
     reduced run (:mod:`femrub.reduction.estimate`, with its ``tolerance``), written as
     ``summary.json["reduction_error"]`` and judged by the ``reduction`` rule of
-    :mod:`~femrub.output.verdict` (``inaccurate`` above the tolerance). Returns the
+    :mod:`~femrub.output.verdict` (``inaccurate`` above the tolerance). ``ran``: ``(results,
+    wall seconds)`` of this very run already stepped (``stepper.model`` from its initial state
+    to ``t_end`` with ``limits``, e.g. by the reduction error estimate): it is judged and
+    written instead of stepped again (no VTK: its states were not streamed). Returns the
     :class:`~femrub.output.results.Results`.
     """
     out = Path(out)
     with nullcontext() if claimed else claim(out, "run", overwrite=overwrite):
         return _run(
             stepper, t_end, out, fields, vtk_stride, inputs, limits, progress, snapshot, plots,
-            timings, n_full, rotation_speed, merge_time, reduction_error,
+            timings, n_full, rotation_speed, merge_time, reduction_error, ran,
         )  # fmt: skip
+
+
+def _judged(ran, tolerances, merge_time):
+    """``(results, wall)`` of a run stepped elsewhere, judged as ``Stepper.run`` judges.
+
+    Its results were judged without these ``tolerances`` and ``merge_time``; the recorder
+    ends a run ``ok`` or with a stop status and only the verdict turns ``ok`` into
+    ``inaccurate``, so an ``inaccurate`` run is judged again from ``ok``.
+    """
+    res, wall = ran
+    if res.status == "inaccurate":
+        res.status, res.message = "ok", ""
+    res.states = res.state_times = None  # the estimate's checkpoints, not the run's output
+    return assess(res, tolerances=tolerances, merge_time=merge_time), wall
 
 
 def _run(
     stepper, t_end, out, fields, vtk_stride, inputs, limits, progress, snapshot, plots, timings,
-    n_full, rotation_speed, merge_time, reduction_error,
+    n_full, rotation_speed, merge_time, reduction_error, ran,
 ):  # fmt: skip
     summary_path = out / "summary.json"
     model = stepper.model
@@ -140,6 +159,8 @@ def _run(
         doc["reduction_error"] = reduction_error
     _write_json(summary_path, doc)
     series = None
+    if ran is not None and fields is not None and vtk_stride:
+        raise ValueError("run_to_folder: a run already stepped has no VTK frames to write")
     if fields is not None and vtk_stride:
         from .vtk import VTKSeries
 
@@ -148,19 +169,23 @@ def _run(
         (out / stale).unlink(missing_ok=True)  # results of an earlier, unfinished run
     history = HistoryCSV(out / "history.csv")
     t0 = time.perf_counter()
+    tolerances = {"reduction": reduction_error} if reduction_error else None
     try:
         with interruptible():
-            res = stepper.run(
-                t_end, progress=progress, limits=limits, on_state=series, on_rows=history,
-                merge_time=merge_time,
-                tolerances={"reduction": reduction_error} if reduction_error else None,
-            )  # fmt: skip
+            if ran is not None:
+                res, wall = _judged(ran, tolerances, merge_time)
+            else:
+                res = stepper.run(
+                    t_end, progress=progress, limits=limits, on_state=series, on_rows=history,
+                    merge_time=merge_time, tolerances=tolerances,
+                )  # fmt: skip
     except KeyboardInterrupt:  # before the recorder took over: say so, keep the folder
         _write_json(summary_path, {**doc, "status": "interrupted", "message": "interrupted"})
         raise
     finally:
         history.close()
-    wall = time.perf_counter() - t0
+    if ran is None:
+        wall = time.perf_counter() - t0
     with deferred():
         return _finish(
             stepper, res, out, doc, series, history, wall, snapshot, plots, timings,

@@ -139,24 +139,33 @@ def _ladder(most: tuple[int, int]) -> list[tuple[int, int]]:
     return out + [most]
 
 
-def _checked(red, model, want, make_stepper, scene, report, log, limits) -> tuple[int, int]:
+def _timed(*args, **kw):
+    """:func:`~femrub.reduction.estimate.simulate`, with its wall seconds appended."""
+    t0 = time.perf_counter()
+    return (*simulate(*args, **kw), time.perf_counter() - t0)
+
+
+def _checked(red, model, want, make_stepper, scene, report, log, limits, on_run=None):
     """Sizes to run and their a-posteriori estimate (``report["error"]``).
 
     ``want``: the sizes asked for (``None`` for ``"auto"``: the smallest of :func:`_ladder`
     whose estimate is within ``SAFETY × tolerance``). The reference is the reductor's largest
     model; the largest model itself is judged by its difference to the next smaller one.
+    ``on_run(results, seconds)`` receives the estimate's run of the chosen sizes (the run
+    itself: same model, stepper and initial state, stepped to ``t_end`` with ``limits``).
     """
     t0 = time.perf_counter()
     tol, t_end = scene["reduction"]["tolerance"], scene["scheme"]["t_end"]
     window = lobe_passage(scene)
     most = (red.n_uv, red.n_theta)
-    ref = simulate(red, most, make_stepper, t_end, limits=limits)
+    *ref, ref_wall = _timed(red, most, make_stepper, t_end, limits=limits)
     cands = [want] if want is not None else _ladder(most)
-    chosen, err, tried, tw = None, None, [], None
+    chosen, err, tried, tw, kept = None, None, [], None, (ref[0], ref_wall)
     for c in cands:
         if c == most:
             break
-        run = simulate(red, c, make_stepper, t_end, limits=limits)
+        *run, wall = _timed(red, c, make_stepper, t_end, limits=limits)
+        kept = (run[0], wall)
         err = estimate((c, *run), (most, *ref), model, window=window)
         if err["estimate"] > SAFETY * tol:  # measure how sensitive the response is
             tw = tw or twin(red, most, make_stepper, t_end, limits=limits)
@@ -166,7 +175,7 @@ def _checked(red, model, want, make_stepper, scene, report, log, limits) -> tupl
             chosen = c
             break
     if chosen is None:  # the largest: judged against the next smaller candidate
-        chosen = most
+        chosen, kept = most, (ref[0], ref_wall)
         if tried:
             err = dict(err, estimate=err["estimate"], judged="largest model: difference to "
                        f"the next smaller one {tried[-1]['sizes']} (pessimistic)")  # fmt: skip
@@ -174,6 +183,8 @@ def _checked(red, model, want, make_stepper, scene, report, log, limits) -> tupl
             err = {"estimate": 0.0, "note": "the run's model is the reference (no estimate)"}
     err.update(tolerance=tol, tried=tried, seconds=time.perf_counter() - t0)
     report["error"] = err
+    if on_run is not None:
+        on_run(*kept)
     if log:
         log(f"reduction error estimate {100 * err['estimate']:.2g} % at sizes {list(chosen)}")
     return chosen
@@ -188,7 +199,9 @@ def lobe_passage(scene) -> float:
     return 2.0 * np.pi / (omega * lobes) if lobes and omega else 0.0
 
 
-def reduce_model(model, scene, log=None, make_stepper=None, reductor=None, limits=None):
+def reduce_model(
+    model, scene, log=None, make_stepper=None, reductor=None, limits=None, on_run=None
+):
     """Reduce ``model`` as ``scene["reduction"]`` asks; return ``(model, reductor, report)``.
 
     ``reductor`` is the one reductor built (at the largest sizes for ``"auto"``, at
@@ -201,7 +214,10 @@ def reduce_model(model, scene, log=None, make_stepper=None, reductor=None, limit
     bases are reused (:meth:`~femrub.reduction.craig_bampton.ThermoelasticCraigBampton.for_model`)
     with the operators projected on them, and only the estimate runs again. ``limits``: the
     run's stop limits (``Stepper.run``), applied to the estimate's runs: they compare the
-    models over the part of the run that the run itself can reach.
+    models over the part of the run that the run itself can reach. ``on_run(results,
+    seconds)``: called with the estimate's run of the returned model's sizes (its
+    :class:`~femrub.output.results.Results`, judged without the reduction rule, and its wall
+    time), which is the scene's run: the caller need not step it again.
     """
     opts = scene["reduction"]
     method = opts["method"]
@@ -253,7 +269,7 @@ def reduce_model(model, scene, log=None, make_stepper=None, reductor=None, limit
     red.solver.free()  # no more interior solves: release the factorisations' memory
     projection = red.project()  # once; every size is then a block of it (or projected)
     if make_stepper is not None:
-        n_uv, n_theta = _checked(red, model, want, make_stepper, scene, report, log, limits)
+        n_uv, n_theta = _checked(red, model, want, make_stepper, scene, report, log, limits, on_run)
     reduced = red.reduce(n_uv, n_theta)
     reduced.info["timings"]["projection"] += projection
     if "error" in report:  # energy the reduced dynamics can create (verdict rule ``reduction``)

@@ -1,0 +1,110 @@
+"""The reduction error estimate's run of the chosen sizes is the run (stepped once)."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+from femrub.app.run import run_scene
+from femrub.app.scheme import bare_stepper
+from femrub.app.simulation import build, reusable_run
+from femrub.output.run_folder import run_to_folder
+from femrub.scene import load_scene
+
+# a coarse twisted blade reduced with fixed sizes (tests/test_cache.py), long enough to rub
+SMALL = {
+    "loads.centrifugal": "off",
+    "geometry.h": 0.03,
+    "geometry.n_sections": 2,
+    "contact.reach": "all",
+    "reduction.method": "craig-bampton",
+    "reduction.n_uv": 8,
+    "reduction.n_theta": 4,
+    "scheme.t_end": 4e-4,
+    "outputs.vtk_stride": 0,
+}
+VARYING = {"timings", "wall_seconds", "cpu_seconds", "cpu_per_step_us"}
+
+
+@pytest.fixture(scope="module")
+def sim():
+    return build(load_scene("twisted-naca", SMALL))
+
+
+def _write(sim, out, ran):
+    s = sim.scene
+    return run_to_folder(
+        bare_stepper(s, sim.model), s["scheme"]["t_end"], out, limits=sim.limits or None,
+        plots=False, reduction_error=sim.report["reduction"]["error"], ran=ran,
+        rotation_speed=s["loads"]["rotation_speed"],
+    )  # fmt: skip
+
+
+def test_the_estimate_run_is_the_run(sim, tmp_path):
+    assert sim.ran is not None and reusable_run(sim.full)
+    res, wall = sim.ran
+    assert wall > 0 and res.steps == sim.stepper.steps_to(sim.scene["scheme"]["t_end"])
+    a = _write(sim, tmp_path / "reused", sim.ran)
+    b = _write(sim, tmp_path / "stepped", None)  # the same model stepped again
+    assert a.status == b.status and a.message == b.message and a.warnings == b.warnings
+    assert np.abs(b.impulse).max() > 0  # it rubs
+    with (
+        np.load(tmp_path / "reused/history.npz") as ha,
+        np.load(tmp_path / "stepped/history.npz") as hb,
+    ):  # noqa: E501
+        assert sorted(ha.files) == sorted(hb.files) and "states" not in ha.files
+        for k in ha.files:
+            if k != "meta":
+                np.testing.assert_array_equal(ha[k], hb[k], err_msg=k)
+    sa, sb = (
+        json.loads((tmp_path / d / "summary.json").read_text()) for d in ("reused", "stepped")
+    )  # noqa: E501
+    assert sorted(sa) == sorted(sb) and sorted(sa["timings"]) == sorted(sb["timings"])
+    assert {k: v for k, v in sa.items() if k not in VARYING} == {
+        k: v for k, v in sb.items() if k not in VARYING
+    }
+    assert (tmp_path / "reused/history.csv").read_text() == (
+        tmp_path / "stepped/history.csv"
+    ).read_text()
+
+
+def test_run_scene_steps_once(tmp_path, monkeypatch):
+    """``femrub run`` without VTK writes the estimate's run; its time is ``stepping``."""
+    from femrub.steppers import theta
+
+    calls = []
+    original = theta.ThetaMethod.run
+
+    def counted(self, *a, **kw):
+        calls.append(kw.get("store_every", 0))
+        return original(self, *a, **kw)
+
+    monkeypatch.setattr(theta.ThetaMethod, "run", counted)
+    res, built = run_scene(load_scene("twisted-naca", SMALL), tmp_path / "run")
+    s = json.loads((tmp_path / "run/summary.json").read_text())
+    # the estimate's reference, its run at the chosen sizes (the run) and possibly a twin
+    assert len(calls) in (2, 3) and all(c > 0 for c in calls)
+    assert s["timings"]["stepping"] == pytest.approx(built.ran[1])
+    assert s["reduction_error"]["sizes"] == [8, 4] and s["status"] == res.status
+
+
+def test_a_sweep_worker_keeps_the_assembly(tmp_path, monkeypatch):
+    """After ``keep_assemblies`` the next build on the blade reads no assembly from disk."""
+    from femrub.app import cached
+    from femrub.app.cache import ModelCache
+
+    monkeypatch.setattr(cached, "_ASSEMBLED", None)
+    cache, notes = ModelCache(tmp_path / "cache"), []
+    scene = load_scene("twisted-naca", {**SMALL, "scheme.t_end": 2e-5})
+    first = build(scene, cache=cache)
+    cached.keep_assemblies()
+    build(scene.with_changes({"loads.rotation_speed": 1400.0}), cache=cache, log=notes.append)
+    assert any("assembly loaded" in n for n in notes)  # from the cache folder, then kept
+    notes.clear()
+    again = build(scene.with_changes({"loads.rotation_speed": 1300.0}), cache=cache,
+                  log=notes.append)  # fmt: skip
+    assert any("assembly kept by this process" in n for n in notes)
+    assert not any("assembly loaded" in n or "assembly stored" in n for n in notes)
+    np.testing.assert_array_equal(again.full.A.toarray(), first.full.A.toarray())
