@@ -160,6 +160,8 @@ def _run(
         raise
     finally:
         history.close()
+        if series is not None:
+            series.close()  # every frame taken is on disk, the writer thread stopped
     wall = time.perf_counter() - t0
     with deferred():
         return _finish(
