@@ -9,10 +9,10 @@ import numpy as np
 import pytest
 
 import femrub as fr
+from femrub.contact.casing import Lobed
 from femrub.geometry import box_blade
 from femrub.model.rub import solid_model
 from femrub.output.vtk import VTKSeries, von_mises
-from femrub.contact.casing import Lobed
 
 H, STRIDE = 1e-5, 20
 

@@ -30,10 +30,10 @@ def _block(a: np.ndarray) -> bytes:
 
 
 def _array_tag(name: str, a: np.ndarray, offset: int) -> str:
-    comps = a.shape[1] if a.ndim == 2 else 1
     label = f' Name="{name}"' if name else ""
+    comps = f' NumberOfComponents="{a.shape[1]}"' if a.ndim == 2 else ""  # scalars: none
     return (
-        f'<DataArray type="{_VTK_TYPES[a.dtype.name]}"{label} NumberOfComponents="{comps}" '
+        f'<DataArray type="{_VTK_TYPES[a.dtype.name]}"{label}{comps} '
         f'format="appended" offset="{offset}"/>'
     )
 
