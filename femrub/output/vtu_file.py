@@ -20,7 +20,10 @@ __all__ = ["VTUWriter", "VTK_TETRA"]
 
 #: VTK cell type of a linear tetrahedron
 VTK_TETRA = 10
-_VTK_TYPES = {"float32": "Float32", "float64": "Float64", "int64": "Int64", "uint8": "UInt8"}
+_VTK_TYPES = {
+    "float32": "Float32", "float64": "Float64", "int32": "Int32", "int64": "Int64",
+    "uint8": "UInt8",
+}  # fmt: skip
 
 
 def _block(a: np.ndarray) -> bytes:
@@ -44,7 +47,8 @@ class VTUWriter:
 
     Parameters
     ----------
-    points, cells, cell_type : the mesh (points are written as float64).
+    points, cells, cell_type : the mesh (points are written as float64, the connectivity as
+        int32 when it fits).
     point_fields : names and components (1 or 3) of the point data, in file order.
     cell_fields : names of the (scalar) cell data, in file order.
     comment : an XML comment written after the declaration (e.g. the units).
@@ -58,7 +62,10 @@ class VTUWriter:
         pts = np.asarray(points, dtype=np.float64)
         if pts.shape[1] < 3:
             pts = np.hstack([pts, np.zeros((pts.shape[0], 3 - pts.shape[1]))])
-        cells = np.asarray(cells, dtype=np.int64)
+        cells = np.asarray(cells)
+        small = max(pts.shape[0], cells.size) < 2**31
+        index = np.int32 if small else np.int64  # fewer bytes per frame
+        cells = cells.astype(index)
         self.n_points, self.n_cells = pts.shape[0], cells.shape[0]
         self.dtype = np.dtype(dtype)
         self.point_fields, self.cell_fields = dict(point_fields), list(cell_fields)
@@ -74,7 +81,7 @@ class VTUWriter:
         geometry = [
             ("Points", "", pts),
             ("Cells", "connectivity", cells.ravel()),
-            ("Cells", "offsets", np.arange(1, self.n_cells + 1, dtype=np.int64) * cells.shape[1]),
+            ("Cells", "offsets", np.arange(1, self.n_cells + 1, dtype=index) * cells.shape[1]),
             ("Cells", "types", np.full(self.n_cells, cell_type, dtype=np.uint8)),
         ]
         geo_tags, blobs = {"Points": [], "Cells": []}, []
