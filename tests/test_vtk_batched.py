@@ -54,7 +54,7 @@ def _frames(series):
 @pytest.mark.parametrize("dense", [False, True])
 def test_batched_frames_equal_the_per_frame_fields(rub, tmp_path, dense):
     model, fields = rub
-    if dense:  # a reduced model's map to the mesh is a dense matrix
+    if dense:  # a reduced model's map to the mesh is a dense matrix (float32 product)
         model = dataclasses.replace(model, to_full=model.to_full.toarray())
     series = VTKSeries(tmp_path, model, fields, h=H, stride=STRIDE, batch=4, dtype=np.float64)
     res = fr.ThetaMethod(model, H).run(0.003, on_state=series, store_every=STRIDE)
@@ -85,10 +85,11 @@ def test_batched_frames_equal_the_per_frame_fields(rub, tmp_path, dense):
     s32.close()
     a = meshio.read(tmp_path / frames[-1][1])
     b = meshio.read(tmp_path / "f32" / frames[-1][1])
-    for k in ("displacement", "velocity", "temperature"):
-        x, y = a.point_data[k], b.point_data[k]
+    pairs = [(a.point_data[k], b.point_data[k]) for k in ("displacement", "velocity")]
+    pairs.append((a.cell_data["von_mises"][0], b.cell_data["von_mises"][0]))
+    for x, y in pairs:  # reconstructed in single precision too
         assert y.dtype == np.float32
-        assert np.abs(x - y).max() <= 1e-6 * np.abs(x).max()
+        assert np.abs(x - y).max() <= 1e-5 * np.abs(x).max()
     assert b"femrub units:" in (tmp_path / "f32" / frames[-1][1]).read_bytes()[:400]
 
 

@@ -61,9 +61,11 @@ class FrameFields:
     model : the (full or reduced) model; needs ``model.to_full``.
     fields : the :class:`~femrub.model.rub.FieldMap` of the full model.
     h : the run's time step (s), to turn contact impulses into forces.
+    dtype : precision of the reconstruction of a reduced model's fields (``float32``
+        halves the product's cost and memory; for files written in single precision).
     """
 
-    def __init__(self, model, fields: FieldMap, h: float):
+    def __init__(self, model, fields: FieldMap, h: float, dtype=np.float64):
         T = model.to_full
         bu, bt = fields.basis_u, fields.basis_t
         nu = bu.N
@@ -82,7 +84,7 @@ class FrameFields:
             self._RT = None
         else:
             self._R = None
-            self._RT = np.ascontiguousarray(np.asarray(T)[rows].T)  # (N, n_rows)
+            self._RT = np.ascontiguousarray(np.asarray(T)[rows].T, dtype=dtype)  # (N, n_rows)
         G, self.pairs = strain_operator(fields)
         self._G = G[:, order_u].tocsr()
         self.mu = float(fields.mu)
@@ -101,11 +103,14 @@ class FrameFields:
 
         Returns point data ``displacement``, ``velocity``, ``contact_force``,
         ``friction_force`` (B × n_points × 3), ``temperature`` (B × n_points) and cell data
-        ``von_mises`` (B × n_cells), all float64.
+        ``von_mises`` (B × n_cells).
         """
         X = np.atleast_2d(np.asarray(X, dtype=float))
         B = X.shape[0]
-        full = X @ self._RT if self._R is None else (self._R @ X.T).T  # (B, n_rows)
+        if self._R is None:
+            full = X.astype(self._RT.dtype) @ self._RT  # (B, n_rows)
+        else:
+            full = (self._R @ X.T).T
         nu, nv, npt, d = self._nu, self._nv, self.n_points, self.dim
         u = full[:, :nu]
         out = {

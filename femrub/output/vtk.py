@@ -111,7 +111,7 @@ class VTKSeries:
         self.h = float(h)
         self.frames: list[tuple[float, str]] = []
         self.seconds = self._main_cpu = self._writer_cpu = 0.0
-        self._fields = FrameFields(model, fields, self.h)
+        self._fields = FrameFields(model, fields, self.h, dtype)
         point = {"displacement": 3, "velocity": 3, "temperature": 1}
         point |= {"contact_force": 3, "friction_force": 3}
         self._vtu = VTUWriter(fields.mesh.p.T, fields.mesh.t.T, VTK_TETRA, point,
