@@ -8,13 +8,15 @@ reduced model in seconds), then steps it ``--revolutions`` revolutions without o
   an impulse and those where some do (wall time of each ``_advance``, median);
 * the floor: the dense ``T X`` product of the step and one ``numpy.linalg.solve`` of the
   Delassus block of the contacts active together (the small contact solve), each timed alone;
+* a VTK series at stride 50 over the same run, written in a background thread and in the
+  stepping thread: CPU and wall per step against the run without output;
 * what compiling the contact kernels costs (fresh process, empty numba cache) and what
   loading them from the cache costs (both happen when a stepper is built).
 
 Writes a table between ``<!-- step_cost:begin -->`` and ``<!-- step_cost:end -->`` in
 ``docs/performance.md`` with the machine's load (``os.getloadavg``).
 
-Run: ``python benchmarks/step_cost.py [--scene rotor37] [--revolutions 5] [--no-write]``
+Run: ``python benchmarks/step_cost.py [--scene rotor37] [--revolutions 5] [--no-vtk] [--no-write]``
 (Rotor 37 needs ``../shared/data``; wrap the first, uncached call in
 ``flock /tmp/femrub-heavy.lock`` on a shared machine).
 """
@@ -77,25 +79,37 @@ def _bare_blocks(model, scheme: dict, opts: dict, t_end: float) -> dict:
     return {"bare_us": 1e6 * cpu / n}
 
 
-def _vtk(sim, scheme: dict, opts: dict, stride: int, frames: int) -> dict:
-    """CPU per step with a VTK series at ``stride`` over ``frames`` frames, and per frame."""
+def _vtk(sim, scheme: dict, opts: dict, stride: int, t_end: float) -> dict:
+    """VTK series at ``stride``: CPU and wall per step with frames written in a background
+    thread and in the stepping thread, against the same run without output (the run
+    includes writing every frame: the recorder flushes the series before it returns)."""
     import tempfile
 
     from femrub.output.vtk import VTKSeries
 
     if sim.fields is None or sim.model.to_full is None:
         return {}
-    t_end = stride * frames * scheme["h"]
-    with tempfile.TemporaryDirectory() as d:
-        series = VTKSeries(d, sim.model, sim.fields, h=scheme["h"], stride=stride)
-        row = _per_step(sim.model, scheme, opts, t_end, False, on_state=series)
-        plain = _per_step(sim.model, scheme, opts, t_end, False)
-    return {
-        "vtk_stride": stride,
-        "vtk_us": row["us"],
-        "vtk_plain_us": plain["us"],
-        "vtk_frame_s": (row["us"] - plain["us"]) * row["steps"] / 1e6 / (frames + 1),
-    }
+    out = {"vtk_stride": stride}
+    for key, background in (("vtk", True), ("vtk_inline", False)):
+        with tempfile.TemporaryDirectory() as d:
+            series = VTKSeries(d, sim.model, sim.fields, h=scheme["h"], stride=stride,
+                               background=background)  # fmt: skip
+            w0 = time.perf_counter()
+            row = _per_step(sim.model, scheme, opts, t_end, False, on_state=series)
+            wall = time.perf_counter() - w0
+            series.close()
+            files = list(Path(d).glob("*.vtu"))
+            out[f"{key}_us"], out[f"{key}_wall_us"] = row["us"], 1e6 * wall / row["steps"]
+            out[f"{key}_main_us"] = 1e6 * series.seconds / row["steps"]
+            out["vtk_frames"] = len(series.frames)
+            out["vtk_mb"] = sum(f.stat().st_size for f in files) / len(files) / 1e6
+    w0 = time.perf_counter()
+    plain = _per_step(sim.model, scheme, opts, t_end, False)
+    out["vtk_plain_us"] = plain["us"]
+    out["vtk_plain_wall_us"] = 1e6 * (time.perf_counter() - w0) / plain["steps"]
+    n = plain["steps"]
+    out["vtk_frame_ms"] = 1e3 * (out["vtk_inline_us"] - plain["us"]) * n / 1e6 / out["vtk_frames"]
+    return out
 
 
 def _split(model, scheme: dict, opts: dict, t_end: float) -> dict:
@@ -161,7 +175,7 @@ def _compile_cost() -> dict:
     return out
 
 
-def measure(scene_name: str, revolutions: float, vtk_frames: int = 10) -> dict:
+def measure(scene_name: str, revolutions: float, vtk: bool = True) -> dict:
     from femrub.app.cache import ModelCache
     from femrub.app.scheme import scheme_options
     from femrub.app.simulation import build
@@ -184,8 +198,8 @@ def measure(scene_name: str, revolutions: float, vtk_frames: int = 10) -> dict:
         **_bare_blocks(m, scene["scheme"], opts, t_end),
         **_split(m, scene["scheme"], opts, t_end),
     }  # fmt: skip
-    if vtk_frames:
-        row.update(_vtk(sim, scene["scheme"], opts, 50, vtk_frames))
+    if vtk:
+        row.update(_vtk(sim, scene["scheme"], opts, 50, t_end))
     row["load"] = [load0, os.getloadavg()[0]]
     row.update(_compile_cost())
     return row
@@ -214,18 +228,33 @@ def table(row: dict) -> str:
         f"| floor: `numpy.linalg.solve` of the {row.get('solve_size', 0)}×"
         f"{row.get('solve_size', 0)} Delassus block | {f(row.get('solve_us'))} |\n"
         f"| floor: sum | {floor} |\n"
-        + (
-            f"| VTK at stride {row['vtk_stride']}: CPU per step (same run without it: "
-            f"{f(row['vtk_plain_us'])}); one frame {row['vtk_frame_s']:.2f} s | "
-            f"{f(row['vtk_us'])} |\n"
-            if "vtk_us" in row
-            else ""
-        )
+        + (_vtk_table(row) if "vtk_us" in row else "")
         + f"\nContact kernels (numba, `femrub.contact.coulomb`): first compilation "
         f"{row.get('compile_s', float('nan')):.1f} s in a fresh process with an empty cache, "
         f"{row.get('cached_s', float('nan')):.2f} s to load them from the on-disk cache; done "
         "when the stepper is built, never inside the steps above. Blocks: chunks of the "
         "recorder's rows advanced in one compiled call (`femrub.steppers.theta_blocks`).\n"
+    )
+
+
+def _vtk_table(row: dict) -> str:
+    f = lambda x: f"{x:.1f}"  # noqa: E731
+    p = row["vtk_plain_us"]
+    pw = row["vtk_plain_wall_us"]
+    pct = lambda x, ref: f"{100 * (x / ref - 1):+.0f} %"  # noqa: E731
+    return (
+        f"\nVTK at stride {row['vtk_stride']} over the same run ({row['vtk_frames']} frames "
+        f"of {row['vtk_mb']:.2f} MB, float32 fields, raw binary), every frame on disk when "
+        f"the run returns; without output: CPU {f(p)} µs, wall {f(pw)} µs per step.\n\n"
+        "| VTK writer | CPU per step (all threads) | wall per step | stepping thread in "
+        "the series | one frame (CPU) |\n|---|---|---|---|---|\n"
+        f"| background thread (default) | {f(row['vtk_us'])} ({pct(row['vtk_us'], p)}) | "
+        f"{f(row['vtk_wall_us'])} ({pct(row['vtk_wall_us'], pw)}) | "
+        f"{f(row['vtk_main_us'])} | |\n"
+        f"| in the stepping thread | {f(row['vtk_inline_us'])} "
+        f"({pct(row['vtk_inline_us'], p)}) | {f(row['vtk_inline_wall_us'])} "
+        f"({pct(row['vtk_inline_wall_us'], pw)}) | {f(row['vtk_inline_main_us'])} | "
+        f"{row['vtk_frame_ms']:.2f} ms |\n"
     )
 
 
@@ -246,11 +275,11 @@ def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--scene", default="rotor37")
     ap.add_argument("--revolutions", type=float, default=5.0)
-    ap.add_argument("--vtk-frames", type=int, default=10, help="frames of the VTK row (0: none)")
+    ap.add_argument("--no-vtk", action="store_true", help="skip the VTK rows")
     ap.add_argument("--no-write", action="store_true", help="print, do not edit the docs")
     args = ap.parse_args(argv)
     try:
-        row = measure(args.scene, args.revolutions, args.vtk_frames)
+        row = measure(args.scene, args.revolutions, not args.no_vtk)
     except (FileNotFoundError, SceneError) as exc:
         print(f"skipped: {exc}")
         return 0

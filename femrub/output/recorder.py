@@ -23,7 +23,6 @@ from __future__ import annotations
 
 import time
 from collections.abc import Callable
-from dataclasses import dataclass
 
 import numpy as np
 import scipy.sparse as sp
@@ -36,6 +35,7 @@ from .energy import SCHEME_INTEGRALS, EnergyMeter
 from .limits import limit_hit as _limit_hit
 from .limits import limit_index as _limit_index
 from .results import Results
+from .state import State
 
 __all__ = ["CHUNK_STEPS", "CHUNK_VALUES", "Recorder", "State"]
 
@@ -44,19 +44,6 @@ __all__ = ["CHUNK_STEPS", "CHUNK_VALUES", "Recorder", "State"]
 CHUNK_STEPS = 512
 # largest number of state values buffered per chunk (16 MB of float64) on large models
 CHUNK_VALUES = 2_000_000
-
-
-@dataclass
-class State:
-    """The state after step ``k``: time, state vector and contact quantities of the step."""
-
-    k: int
-    t: float
-    X: np.ndarray
-    impulse: np.ndarray
-    gap: np.ndarray
-    gap_velocity: np.ndarray
-    friction_impulse: np.ndarray | None = None
 
 
 class _Stop(Exception):
@@ -81,7 +68,7 @@ class Recorder:
     energy : keep the energy balance (needs ``model.energy``).
     limits : physical stop criteria ``{signal name or "contact_force": max |value|}``.
     store_every : keep the full state every that many steps (0: never).
-    on_state : callback ``f(State)`` fed each checked state.
+    on_state : callback ``f(State)`` fed each checked state (each ``on_state.stride``-th).
     on_rows : callback ``f(arrays)`` fed each checked block of rows, ``{name: array}`` as
         :meth:`per_step` gives them (row 0 comes with the first block).
     label : name of the run (progress bar and ``Results.info``).
@@ -90,25 +77,16 @@ class Recorder:
     """
 
     def __init__(
-        self,
-        model: FirstOrderModel,
-        h: float,
-        n_steps: int,
-        *,
-        scheme: str,
-        stability_limit: float,
-        energy: bool = True,
-        limits: dict[str, float] | None = None,
-        store_every: int = 0,
-        on_state: Callable | None = None,
-        on_rows: Callable | None = None,
-        label: str | None = None,
-        blowup_check: bool = True,
-    ):
+        self, model: FirstOrderModel, h: float, n_steps: int, *, scheme: str,
+        stability_limit: float, energy: bool = True, limits: dict[str, float] | None = None,
+        store_every: int = 0, on_state: Callable | None = None,
+        on_rows: Callable | None = None, label: str | None = None, blowup_check: bool = True,
+    ):  # fmt: skip
         self.model, self.h, self.n, self.scheme = model, h, n_steps, scheme
         self.h_lim, self.label = stability_limit, label
         self.store_every, self.on_state, self.on_rows = store_every, on_state, on_rows
         self._streamed = -1
+        self._delivered = 0
         #: further per-step arrays ``(n + 1, ...)`` filled by a stepper (kept and streamed)
         self.extra: dict[str, np.ndarray] = {}
         self.blowup_check = blowup_check
@@ -233,7 +211,17 @@ class Recorder:
                 self._stream(i_end)
             finally:
                 bar.close()
+            self._flush_sink()
         return self._results(i_end, time.process_time() - cpu0)
+
+    def _flush_sink(self) -> None:
+        """``on_state.flush()`` if it holds states back (batched VTK frames), also after an
+        interruption or a failure; its error fails the run."""
+        try:
+            getattr(self.on_state, "flush", lambda: None)()
+        except Exception as exc:
+            if self.status != "failed":
+                self.status, self.message = "failed", f"output: {type(exc).__name__}: {exc}"
 
     def _work_rows(self, k: int) -> np.ndarray:
         """Per-step works and heats reported by the scheme (the first ``k`` of
@@ -330,14 +318,18 @@ class Recorder:
 
     def _deliver(self, i0: int, last: int) -> None:
         """Feed ``on_state`` the checked rows ``i0 + 1 .. last`` of the buffer."""
-        if self.on_state is None or last <= i0:
+        first = max(i0, self._delivered)  # a sink interrupted once is not fed a row twice
+        if self.on_state is None or last <= first:
             return
-        c, rows = self.model.contact, slice(i0 + 1, last + 1)
-        X = self.buf[1 : last - i0 + 1]
-        gdot = np.zeros((X.shape[0], 0)) if c is None else c.gap_velocity(self.t[rows], X)
-        for k, r in enumerate(range(rows.start, rows.stop)):
-            fi = self.imp_t[r] if self.tangents else None
-            self.on_state(State(r, self.t[r], X[k], self.imp[r], self.gap[r], gdot[k], fi))
+        c, self._delivered = self.model.contact, last
+        r = np.arange(first + 1, last + 1)
+        stride = getattr(self.on_state, "stride", 1)  # a sink that keeps every stride-th
+        r = r[r % stride == 0]
+        X = self.buf[r - i0]
+        gdot = np.zeros((X.shape[0], 0)) if c is None else c.gap_velocity(self.t[r], X)
+        for k, ri in enumerate(r):
+            fi = self.imp_t[ri] if self.tangents else None
+            self.on_state(State(ri, self.t[ri], X[k], self.imp[ri], self.gap[ri], gdot[k], fi))
 
     # -- the collected results -------------------------------------------------------------
     def per_step(self, rows: slice) -> dict[str, np.ndarray]:

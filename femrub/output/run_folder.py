@@ -184,6 +184,8 @@ def _run(
         raise
     finally:
         history.close()
+        if series is not None:
+            series.close()  # every frame taken is on disk, the writer thread stopped
     if ran is None:
         wall = time.perf_counter() - t0
     with deferred():
