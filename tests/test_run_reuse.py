@@ -6,6 +6,7 @@ import json
 
 import numpy as np
 import pytest
+from test_cache import SMALL as CACHE_SMALL
 
 from femrub.app.run import run_scene
 from femrub.app.scheme import bare_stepper
@@ -14,17 +15,7 @@ from femrub.output.run_folder import run_to_folder
 from femrub.scene import load_scene
 
 # a coarse twisted blade reduced with fixed sizes (tests/test_cache.py), long enough to rub
-SMALL = {
-    "loads.centrifugal": "off",
-    "geometry.h": 0.03,
-    "geometry.n_sections": 2,
-    "contact.reach": "all",
-    "reduction.method": "craig-bampton",
-    "reduction.n_uv": 8,
-    "reduction.n_theta": 4,
-    "scheme.t_end": 4e-4,
-    "outputs.vtk_stride": 0,
-}
+SMALL = {**CACHE_SMALL, "scheme.t_end": 4e-4, "outputs.vtk_stride": 0}
 VARYING = {"timings", "wall_seconds", "cpu_seconds", "cpu_per_step_us"}
 
 
