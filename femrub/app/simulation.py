@@ -254,10 +254,10 @@ def _build(scene, log, modes, stages, with_stepper=True) -> Simulation:
     if modes:
         report["natural_frequencies_hz"] = stages.frequencies(model, modes).tolist()
     make = lambda m: bare_stepper(scene, m)  # noqa: E731  (the reduction error estimate)
-    ran = []
-    keep = ran.append if reusable_run(model) else None
+    ran = []  # (results, wall seconds) of the estimate's run of the chosen sizes
+    keep = (lambda res, wall: ran.append((res, wall))) if reusable_run(model) else None
     reduced, reductor, report["reduction"] = stages.reduce(
-        model, scene, log, make, limits, on_run=keep and (lambda *r: keep(r))
+        model, scene, log, make, limits, on_run=keep
     )
     ran = ran[0] if ran else None
     if ran is not None:  # the run itself: its time is the run's ``stepping``

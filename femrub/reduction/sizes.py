@@ -160,7 +160,7 @@ def _checked(red, model, want, make_stepper, scene, report, log, limits, on_run=
     most = (red.n_uv, red.n_theta)
     *ref, ref_wall = _timed(red, most, make_stepper, t_end, limits=limits)
     cands = [want] if want is not None else _ladder(most)
-    chosen, err, tried, tw, kept = None, None, [], None, (ref[0], ref_wall)
+    chosen, err, tried, tw = None, None, [], None
     for c in cands:
         if c == most:
             break
