@@ -29,8 +29,7 @@ def strain_operator(fields: FieldMap) -> tuple[sp.csr_matrix, list[tuple[int, in
     """Sparse ``G`` with ``(G u)[c n_e + e] = ε_ab`` at the centroid of element ``e``.
 
     ``c`` runs over the pairs ``(a, b)``, ``a ≤ b`` (returned); ``ε_ab`` is the mean over
-    the element's quadrature points of ``(∂_b u_a + ∂_a u_b) / 2``, as in
-    :func:`femrub.output.vtk.von_mises`.
+    the element's quadrature points of ``(∂_b u_a + ∂_a u_b) / 2``.
     """
     bu = fields.basis_u
     dim = fields.mesh.p.shape[0]

@@ -6,7 +6,7 @@ written, in a background thread by default, as ``.vtu`` files with point data
 ``displacement`` (m, vector), ``velocity`` (m/s), ``temperature`` (K above ambient),
 ``contact_force`` and ``friction_force`` (N, vector, at the contact vertices) and cell data
 ``von_mises`` (Pa, at the tetrahedron centroid). The ``.pvd`` index is rewritten
-(atomically) after every file, and every ``.vtu`` is written to a temporary name and
+(atomically) after every batch of files, and every ``.vtu`` is written to a temporary name and
 renamed when complete, so a run that crashes or is interrupted stays viewable up to its
 last written frame and never leaves a half-written frame; the recorder flushes the series
 at the end of every run, interrupted or failed ones included. Frames of an earlier run in
@@ -29,7 +29,7 @@ from ..model.rub import FieldMap
 from .frame_fields import FrameFields
 from .vtu_file import VTK_TETRA, VTUWriter
 
-__all__ = ["FIELD_UNITS", "VTKSeries", "von_mises", "snapshot_png"]
+__all__ = ["FIELD_UNITS", "VTKSeries", "snapshot_png"]
 
 #: SI units of the point and cell data of every frame
 FIELD_UNITS = {
@@ -47,23 +47,6 @@ _UNITS_COMMENT = (
 )
 
 
-def von_mises(fields: FieldMap, u_all: np.ndarray) -> np.ndarray:
-    """Von Mises stress (Pa) per tetrahedron, from the displacement at the centroid.
-
-    The isotropic thermal part of the stress does not change the deviator, so it is
-    omitted; ``σ = 2 μ ε + λ tr(ε) I``.
-    """
-    ui = fields.basis_u.interpolate(u_all)
-    grad = ui.grad.mean(axis=-1)  # (3, 3, n_elements), mean over quadrature points
-    eps = 0.5 * (grad + grad.transpose(1, 0, 2))
-    tr = np.einsum("iie->e", eps)
-    sig = 2.0 * fields.mu * eps
-    sig[[0, 1, 2], [0, 1, 2]] += fields.lam * tr
-    dev = sig.copy()
-    dev[[0, 1, 2], [0, 1, 2]] -= np.einsum("iie->e", sig) / 3.0
-    return np.sqrt(1.5 * np.einsum("ije,ije->e", dev, dev))
-
-
 class VTKSeries:
     """Stream a run to ``directory/name_XXXXXX.vtu`` plus ``directory/name.pvd``.
 
@@ -73,8 +56,8 @@ class VTKSeries:
     when ``background``, which overlaps the stepping and whose error is raised here at the
     next frame or at :meth:`flush`), which reconstructs the whole batch at once
     (:class:`~femrub.output.frame_fields.FrameFields`) and writes its files
-    (:class:`~femrub.output.vtu_file.VTUWriter`), each renamed when complete and followed
-    by an atomic rewrite of the ``.pvd``. :meth:`flush` (called by the recorder at the end
+    (:class:`~femrub.output.vtu_file.VTUWriter`), each renamed when complete, then
+    rewrites the ``.pvd`` atomically. :meth:`flush` (called by the recorder at the end
     of a run, also an interrupted or failed one) writes every frame taken; a killed
     process loses at most the frames not yet written: the batch being filled, one queued
     batch and the rest of the batch being written.
@@ -234,7 +217,7 @@ class VTKSeries:
                 return
 
     def _write_batch(self, first: int, t, X, impulse, friction) -> None:
-        """Reconstruct a batch and write its frames, each followed by the ``.pvd``."""
+        """Reconstruct a batch, write its frames, then the ``.pvd`` listing them."""
         data = self._fields.compute(X, impulse, friction)
         cells = ("von_mises",)
         for b in range(len(t)):
@@ -242,7 +225,7 @@ class VTKSeries:
             point = {k: v[b] for k, v in data.items() if k not in cells}
             self._vtu.write(self.dir / fname, point, {k: data[k][b] for k in cells})
             self.frames.append((float(t[b]), fname))
-            self._write_pvd()
+        self._write_pvd()  # once per batch: every frame it lists is complete on disk
 
     def _raise_error(self) -> None:
         """Raise the writer's error here, once (the writer writes nothing after it)."""
