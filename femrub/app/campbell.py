@@ -147,7 +147,7 @@ def campbell(scene, speeds, *, modes: int = 6, samples: int = 3, check: bool = T
     }
     if method != "off":
         pts = locate_contacts(disc)
-        g = np.sum(pts.normals[None] * fam.displacement[:, pts.u_dofs], axis=1)
+        g = pts.normal_displacement(fam.displacement)
         info["tip_growth_max_m"] = g.max(axis=1).tolist()  # per sample speed
         info["tip_growth_mean_m"] = g.mean(axis=1).tolist()
     if check and method != "off" and samples > 1:

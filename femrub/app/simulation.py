@@ -199,7 +199,7 @@ def _build(scene, log, modes, stages, with_stepper=True) -> Simulation:
             rayleigh=tuple(p["rayleigh"]), damping_ratio=p["damping_ratio"],
             damping_modes=tuple(p["damping_modes"]), prestress=prestress,
         )  # fmt: skip
-        candidates = locate_contacts(disc)
+        candidates = locate_contacts(disc, spread=c["spread"])
         growth = prestress.growth(candidates) if prestress is not None else np.zeros(candidates.n)
         force = tr.force_law(scene)
         loads = []

@@ -5,8 +5,11 @@
 normal ``n_i`` (the radial direction, away from the machine axis; ``+x`` on the paper's
 bar), its radius ``r_i`` and angular position ``φ_i`` around the axis, and the weights that
 spread its frictional heat over its tributary part of the tip face (see
-:func:`tributary_heat_weights`). :meth:`ContactPoints.restrict` keeps a subset (the points
-the casing can reach), before any model exists.
+:func:`tributary_heat_weights`). On a 3D blade with a tip face the contact acts on that same
+part of the tip (:mod:`femrub.contact.patches`: the weighted mean displacement, the force
+spread with the heat's weights); ``spread="node"`` keeps it on the point's node.
+:meth:`ContactPoints.restrict` keeps a subset (the points the casing can reach), before any
+model exists.
 """
 
 from __future__ import annotations
@@ -17,8 +20,12 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.spatial import cKDTree
 
+from .patches import patch_rows, tip_patch_weights
+
 __all__ = ["ContactPoints", "locate_contacts", "tributary_heat_weights"]
 
+#: How a contact acts on the blade: on its part of the tip face, or on its node.
+SPREADS = ("patch", "node")
 #: Distance (relative to the blade size) within which a point is taken to be a mesh node.
 NODE_TOLERANCE = 1e-6
 
@@ -40,6 +47,9 @@ class ContactPoints:
     tangents : (dim, 2, n_c) casing tangents at each point: the axial direction and the
         circumferential one ``axis × n`` (the direction of rotation for Ω > 0); ``None`` on
         the bar.
+    patch : (dim n_c, n_u_all) rows of the patch mean displacements (row ``dim i + k``:
+        component k of contact i, full dof numbering; :mod:`femrub.contact.patches`), or
+        ``None``: each contact acts on its node's dofs ``u_dofs``.
     """
 
     points: np.ndarray
@@ -51,6 +61,7 @@ class ContactPoints:
     vertices: np.ndarray
     names: tuple[str, ...]
     tangents: np.ndarray | None = None
+    patch: sp.csr_matrix | None = None
 
     @property
     def n(self) -> int:
@@ -70,22 +81,49 @@ class ContactPoints:
             vertices=self.vertices[idx],
             names=tuple(self.names[i] for i in idx),
             tangents=None if self.tangents is None else self.tangents[:, :, idx],
+            patch=None
+            if self.patch is None
+            else self.patch[(self.u_dofs.shape[0] * idx[:, None] + np.arange(self.dim)).ravel()],
         )
 
+    @property
+    def dim(self) -> int:
+        return self.u_dofs.shape[0]
+
+    def _means(self, n_u_all: int) -> sp.csr_matrix:
+        """(dim n_c, n_u_all) rows of the displacement each contact acts on (full numbering)."""
+        if self.patch is not None:
+            return self.patch
+        n = self.u_dofs.size
+        return sp.csr_matrix((np.ones(n), (np.arange(n), self.u_dofs.T.ravel())), (n, n_u_all))
+
+    def mean_rows(self, mats) -> sp.csr_matrix:
+        """(dim n_c, n_u) rows of the contacts' displacements (patch means) on the free dofs."""
+        rows = sp.coo_matrix(self._means(mats.n_u_all))
+        cols = mats.u_index(rows.col)
+        return sp.csr_matrix((rows.data, (rows.row, cols)), shape=(rows.shape[0], mats.n_u))
+
+    def _directions(self, vectors: np.ndarray) -> sp.csr_matrix:
+        """(m n_c, dim n_c): row ``m i + j`` takes direction ``vectors[:, j, i]`` of contact i."""
+        dim, m, nc = vectors.shape
+        rows = np.repeat(np.arange(m * nc), dim)
+        cols = (dim * np.arange(nc)[:, None, None] + np.arange(dim)).repeat(m, axis=1).ravel()
+        vals = np.transpose(vectors, (2, 1, 0)).ravel()
+        return sp.csr_matrix((vals, (rows, cols)), shape=(m * nc, dim * nc))
+
     def normal_rows(self, mats) -> sp.csr_matrix:
-        """(n_c, n_u) rows giving the normal displacement ``n_i · u(p_i)`` on the free dofs."""
-        dim, nc = self.u_dofs.shape
-        cols = mats.u_index(self.u_dofs.T.ravel())
-        rows = np.repeat(np.arange(nc), dim)
-        return sp.csr_matrix((self.normals.T.ravel(), (rows, cols)), shape=(nc, mats.n_u))
+        """(n_c, n_u) rows giving the normal displacement ``n_i · ū_i`` on the free dofs."""
+        return sp.csr_matrix(self._directions(self.normals[:, None, :]) @ self.mean_rows(mats))
 
     def tangent_rows(self, mats) -> sp.csr_matrix:
-        """(2 n_c, n_u) rows ``t_ij · u(p_i)`` (row ``2 i + j``) on the free dofs."""
-        dim, nc = self.u_dofs.shape
-        cols = np.repeat(mats.u_index(self.u_dofs.T.ravel()).reshape(nc, 1, dim), 2, axis=1)
-        rows = np.repeat(np.arange(2 * nc), dim).reshape(nc, 2, dim)
-        vals = np.transpose(self.tangents, (2, 1, 0))  # (n_c, 2, dim)
-        return sp.csr_matrix((vals.ravel(), (rows.ravel(), cols.ravel())), shape=(2 * nc, mats.n_u))
+        """(2 n_c, n_u) rows ``t_ij · ū_i`` (row ``2 i + j``) on the free dofs."""
+        return sp.csr_matrix(self._directions(self.tangents) @ self.mean_rows(mats))
+
+    def normal_displacement(self, u: np.ndarray) -> np.ndarray:
+        """``n_i · ū_i`` (..., n_c) of displacement fields ``u`` (..., n_u_all) (full numbering)."""
+        u = np.asarray(u, dtype=float)
+        N = self._directions(self.normals[:, None, :]) @ self._means(u.shape[-1])
+        return (N @ u.reshape(-1, u.shape[-1]).T).T.reshape(u.shape[:-1] + (self.n,))
 
     def frames(self) -> np.ndarray:
         """(n_c, 3, dim): unit normal, axial and circumferential tangents of each point."""
@@ -118,11 +156,15 @@ def _axis_frame(axis):
     return a, e1, np.cross(a, e1)
 
 
-def locate_contacts(disc, points=None) -> ContactPoints:
+def locate_contacts(disc, points=None, spread: str = "patch") -> ContactPoints:
     """Dofs, normals, radii, angles and heat weights of the contact points of ``disc``.
 
-    ``points`` defaults to ``disc.blade.contact_points``.
+    ``points`` defaults to ``disc.blade.contact_points``. ``spread``: ``"patch"`` makes each
+    contact act on its part of the tip face where the blade has one
+    (:mod:`femrub.contact.patches`), ``"node"`` on its node.
     """
+    if spread not in SPREADS:
+        raise ValueError(f"contact spread must be one of {SPREADS}, got {spread!r}")
     blade, basis_u = disc.blade, disc.basis_u
     dim = blade.dim
     pts = np.asarray(blade.contact_points if points is None else points, dtype=float)
@@ -145,7 +187,8 @@ def locate_contacts(disc, points=None) -> ContactPoints:
     u_dofs = np.empty((dim, pts.shape[1]), dtype=int)
     u_dofs[comp.T, np.arange(pts.shape[1])] = idx.T
     vertices = cKDTree(blade.mesh.p.T).query(pts.T)[1]
-    weights = tributary_heat_weights(blade, pts, tol, vertices)
+    face = tip_patch_weights(blade, pts)
+    weights = tributary_heat_weights(blade, pts, tol, vertices, face)
     tdofs = disc.basis_t.nodal_dofs[0]
     heat = sp.csr_matrix(
         (weights.data, tdofs[weights.indices], weights.indptr),
@@ -167,10 +210,24 @@ def locate_contacts(disc, points=None) -> ContactPoints:
         t1 = a[:, None] - (a @ normals) * normals
         t1 /= np.linalg.norm(t1, axis=0)
         tangents = np.stack([t1, np.cross(t1, normals, axis=0)], axis=1)
-    return ContactPoints(pts, normals, radii, angles, u_dofs, heat, vertices, names, tangents)
+    patch = None
+    if spread == "patch" and face is not None:
+        patch = patch_rows(face, _vertex_dofs(basis_u), basis_u.N)
+    return ContactPoints(
+        pts, normals, radii, angles, u_dofs, heat, vertices, names, tangents, patch
+    )
 
 
-def tributary_heat_weights(blade, pts, tol, vertices) -> sp.csr_matrix:
+def _vertex_dofs(basis) -> np.ndarray:
+    """(dim, n_vertices) displacement dof of each mesh vertex and component."""
+    comp = _component_of(basis)
+    nodal = basis.nodal_dofs  # (dim, n_vertices), components in some order per vertex
+    out = np.empty_like(nodal)
+    out[comp[nodal], np.arange(nodal.shape[1])[None, :]] = nodal
+    return out
+
+
+def tributary_heat_weights(blade, pts, tol, vertices, face=None) -> sp.csr_matrix:
     """(n_c, n_vertices) weights spreading each contact's heat over its share of the tip.
 
     The frictional heat of contact ``i`` is generated over the part ``S_i`` of the tip face
@@ -178,25 +235,14 @@ def tributary_heat_weights(blade, pts, tol, vertices) -> sp.csr_matrix:
     vertex ``j`` is ``∫_{S_i} N_j ds / |S_i|`` (rows sum to 1). Dumping it into one vertex
     would make the temperature depend on the mesh (a point source in 3D); without a usable
     ``tip`` face (and on the bar) the heat goes to the point's vertex ``vertices`` (or the
-    two ends of its mid-edge).
+    two ends of its mid-edge). ``face``: the tip-face weights when already computed
+    (:func:`~femrub.contact.patches.tip_patch_weights`).
     """
     mesh = blade.mesh
     n_c, n_v = pts.shape[1], mesh.p.shape[1]
-    tip = blade.node_sets.get("tip")
-    facets = np.zeros(0, dtype=int)
-    if blade.dim == 3 and tip is not None and tip.size:
-        bf = mesh.boundary_facets()
-        facets = bf[np.all(np.isin(mesh.facets[:, bf], tip), axis=0)]
-    if facets.size >= n_c:
-        tri = mesh.facets[:, facets]  # (3, n_f)
-        P = mesh.p[:, tri]  # (3 coords, 3 vertices, n_f)
-        area = 0.5 * np.linalg.norm(np.cross(P[:, 1] - P[:, 0], P[:, 2] - P[:, 0], axis=0), axis=0)
-        owner = cKDTree(pts.T).query(P.mean(axis=1).T)[1]
-        if np.unique(owner).size == n_c:
-            rows = np.repeat(owner, 3)
-            vals = np.repeat(area / 3.0, 3)  # ∫ N_j ds over a linear triangle = area / 3
-            W = sp.csr_matrix((vals, (rows, tri.T.ravel())), shape=(n_c, n_v))
-            return sp.diags(1.0 / np.asarray(W.sum(axis=1)).ravel()) @ W
+    face = tip_patch_weights(blade, pts) if face is None else face
+    if face is not None:
+        return face
     vi = np.asarray(vertices)
     on_vertex = np.linalg.norm(mesh.p[:, vi] - pts, axis=0) <= tol
     rows, cols, vals = [np.flatnonzero(on_vertex)], [vi[on_vertex]], [np.ones(on_vertex.sum())]

@@ -66,8 +66,9 @@ class Prestress:
         return self.u[np.asarray(dofs, dtype=int)]
 
     def growth(self, points) -> np.ndarray:
-        """Outward radial growth ``n_i · u(p_i)`` (m) of :class:`ContactPoints` ``points``."""
-        return np.sum(points.normals * self.u[points.u_dofs], axis=0)
+        """Outward radial growth ``n_i · ū_i`` (m) of :class:`ContactPoints` ``points`` (at
+        each contact's node or the mean over its patch, as the contacts act)."""
+        return points.normal_displacement(self.u)
 
 
 class _Forms:

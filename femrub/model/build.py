@@ -18,6 +18,7 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.sparse as sp
 
+from ..contact.patches import patch_masters
 from ..fem.assembly import ThermoelasticMatrices
 from .first_order import Contact, EnergyForms, FirstOrderModel, Layout, LoadTerm
 
@@ -45,6 +46,10 @@ class ContactSpec:
         global axes; heat_law ``"alpha"`` or ``"power"``; heat_partition η.
     wear : :class:`~femrub.contact.abradable.Abradable` coating on the obstacle, or None;
         casing_heat : :class:`~femrub.contact.casing_heat.CasingHeat`, or None.
+    patches : (dim n_c, n_u) rows of the patch mean displacements the normal and tangent
+        rows are made of (:mod:`femrub.contact.patches`), or None (contacts on nodes). The
+        model's ``boundary`` then holds them as ``"u_rows"``, with one master dof per row as
+        ``"u"`` (:mod:`femrub.reduction.boundary_coordinates`).
     """
 
     normals: object
@@ -62,6 +67,7 @@ class ContactSpec:
     heat_partition: object = 1.0
     wear: object = None
     casing_heat: object = None
+    patches: object = None
 
 
 @dataclass
@@ -178,6 +184,9 @@ def first_order_model(
             else:
                 Ht[L.t] = hd.T
         boundary["theta"] = np.flatnonzero(np.any(Ht[L.t] != 0.0, axis=1))
+        if contact.patches is not None:  # boundary coordinates: the patch means
+            P = _rows(contact.patches, nu)
+            boundary["u"], boundary["u_rows"] = patch_masters(P), P
         con = Contact(
             G=G,
             Gv=Gv,

@@ -168,6 +168,7 @@ def rub_model(
             **_friction_spec(points, mats, friction, rotation_speed),
             wear=wear,
             casing_heat=casing_heat,
+            patches=None if points.patch is None else points.mean_rows(mats),
         )
     )
     model = first_order_model(mats, contact=spec, loads=loads, observe=observe, thermal=thermal)

@@ -21,7 +21,7 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["assemble_basis"]
+__all__ = ["assemble_basis", "left_static_shapes", "velocity_static_shapes"]
 
 
 def assemble_basis(index, interior, n_u: int, n_full: int, layout, psi, u_shapes, v_shapes,
@@ -56,3 +56,29 @@ def assemble_basis(index, interior, n_u: int, n_full: int, layout, psi, u_shapes
     V[(2 * n_u + ti)[:, None], cq_t[None, :]] = chi
     V[mi[:, None], cq_t[None, :]] = chi_u
     return V
+
+
+def velocity_static_shapes(psi, projection: str, n_i: int, nb: int) -> None:
+    """Set, in place, the boundary velocities' static shapes the ``projection`` asks for.
+
+    ``psi`` (interior rows ``[u_i, v_i, θ_i]``, columns ``[u_b, v_b, θ_b]``) holds Eq. (11)'s
+    ``−B_ii⁻¹ B_ib``. ``"static-mass"``: ``v_i = Ψ_uu v_b`` (the static shapes' inertia);
+    ``"second-order"``: the velocity shapes are the displacement ones, ``[I; Ψ_uu]``.
+    """
+    if projection in ("static-mass", "second-order"):
+        psi[n_i : 2 * n_i, nb : 2 * nb] = psi[:n_i, :nb]
+    if projection == "second-order":
+        psi[:n_i, nb : 2 * nb] = 0.0
+
+
+def left_static_shapes(psi, projection: str, n_i: int, nb: int, adjoint_shapes):
+    """Static shapes of the left basis: the adjoint ones (``adjoint_shapes()``,
+    ``"adjoint"``), the momentum rows of ``v_b`` on ``[1; Ψ_uu]`` (``"static-mass"``), or
+    ``None`` (``"petrov-galerkin"``: the boundary equations kept as in the full model)."""
+    if projection == "adjoint":
+        return adjoint_shapes()
+    if projection == "static-mass":
+        psi_l = np.zeros_like(psi)
+        psi_l[n_i : 2 * n_i, nb : 2 * nb] = psi[:n_i, :nb]
+        return psi_l
+    return None

@@ -60,8 +60,9 @@ import scipy.sparse as sp
 from .. import progress
 from ..fem.eigen import lowest_modes, normalise_columns, orient_columns
 from ..model.first_order import FirstOrderModel, Layout
-from .basis import assemble_basis
-from .interior import InteriorSolver
+from .basis import assemble_basis, left_static_shapes, velocity_static_shapes
+from .boundary_coordinates import boundary_coordinates, boundary_dofs
+from .interior import InteriorSolver, condensed_solve
 from .operators import projected, sliced
 from .thermal_inputs import input_basis, input_distributions
 
@@ -151,7 +152,14 @@ class ThermoelasticCraigBampton:
         nu, nt = L.n_u, L.n_t
         if boundary is None and fom.boundary is None:
             raise ValueError("the model has no contact boundary (model.boundary is None)")
-        mb, tb = _given(fom.boundary if boundary is None else boundary, nu, nt)
+        given = fom.boundary if boundary is None else boundary
+        mb, tb = boundary_dofs(given, nu, nt)
+        # contacts on patch means: reduce in the coordinates where they are dofs
+        self.coordinates = coords = boundary_coordinates(given, nu)
+        if coords is not None:
+            blocks, B = coords.blocks(blocks), coords.operator(fom.B, L)
+        else:
+            B = fom.B.tocsr()
         if thermal == "inputs":
             tb = np.zeros(0, dtype=int)  # heat enters through its distributions, not dofs
         mi, ti = np.setdiff1d(np.arange(nu), mb), np.setdiff1d(np.arange(nt), tb)
@@ -159,7 +167,7 @@ class ThermoelasticCraigBampton:
         self.n_theta = ti.size if max_n_theta is None else _count("n_theta", max_n_theta, ti.size)
         self.n_qu, self.n_qv = self.n_uv // 2, (self.n_uv + 1) // 2
         self.boundary = {"u": mb, "theta": tb}
-        if sp.csr_matrix(blocks.M)[mb][:, mi].count_nonzero():
+        if coords is None and sp.csr_matrix(blocks.M)[mb][:, mi].count_nonzero():
             warnings.warn(
                 "the mass matrix couples the contact dofs to the interior; the paper's "
                 "reduction assumes it lumped on the contacting dofs",
@@ -171,15 +179,9 @@ class ThermoelasticCraigBampton:
         self.solver = solver = InteriorSolver(blocks, mi, ti)
         self._bnd = np.r_[mb, nu + mb, 2 * nu + tb].astype(int)
         self._int = np.r_[mi, nu + mi, 2 * nu + ti].astype(int)
-        B = fom.B.tocsr()
         psi = solver.solve(-B[self._int][:, self._bnd])  # Eq. (11), sparse right-hand sides
         n_i = mi.size
-        if projection == "static-mass":  # v_i = Ψ_uu v_b: the static shapes' inertia
-            psi[n_i : 2 * n_i, mb.size : 2 * mb.size] = psi[:n_i, : mb.size]
-        if projection == "second-order":  # velocity shapes = displacement shapes [I; Ψ]
-            n_mi, nb = mi.size, mb.size
-            psi[n_mi : 2 * n_mi, nb : 2 * nb] = psi[:n_mi, :nb]
-            psi[:n_mi, nb : 2 * nb] = 0.0
+        velocity_static_shapes(psi, projection, n_i, mb.size)
         self.timings["static_shapes"] = time.perf_counter() - t0
         t0 = time.perf_counter()
         self.omega2, phi = lowest_modes(solver.K, solver.M, self.n_qv, solver.solve_K)
@@ -201,13 +203,10 @@ class ThermoelasticCraigBampton:
         self.layout = self._layout(self.n_uv, self.n_theta)
         left = None  # (left) adjoint modes; boundary columns: adjoint static shapes or unit vectors
         if projection not in ("galerkin", "second-order"):
-            if projection == "adjoint":
-                psi_l = solver.solve_transposed(-B[self._bnd][:, self._int].T)
-            elif projection == "static-mass":  # momentum rows of v_b on [1; Ψ_uu]
-                psi_l = np.zeros_like(psi)
-                psi_l[n_i : 2 * n_i, mb.size : 2 * mb.size] = psi[:n_i, : mb.size]
-            else:  # boundary equations kept as in the full model: no static shapes
-                psi_l = None
+            psi_l = left_static_shapes(
+                psi, projection, n_i, mb.size,
+                lambda: solver.solve_transposed(-B[self._bnd][:, self._int].T),
+            )  # fmt: skip
             mphi = orient_columns(normalise_columns(solver.M @ phi[:, : self.n_qu]))
             left = (psi_l, mphi, phi, chi, solver.Ctu.T @ chi)
         if not keep_solver:  # no more solves: the factorisations' memory before the bases'
@@ -215,6 +214,9 @@ class ThermoelasticCraigBampton:
         at = (self._idx, self._int, nu, fom.n_dofs, self.layout)  # where each shape goes
         self.R = assemble_basis(*at, psi, phi[:, : self.n_qu], phi, chi, phi_ut)
         self.left = self.R if left is None else assemble_basis(*at, *left)
+        if coords is not None:  # back to the physical coordinates: R = T̃ R', R̃ = L̃ R̃'
+            self.left = self.R if left is None else coords.left(self.left, L)
+            self.R = coords.right(self.R, L)
         self.timings["bases"] = time.perf_counter() - t0
 
     # -- bases -----------------------------------------------------------------------------
@@ -236,6 +238,15 @@ class ThermoelasticCraigBampton:
             np.arange(Lr.n_u), Lm.v.start + np.arange(Lr.n_v), Lm.t.start + np.arange(Lr.n_t)
         ]
         return n_uv, n_theta, cols, Lr
+
+    def stiffness_solver(self):
+        """``f ↦ K⁻¹ f`` for the full model's whole stiffness (contacts free), by static
+        condensation on the interior factorisation (:func:`.interior.condensed_solve`)."""
+        K, coords = self.fom.blocks.K, self.coordinates
+        if coords is None:
+            return condensed_solve(K, self.boundary["u"], self.solver)
+        K_prime = coords.blocks(self.fom.blocks).K
+        return coords.solve(condensed_solve(K_prime, self.boundary["u"], self.solver))
 
     def mechanical_basis(self) -> np.ndarray:
         """Second-order Craig–Bampton basis of the displacements: ``[[I, 0], [Ψ_uu, Φ]]``."""
@@ -386,11 +397,3 @@ def _count(name, value, most) -> int:
     if not (isinstance(value, (int, np.integer)) and 0 <= value <= most):
         raise ValueError(f"{name} must be an integer in [0, {most}], got {value!r}")
     return int(value)
-
-
-def _given(boundary, nu, nt):
-    mb = np.unique(np.asarray(boundary.get("u", []), dtype=int))
-    tb = np.unique(np.asarray(boundary.get("theta", []), dtype=int))
-    if mb.size and (mb.min() < 0 or mb.max() >= nu) or tb.size and (tb.min() < 0 or tb.max() >= nt):
-        raise ValueError("boundary dofs out of range of the u- or θ-block")
-    return mb, tb

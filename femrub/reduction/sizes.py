@@ -41,7 +41,6 @@ from ..fem import eigen
 from ..scene.spec import SceneError, fail
 from .craig_bampton import ThermoelasticCraigBampton
 from .estimate import estimate, reference_sizes, simulate, twin
-from .interior import condensed_solve
 
 __all__ = ["natural_frequencies", "reduce_model"]
 
@@ -102,7 +101,7 @@ def _auto_sizes(red, model, opts: dict, t_end: float, report: dict) -> tuple[int
     L, b = model.layout, model.blocks
     nb, ntb = red.boundary["u"].size, red.n_theta_b
     target, modes = opts["target"], min(opts["modes"], L.n_u)
-    solve = condensed_solve(b.K, red.boundary["u"], red.solver)  # no factorisation of K
+    solve = red.stiffness_solver()  # no factorisation of K
     tol = REFERENCE_TOL_PER_TARGET * opts["target"]
     ref = eigen.angular_frequencies(b.K, b.M, modes, solve, tol=tol) / (2.0 * np.pi)
     errs = _freq_errors(b.K, b.M, red.mechanical_basis(), nb, ref)

@@ -169,6 +169,13 @@ CONTACT = {
     "group": Spec(S, "contact", doc="node group of the contact points ('tip': every tip node)"),
     "nodes": Spec("ints", None, doc="node numbers of the contact points (mesh files)"),
     "casing": CASING,
+    "spread": Spec(
+        C,
+        "patch",
+        choices=("patch", "node"),
+        doc="3D: a contact acts on its share of the tip face (mean displacement, force "
+        "spread like its heat; femrub.contact.patches) or on its node alone",
+    ),
     "restitution": _f(0.0, "none", "Newton's restitution coefficient e", lo=0.0, hi=1.0),
     "friction": _f(
         0.0, "none", "3D: Coulomb coefficient μ (tangential force |λ_t| <= μ λ)", **NONNEG
