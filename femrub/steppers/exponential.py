@@ -41,6 +41,7 @@ from ..contact.impulses import solve_impulses
 from ..fem.linalg import Factorised
 from .base import Stepper
 from .events import EventLocation
+from .exponential_kernels import warm_up
 from .flows import FlowFamily
 from .work import WorkIntegrals
 
@@ -112,6 +113,7 @@ class ExponentialMoreau(EventLocation, Stepper):
     # -- set-up ------------------------------------------------------------------------------
     def _setup(self):
         m, h = self.model, self.h
+        warm_up()  # the compiled dyadic kernels: loaded (or compiled) once per process
         lu = Factorised(m.A, what="matrix A")
         L = np.asarray(lu.solve(m.B.toarray()))
         F = (
