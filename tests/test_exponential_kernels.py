@@ -21,6 +21,8 @@ from femrub.steppers.exponential_kernels import (
     compose,
     compose_integrals,
     double_integrals,
+    flight,
+    quiet,
     square_levels,
 )
 
@@ -84,6 +86,36 @@ def test_doubled_integrals_compose_to_van_loan():
     # bits below lo are left to the caller
     *_, rest = compose_integrals(Y[2:], z.copy(), 7, 2, 1)
     assert rest == 3
+
+
+def test_quiet_flags_closings_and_releases_only():
+    # two contacts then one held multiplier, grid of 3 points
+    V = np.array([[1.0, -0.2, 5.0], [0.5, -0.1, 4.0], [0.2, -0.15, 3.0]])
+    free = np.zeros(2, dtype=np.bool_)
+    assert quiet(V, 2, free)  # gap 0 stays above min(g(0), 0); gap 1 rises from -0.2
+    V2 = V.copy()
+    V2[2, 0] = -1e-12  # a closing
+    assert not quiet(V2, 2, free)
+    held = np.array([True, False])
+    assert quiet(V2, 2, held)  # a held contact's gap is not checked
+    V3 = V.copy()
+    V3[1, 2] = -1.0  # a held multiplier pulls: a release
+    assert not quiet(V3, 2, held)
+
+
+def test_flight_reads_state_integrals_and_grid_off_one_product():
+    rng = np.random.default_rng(3)
+    F, u = rng.standard_normal((3 + 2 * 4 + 2 + 2 * 2, 4)), rng.standard_normal(4)
+    act, works = np.array([1, 3]), np.zeros(6)
+    k = 3 + 2 * 4 + 2
+    g0 = np.full((2, 1), 10.0)
+    y, V, calm = flight(F, u, k, 1, g0, np.zeros(1, dtype=np.bool_), 3, act, True, works)
+    ref = F @ u
+    assert y[:k] == pytest.approx(ref[:k])  # (the rows past k: V, maybe shared)
+    assert works[1] == pytest.approx(ref[3:7] @ u) and works[3] == pytest.approx(ref[7:11] @ u)
+    assert works[4:] == pytest.approx(ref[11:13]) and works[0] == works[2] == 0.0
+    assert V == pytest.approx(ref[k:].reshape(2, 2) + np.c_[g0, np.zeros(2)])
+    assert calm == quiet(V, 1, np.zeros(1, dtype=np.bool_))
 
 
 _CHILD = """

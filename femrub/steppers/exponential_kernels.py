@@ -5,7 +5,9 @@ the increment ``D = Z − I`` of the smallest level (:func:`square_levels`), and
 advanced over any duration ``k unit 2^LEVEL_MIN`` by composing the levels of the binary
 expansion of ``k`` from the top bit down (:func:`compose`); the work integrals of
 :mod:`~.work` compose their stacked level rows ``[Γ_e; C J_e; Z_e]`` the same way
-(:func:`compose_integrals`). These three loops are the only implementation of that algebra:
+(:func:`compose_integrals`). A whole step without event is one product of a matrix stacked
+once per held set, its integrals and event check read off it (:func:`flight`). These loops
+are the only implementation of that algebra:
 compiled with :func:`femrub.contact.jit.njit` (one compilation per machine, cached on disk),
 and plain Python/numpy under ``NUMBA_DISABLE_JIT=1``.
 """
@@ -16,7 +18,16 @@ import numpy as np
 
 from ..contact.jit import compiled, njit
 
-__all__ = ["compose", "compose_integrals", "double_integrals", "square_levels", "warm_up"]
+__all__ = [
+    "compose",
+    "compose_integrals",
+    "double_integrals",
+    "flight",
+    "form_values",
+    "quiet",
+    "square_levels",
+    "warm_up",
+]
 
 
 @njit
@@ -112,6 +123,56 @@ def double_integrals(g, j, Z, flush):
     return Y
 
 
+@njit
+def form_values(y, u, nz, act, out):
+    """The integrals of a whole step into ``out`` (6,) from ``y = F u``
+    (:meth:`~.work.WorkIntegrals.flight_matrix`): the quadratic forms ``uᵀ (EᵀΓE)_f u`` of the
+    non-zero forms ``act`` (rows ``nz + f len(u)`` on), then the two heats as read."""
+    nu = u.size
+    for f in range(act.size):
+        out[act[f]] = y[nz + f * nu : nz + (f + 1) * nu] @ u
+    kn = act.size * nu
+    out[4] = y[nz + kn]
+    out[5] = y[nz + kn + 1]
+
+
+@njit
+def quiet(V, n_c, held):
+    """No event on the check grid ``V`` (q + 1, n_c + s) of exact gaps, then held multipliers:
+    no free gap falls below ``min(g(0), 0)`` and no held multiplier is negative."""
+    for i in range(n_c):
+        if held[i]:
+            continue
+        ref = min(V[0, i], 0.0)
+        for j in range(1, V.shape[0]):
+            if V[j, i] < ref:
+                return False
+    for j in range(V.shape[0]):
+        for i in range(n_c, V.shape[1]):
+            if V[j, i] < 0.0:
+                return False
+    return True
+
+
+@njit
+def flight(F, u, k, q, gap0, held, nz, act, measure, works):
+    """A whole step's exact flight in one product ``y = F u`` (``F``: the state rows, the
+    integrals' rows with ``measure``, then from row ``k`` the check grid's rows): the
+    integrals into ``works`` (:func:`form_values`), the check grid ``V`` (q + 1, r) with the
+    casing's gaps ``gap0`` (q + 1, n_c) added, and whether the step is :func:`quiet`.
+    Returns ``(y, V, quiet)`` (``V``: ``y``'s rows past ``k``, which may share its memory; empty
+    and quiet without grid rows)."""
+    y = F @ u
+    if measure:
+        form_values(y, u, nz, act, works)
+    if k >= y.size:
+        return y, np.empty((0, 0)), True
+    V = np.ascontiguousarray(y[k:]).reshape(q + 1, (y.size - k) // (q + 1))
+    n_c = gap0.shape[1]
+    V[:, :n_c] += gap0
+    return y, V, quiet(V, n_c, held)
+
+
 def warm_up() -> None:
     """Compile (or load from the disk cache) the kernels for the argument types of a run,
     before any timed step (nothing is computed that is kept)."""
@@ -121,3 +182,5 @@ def warm_up() -> None:
     compose(Z, np.zeros(2), 1)
     compose_integrals(np.zeros((2, 6, 2)), np.zeros(2), 1, 0, 1)
     double_integrals(np.zeros((1, 2, 2)), np.zeros((2, 2)), Z, 1e-150)
+    act, held, w = np.zeros(1, dtype=np.int64), np.zeros(1, dtype=np.bool_), np.zeros(6)
+    flight(np.zeros((10, 2)), np.zeros(2), 6, 1, np.zeros((2, 1)), held, 2, act, True, w)

@@ -30,7 +30,7 @@ import numpy as np
 import scipy.linalg as sla
 import scipy.sparse as sp
 
-from .exponential_kernels import compose, compose_integrals, double_integrals
+from .exponential_kernels import compose, compose_integrals, double_integrals, form_values
 from .flows import _FLUSH, LEVEL_MIN
 
 __all__ = ["QUADRATIC", "LINEAR", "WorkIntegrals"]
@@ -234,10 +234,8 @@ class WorkIntegrals:
         """The integrals (6,) of a whole step from ``y = F u`` (:meth:`flight_matrix`; rows
         of ``y`` past ``F``'s are ignored): the forms ``uᵀ (EᵀΓE) u``, the heats as read."""
         _, act, _, nz = self._flight[(S, unit)]
-        kn = act.size * u.size
         out = np.zeros(6)
-        out[act] = y[nz : nz + kn].reshape(-1, u.size) @ u
-        out[4:] = y[nz + kn : nz + kn + 2]
+        form_values(y, u, nz, act, out)
         return out
 
 
