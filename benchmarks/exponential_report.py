@@ -170,8 +170,8 @@ held set the sub-step flows, probe rows and work integrals: dense O(N³) product
 dyadic levels, matrix-product bound once compiled) exceeds a third of θ's whole 1 % run,
 before any step or event. The paper `u_L2` (which needs h <= 2.5e-4 s only because the error
 is measured on the piecewise-linear interpolant of the output): its fixed cost plus the
-recorder alone are within about 10 % of the 3× target, and its 27 event steps cost more
-than the target by themselves ("run − steps without event" is the run with such steps free).
+recorder are already most of the 3× target, and its 27 event steps cost more than the
+target by themselves ("run − steps without event" is the run with such steps free).
 Without event location (`events = false`) the same stepper is cheap but wrong: an
 end-of-step impulse only stops the tip mass while the rest of the bar flies through the
 casing for a whole step; event location and held contacts are therefore kept. On the free
