@@ -88,7 +88,7 @@ def test_whole_step_product_matches_the_matrix_exponential(S, measure, h):
     X = rng.standard_normal(n) * 1e-6
     X[st.model.layout.t] = 50.0 + 10.0 * rng.random(st.model.layout.n_t)
     b = rng.standard_normal((flows.degree + 1, flows.G.shape[1]))
-    Xe, PS, rest, V = st._flight(S, X, b)
+    Xe, PS, rest, V, calm = st._flight(S, X, b)
     z0 = np.r_[X, np.zeros(s), flows.chain(b, 0.0)]
     lam = flows.generator(S)[2]
     ref = []
@@ -103,6 +103,12 @@ def test_whole_step_product_matches_the_matrix_exponential(S, measure, h):
     ref = np.array(ref)
     assert V.shape == ref.shape
     assert np.allclose(V, ref, rtol=0, atol=1e-10 * np.abs(ref).max())
+    # the compiled quiet check agrees with the grid: no free gap below min(g(0), 0), no
+    # held multiplier negative
+    free = np.ones(c.n, dtype=bool)
+    free[list(S)] = False
+    fall = (ref[1:, : c.n][:, free] < np.minimum(ref[0, : c.n][free], 0.0)).any()
+    assert calm == (not fall and not (ref[:, c.n :] < 0.0).any())
     if measure:
         assert np.allclose(rest, W.step(S, z0, q, unit), rtol=1e-10, atol=1e-16)
     else:

@@ -15,6 +15,7 @@ import math
 
 import numpy as np
 
+from .exponential_kernels import quiet
 from .flows import first_zero, shift
 
 __all__ = ["EventLocation"]
@@ -31,7 +32,7 @@ class EventLocation:
         """Earliest closing or release in ``(a, h]``: ``(τ, kind, i, X(τ), P_S(a..τ))``.
 
         The exact gaps and held multipliers are checked on a grid of spacing ``h / probes``
-        (at a step start: the rows ``V`` of :meth:`_grid_values`, computed with the flight;
+        (at a step start: the rows ``V`` of :meth:`_grid_rows`, computed with the flight;
         on a part step: probe rows and cached sub-step flows); the first sign change is then
         located on the exact flow (cached sub-step flows over ``h / probes × 2^e``).
         """
@@ -166,26 +167,11 @@ class EventLocation:
             self._probe_rows[key] = R.reshape((q + 1) * r, n_in)
         return self._probe_rows[key]
 
-    def _grid_values(self, S, y) -> np.ndarray:
-        """``V`` (q + 1, r): the rows ``y = R u`` of :meth:`_grid_rows` with the casing's
-        gaps ``g0`` added at ``t + j h / q``."""
-        c, q = self.model.contact, self.probes
-        V = y.reshape(q + 1, -1)
-        if callable(c.gap0):
-            V[:, : c.n] += c.gap_at(self.t + (self.h / q) * np.arange(q + 1))
-        else:
-            V[:, : c.n] += c.gap0
-        return V
-
     def _quiet(self, S, V) -> bool:
-        """A whole step without event: on the grid ``V`` (:meth:`_grid_values`) no free gap
-        falls below ``min(g(0), 0)`` and no held multiplier is negative (the common case)."""
-        n = self.model.contact.n
-        gv = V[:, :n]
-        ref = np.minimum(gv[0], 0.0)
-        if S:
-            ref[list(S)] = -np.inf
-        return not ((gv[1:] < ref).any() or (V[:, n:] < 0.0).any())
+        """A whole step without event: on the grid ``V`` (rows ``[g; λ_S]`` at ``j h / q``)
+        no free gap falls below ``min(g(0), 0)`` and no held multiplier is negative (the
+        common case; compiled, :func:`~.exponential_kernels.quiet`)."""
+        return quiet(V, self.model.contact.n, self._held(S))
 
     def _root(self, S, f, lo, hi, X_lo, b):
         """First zero of ``f`` in ``(lo, hi]`` on the exact flow from ``(lo, X_lo)``

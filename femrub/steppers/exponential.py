@@ -41,6 +41,7 @@ from ..contact.impulses import solve_impulses
 from ..fem.linalg import Factorised
 from .base import Stepper
 from .events import EventLocation
+from .exponential_kernels import flight, warm_up
 from .flows import FlowFamily
 from .work import WorkIntegrals
 
@@ -112,6 +113,7 @@ class ExponentialMoreau(EventLocation, Stepper):
     # -- set-up ------------------------------------------------------------------------------
     def _setup(self):
         m, h = self.model, self.h
+        warm_up()  # the compiled dyadic kernels: loaded (or compiled) once per process
         lu = Factorised(m.A, what="matrix A")
         L = np.asarray(lu.solve(m.B.toarray()))
         F = (
@@ -170,6 +172,8 @@ class ExponentialMoreau(EventLocation, Stepper):
         self._measure = False  # step() / iterate(): no meter to hand them to
         self._fused: dict[tuple, tuple] = {}  # (S, measure) -> whole-step matrix (_flight)
         self._probe_rows: dict[tuple, np.ndarray] = {}  # the check grids' rows (events)
+        self._masks: dict[tuple, np.ndarray] = {}  # held sets as masks
+        self._g0grid = None  # a fixed casing's gaps on the check grid
 
     def _signal_values(self, t):
         """Load signals, then the casing's gap rates ``ġ0`` (moving casing, held contacts)."""
@@ -234,8 +238,9 @@ class ExponentialMoreau(EventLocation, Stepper):
         self._w = np.zeros(6)
         for n_events in range(MAX_EVENTS + 1):
             rest = V = None  # the flight's integrals to the step end and its check grid
+            calm = False  # a whole step whose check grid shows no event
             if a == 0.0:  # the whole step, its integrals and check grid in one product
-                Xe, PS, rest, V = self._flight(S, X, b)
+                Xe, PS, rest, V, calm = self._flight(S, X, b)
             elif self._measure:  # after an event: the flight and its integrals at once
                 Xe, PS, rest = self._integrate(S, X, a, h, b, state=True)
             else:  # after an event: cached sub-step flows
@@ -244,7 +249,7 @@ class ExponentialMoreau(EventLocation, Stepper):
                 self._w += self._integrate(S, X, a, h, b) if rest is None else rest
                 return Xe, P
             ev = None
-            if self.events and n_events < MAX_EVENTS:
+            if self.events and n_events < MAX_EVENTS and not calm:
                 ev = self._event(S, X, a, Xe, b, V)
             if ev is None:
                 break
@@ -269,30 +274,52 @@ class ExponentialMoreau(EventLocation, Stepper):
 
     def _flight(self, S, X, b):
         """The exact flight of ``S`` over the whole step from ``X`` with the load polynomial
-        ``b``, in one product of a matrix stacked once per held set: ``(X(h), P_S,
-        integrals, V)``, the integrals (:meth:`~.work.WorkIntegrals.flight_matrix`) with
-        ``run(energy=True)`` and the event check grid ``V`` (:meth:`_grid_rows`) when events
-        are located (else ``None``)."""
+        ``b``, in one product of a matrix stacked once per held set (compiled,
+        :func:`~.exponential_kernels.flight`): ``(X(h), P_S, integrals, V, quiet)``, the
+        integrals (:meth:`~.work.WorkIntegrals.flight_matrix`) with ``run(energy=True)``
+        (else ``None``), the event check grid ``V`` (:meth:`_grid_rows`, with the casing's
+        gaps) when events are located and whether it shows no event (:meth:`_quiet`)."""
         key = (S, self._measure)
         q, n, nz = self.probes, self.model.n_dofs, self.model.n_dofs + len(S)
+        c = self.model.contact
         if key not in self._fused:
             f = self._flows.flow(S, self.h)
+            act = np.zeros(0, dtype=np.int64)
             if self._measure:
-                F = self._integrals.flight_matrix(S, q, self.h / q)[0]
+                F, act = self._integrals.flight_matrix(S, q, self.h / q)[:2]
             else:
                 F = np.hstack([f.Phi, f.Psi])
             k = F.shape[0]  # the rows past k: the check grid
-            if self.events and self.model.contact is not None:
+            if self.events and c is not None:
                 F = np.vstack([F, self._grid_rows(S, f)])
-            self._fused[key] = (F, k)
-        F, k = self._fused[key]
+            self._fused[key] = (np.ascontiguousarray(F), k, np.asarray(act, dtype=np.int64))
+        F, k, act = self._fused[key]
         u = np.concatenate([X, (self._T01 @ b).ravel()])
-        y = F @ u
-        rest = None
-        if self._measure:
-            rest = self._integrals.flight_integrals(S, q, self.h / q, y, u)
-        V = self._grid_values(S, y[k:]) if k < y.size else None
-        return y[:n], y[n:nz], rest, V
+        works = np.zeros(6)
+        y, V, calm = flight(
+            F, u, k, q, self._gap_grid(), self._held(S), nz, act, self._measure, works
+        )
+        rest = works if self._measure else None
+        return y[:n], y[n:nz], rest, (V if V.size else None), calm
+
+    def _held(self, S) -> np.ndarray:
+        """Mask (n_c,) of the held set ``S`` (cached)."""
+        if S not in self._masks:
+            m = np.zeros(self.model.n_contacts, dtype=np.bool_)
+            m[list(S)] = True
+            self._masks[S] = m
+        return self._masks[S]
+
+    def _gap_grid(self) -> np.ndarray:
+        """The casing's gaps ``g0`` (q + 1, n_c) at ``t + j h / q`` (constant ones once)."""
+        c, q = self.model.contact, self.probes
+        if c is None:
+            return np.zeros((q + 1, 0))
+        if callable(c.gap0):
+            return np.ascontiguousarray(c.gap_at(self.t + (self.h / q) * np.arange(q + 1)))
+        if self._g0grid is None:
+            self._g0grid = np.ascontiguousarray(np.broadcast_to(c.gap0, (q + 1, c.n)))
+        return self._g0grid
 
     def _integrate(self, S, X, a, tau, b, state=False):
         """The exact works and heats (6,) of the flight of ``S`` from ``(a, X)`` to ``tau``

@@ -35,6 +35,8 @@ import math
 import numpy as np
 import scipy.linalg as sla
 
+from .exponential_kernels import compose, square_levels
+
 __all__ = ["Flow", "FlowFamily", "LEVEL_MIN", "first_zero", "shift"]
 
 #: Smallest sub-step flow, ``unit 2^LEVEL_MIN`` (events are located to this resolution).
@@ -155,14 +157,15 @@ class FlowFamily:
             self._flows[key] = f
         return f
 
-    def levels(self, S: tuple, unit: float) -> list[np.ndarray]:
+    def levels(self, S: tuple, unit: float) -> np.ndarray:
         """Exact flows ``Z_e`` of held set ``S`` over ``unit 2^e``, e = ``LEVEL_MIN`` … ``e_max``
         (``unit 2^e_max >= h``), on the augmented state ``z = [X; P_S; s, ṡ, …, s^(p)]`` (load
         derivatives in physical units): ``z(τ + unit 2^e) = Z_e z(τ)`` (cached per ``S``).
 
         One augmented matrix ``M = [[K, E, 0, …], [0, 0, I, …], …]``; the smallest level from
         its Taylor series, the others by squaring its increment (``Z = I + D``,
-        ``D_{e+1} = 2 D_e + D_e²``: no cancellation against the identity)."""
+        ``D_{e+1} = 2 D_e + D_e²``: no cancellation against the identity; compiled,
+        :func:`~.exponential_kernels.square_levels`). Returns the stack (levels, N, N)."""
         key = (S, unit)
         if key not in self._levels:
             M = self.generator_z(S)
@@ -180,13 +183,8 @@ class FlowFamily:
                         break
             else:  # a very stiff model: the exponential itself
                 D = sla.expm(T) - np.eye(N)
-            out, eye = [], np.eye(N)
-            for e in range(LEVEL_MIN, e_max + 1):
-                D[np.abs(D) < _FLUSH] = 0.0  # no subnormal products (they are slow)
-                out.append(np.ascontiguousarray(eye + D))
-                if e < e_max:
-                    D = 2.0 * D + D @ D
-            self._levels[key] = out
+            D = np.ascontiguousarray(D)
+            self._levels[key] = square_levels(D, e_max - LEVEL_MIN + 1, _FLUSH)
         return self._levels[key]
 
     def generator_z(self, S: tuple) -> np.ndarray:
@@ -217,11 +215,7 @@ class FlowFamily:
         Z = self.levels(S, unit)
         k = int(rest / unit * 2.0**-LEVEL_MIN * (1.0 + 1e-12)) if rest > 0.0 else 0
         k = min(k, (1 << len(Z)) - 1)
-        while k:
-            e = k.bit_length() - 1
-            z = Z[e] @ z
-            k ^= 1 << e
-        return z
+        return compose(Z, np.ascontiguousarray(z, dtype=float), k) if k else z
 
     def advance(self, S: tuple, X, tau0: float, tau1: float, b, unit: float):
         """Flow of ``S`` from ``tau0`` to ``tau1`` in the step (:meth:`advance_z`); ``b``: the

@@ -30,6 +30,7 @@ import numpy as np
 import scipy.linalg as sla
 import scipy.sparse as sp
 
+from .exponential_kernels import compose, compose_integrals, double_integrals, form_values
 from .flows import _FLUSH, LEVEL_MIN
 
 __all__ = ["QUADRATIC", "LINEAR", "WorkIntegrals"]
@@ -121,21 +122,12 @@ class WorkIntegrals:
             # the series' last term is round-off against its first up to level lo - 1
             ok = tau ** (_TERMS - 1) / _FACTORIALS[-1] * size[-1] <= 1e-16 * size[0]
             lo = len(Z) if ok.all() else int(np.argmin(ok))
-            Y = []
+            N = M.shape[0]
+            Y = np.zeros((0, _level_rows(act.size, N), N))
             if lo < len(Z):  # the first level after the series' range, then doubling
                 g, j = self._van_loan(M, Q, C, tau[0]) if lo == 0 else _series(A, B, tau[lo])
-                N, kn = M.shape[0], Q.shape[0] * M.shape[0]
-                g = g.reshape(kn, N)  # the forms stacked: [Γ_1; Γ_2; …]
-                for i, Zi in enumerate(Z[lo:], start=lo + 1):
-                    y = np.vstack([g, j, Zi])
-                    y[np.abs(y) < _FLUSH] = 0.0  # no subnormal products (they are slow)
-                    Y.append(y)
-                    if i == len(Z):  # the last level: no next one
-                        break
-                    # [0, 2τ] = [0, τ] and [τ, 2τ]: Γ + Zᵀ Γ Z, Zᵀ Γ Z = (Γ Z)ᵀ Z (Γ symmetric)
-                    gz = (g @ Zi).reshape(-1, N, N).transpose(0, 2, 1).reshape(kn, N)
-                    g = g + gz @ Zi
-                    j = j + j @ Zi
+                g, j = np.ascontiguousarray(g), np.ascontiguousarray(j)
+                Y = double_integrals(g, j, np.ascontiguousarray(Z[lo:]), _FLUSH)
             self._levels[key] = (Y, lo, act, A, B)
         return self._levels[key]
 
@@ -161,21 +153,11 @@ class WorkIntegrals:
         for the rest. With ``state``: ``(z(rest), integrals)``, ``z`` composed exactly as
         :meth:`~.flows.FlowFamily.advance_z` does."""
         Y, lo, act, A, B = self.levels(S, unit)
-        N, kn = z.size, act.size * z.size
         k = int(rest / unit * 2.0**-LEVEL_MIN * (1.0 + 1e-12)) if rest > 0.0 else 0
         k = min(k, (1 << (lo + len(Y))) - 1)
-        ys, zs = [], []  # per level: [Γ_e z; C J_e z; Z_e z] and z (one product each)
-        while k >> lo:
-            e = k.bit_length() - 1
-            zs.append(z)
-            ys.append(Y[e - lo] @ z)
-            z = ys[-1][kn + 2 :]
-            k ^= 1 << e
-        wq, wl = np.zeros(act.size), np.zeros(2)
-        if ys:
-            ys, zs = np.array(ys), np.array(zs)
-            wq = np.einsum("bkn,bn->k", ys[:, :kn].reshape(len(zs), -1, N), zs)
-            wl = ys[:, kn : kn + 2].sum(axis=0)
+        # per level from the top bit: [Γ_e z; C J_e z; Z_e z] in one product (compiled)
+        z = np.ascontiguousarray(z, dtype=float)
+        wq, wl, z, k = compose_integrals(Y, z, k, lo, act.size)
         if k:
             d = k * unit * 2.0**LEVEL_MIN
             c = d ** np.arange(1, _TERMS + 1) / _FACTORIALS
@@ -185,12 +167,7 @@ class WorkIntegrals:
         w[act], w[4:] = wq, wl
         if not state:
             return w
-        Z = self.flows.levels(S, unit)
-        while k:
-            e = k.bit_length() - 1
-            z = Z[e] @ z
-            k ^= 1 << e
-        return z, w
+        return (compose(self.flows.levels(S, unit), z, k) if k else z), w
 
     def step(self, S: tuple, z, q: int, unit: float) -> np.ndarray:
         """The integrals (6,) over a whole step ``h = q unit`` from ``z`` (one form each)."""
@@ -257,11 +234,14 @@ class WorkIntegrals:
         """The integrals (6,) of a whole step from ``y = F u`` (:meth:`flight_matrix`; rows
         of ``y`` past ``F``'s are ignored): the forms ``uᵀ (EᵀΓE) u``, the heats as read."""
         _, act, _, nz = self._flight[(S, unit)]
-        kn = act.size * u.size
         out = np.zeros(6)
-        out[act] = y[nz : nz + kn].reshape(-1, u.size) @ u
-        out[4:] = y[nz + kn : nz + kn + 2]
+        form_values(y, u, nz, act, out)
         return out
+
+
+def _level_rows(n_forms: int, N: int) -> int:
+    """Rows of one level's stack ``[Γ_e (n_forms × N); C J_e (2); Z_e (N)]``."""
+    return n_forms * N + 2 + N
 
 
 def _series(A, B, tau):

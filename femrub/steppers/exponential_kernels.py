@@ -1,0 +1,186 @@
+"""Compiled dyadic algebra of the exponential stepper's exact flows (numba).
+
+The exact flows of :mod:`~.flows` over ``unit 2^e`` are built once per held set by squaring
+the increment ``D = Z − I`` of the smallest level (:func:`square_levels`), and a state is
+advanced over any duration ``k unit 2^LEVEL_MIN`` by composing the levels of the binary
+expansion of ``k`` from the top bit down (:func:`compose`); the work integrals of
+:mod:`~.work` compose their stacked level rows ``[Γ_e; C J_e; Z_e]`` the same way
+(:func:`compose_integrals`). A whole step without event is one product of a matrix stacked
+once per held set, its integrals and event check read off it (:func:`flight`). These loops
+are the only implementation of that algebra:
+compiled with :func:`femrub.contact.jit.njit` (one compilation per machine, cached on disk),
+and plain Python/numpy under ``NUMBA_DISABLE_JIT=1``.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..contact.jit import compiled, njit
+
+__all__ = [
+    "compose",
+    "compose_integrals",
+    "double_integrals",
+    "flight",
+    "form_values",
+    "quiet",
+    "square_levels",
+    "warm_up",
+]
+
+
+@njit
+def square_levels(D, count, flush):
+    """The flows ``Z_e = I + D_e`` (count, N, N) of ``count`` successive dyadic levels from
+    the increment ``D`` (N, N) of the first: ``D_{e+1} = 2 D_e + D_e²`` (no cancellation
+    against the identity); entries below ``flush`` are set to zero before each level (no
+    subnormal products, they are slow). ``D`` is overwritten."""
+    n = D.shape[0]
+    out = np.empty((count, n, n))
+    for lev in range(count):
+        for i in range(n):
+            for j in range(n):
+                if abs(D[i, j]) < flush:
+                    D[i, j] = 0.0
+        out[lev] = D
+        for i in range(n):
+            out[lev, i, i] += 1.0
+        if lev + 1 < count:
+            D = 2.0 * D + D @ D
+    return out
+
+
+@njit
+def compose(Z, z, k):
+    """``z`` advanced over ``k`` smallest units: ``Z[e] @ z`` for each set bit ``e`` of ``k``
+    from the top down (``Z`` (levels, N, N), level 0 the smallest; ``k < 2^levels``)."""
+    e = Z.shape[0] - 1
+    while k > 0 and e >= 0:
+        if k >> e & 1:
+            z = Z[e] @ z
+            k -= 1 << e
+        e -= 1
+    return z
+
+
+@njit
+def compose_integrals(Y, z, k, lo, n_forms):
+    """The integrals over the levels ``e >= lo`` of the binary expansion of ``k`` (top bit
+    first), each level's stacked rows ``Y[e − lo] = [Γ_e (n_forms × N rows); C J_e (2 rows);
+    Z_e (N rows)]`` applied to the state at its start (one product per level)::
+
+        w_f += z_eᵀ Γ_{e,f} z_e,      w_lin += C J_e z_e,      z_{e+1} = Z_e z_e
+
+    Returns ``(w_forms (n_forms,), w_lin (2,), z after these levels, the bits left below lo)``.
+    """
+    n = z.size
+    kn = n_forms * n
+    wq = np.zeros(n_forms)
+    wl = np.zeros(2)
+    e = lo + Y.shape[0] - 1
+    while e >= lo:
+        if k >> e & 1:
+            y = Y[e - lo] @ z
+            for f in range(n_forms):
+                wq[f] += y[f * n : (f + 1) * n] @ z
+            wl += y[kn : kn + 2]
+            z = y[kn + 2 :].copy()
+            k -= 1 << e
+        e -= 1
+    return wq, wl, z, k
+
+
+@njit
+def double_integrals(g, j, Z, flush):
+    """The stacked rows ``Y[i] = [Γ_i (forms × N rows); C J_i (2 rows); Z_i (N rows)]`` of
+    successive dyadic levels from the integrals of the first, ``g`` (forms, N, N) and ``j``
+    (2, N), and the levels' flows ``Z`` (count, N, N): over ``[0, 2τ] = [0, τ] ∪ [τ, 2τ]``::
+
+        Γ_{i+1} = Γ_i + Z_iᵀ Γ_i Z_i,        C J_{i+1} = C J_i + C J_i Z_i
+
+    (``Z_iᵀ Γ Z_i = (Γ Z_i)ᵀ Z_i``, Γ symmetric). Entries of ``Y`` below ``flush`` are set to
+    zero (no subnormal products when they are applied)."""
+    nf, n = g.shape[0], g.shape[1]
+    count = Z.shape[0]
+    kn = nf * n
+    Y = np.empty((count, kn + 2 + n, n))
+    for i in range(count):
+        Zi = Z[i]
+        for f in range(nf):
+            Y[i, f * n : (f + 1) * n] = g[f]
+        Y[i, kn : kn + 2] = j
+        Y[i, kn + 2 :] = Zi
+        for r in range(kn + 2 + n):
+            for c in range(n):
+                if abs(Y[i, r, c]) < flush:
+                    Y[i, r, c] = 0.0
+        if i + 1 < count:
+            for f in range(nf):
+                gz = np.ascontiguousarray((g[f] @ Zi).T)
+                g[f] = g[f] + gz @ Zi
+            j = j + j @ Zi
+    return Y
+
+
+@njit
+def form_values(y, u, nz, act, out):
+    """The integrals of a whole step into ``out`` (6,) from ``y = F u``
+    (:meth:`~.work.WorkIntegrals.flight_matrix`): the quadratic forms ``uᵀ (EᵀΓE)_f u`` of the
+    non-zero forms ``act`` (rows ``nz + f len(u)`` on), then the two heats as read."""
+    nu = u.size
+    for f in range(act.size):
+        out[act[f]] = y[nz + f * nu : nz + (f + 1) * nu] @ u
+    kn = act.size * nu
+    out[4] = y[nz + kn]
+    out[5] = y[nz + kn + 1]
+
+
+@njit
+def quiet(V, n_c, held):
+    """No event on the check grid ``V`` (q + 1, n_c + s) of exact gaps, then held multipliers:
+    no free gap falls below ``min(g(0), 0)`` and no held multiplier is negative."""
+    for i in range(n_c):
+        if held[i]:
+            continue
+        ref = min(V[0, i], 0.0)
+        for j in range(1, V.shape[0]):
+            if V[j, i] < ref:
+                return False
+    for j in range(V.shape[0]):
+        for i in range(n_c, V.shape[1]):
+            if V[j, i] < 0.0:
+                return False
+    return True
+
+
+@njit
+def flight(F, u, k, q, gap0, held, nz, act, measure, works):
+    """A whole step's exact flight in one product ``y = F u`` (``F``: the state rows, the
+    integrals' rows with ``measure``, then from row ``k`` the check grid's rows): the
+    integrals into ``works`` (:func:`form_values`), the check grid ``V`` (q + 1, r) with the
+    casing's gaps ``gap0`` (q + 1, n_c) added, and whether the step is :func:`quiet`.
+    Returns ``(y, V, quiet)`` (``V``: ``y``'s rows past ``k``, which may share its memory; empty
+    and quiet without grid rows)."""
+    y = F @ u
+    if measure:
+        form_values(y, u, nz, act, works)
+    if k >= y.size:
+        return y, np.empty((0, 0)), True
+    V = np.ascontiguousarray(y[k:]).reshape(q + 1, (y.size - k) // (q + 1))
+    n_c = gap0.shape[1]
+    V[:, :n_c] += gap0
+    return y, V, quiet(V, n_c, held)
+
+
+def warm_up() -> None:
+    """Compile (or load from the disk cache) the kernels for the argument types of a run,
+    before any timed step (nothing is computed that is kept)."""
+    if not compiled():
+        return
+    Z = square_levels(np.zeros((2, 2)), 2, 1e-150)
+    compose(Z, np.zeros(2), 1)
+    compose_integrals(np.zeros((2, 6, 2)), np.zeros(2), 1, 0, 1)
+    double_integrals(np.zeros((1, 2, 2)), np.zeros((2, 2)), Z, 1e-150)
+    act, held, w = np.zeros(1, dtype=np.int64), np.zeros(1, dtype=np.bool_), np.zeros(6)
+    flight(np.zeros((10, 2)), np.zeros(2), 6, 1, np.zeros((2, 1)), held, 2, act, True, w)
