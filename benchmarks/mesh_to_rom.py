@@ -8,8 +8,13 @@ estimate's run of the chosen sizes, which is the scene's run (``Simulation.ran``
 stepped again), so the path is also reported without it. Writes the table
 between the ``mesh_to_rom`` markers of ``docs/performance.md`` (``--no-write``: print it).
 
-Run: ``python benchmarks/mesh_to_rom.py [--scene rotor37] [--no-write]`` (Rotor 37-sized:
-``flock /tmp/femrub-heavy.lock python benchmarks/mesh_to_rom.py``). Skips without
+The contact kernels are compiled once per machine (numba's on-disk cache); the table says
+whether this run found them compiled (``kernels``: ``cached``) or compiled them (``compiled
+in a background process``, overlapping the assembly: a first run on a fresh install);
+``--cold-kernels`` measures the latter with an empty kernel cache (``NUMBA_CACHE_DIR``).
+
+Run: ``python benchmarks/mesh_to_rom.py [--scene rotor37] [--no-write] [--cold-kernels]``
+(Rotor 37-sized: ``flock /tmp/femrub-heavy.lock python benchmarks/mesh_to_rom.py``). Skips without
 ``../shared/data``.
 """
 
@@ -20,6 +25,7 @@ import json
 import os
 import subprocess
 import sys
+import tempfile
 import time
 from pathlib import Path
 
@@ -38,9 +44,12 @@ def _peak_mib() -> float:
 def child(scene_name: str) -> dict:
     """Build ``scene_name`` without cache up to its first step (in this process)."""
     from femrub.app.simulation import build
+    from femrub.contact import jit
+    from femrub.contact.theta_block import friction_block
     from femrub.scene import load_scene
 
     scene = load_scene(scene_name)
+    cold = jit.compiled() and jit._cold(friction_block)
     lines: list[str] = []
     t0, c0, load0 = time.perf_counter(), time.process_time(), os.getloadavg()[0]
 
@@ -65,6 +74,7 @@ def child(scene_name: str) -> dict:
         # the estimate's run of the chosen sizes, kept as the scene's run (Simulation.ran)
         "run_seconds": sim.ran[1] if sim.ran is not None else 0.0,
         "tolerance": err.get("tolerance"),
+        "kernels": "compiled in a background process" if cold else "cached",
         "log": lines,
     }
 
@@ -81,14 +91,14 @@ def row(r: dict) -> str:
         f"({ph}; estimate {est:.1f}, of which the run itself {run:.1f}, kept as the run; "
         f"wall without it {r['wall'] - run:.1f}) | "
         f"{100 * (r['estimate'] or 0):.2f} % ({verdict}) | "
-        f"{r['n_dofs']} | {r['load'][0]}–{r['load'][1]} |"
+        f"{r['n_dofs']} | {r.get('kernels', '?')} | {r['load'][0]}–{r['load'][1]} |"
     )
 
 
 HEADER = (
     "| scene | wall (s) | wall without the estimate (s) | CPU (s) | peak MiB | assembly (s) "
-    "| reduction (s) | estimate (verdict) | reduced dofs | load |\n"
-    "|---|---|---|---|---|---|---|---|---|---|"
+    "| reduction (s) | estimate (verdict) | reduced dofs | kernels | load |\n"
+    "|---|---|---|---|---|---|---|---|---|---|---|"
 )
 
 
@@ -96,6 +106,7 @@ def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--scene", default="rotor37")
     ap.add_argument("--no-write", action="store_true")
+    ap.add_argument("--cold-kernels", action="store_true", help="empty kernel cache")
     ap.add_argument("--child", action="store_true", help=argparse.SUPPRESS)
     a = ap.parse_args(argv)
     if a.child:
@@ -107,7 +118,10 @@ def main(argv=None) -> int:
             return 0
     env = dict(os.environ, PYTHONPATH=str(ROOT) + os.pathsep + os.environ.get("PYTHONPATH", ""))
     cmd = [sys.executable, __file__, "--child", "--scene", a.scene]
-    p = subprocess.run(cmd, capture_output=True, text=True, env=env)
+    with tempfile.TemporaryDirectory() as kernels:
+        if a.cold_kernels:  # a first run on this machine: numba compiles the kernels
+            env["NUMBA_CACHE_DIR"] = kernels
+        p = subprocess.run(cmd, capture_output=True, text=True, env=env)
     last = [x for x in p.stdout.splitlines() if x.startswith("{")]
     if p.returncode or not last:
         print(p.stderr[-2000:], file=sys.stderr)

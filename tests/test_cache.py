@@ -102,6 +102,23 @@ def test_speed_change_reuses_the_matrices_with_the_new_gap_and_heat(first):
     _close(_states(hit), _states(fresh), 1e-6)
 
 
+def test_another_process_loads_the_bases(first, monkeypatch):
+    """A process that did not build the bases (the other sweep worker) loads them."""
+    from femrub.app import cached
+
+    cache, _, _ = first
+    assert cache.info()["stages"]["bases"]["entries"] == 1
+    monkeypatch.setattr(cached, "_REDUCTORS", {})  # as in a new process
+    notes = []
+    hit = _build(cache, notes, **{"loads.rotation_speed": 1600.0})
+    assert any("bases loaded" in n for n in notes)
+    assert hit.report["reduction"]["bases"].startswith("reused")
+    assert not any("static shapes" in n for n in notes if n.startswith("reduction phases"))
+    fresh = _build(None, None, **{"loads.rotation_speed": 1600.0})
+    _same_model(hit.model, fresh.model)
+    _close(_states(hit), _states(fresh), 1e-6)
+
+
 def test_prestress_is_cached_per_speed(tmp_path):
     cache = ModelCache(tmp_path / "cache")
     on = {"loads.centrifugal": "nonlinear"}

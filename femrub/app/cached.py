@@ -25,8 +25,8 @@ estimate (``docs/reduction.md``) steps the run itself, so a reduced model is key
 scene's ``scheme``, ``loads`` and ``contact`` too; a cached reduced model takes the gap
 functions and signals from the full model built in this run. Every key also holds
 :func:`~femrub.app.cache.code_version`.
-On a hit ``Simulation.reductor`` is ``None`` (the bases are not stored: the reduced model
-carries what the run needs, including its map to the mesh).
+On a hit ``Simulation.reductor`` is ``None`` (the reduced model carries what the run needs,
+including its map to the mesh).
 
 A sweep worker keeps the last assembly it built or loaded (:func:`keep_assemblies`): the
 next point of a speed sweep on the same dask worker takes it from memory instead of the
@@ -36,7 +36,10 @@ A reduced model missing from the cache but whose bases this process already buil
 next point of a speed sweep on a dask worker: same matrices, same ``reduction`` options,
 given sizes) reuses that reductor (:data:`_REDUCTORS`, the last one only) with the reduced
 operators it projected (:mod:`femrub.reduction.truncation`): only the reduction error
-estimate runs again; the static shapes, modes and projection do not.
+estimate runs again; the static shapes, modes and projection do not. The reductor is also
+stored in the cache (stage ``bases``, without its full model; key: the reduced model's key
+without what only the run depends on), so that another process (the other sweep worker, a
+later sweep or run at another speed) loads it instead of building it.
 """
 
 from __future__ import annotations
@@ -170,12 +173,18 @@ class Stages:
         if hit is not None:
             return _attach(hit, model), None, dict(hit["report"], cache="hit")
         bases = self._model_key(model, "bases", opts) if opts["method"] != "auto" else None
+        kept = _REDUCTORS.get(bases)
+        if kept is None and bases is not None:  # built by another process (sweep worker)
+            kept = self._fetch("bases", bases)
         reduced, reductor, report = reduce_model(
-            model, scene, log, make_stepper, reductor=_REDUCTORS.get(bases), **kw
+            model, scene, log, make_stepper, reductor=kept, **kw
         )
         if bases is not None:
             _REDUCTORS.clear()
             _REDUCTORS[bases] = reductor.detached()  # not the model of this point
+            if kept is None:
+                self._keep("bases", bases, _REDUCTORS[bases], f"{reductor.n_uv} + "
+                           f"{reductor.n_theta} shapes on {model.n_dofs} dofs")  # fmt: skip
         _say_phases(self._say, reduced.info.get("timings", {}))
         self._keep("reduction", key, _detach(reduced, report), f"{reduced.n_dofs} dofs")
         return reduced, reductor, report

@@ -29,6 +29,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .. import progress
+from ..contact import jit
 from ..contact.heat import heat_coefficients
 from ..contact.points import locate_contacts
 from ..contact.reach import contact_reach, normal_deflection
@@ -165,6 +166,8 @@ class _Clock:
 
 def _build(scene, log, modes, stages, with_stepper=True) -> Simulation:
     scene.check_files()
+    if jit.compile_in_background() and log:  # the first run on this machine: overlapped
+        log("compiling the contact kernels in a background process (first run here) ...")
     clock = _Clock(log)
     c, p = scene["contact"], scene["physics"]
     report = {

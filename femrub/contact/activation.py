@@ -191,10 +191,11 @@ def compile_kernels() -> None:
     contact step does not pay for it. Without compilation (``NUMBA_DISABLE_JIT=1``) a no-op.
     """
     from .friction import solve_frictional_contact
-    from .jit import compiled
+    from .jit import compiled, wait_background
 
     if not compiled():
         return
+    wait_background()  # a build's child compiling them (jit.compile_in_background)
     one, z, W = np.ones(1), np.zeros(1), np.eye(3)
     q = np.array([[-1.0, 0.0, 0.0]])
     for code in (FIXED_POINT, PREDICTED):
@@ -209,11 +210,12 @@ def compile_kernels() -> None:
 def compile_blocks() -> None:
     """Compile (or load) the θ-method's block kernels of :mod:`femrub.contact.theta_block`
     for the argument types of a run (no step is taken: blocks of zero rows)."""
-    from .jit import compiled
+    from .jit import compiled, wait_background
     from .theta_block import friction_block, one_contact_block
 
     if not compiled():
         return
+    wait_background()  # a build's child compiling them (jit.compile_in_background)
     N, E, one = 2, np.empty, np.ones(1)
     T, Y, sig = np.eye(N), np.zeros((N, 0)), np.zeros((1, 0))
     one_contact_block(np.zeros(N), T, Y, Y, sig, 0, 1.0, np.ones(N), np.ones(N), np.ones(N),

@@ -30,6 +30,8 @@ __all__ = [
     "casing_profile",
     "PROFILES",
     "swept_gap",
+    "SweptGap",
+    "SweptGapRate",
 ]
 
 
@@ -142,14 +144,32 @@ def swept_gap(profile: CasingProfile, angles, rotation_speed: float, offset=0.0)
     omega = float(rotation_speed)
     if isinstance(profile, Concentric) or omega == 0.0:
         return np.asarray(profile.gap(angles), dtype=float) + offset, None
+    return SweptGap(profile, omega, angles, offset), SweptGapRate(profile, omega, angles)
 
-    def gap(t):
-        return profile.gap(omega * t + angles) + offset
 
-    def gap_rate(t):
-        return omega * profile.slope(omega * t + angles)
+class SweptGap:
+    """``t -> g(Ω t + φ_i) + offset_i`` (m, (n_c,)); :meth:`over_times`: rows at an array
+    of times (m,) in one call, (m, n_c). A small class rather than a closure, so that a
+    contact holding it can be pickled (a model sent to a worker or stored)."""
 
-    # rows at an array of times (m,) in one call: (m, n_c)
-    gap.over_times = lambda t: profile.gap(omega * t[:, None] + angles) + offset
-    gap_rate.over_times = lambda t: omega * profile.slope(omega * t[:, None] + angles)
-    return gap, gap_rate
+    def __init__(self, profile: CasingProfile, omega: float, angles, offset):
+        self.profile, self.omega, self.angles, self.offset = profile, omega, angles, offset
+
+    def __call__(self, t):
+        return self.profile.gap(self.omega * t + self.angles) + self.offset
+
+    def over_times(self, t):
+        return self.profile.gap(self.omega * t[:, None] + self.angles) + self.offset
+
+
+class SweptGapRate:
+    """``t -> Ω g'(Ω t + φ_i)`` (m/s), the rate of :class:`SweptGap`, same calls."""
+
+    def __init__(self, profile: CasingProfile, omega: float, angles):
+        self.profile, self.omega, self.angles = profile, omega, angles
+
+    def __call__(self, t):
+        return self.omega * self.profile.slope(self.omega * t + self.angles)
+
+    def over_times(self, t):
+        return self.omega * self.profile.slope(self.omega * t[:, None] + self.angles)

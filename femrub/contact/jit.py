@@ -10,6 +10,12 @@ numba stamps a cached function with its own source file only, so a kernel cached
 file would keep a stale copy of a callee changed in another. The kernel files of
 :data:`KERNEL_FILES` are therefore stamped together (a change to any of them recompiles
 all of their kernels), through a cache locator registered with numba below.
+
+The first run on a machine compiles the kernels (about 20 s of one core). A build starts
+that compilation in a child process at its beginning when numba's cache of the kernels is
+cold (:func:`compile_in_background`), so it overlaps the assembly of the model; the first
+kernel call waits for the child (:func:`wait_background`) and loads the machine code it
+cached.
 """
 
 from __future__ import annotations
@@ -21,8 +27,15 @@ except ImportError:  # pragma: no cover
 
 import hashlib
 import os
+import subprocess
+import sys
 
-__all__ = ["njit", "compiled", "KERNEL_FILES"]
+__all__ = ["njit", "compiled", "compile_in_background", "wait_background", "KERNEL_FILES"]
+
+#: the child process compiling the kernels (:func:`compile_in_background`), once per process
+_CHILD: dict = {}
+#: longest wait (s) for that child before the kernels are compiled here instead
+WAIT_SECONDS = 300.0
 
 _HERE = os.path.dirname(os.path.abspath(__file__))
 #: the source files of compiled functions that call each other (one cache stamp)
@@ -88,3 +101,54 @@ def compiled() -> bool:
     from numba.core import config
 
     return not config.DISABLE_JIT
+
+
+def _cold(dispatcher) -> bool:
+    """Whether numba's on-disk cache holds no machine code of ``dispatcher`` for the
+    current kernel files (``False`` when numba's cache layout is not the one known)."""
+    try:
+        return not dispatcher._cache._cache_file._load_index()
+    except Exception:  # pragma: no cover - another numba layout
+        return False
+
+
+def compile_in_background() -> bool:
+    """Compile the contact kernels in a child process if their on-disk cache is cold.
+
+    The child runs :func:`femrub.contact.activation.compile_kernels` (which also compiles
+    the θ-method's block kernels) and writes numba's cache; this process goes on (the
+    build's assembly) and :func:`wait_background` joins it before the first kernel call.
+    At most one child per process; nothing without compilation or with a warm cache.
+    Returns whether a child was started.
+    """
+    if _CHILD or not compiled():
+        return False
+    from .theta_block import friction_block
+
+    _CHILD["started"] = True
+    if not _cold(friction_block):
+        return False
+    root = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join(filter(None, (root, os.environ.get(
+        "PYTHONPATH")))))  # fmt: skip
+    code = "from femrub.contact.activation import compile_kernels; compile_kernels()"
+    try:
+        _CHILD["process"] = subprocess.Popen(
+            [sys.executable, "-c", code], env=env, stdout=subprocess.DEVNULL,
+            stderr=subprocess.DEVNULL,
+        )  # fmt: skip
+    except OSError:  # pragma: no cover - no process to spare: compiled on first use
+        return False
+    return True
+
+
+def wait_background() -> None:
+    """Wait for the child of :func:`compile_in_background` (if any, at most
+    :data:`WAIT_SECONDS`); the kernels then load from numba's cache."""
+    proc = _CHILD.pop("process", None)
+    if proc is None:
+        return
+    try:
+        proc.wait(timeout=WAIT_SECONDS)
+    except subprocess.TimeoutExpired:  # pragma: no cover - compiled here instead
+        proc.kill()

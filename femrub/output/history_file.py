@@ -15,7 +15,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .results import UNITS, csv_header, flatten_columns
+from .results import UNITS, csv_header, flatten_columns, write_csv_rows
 
 __all__ = ["HistoryCSV"]
 
@@ -39,7 +39,7 @@ class HistoryCSV:
         elif list(cols) != self._columns:
             raise ValueError(f"history columns changed during the run: {list(cols)}")
         block = np.column_stack(list(cols.values()))
-        self._writer.writerows(block.tolist())
+        write_csv_rows(self._fh, block)
         self.rows += block.shape[0]
         self._fh.flush()
         os.fsync(self._fh.fileno())

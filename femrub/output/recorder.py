@@ -350,6 +350,10 @@ class Recorder:
 
     def _results(self, i_end: int, cpu_seconds: float) -> Results:
         m = i_end + 1
+
+        def reached(a):  # the rows reached; no copy of a complete run's arrays (not reused)
+            return a[:m] if m == a.shape[0] else a[:m].copy()
+
         signals, col = {}, 0
         for name, size in zip(self.names, self.sizes):
             signals[name] = self.obs[:m, col : col + size].copy()
@@ -372,10 +376,10 @@ class Recorder:
         return Results(
             scheme=self.scheme,
             h=self.h,
-            t=self.t[:m].copy(),
+            t=reached(self.t),
             signals=signals,
-            gap=self.gap[:m].copy(),
-            impulse=self.imp[:m].copy(),
+            gap=reached(self.gap),
+            impulse=reached(self.imp),
             energy=self.meter.arrays(m) if self.meter is not None else {},
             status=self.status,
             message=self.message,
@@ -385,8 +389,8 @@ class Recorder:
             state_times=times,
             friction_force=ff,
             slip_velocity=sv,
-            contact_state=self.cstate[:m].copy(),
+            contact_state=reached(self.cstate),
             friction_limit=None if c is None else c.friction.copy(),
             info={"label": self.label, "stability_limit": self.h_lim, "n_dofs": self.model.n_dofs},
-            extra={k: v[:m].copy() for k, v in self.extra.items()},
+            extra={k: reached(v) for k, v in self.extra.items()},
         )

@@ -1,0 +1,46 @@
+"""The fast writers of the history files give what the standard ones give."""
+
+import csv
+import io
+import json
+import zipfile
+
+import numpy as np
+
+from femrub.output import results as R
+
+
+def test_csv_rows_are_the_csv_modules_bytes(monkeypatch):
+    monkeypatch.setattr(R, "CSV_ROWS", 7)  # several blocks, the last one short
+    rng = np.random.default_rng(1)
+    tables = [
+        rng.standard_normal((50, 9)) * 10.0 ** rng.integers(-30, 30, 9),
+        np.array([[np.nan, np.inf, -np.inf, -0.0, 0.0, 1e16, 1e-5, 0.1 + 0.2]] * 3),
+        np.arange(12).reshape(3, 4),
+        np.zeros((0, 3)),
+    ]
+    for table in tables:
+        want, got = io.StringIO(), io.StringIO()
+        csv.writer(want).writerows(table.tolist())
+        R.write_csv_rows(got, table)
+        assert got.getvalue() == want.getvalue()
+
+
+def test_npz_is_a_compressed_numpy_archive(tmp_path):
+    t = np.linspace(0.0, 1.0, 101)
+    res = R.Results(
+        scheme="theta", h=0.01, t=t, signals={"tip_displacement": np.sin(t)[:, None]},
+        gap=np.cos(t)[:, None], impulse=np.abs(np.sin(3 * t))[:, None], steps=100,
+    )  # fmt: skip
+    path = res.save_npz(tmp_path / "history.npz")
+    with np.load(path) as d:
+        assert {"t", "gap", "impulse", "normal_force", "meta", "signal_tip_displacement"} <= set(
+            d.files
+        )
+        assert json.loads(str(d["meta"]))["scheme"] == "theta"
+        np.testing.assert_array_equal(d["normal_force"], res.force)
+    back = R.Results.load_npz(path)
+    np.testing.assert_array_equal(back.t, t)
+    np.testing.assert_array_equal(back.signals["tip_displacement"], res.signals["tip_displacement"])
+    with zipfile.ZipFile(path) as zf:  # compressed, as numpy.savez_compressed writes
+        assert {i.compress_type for i in zf.infolist()} == {zipfile.ZIP_DEFLATED}
