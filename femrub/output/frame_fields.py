@@ -1,18 +1,28 @@
 """Mesh fields of many output frames at once, from a batch of (reduced) states.
 
-:class:`FrameFields` is built once per output series. It stacks the rows of the model's
-map to the full mesh that a frame needs (every displacement dof, the velocity and
-temperature at the vertices) into one operator ``R``, so that a batch of ``B`` states
-``X`` (``B × N``) is reconstructed by one product ``X Rᵀ`` (a GEMM for a reduced model,
-whose ``to_full`` is dense, instead of ``B`` matrix-vector products). The centroid strain
-is linear in the displacement, ``ε_e = G_e u``, with ``G`` sparse (the symmetric gradient
-of each element's shape functions averaged over its quadrature points), so the von Mises
-stress of a batch is ``G U`` followed by the invariant
+:class:`FrameFields` is built once per output series. A frame needs the displacement and
+velocity at the vertices, the temperature at the vertices and the von Mises stress at the
+centroid of every element. Each is linear in the state ``X`` (but the last, a norm of a
+linear function), so the class stacks, once, the rows of the model's map to the full mesh
+``to_full`` that give them, restricted to the columns of ``X`` they depend on (a reduced
+model's displacement rows depend on its displacement coordinates only): a batch of ``B``
+states is then a few products ``X_c M_cᵀ`` (GEMMs for a reduced model, whose ``to_full`` is
+dense, in the files' precision; sparse products for a full model).
 
-.. math:: σ_{vM} = 2 μ \\sqrt{\\tfrac32\\, \\operatorname{dev} ε : \\operatorname{dev} ε},
+The centroid strain is linear in the displacement, ``ε_e = G_e u`` (``G`` sparse: the
+symmetric gradient of each element's shape functions averaged over its quadrature points).
+The von Mises stress only needs the deviator of ``ε``, and
 
-the isotropic (``λ tr ε`` and thermal) part of the stress having no deviator. Contact and
-friction impulses become vertex forces through a sparse scatter matrix built once.
+.. math:: σ_{vM} = 2 μ \\sqrt{\\tfrac32\\, \\operatorname{dev} ε : \\operatorname{dev} ε}
+          = \\lVert Q ε \\rVert ,
+
+with ``Q`` (``k × n_pairs``: ``k = 5`` in 3D) the square root of that quadratic form,
+``Qᵀ Q = 6 μ² D`` (``D``: ``dev ε : dev ε`` on the independent components ``ε_ab``,
+``a ≤ b``), the isotropic (``λ tr ε`` and thermal) part of the stress having no deviator.
+For a reduced model ``Q G Φ_u`` (``Φ_u``: the displacement rows of ``to_full``) is a dense
+``k n_e × r_u`` matrix computed once, so the stress of a batch is one GEMM and a norm over
+``k`` rows. Contact and friction impulses become vertex forces through a sparse scatter
+matrix built once.
 """
 
 from __future__ import annotations
@@ -22,7 +32,7 @@ import scipy.sparse as sp
 
 from ..model.rub import FieldMap
 
-__all__ = ["FrameFields", "strain_operator"]
+__all__ = ["FrameFields", "strain_operator", "deviator_root"]
 
 
 def strain_operator(fields: FieldMap) -> tuple[sp.csr_matrix, list[tuple[int, int]]]:
@@ -52,6 +62,22 @@ def strain_operator(fields: FieldMap) -> tuple[sp.csr_matrix, list[tuple[int, in
     return G, pairs
 
 
+def deviator_root(pairs: list[tuple[int, int]], mu: float) -> np.ndarray:
+    """``Q`` (k × n_pairs) with ``‖Q ε‖² = 6 μ² (Σ_a (ε_aa − tr ε / 3)² + 2 Σ_{a<b} ε_ab²)``,
+    i.e. ``‖Q ε‖ = σ_vM``, on the components ``ε_ab`` of ``pairs`` (``tr ε`` as a sum over
+    the diagonal pairs); ``k`` is the rank of the form (5 in 3D)."""
+    diag = [c for c, (a, b) in enumerate(pairs) if a == b]
+    P = np.zeros((len(pairs), len(pairs)))
+    Dd = np.eye(len(diag)) - 1.0 / 3.0  # ε_aa − tr ε / 3 on the diagonal pairs
+    P[np.ix_(diag, diag)] = Dd.T @ Dd
+    for c, (a, b) in enumerate(pairs):
+        if a != b:
+            P[c, c] = 2.0
+    w, V = np.linalg.eigh(6.0 * mu**2 * P)
+    keep = w > 1e-12 * w.max()
+    return np.sqrt(w[keep])[:, None] * V[:, keep].T
+
+
 class FrameFields:
     """Point and cell data of a batch of frames of ``model`` on the mesh of ``fields``.
 
@@ -61,7 +87,7 @@ class FrameFields:
     fields : the :class:`~femrub.model.rub.FieldMap` of the full model.
     h : the run's time step (s), to turn contact impulses into forces.
     dtype : precision of the reconstruction of a reduced model's fields (``float32``
-        halves the product's cost and memory; for files written in single precision).
+        halves the products' cost and memory; for files written in single precision).
     """
 
     def __init__(self, model, fields: FieldMap, h: float, dtype=np.float64):
@@ -71,22 +97,39 @@ class FrameFields:
         vd = bu.nodal_dofs.T.ravel()  # vertex-major: (n_vertices, dim) flattened
         self.n_points, self.dim = bu.nodal_dofs.shape[1], bu.nodal_dofs.shape[0]
         self.n_cells = fields.mesh.t.shape[1]
-        rest = np.setdiff1d(np.arange(nu), vd)
-        order_u = np.concatenate([vd, rest])  # vertex dofs first, then any others
-        has_t = model.layout.n_t > 0
-        rows = [order_u, nu + vd] + ([2 * nu + bt.nodal_dofs[0]] if has_t else [])
-        rows = np.concatenate(rows)
-        self._nu, self._nv = nu, vd.size
-        self._has_t, self._nt_points = has_t, bt.nodal_dofs.shape[1]
-        if sp.issparse(T):
-            self._R = sp.csr_matrix(T)[rows]
-            self._RT = None
-        else:
-            self._R = None
-            self._RT = np.ascontiguousarray(np.asarray(T)[rows].T, dtype=dtype)  # (N, n_rows)
+        self._has_t, self._nt_points = model.layout.n_t > 0, bt.nodal_dofs.shape[1]
         G, self.pairs = strain_operator(fields)
-        self._G = G[:, order_u].tocsr()
-        self.mu = float(fields.mu)
+        Q = deviator_root(self.pairs, float(fields.mu))
+        n_e = self.n_cells
+        # ‖Q ε_e‖ for every element: rows (i n_e + e) of the k n_e × n_u operator Q ⊗ G
+        QG = sp.vstack([sum(Q[i, c] * G[c * n_e : (c + 1) * n_e] for c in range(len(self.pairs))
+                            if Q[i, c] != 0.0) for i in range(Q.shape[0])]).tocsr()  # fmt: skip
+        self._k = Q.shape[0]
+        # blocks (name, rows of to_full or None for the stress, columns of X they need)
+        blocks = [("displacement", vd), ("velocity", nu + vd)]
+        if self._has_t:
+            blocks.append(("temperature", 2 * nu + bt.nodal_dofs[0]))
+        self._sparse = sp.issparse(T)
+        self._ops = []  # (names, sizes, columns of X or None, operator)
+        if self._sparse:
+            T = sp.csr_matrix(T)
+            for name, rows in blocks:
+                self._ops.append(((name,), (rows.size,), None, T[rows]))
+            self._ops.append((("von_mises",), (QG.shape[0],), None, (QG @ T[:nu]).tocsr()))
+        else:
+            T = np.asarray(T)
+            used = lambda A: np.flatnonzero(np.any(A != 0.0, axis=0))  # noqa: E731
+            Tu = T[:nu]
+            cu = used(Tu)
+            # displacement and stress share the displacement columns: one GEMM
+            S = np.asarray(QG @ Tu[:, cu])
+            U = np.concatenate([T[vd][:, cu], S], axis=0)
+            self._ops.append((("displacement", "von_mises"), (vd.size, S.shape[0]), cu,
+                              np.ascontiguousarray(U.T, dtype=dtype)))  # fmt: skip
+            for name, rows in blocks[1:]:
+                c = used(T[rows])
+                self._ops.append(((name,), (rows.size,), c,
+                                  np.ascontiguousarray(T[rows][:, c].T, dtype=dtype)))  # fmt: skip
         c = fields.contacts
         nc = c.vertices.size
         self._scatter = sp.csr_matrix(
@@ -105,36 +148,37 @@ class FrameFields:
         ``von_mises`` (B × n_cells).
         """
         X = np.atleast_2d(np.asarray(X, dtype=float))
-        B = X.shape[0]
-        if self._R is None:
-            full = X.astype(self._RT.dtype) @ self._RT  # (B, n_rows)
-        else:
-            full = (self._R @ X.T).T
-        nu, nv, npt, d = self._nu, self._nv, self.n_points, self.dim
-        u = full[:, :nu]
+        B, npt, d = X.shape[0], self.n_points, self.dim
+        raw = {}
+        for names, sizes, cols, M in self._ops:
+            if cols is None:
+                full = (M @ X.T).T
+            else:
+                full = X[:, cols].astype(M.dtype) @ M  # (B, rows)
+            start = 0
+            for name, n in zip(names, sizes):
+                raw[name] = full[:, start : start + n]
+                start += n
         out = {
-            "displacement": _pad3(u[:, :nv].reshape(B, npt, d)),
-            "velocity": _pad3(full[:, nu : nu + nv].reshape(B, npt, d)),
+            "displacement": _pad3(raw["displacement"].reshape(B, npt, d)),
+            "velocity": _pad3(raw["velocity"].reshape(B, npt, d)),
         }
         if self._has_t:
-            out["temperature"] = full[:, nu + nv : nu + nv + self._nt_points]
+            out["temperature"] = raw["temperature"]
         else:
             out["temperature"] = np.zeros((B, self._nt_points))
         out["contact_force"] = self._forces(impulse, B)
         out["friction_force"] = self._friction(friction, B)
-        out["von_mises"] = self.von_mises(u)
+        out["von_mises"] = self._norm(raw["von_mises"].reshape(B, self._k, self.n_cells))
         return out
 
-    def von_mises(self, u: np.ndarray) -> np.ndarray:
-        """Von Mises stress (Pa) per element of displacements ``u`` (B × n_u, this
-        object's dof order): ``ε = G u``, then the invariant of its deviator."""
-        n_e = self.n_cells
-        eps = (self._G @ u.T).reshape(len(self.pairs), n_e, u.shape[0])
-        diag = [c for c, (a, b) in enumerate(self.pairs) if a == b]
-        off = [c for c, (a, b) in enumerate(self.pairs) if a != b]
-        tr = eps[diag].sum(axis=0) / 3.0
-        dev2 = ((eps[diag] - tr) ** 2).sum(axis=0) + 2.0 * (eps[off] ** 2).sum(axis=0)
-        return (2.0 * self.mu * np.sqrt(1.5 * dev2)).T
+    @staticmethod
+    def _norm(s: np.ndarray) -> np.ndarray:
+        """``‖s[:, :, e]‖`` over the ``k`` deviator components (B × k × n_e -> B × n_e)."""
+        acc = np.square(s[:, 0])
+        for i in range(1, s.shape[1]):
+            acc += np.square(s[:, i])
+        return np.sqrt(acc, out=acc)
 
     def _forces(self, impulse, B: int) -> np.ndarray:
         """Normal contact force (N) at the contact vertices, ``-λ n / h`` summed per vertex."""
