@@ -7,11 +7,12 @@ import zipfile
 
 import numpy as np
 
+from femrub.output import csv_rows as C
 from femrub.output import results as R
 
 
 def test_csv_rows_are_the_csv_modules_bytes(monkeypatch):
-    monkeypatch.setattr(R, "CSV_ROWS", 7)  # several blocks, the last one short
+    monkeypatch.setattr(C, "CSV_ROWS", 7)  # several blocks, the last one short
     rng = np.random.default_rng(1)
     tables = [
         rng.standard_normal((50, 9)) * 10.0 ** rng.integers(-30, 30, 9),
@@ -22,7 +23,7 @@ def test_csv_rows_are_the_csv_modules_bytes(monkeypatch):
     for table in tables:
         want, got = io.StringIO(), io.StringIO()
         csv.writer(want).writerows(table.tolist())
-        R.write_csv_rows(got, table)
+        C.write_csv_rows(got, table)
         assert got.getvalue() == want.getvalue()
 
 

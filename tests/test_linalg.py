@@ -9,7 +9,7 @@ import scipy.sparse as sp
 from femrub import progress
 from femrub.fem import linalg
 from femrub.fem.eigen import lowest_modes
-from femrub.output.results import decimate_columns
+from femrub.output.csv_rows import decimate_columns
 
 
 def _laplacian(n: int, shift: float = 0.0) -> sp.csr_matrix:

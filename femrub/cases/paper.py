@@ -29,11 +29,12 @@ import numpy as np
 
 from .. import __version__
 from ..contact.activation import DEFAULT_RULE
+from ..output.csv_rows import decimate_columns
 from ..output.folder import claim
 from ..output.interrupts import interruptible
 from ..output.jsonfile import write_json
 from ..output.plots import energy_panel, savefig, tip_panels
-from ..output.results import UNITS, decimate_columns
+from ..output.results import UNITS
 from ..steppers import make_stepper
 from ..steppers.base import MAX_STEPS
 from .bar import PAPER, bar_model

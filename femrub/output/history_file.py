@@ -15,7 +15,8 @@ from pathlib import Path
 
 import numpy as np
 
-from .results import UNITS, csv_header, flatten_columns, write_csv_rows
+from .csv_rows import write_csv_rows
+from .results import UNITS, csv_header, flatten_columns
 
 __all__ = ["HistoryCSV"]
 

@@ -31,6 +31,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .csv_rows import decimate_columns, write_csv_rows
 from .jsonfile import jsonable
 
 __all__ = [
@@ -38,8 +39,6 @@ __all__ = [
     "UNITS",
     "Results",
     "csv_header",
-    "write_csv_rows",
-    "decimate_columns",
     "flatten_columns",
     "unit_of",
 ]
@@ -127,23 +126,8 @@ def csv_header(columns, units: dict[str, str]) -> list[str]:
     return out
 
 
-#: rows formatted per call of :func:`write_csv_rows` (bounds its temporary strings)
-CSV_ROWS = 4096
 #: zlib level of ``history.npz`` (1: float histories barely compress more at 6, 1.5× slower)
 NPZ_LEVEL = 1
-
-
-def write_csv_rows(fh, table: np.ndarray) -> None:
-    """Write the rows of a 2D ``table`` to the text file ``fh`` as :mod:`csv` writes them
-    (``repr`` of each number, ``,`` between, ``\\r\\n`` after: the same bytes as
-    ``csv.writer(fh).writerows(table.tolist())``), formatted by one ``%`` per block of
-    :data:`CSV_ROWS` rows instead of a Python call per row."""
-    if table.ndim != 2 or table.shape[0] == 0:
-        return
-    line = ",".join(["%r"] * table.shape[1]) + "\r\n"
-    for i in range(0, table.shape[0], CSV_ROWS):
-        block = table[i : i + CSV_ROWS]
-        fh.write((line * block.shape[0]) % tuple(block.ravel().tolist()))
 
 
 def _savez(path: Path, arrays: dict) -> None:
@@ -399,21 +383,3 @@ class Results:
                 warnings=meta.get("warnings", []),
                 **friction,
             )
-
-
-def decimate_columns(cols: dict, every: int) -> dict:
-    """Rows ``0, every, 2 every, …, last`` of ``cols`` (see :meth:`Results.save_csv`)."""
-    t = cols["t"]
-    idx = np.unique(np.r_[np.arange(0, t.size, every), t.size - 1]) if t.size else t.astype(int)
-    out = {k: np.asarray(v)[idx].copy() for k, v in cols.items()}
-    if idx.size < 2:
-        return out
-    dt = np.diff(t[idx])
-    for k in cols:
-        if k.startswith("contact_impulse"):
-            total = np.add.reduceat(np.asarray(cols[k]), idx[:-1] + 1)  # (idx[j-1], idx[j]]
-            out[k][1:] = total
-            force = "contact_force" + k[len("contact_impulse") :]
-            if force in out:
-                out[force][1:] = total / np.where(dt > 0, dt, np.inf)
-    return out
