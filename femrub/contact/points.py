@@ -187,8 +187,8 @@ def locate_contacts(disc, points=None, spread: str = "patch") -> ContactPoints:
     u_dofs = np.empty((dim, pts.shape[1]), dtype=int)
     u_dofs[comp.T, np.arange(pts.shape[1])] = idx.T
     vertices = cKDTree(blade.mesh.p.T).query(pts.T)[1]
-    face = tip_patch_weights(blade, pts)
-    weights = tributary_heat_weights(blade, pts, tol, vertices, face)
+    face = tip_patch_weights(blade, pts)  # the heat's weights, and the patches' unless nodes
+    weights = face if face is not None else _node_heat_weights(blade.mesh, pts, tol, vertices)
     tdofs = disc.basis_t.nodal_dofs[0]
     heat = sp.csr_matrix(
         (weights.data, tdofs[weights.indices], weights.indptr),
@@ -227,7 +227,7 @@ def _vertex_dofs(basis) -> np.ndarray:
     return out
 
 
-def tributary_heat_weights(blade, pts, tol, vertices, face=None) -> sp.csr_matrix:
+def tributary_heat_weights(blade, pts, tol, vertices) -> sp.csr_matrix:
     """(n_c, n_vertices) weights spreading each contact's heat over its share of the tip.
 
     The frictional heat of contact ``i`` is generated over the part ``S_i`` of the tip face
@@ -235,14 +235,15 @@ def tributary_heat_weights(blade, pts, tol, vertices, face=None) -> sp.csr_matri
     vertex ``j`` is ``∫_{S_i} N_j ds / |S_i|`` (rows sum to 1). Dumping it into one vertex
     would make the temperature depend on the mesh (a point source in 3D); without a usable
     ``tip`` face (and on the bar) the heat goes to the point's vertex ``vertices`` (or the
-    two ends of its mid-edge). ``face``: the tip-face weights when already computed
-    (:func:`~femrub.contact.patches.tip_patch_weights`).
+    two ends of its mid-edge).
     """
-    mesh = blade.mesh
+    face = tip_patch_weights(blade, pts)
+    return face if face is not None else _node_heat_weights(blade.mesh, pts, tol, vertices)
+
+
+def _node_heat_weights(mesh, pts, tol, vertices) -> sp.csr_matrix:
+    """Heat weights of points on vertices (1) or mid-edges (1/2 to each end)."""
     n_c, n_v = pts.shape[1], mesh.p.shape[1]
-    face = tip_patch_weights(blade, pts) if face is None else face
-    if face is not None:
-        return face
     vi = np.asarray(vertices)
     on_vertex = np.linalg.norm(mesh.p[:, vi] - pts, axis=0) <= tol
     rows, cols, vals = [np.flatnonzero(on_vertex)], [vi[on_vertex]], [np.ones(on_vertex.sum())]
