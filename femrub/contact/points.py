@@ -187,8 +187,7 @@ def locate_contacts(disc, points=None, spread: str = "patch") -> ContactPoints:
     u_dofs = np.empty((dim, pts.shape[1]), dtype=int)
     u_dofs[comp.T, np.arange(pts.shape[1])] = idx.T
     vertices = cKDTree(blade.mesh.p.T).query(pts.T)[1]
-    face = tip_patch_weights(blade, pts)  # the heat's weights, and the patches' unless nodes
-    weights = face if face is not None else _node_heat_weights(blade.mesh, pts, tol, vertices)
+    weights, on_face = tributary_heat_weights(blade, pts, tol, vertices)
     tdofs = disc.basis_t.nodal_dofs[0]
     heat = sp.csr_matrix(
         (weights.data, tdofs[weights.indices], weights.indptr),
@@ -211,8 +210,8 @@ def locate_contacts(disc, points=None, spread: str = "patch") -> ContactPoints:
         t1 /= np.linalg.norm(t1, axis=0)
         tangents = np.stack([t1, np.cross(t1, normals, axis=0)], axis=1)
     patch = None
-    if spread == "patch" and face is not None:
-        patch = patch_rows(face, _vertex_dofs(basis_u), basis_u.N)
+    if spread == "patch" and on_face:  # the contact acts where its heat goes
+        patch = patch_rows(weights, _vertex_dofs(basis_u), basis_u.N)
     return ContactPoints(
         pts, normals, radii, angles, u_dofs, heat, vertices, names, tangents, patch
     )
@@ -227,7 +226,7 @@ def _vertex_dofs(basis) -> np.ndarray:
     return out
 
 
-def tributary_heat_weights(blade, pts, tol, vertices) -> sp.csr_matrix:
+def tributary_heat_weights(blade, pts, tol, vertices) -> tuple[sp.csr_matrix, bool]:
     """(n_c, n_vertices) weights spreading each contact's heat over its share of the tip.
 
     The frictional heat of contact ``i`` is generated over the part ``S_i`` of the tip face
@@ -235,10 +234,13 @@ def tributary_heat_weights(blade, pts, tol, vertices) -> sp.csr_matrix:
     vertex ``j`` is ``∫_{S_i} N_j ds / |S_i|`` (rows sum to 1). Dumping it into one vertex
     would make the temperature depend on the mesh (a point source in 3D); without a usable
     ``tip`` face (and on the bar) the heat goes to the point's vertex ``vertices`` (or the
-    two ends of its mid-edge).
+    two ends of its mid-edge). Returns the weights and whether they are the tip face's
+    (:func:`~femrub.contact.patches.tip_patch_weights`, the patches contacts act on).
     """
     face = tip_patch_weights(blade, pts)
-    return face if face is not None else _node_heat_weights(blade.mesh, pts, tol, vertices)
+    if face is not None:
+        return face, True
+    return _node_heat_weights(blade.mesh, pts, tol, vertices), False
 
 
 def _node_heat_weights(mesh, pts, tol, vertices) -> sp.csr_matrix:
