@@ -168,6 +168,8 @@ class Stages:
         run = None  # what the estimate's runs depend on
         if make_stepper:
             run = [dict(scene[k]) for k in ("scheme", "loads", "contact")] + [dict(limits or {})]
+            for key in ("step_check", "step_tolerance"):  # the time-step check's keys
+                run[0].pop(key, None)
         key = self._model_key(model, "reduction", opts, t_end, run)
         hit = self._fetch("reduction", key)
         if hit is not None:

@@ -144,6 +144,7 @@ def _run_claimed(scene, out, progress, log, on_built, modes, cache):
         merge_time=merge_time(scene),
         claimed=True,
         reduction_error=built.report["reduction"].get("error"),
+        step_error=built.report.get("time_step"),
         ran=None if stride else built.ran,  # stepped by the error estimate: not twice
     )
     if log:

@@ -29,10 +29,11 @@ def scheme_options(scene) -> dict:
     return {}
 
 
-def bare_stepper(scene, model):
+def bare_stepper(scene, model, h=None):
+    """The scene's stepper on ``model`` at ``scheme.h`` (or at the step ``h``)."""
     s = scene["scheme"]
     try:
-        return make_stepper(s["name"], model, s["h"], **scheme_options(scene))
+        return make_stepper(s["name"], model, s["h"] if h is None else h, **scheme_options(scene))
     except ValueError as exc:
         raise SceneError(f"scheme ({s['name']}): {exc}") from None
 

@@ -42,6 +42,7 @@ from .cached import Stages
 from .casing import abradable_of, casing_grid, casing_heat_of
 from .explain import explain
 from .scheme import bare_stepper, stepper_of
+from .step_check import check_step
 
 __all__ = [
     "MAX_CLEARANCE_RATIO",
@@ -257,15 +258,23 @@ def _build(scene, log, modes, stages, with_stepper=True) -> Simulation:
     if modes:
         report["natural_frequencies_hz"] = stages.frequencies(model, modes).tolist()
     make = lambda m: bare_stepper(scene, m)  # noqa: E731  (the reduction error estimate)
-    ran = []  # (results, wall seconds) of the estimate's run of the chosen sizes
-    keep = (lambda res, wall: ran.append((res, wall))) if reusable_run(model) else None
+    chosen = []  # (results, wall seconds, full states) of the estimate's run of the chosen sizes
     reduced, reductor, report["reduction"] = stages.reduce(
-        model, scene, log, make, limits, on_run=keep
+        model, scene, log, make, limits, on_run=lambda *run: chosen.append(run)
     )
-    ran = ran[0] if ran else None
+    ran = chosen[0][:2] if chosen and reusable_run(model) else None
     if ran is not None:  # the run itself: its time is the run's ``stepping``
         clock.exclude(ran[1])
     clock.done("reduction", f"{reduced.n_dofs} dofs")
+    if scene["scheme"]["step_check"]:
+        report["time_step"], run_h, wall_h = check_step(
+            scene, reduced, full, lambda m, h: bare_stepper(scene, m, h), limits,
+            run=(chosen[0][0], chosen[0][2]) if chosen else None,
+        )  # fmt: skip
+        if ran is None and wall_h is not None and reusable_run(model):
+            ran = (run_h[0], wall_h)  # the check stepped the run itself
+            clock.exclude(wall_h)
+        clock.done("step_check", f"time-step error {100 * report['time_step']['estimate']:.2g} %")
     report["model"] = {"n_dofs": reduced.n_dofs, **_layout(reduced)}
     stepper = stepper_of(scene, reduced, report) if with_stepper else None
     report["outputs"] = {

@@ -37,6 +37,8 @@ __all__ = ["STAGES", "run_to_folder", "ResultExists"]
 
 #: Pipeline stages timed in ``summary.json["timings"]`` (seconds).
 STAGES = ("mesh", "assembly", "reduction", "stepping", "output")
+#: stages timed only when the scene asks for them (``scheme.step_check``)
+OPTIONAL_STAGES = ("step_check",)
 
 
 #: what each curve of signals.png is, for several contact points
@@ -96,6 +98,7 @@ def run_to_folder(
     claimed: bool = False,
     reduction_error: dict | None = None,
     ran=None,
+    step_error: dict | None = None,
 ):
     """Run ``stepper`` to ``t_end`` and write the results folder ``out`` (module docstring).
 
@@ -108,7 +111,9 @@ def run_to_folder(
     :func:`~femrub.output.folder.claim` on ``out``. ``reduction_error``: the estimate of a
     reduced run (:mod:`femrub.reduction.estimate`, with its ``tolerance``), written as
     ``summary.json["reduction_error"]`` and judged by the ``reduction`` rule of
-    :mod:`~femrub.output.verdict` (``inaccurate`` above the tolerance). ``ran``: ``(results,
+    :mod:`~femrub.output.verdict` (``inaccurate`` above the tolerance); ``step_error``: the
+    time-step error estimate (:mod:`femrub.app.step_check`), written as
+    ``summary.json["time_step_error"]`` and judged by the ``time_step`` rule. ``ran``: ``(results,
     wall seconds)`` of this very run already stepped (``stepper.model`` from its initial state
     to ``t_end`` with ``limits``, e.g. by the reduction error estimate): it is judged and
     written instead of stepped again (no VTK: its states were not streamed). Returns the
@@ -118,7 +123,7 @@ def run_to_folder(
     with nullcontext() if claimed else claim(out, "run", overwrite=overwrite):
         return _run(
             stepper, t_end, out, fields, vtk_stride, inputs, limits, progress, snapshot, plots,
-            timings, n_full, rotation_speed, merge_time, reduction_error, ran,
+            timings, n_full, rotation_speed, merge_time, reduction_error, ran, step_error,
         )  # fmt: skip
 
 
@@ -138,7 +143,7 @@ def _judged(ran, tolerances, merge_time):
 
 def _run(
     stepper, t_end, out, fields, vtk_stride, inputs, limits, progress, snapshot, plots, timings,
-    n_full, rotation_speed, merge_time, reduction_error, ran,
+    n_full, rotation_speed, merge_time, reduction_error, ran, step_error=None,
 ):  # fmt: skip
     summary_path = out / "summary.json"
     model = stepper.model
@@ -157,6 +162,8 @@ def _run(
     }
     if reduction_error is not None:
         doc["reduction_error"] = reduction_error
+    if step_error is not None:
+        doc["time_step_error"] = step_error
     _write_json(summary_path, doc)
     series = None
     if ran is not None and fields is not None and vtk_stride:
@@ -169,7 +176,7 @@ def _run(
         (out / stale).unlink(missing_ok=True)  # results of an earlier, unfinished run
     history = HistoryCSV(out / "history.csv")
     t0 = time.perf_counter()
-    tolerances = {"reduction": reduction_error} if reduction_error else None
+    tolerances = {"reduction": reduction_error, "time_step": step_error}
     try:
         with interruptible():
             if ran is not None:
@@ -239,7 +246,7 @@ def _finish(
     omega = float(rotation_speed)
     stages = {k: 0.0 for k in STAGES} | dict(timings or {})
     stages.update(stepping=wall - vtk_wall, output=vtk_wall + time.perf_counter() - t_out)
-    res.info["timings"] = {k: stages[k] for k in STAGES}
+    res.info["timings"] = {k: stages[k] for k in STAGES + OPTIONAL_STAGES if k in stages}
     doc.update(
         status=res.status,
         message=res.message,

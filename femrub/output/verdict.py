@@ -13,6 +13,9 @@ The recorder ends a run as ``unstable`` (blow-up), ``diverged-physically`` (a st
   ``summary.json["reduction_error"]``), above its tolerance -> ``"inaccurate"``; also when
   the reduced dynamics can create energy: its largest relative energy growth rate
   (``energy_growth_rate``, 1/s) times the run's duration above ``tolerances["energy"]``;
+* ``time_step``: the run's estimated time-step error (``tolerances["time_step"]``: the dict
+  of :func:`femrub.app.step_check.check_step` with its ``tolerance``, as
+  ``summary.json["time_step_error"]``) above its tolerance -> ``"inaccurate"``;
 * ``coulomb``: the recorded friction forces break Coulomb's law (outside the cone, not on it
   while sliding, or not opposite to the slip velocity) beyond ``tolerances["coulomb"]``
   (relative, :func:`femrub.contact.friction.coulomb_check`) -> ``"inaccurate"``.
@@ -96,7 +99,23 @@ def reduction(res, tol):
     )
 
 
-#: status rules applied in order to a run the recorder ended as ``ok``
+def time_step(res, tol):
+    """The run's estimated time-step error exceeds ``scheme.step_tolerance``
+    (``scheme.step_check``, :mod:`femrub.app.step_check`)."""
+    err = tol.get("time_step")
+    if not err:
+        return None
+    est, bound = err.get("estimate", 0.0), err.get("tolerance")
+    if bound is None or est <= bound:
+        return None
+    return (
+        f"estimated time-step error {100 * est:.3g} % ({err.get('decided_by', '?')}: twice "
+        f"the difference to the run at h/2) exceeds scheme.step_tolerance {100 * bound:.3g} "
+        "%: use scheme.h <= "
+        f"{0.5 * err.get('h', res.h):.3g} s"
+    )
+
+
 def coulomb_message(check: dict | None, bound: float) -> str | None:
     """Why a :func:`~femrub.contact.friction.coulomb_check` fails at ``bound``, or ``None``."""
     if not check:
@@ -120,7 +139,8 @@ def _coulomb(res, tol):
     return coulomb_message(check, bound)
 
 
-RULES = [_balance("energy"), _balance("heat"), reduction, _coulomb]
+#: status rules applied in order to a run the recorder ended as ``ok``
+RULES = [_balance("energy"), _balance("heat"), reduction, time_step, _coulomb]
 
 
 def _episodes(res, merge_time: float) -> list[int]:

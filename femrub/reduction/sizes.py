@@ -165,8 +165,9 @@ def _checked(red, model, want, make_stepper, scene, report, log, limits, on_run=
     ``want``: the sizes asked for (``None`` for ``"auto"``: the smallest of :func:`_ladder`
     whose estimate is within ``SAFETY × tolerance``). The reference is the reductor's largest
     model; the largest model itself is judged by its difference to the next smaller one.
-    ``on_run(results, seconds)`` receives the estimate's run of the chosen sizes (the run
-    itself: same model, stepper and initial state, stepped to ``t_end`` with ``limits``).
+    ``on_run(results, seconds, full states)`` receives the estimate's run of the chosen sizes
+    (the run itself: same model, stepper and initial state, stepped to ``t_end`` with
+    ``limits``; its states at the estimate's checkpoints, reconstructed).
     """
     t0 = time.perf_counter()
     tol, t_end = scene["reduction"]["tolerance"], scene["scheme"]["t_end"]
@@ -181,7 +182,7 @@ def _checked(red, model, want, make_stepper, scene, report, log, limits, on_run=
         if c == most:
             break
         *run, wall = _timed(red, c, make_stepper, t_end, limits=limits)
-        kept = (run[0], wall)
+        kept = (run[0], wall, run[1])
         err = estimate((c, *run), (most, *ref), model, window=window)
         if err["estimate"] > SAFETY * tol:  # measure how sensitive the response is
             tw = tw or _lean(twin(red, most, make_stepper, t_end, limits=limits))
@@ -191,7 +192,7 @@ def _checked(red, model, want, make_stepper, scene, report, log, limits, on_run=
             chosen = c
             break
     if chosen is None:  # the largest: judged against the next smaller candidate
-        chosen, kept = most, (ref[0], ref_wall)
+        chosen, kept = most, (ref[0], ref_wall, ref[1])
         if tried:
             err = dict(err, estimate=err["estimate"], judged="largest model: difference to "
                        f"the next smaller one {tried[-1]['sizes']} (pessimistic)")  # fmt: skip
@@ -231,7 +232,7 @@ def reduce_model(
     with the operators projected on them, and only the estimate runs again. ``limits``: the
     run's stop limits (``Stepper.run``), applied to the estimate's runs: they compare the
     models over the part of the run that the run itself can reach. ``on_run(results,
-    seconds)``: called with the estimate's run of the returned model's sizes (its
+    seconds, states)``: called with the estimate's run of the returned model's sizes (its
     :class:`~femrub.output.results.Results`, judged without the reduction rule, and its wall
     time), which is the scene's run: the caller need not step it again.
     """

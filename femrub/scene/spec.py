@@ -14,9 +14,15 @@ from dataclasses import dataclass, field
 
 from .units import SI_LABEL, to_si
 
-__all__ = ["REQUIRED", "SceneError", "Spec", "Variant", "fail", "unknown_key"]
+__all__ = [
+    "NONNEG", "POS", "REQUIRED", "SceneError", "Spec", "Variant", "fail", "float_spec",
+    "unknown_key",
+]  # fmt: skip
 
 REQUIRED = object()
+#: bounds of a positive and of a non-negative value (``Spec`` keywords)
+POS = {"lo": 0.0, "lo_open": True}
+NONNEG = {"lo": 0.0}
 
 
 class SceneError(ValueError):
@@ -166,3 +172,8 @@ class Variant:
 
     def keys_for(self, choice: str) -> dict:
         return {**self.common, **self.variants[choice]}
+
+
+def float_spec(default, dim, doc, **kw) -> Spec:
+    """A float key of dimension ``dim`` (``Spec("float", default, dim, doc=doc, **kw)``)."""
+    return Spec("float", default, dim, doc=doc, **kw)

@@ -1,0 +1,169 @@
+"""A-posteriori time-step error of a run: the same model stepped again at ``h/2``.
+
+A run is trustworthy only if its step is fine enough. ``scheme.step_check = true`` measures
+it the way the reduction error is measured (:mod:`femrub.reduction.estimate`): by the
+difference with a richer run, here the run's own model at half the step, from the same
+initial state to the same end time and stop limits. The fine run is coarsened to the run's
+steps (:func:`coarsen`: its impulses summed over each pair of steps, its signals at the run's
+times; fields at the same checkpoints) and both are compared with the estimate's measures
+(contact impulse per lobe passage, contact temperature history, displacement and
+temperature fields; a round-off twin of the fine run splits a sensitive response into a
+pointwise and a statistical part, as :func:`~femrub.reduction.estimate.estimate` does)::
+
+    d = ‖y_h − y_{h/2}‖ / ‖y_{h/2}‖
+
+The steppers converge at order ``p ≈ 1`` on rubs (velocity jumps at impacts, switches of
+the contact and friction state, wear: docs/performance.md §2), so the run's own error is
+estimated by Richardson's rule with the nominal order :data:`ORDER`::
+
+    e_h ≈ d 2^p / (2^p − 1) = 2 d      (p = 1)
+
+which is what ``estimate`` holds; the verdict rule ``time_step``
+(:mod:`femrub.output.verdict`) makes a run above ``scheme.step_tolerance`` ``inaccurate``.
+It doubles the stepping cost at least (three times when the twin is needed).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import time
+
+import numpy as np
+
+from ..progress import phase
+from ..reduction.estimate import DECISIVE, PERTURBATION, estimate
+from ..reduction.sizes import SAFETY, lobe_passage
+
+__all__ = ["ORDER", "check_step", "coarsen"]
+
+#: nominal convergence order of the steppers on nonsmooth rubs (Richardson's factor 2)
+ORDER = 1.0
+#: checkpoints of the fields compared (as the reduction error estimate)
+CHECKPOINTS = 5
+
+
+def coarsen(res, factor: int):
+    """The results ``res`` of a run at ``h / factor`` seen on the steps of ``h``.
+
+    Times and signals every ``factor`` rows; the impulse of each coarse step is the sum of
+    the fine impulses in it (so impulses per window and mean forces are preserved); the
+    checkpoint states are kept (the fine run stores them at the same times).
+    """
+    factor = int(factor)
+    if factor == 1:
+        return res
+    n = (len(res.t) - 1) // factor
+    rows = slice(0, n * factor + 1, factor)
+    impulse = res.impulse[1 : n * factor + 1].reshape(n, factor, -1).sum(axis=1)
+    return dataclasses.replace(
+        res,
+        h=res.h * factor,
+        t=res.t[rows],
+        impulse=np.vstack([res.impulse[:1], impulse]),
+        gap=res.gap[rows],
+        signals={k: v[rows] for k, v in res.signals.items()},
+        energy={},
+        friction_force=None,
+        slip_velocity=None,
+        contact_state=None,
+        extra={},
+    )
+
+
+def _to_full_states(model, full):
+    """``X -> full states`` of the rows of ``X`` (states of ``model``): ``Pᵀ (T Xᵀ)`` with
+    ``T = model.to_full`` (reduced: the mesh map of ``R``) and ``P = full.to_full`` (the
+    full model's injection of its free dofs into the mesh, ``Pᵀ P = I``), i.e. ``R X̄``."""
+    if model is full or model.to_full is None or full.to_full is None:
+        return lambda X: X
+    P, T = full.to_full, model.to_full
+    return lambda X: np.asarray(P.T @ (T @ np.asarray(X).T)).T
+
+
+def _simulate(stepper, t_end, every, limits, fields):
+    """Run ``stepper`` to ``t_end``, full states stored every ``every`` steps."""
+    res = stepper.run(t_end, store_every=every, limits=limits)
+    return res, fields(res.states)
+
+
+def _perturbed(model):
+    """``model`` with :data:`~femrub.reduction.estimate.PERTURBATION` (m) of random
+    displacement added to its initial state (the estimate's round-off twin)."""
+    x0 = np.array(model.x0, dtype=float)
+    x0[model.layout.u] += PERTURBATION * np.random.default_rng(0).standard_normal(model.layout.n_u)
+    return model.with_(x0=x0)
+
+
+def check_step(scene, model, full, make_stepper, limits, run=None):
+    """The run's time-step error estimate (``summary.json["time_step_error"]``).
+
+    Parameters
+    ----------
+    scene : the scene (``scheme.h``, ``scheme.t_end``, ``scheme.step_tolerance``, the lobe
+        passage of the casing).
+    model : the model that runs (reduced or full); ``full``: the full model (field norms).
+    make_stepper : ``(model, h) -> stepper`` of the scene's scheme at step ``h``.
+    limits : the run's stop limits.
+    run : ``(results, full states at checkpoints)`` of the run at ``h`` when already stepped
+        (the reduction error estimate's run of these sizes), else ``None``: stepped here.
+
+    Returns
+    -------
+    (dict, run, wall) : the estimate (:func:`~femrub.reduction.estimate.estimate`'s
+        measures, ``difference``: the largest decisive one, ``estimate``: Richardson's error
+        of the run, ``tolerance``, ``h``, ``reference_h``, ``order``, ``seconds``), the run at
+        ``h`` (its results and states) and the wall seconds of that run when stepped here
+        (``None`` when given): the caller may keep it as the scene's run.
+    """
+    t0 = time.perf_counter()
+    s = scene["scheme"]
+    h, t_end, tol = s["h"], s["t_end"], s["step_tolerance"]
+    fields = _to_full_states(model, full)
+    fine_h = 0.5 * h
+    st = make_stepper(model, fine_h)
+    every = max(1, st.steps_to(t_end) // (2 * CHECKPOINTS))  # of the run at h
+    wall = None
+    if run is None:
+        with phase(f"time-step check: run at h = {h:g} s"):
+            w0 = time.perf_counter()
+            run = _simulate(make_stepper(model, h), t_end, every, limits, fields)
+            wall = time.perf_counter() - w0
+    with phase(f"time-step check: run at h/2 = {fine_h:g} s") as p:
+        res, states = _simulate(st, t_end, 2 * every, limits, fields)
+        fine, fine_status = (coarsen(res, 2), states), res.status
+        p["detail"] = f"{res.steps} steps"
+        del res  # only its coarsened rows are compared
+    window, label = lobe_passage(scene), ()
+    err = estimate((label, *run), (label, *fine), full, window=window)
+    if _richardson(err["estimate"]) > SAFETY * tol:  # how sensitive is the response?
+        with phase(f"time-step check: twin at h/2 = {fine_h:g} s"):
+            tw, Xt = _simulate(make_stepper(_perturbed(model), fine_h), t_end, 2 * every,
+                               limits, fields)  # fmt: skip
+        err = estimate((label, *run), (label, *fine), full, window=window,
+                       twin=(coarsen(tw, 2), Xt), tolerance=tol)  # fmt: skip
+    for key in ("sizes", "reference_sizes", "status_run", "status_reference"):
+        err.pop(key, None)
+    split = "predictability_horizon" in err
+    measures = {k: err[k] for k in DECISIVE if k in err}
+    err.update(
+        difference=err["estimate"],
+        estimate=_richardson(err["estimate"]),
+        decided_by="statistics after the predictability horizon"
+        if split
+        else max(measures, key=measures.get, default=""),
+        method="Richardson (order 1) on the difference to the same model at h/2"
+        + (f"; {err['method']}" if split else ""),
+        h=h,
+        reference_h=fine_h,
+        order=ORDER,
+        tolerance=tol,
+        status_reference=fine_status,
+        seconds=time.perf_counter() - t0,
+    )
+    return err, run, wall
+
+
+def _richardson(difference: float) -> float:
+    """Error of the run at ``h`` from its difference with the run at ``h/2`` (order ORDER)."""
+    r = 2.0**ORDER
+    return float(difference * r / (r - 1.0))

@@ -1,0 +1,128 @@
+"""The scene schema of how a scene runs: stepper, reduction, outputs and stop limits.
+
+Part of :data:`femrub.scene.schema.SCHEMA` (``scheme``, ``reduction``, ``outputs``,
+``limits``); the signals a model can observe (:data:`SIGNALS`) and their dimensions.
+"""
+
+from __future__ import annotations
+
+from ..contact.activation import DEFAULT_RULE, RULES
+from .spec import NONNEG, POS, REQUIRED, Spec, Variant
+from .spec import float_spec as _f
+
+__all__ = ["LIMITS", "OUTPUTS", "REDUCTION", "SCHEME", "SIGNALS"]
+
+I, B, C = "int", "bool", "choice"
+
+SCHEME = Variant(
+    "name",
+    default="theta",
+    doc="time stepper (femrub.steppers)",
+    common={
+        "h": _f(REQUIRED, "time", "time step", **POS),
+        "t_end": _f(REQUIRED, "time", "end time", **POS),
+        "step_check": Spec(
+            B,
+            False,
+            doc="also step the model at h/2 and judge the run by the difference "
+            "(a-posteriori time-step error, femrub.app.step_check; doubles the stepping)",
+        ),
+        "step_tolerance": _f(
+            0.05,
+            "none",
+            "estimated time-step error above which a checked run is inaccurate",
+            lo=0.0,
+            hi=1.0,
+            lo_open=True,
+        ),
+    },
+    variants={
+        "theta": {
+            "gamma": _f(0.5, "none", "θ of the θ-method", lo=0.5, hi=1.0),
+            "gamma_thermal": _f(
+                None,
+                "none",
+                "θ of the heat-equation rows (default: gamma; 1 damps stiff thermal modes)",
+                lo=0.5,
+                hi=1.0,
+            ),
+            "activation": Spec(
+                C, DEFAULT_RULE, choices=RULES, doc="contact rule (femrub.contact.activation)"
+            ),
+        },
+        "carpenter": {},
+        "penalty": {
+            "stiffness": _f(REQUIRED, "stiffness", "penalty stiffness", **POS),
+            "damping": _f(0.0, "damping", "penalty damping", **NONNEG),
+            "method": Spec(C, "Radau", choices=("Radau", "BDF"), doc="implicit integrator"),
+        },
+        "exponential": {
+            "events": Spec(
+                B, True, doc="locate contact closings and releases inside the step (exact times)"
+            ),
+        },
+    },
+)
+
+REDUCTION = Variant(
+    "method",
+    default="none",
+    doc="thermoelastic Craig-Bampton reduction (paper Sec. 2)",
+    common={
+        "projection": Spec(
+            C,
+            "static-mass",
+            choices=("static-mass", "petrov-galerkin", "galerkin", "adjoint", "second-order"),
+            doc="left basis (static-mass: Petrov-Galerkin with the static shapes' inertia; "
+            "second-order: classical Galerkin Craig-Bampton of the mechanics)",
+        ),
+        "thermal": Spec(
+            C,
+            "inputs",
+            choices=("inputs", "boundary"),
+            doc="thermal reduction: one shape pair per heat input, or the heated dofs kept",
+        ),
+        "tolerance": _f(
+            0.05,
+            "none",
+            "estimated relative error above which a run is inaccurate",
+            lo=0.0,
+            hi=1.0,
+            lo_open=True,
+        ),
+    },
+    variants={
+        "none": {},
+        "craig-bampton": {
+            "n_uv": Spec(I, REQUIRED, lo=0, doc="first-order mechanical shapes"),
+            "n_theta": Spec(I, REQUIRED, lo=0, doc="thermal modes"),
+        },
+        "auto": {
+            "target": _f(0.01, "none", "relative error target", lo=0.0, hi=1.0, lo_open=True),
+            "modes": Spec(I, 10, lo=1, hi=50, doc="natural frequencies that must meet it"),
+            "max_n_uv": Spec(I, 64, lo=2, hi=400, doc="largest n_uv tried"),
+            "max_n_theta": Spec(I, 64, lo=0, hi=400, doc="largest n_theta tried"),
+        },
+    },
+)
+
+#: observed signals and their dimension; which exist depends on the geometry
+SIGNALS = {
+    "tip_displacement": "length",
+    "tip_velocity": "velocity",
+    "tip_temperature": "temperature",
+    "contact_displacement": "length",
+    "contact_temperature": "temperature",
+    "contact_force": "force",
+}
+
+OUTPUTS = {
+    "signals": Spec("strs", "all", choices=("all",), doc="history signals kept"),
+    "vtk_stride": Spec(I, 0, lo=0, doc="3D: write a VTK frame every that many steps (0: none)"),
+    "plots": Spec(B, True, doc="snapshot.png of the last VTK frame"),
+}
+
+LIMITS = {
+    name: _f(None, dim, f"stop the run when |{name}| exceeds this", **POS)
+    for name, dim in SIGNALS.items()
+}
