@@ -169,6 +169,15 @@ def explain(report: dict, reach_key=None) -> str:
             f"{s['steps']} steps" + (f" ({opts})" if opts else ""),
         )
     )
+    ts = report.get("time_step")
+    if ts:
+        verdict = "within" if ts["estimate"] <= ts["tolerance"] else "EXCEEDS"
+        rows.append((
+            "time step",
+            f"estimated error {100 * ts['estimate']:.2g} % ({verdict} scheme.step_tolerance "
+            f"{100 * ts['tolerance']:.2g} %): twice the difference to the run at h/2 "
+            f"({ts['decided_by']} {100 * ts['difference']:.2g} %), {ts['seconds']:.1f} s",
+        ))  # fmt: skip
     rows.append(("signals", ", ".join(report["signals"]) + " (+ gaps, contact forces, energy)"))
     if report["signals_not_observed"]:
         rows.append(("not kept", ", ".join(report["signals_not_observed"]) + " (outputs.signals)"))
