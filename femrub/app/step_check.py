@@ -34,7 +34,7 @@ from ..progress import phase
 from ..reduction.estimate import DECISIVE, PERTURBATION, estimate
 from ..reduction.sizes import SAFETY, lobe_passage
 
-__all__ = ["ORDER", "check_step", "coarsen"]
+__all__ = ["ORDER", "check_step", "coarsen", "full_states"]
 
 #: nominal convergence order of the steppers on nonsmooth rubs (Richardson's factor 2)
 ORDER = 1.0
@@ -70,7 +70,7 @@ def coarsen(res, factor: int):
     )
 
 
-def _to_full_states(model, full):
+def full_states(model, full):
     """``X -> full states`` of the rows of ``X`` (states of ``model``): ``Pᵀ (T Xᵀ)`` with
     ``T = model.to_full`` (reduced: the mesh map of ``R``) and ``P = full.to_full`` (the
     full model's injection of its free dofs into the mesh, ``Pᵀ P = I``), i.e. ``R X̄``."""
@@ -118,7 +118,7 @@ def check_step(scene, model, full, make_stepper, limits, run=None):
     t0 = time.perf_counter()
     s = scene["scheme"]
     h, t_end, tol = s["h"], s["t_end"], s["step_tolerance"]
-    fields = _to_full_states(model, full)
+    fields = full_states(model, full)
     fine_h = 0.5 * h
     st = make_stepper(model, fine_h)
     every = max(1, st.steps_to(t_end) // (2 * CHECKPOINTS))  # of the run at h
