@@ -138,6 +138,7 @@ def _run_claimed(scene, out, progress, log, on_built, modes, cache):
         progress=progress,
         overwrite=True,
         snapshot=o["plots"],
+        plots=o["plots"],
         timings=built.timings,
         n_full=built.full.n_dofs,
         rotation_speed=scene["loads"]["rotation_speed"],

@@ -119,7 +119,12 @@ SIGNALS = {
 OUTPUTS = {
     "signals": Spec("strs", "all", choices=("all",), doc="history signals kept"),
     "vtk_stride": Spec(I, 0, lo=0, doc="3D: write a VTK frame every that many steps (0: none)"),
-    "plots": Spec(B, True, doc="snapshot.png of the last VTK frame"),
+    "plots": Spec(
+        B,
+        True,
+        doc="the PNG plots of the run (signals, response, spectrum, contact forces, "
+        "snapshot of the last VTK frame)",
+    ),
 }
 
 LIMITS = {
