@@ -40,6 +40,7 @@ def _value(text: str):
 
 def ladder(scene, factors, gammas, log=print) -> list[dict]:
     """One row per (γ_θ, f): the run at ``h/f`` against the run at the previous factor."""
+    from femrub.app.cache import ModelCache
     from femrub.app.scheme import scheme_options
     from femrub.app.simulation import build
     from femrub.app.step_check import CHECKPOINTS, coarsen, full_states
@@ -47,7 +48,7 @@ def ladder(scene, factors, gammas, log=print) -> list[dict]:
     from femrub.reduction.sizes import lobe_passage
     from femrub.steppers import make_stepper
 
-    sim = build(scene, log=log)
+    sim = build(scene, log=log, cache=ModelCache())
     model, full = sim.model, sim.full
     fields = full_states(model, full)
     s = scene["scheme"]
@@ -76,7 +77,7 @@ def ladder(scene, factors, gammas, log=print) -> list[dict]:
                 "heat": res.heat_error(),
                 "t_max": _largest(res, "contact_temperature"),
                 "impulse": float(res.impulse.sum()),
-                "wear": wear.max_depth() if wear is not None else float("nan"),
+                "wear": wear.max_depth if wear is not None else float("nan"),
                 "load": (load0, os.getloadavg()[0]),
             }
             cur = (coarsen(res, f), fields(res.states))
