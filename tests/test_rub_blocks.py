@@ -196,6 +196,17 @@ def test_wear_kernels_equal_the_grid_and_a_vectorised_cut():
         levels.append(level)
     np.testing.assert_array_equal(got, ref)
     assert deepest == np.concatenate(levels).max() and np.any(got > flat)
+    # the recorder's rows of gaps and rates on the worn surface: one broadcast, the same
+    # values as one call per time
+    from femrub.contact.gap import Contact
+
+    w.reset(h=1e-4)
+    w.depth.ravel()[:] = got
+    c = Contact(G=np.ones((1, 9)), Gv=np.ones((1, 9)), Hm=np.ones((1, 9)), Ht=np.zeros((1, 9)),
+                gap0=np.full(9, 1e-4), wear=w)  # fmt: skip
+    t = 0.0123 + 1e-4 * np.arange(50)
+    np.testing.assert_array_equal(c.gap_at(t), np.array([c.gap_at(ti) for ti in t]))
+    np.testing.assert_array_equal(c.rate_at(t), np.array([c.rate_at(ti) for ti in t]))
 
 
 _CHILD = """
