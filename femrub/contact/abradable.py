@@ -29,7 +29,9 @@ the cell size. Once the surface is worn through (``w = e``) the rigid casing beh
 any force. Wear is monotone, never negative and never deeper than ``e``.
 
 The wear map is casing state that evolves during a run: a stepper calls :meth:`reset` when
-it starts. ``history`` keeps ``(t, max depth)`` at every step that removed material.
+it starts. ``history`` keeps ``(t, max depth)`` at every step that removed material. The
+cut is :func:`femrub.contact.wear_map.cut_sweeps` (compiled), which the θ-method's blocks
+of steps also call (:mod:`femrub.contact.rub_block`).
 """
 
 from __future__ import annotations
@@ -39,6 +41,7 @@ import math
 import numpy as np
 
 from ..fem.material import check_finite_positive
+from .wear_map import cut_sweeps
 
 __all__ = ["Abradable", "CasingGrid"]
 
@@ -186,19 +189,9 @@ class Abradable:
             x0, r0 = x1, r1
         else:
             x0, r0 = g.position(last[0])[i], last[1][i]
-        lo = np.floor(np.minimum(x0, x1)).astype(np.int64)
-        hi = np.floor(np.maximum(x0, x1)).astype(np.int64) + 1
-        span = int(np.max(hi - lo)) + 1
-        k = lo[:, None] + np.arange(span)[None, :]  # centres swept (and the two bracketing)
-        inside = k <= hi[:, None]
-        dx = (x1 - x0)[:, None]
-        still = dx == 0.0  # no sweep (first call): the reach at the end everywhere
-        frac = np.where(still, 1.0, np.clip((k - x0[:, None]) / np.where(still, 1.0, dx), 0, 1))
-        level = np.minimum(self.thickness, r0[:, None] + frac * (r1 - r0)[:, None])
-        cells = g.flat(k, g.axial_cell[i][:, None])
-        flat = self.depth.ravel()
-        # several contacts (or sweeps) over one centre: the deepest cut counts
-        np.maximum.at(flat, cells[inside], level[inside])
+        flat = self.depth.ravel()  # a view: cut in place (the deepest cut counts)
+        cut_sweeps(flat, g.axial_cell[i], x0, x1, r0, r1, self.thickness, self.n_angle,
+                   self.n_axial)  # fmt: skip
         self.history.append((float(t), float(flat.max())))
 
     # -- results ------------------------------------------------------------------------

@@ -209,20 +209,30 @@ def compile_kernels() -> None:
 
 def compile_blocks() -> None:
     """Compile (or load) the θ-method's block kernels of :mod:`femrub.contact.theta_block`
-    for the argument types of a run (no step is taken: blocks of zero rows)."""
+    and :mod:`femrub.contact.rub_block`, and the wear map's cut
+    (:func:`femrub.contact.wear_map.cut_sweeps`), for the argument types of a run (no step
+    is taken: blocks of zero rows)."""
     from .jit import compiled, wait_background
+    from .rub_block import rub_block
     from .theta_block import friction_block, one_contact_block
+    from .wear_map import cut_sweeps
 
     if not compiled():
         return
     wait_background()  # a build's child compiling them (jit.compile_in_background)
-    N, E, one = 2, np.empty, np.ones(1)
+    N, E, one, z = 2, np.empty, np.ones(1), np.zeros(1)
     T, Y, sig = np.eye(N), np.zeros((N, 0)), np.zeros((1, 0))
     one_contact_block(np.zeros(N), T, Y, Y, sig, 0, 1.0, np.ones(N), np.ones(N), np.ones(N),
                       1.0, 1.0, 0.0, 1.0, 0.5, np.inf, E((0, N)), E((0, 1)))  # fmt: skip
-    friction_block(
-        np.zeros(N), T, Y, Y, sig, np.zeros((4, N)), np.zeros((1, 4)), np.zeros((N, 3)),
-        np.eye(3), np.zeros((1, 3)), FIXED_POINT, one, one * 0.0, one * np.inf,
-        np.zeros((1, 3)), False, 1.0, 0.5, one * 0.0, 1e-12, 60, E((0, N)), E((0, 1)),
-        E((0, 1, 2)), E((0, 1)), E((0, 1), dtype=np.int8),
+    rows = (E((0, N)), E((0, 1)), E((0, 1, 2)), E((0, 1)), E((0, 1), dtype=np.int8))
+    head = (np.zeros(N), T, Y, Y, sig, np.zeros((4, N)), np.zeros((1, 4)), np.zeros((N, 3)),
+            np.eye(3), np.zeros((1, 3)), FIXED_POINT, one, one * 0.0, one * np.inf,
+            np.zeros((1, 3)), False, 1.0, 0.5, one * 0.0, 1e-12, 60)  # fmt: skip
+    friction_block(*head, *rows)
+    ints = np.zeros(1, dtype=np.int64)
+    rub_block(
+        *head, True, np.zeros((N, 1)), np.zeros((3, 1)), one * 0.5, 20, True, E(0), E(0),
+        np.zeros((0, 1)), np.zeros((1, N)), z.copy(), z.copy(), ints, np.ones(4),
+        np.ones(2, dtype=np.int64), z.copy(), np.zeros(3), *rows, E(0),
     )  # fmt: skip
+    cut_sweeps(z.copy(), ints, z.copy(), one * 0.5, z.copy(), z.copy(), 1.0, 1, 1)

@@ -145,10 +145,8 @@ class Contact:
             else:
                 g0 = np.asarray(g0(t), dtype=float)
         rows = isinstance(t, np.ndarray) and t.ndim
-        if self.wear is not None:
-            g0 = g0 + (
-                _over_times(self.wear.depth_at, t, self.n) if rows else self.wear.depth_at(t)
-            )
+        if self.wear is not None:  # rows: one broadcast interpolation (m, n_c)
+            g0 = g0 + (self.wear.depth_at(t[:, None]) if rows else self.wear.depth_at(t))
         if self.casing_heat is not None:
             ch = self.casing_heat
             g0 = g0 - (_over_times(ch.closure_at, t, self.n) if rows else ch.closure_at(t))
@@ -198,7 +196,7 @@ class Contact:
         if rate is not None:
             out = _over_times(rate, t, self.n) if rows else np.asarray(rate(t), dtype=float)
         if wear is not None:
-            out = out + (_over_times(wear.rate_at, t, self.n) if rows else wear.rate_at(t))
+            out = out + (wear.rate_at(t[:, None]) if rows else wear.rate_at(t))
         if ch is not None:
             out = out - (
                 _over_times(ch.closure_rate_at, t, self.n) if rows else ch.closure_rate_at(t)

@@ -39,7 +39,9 @@ WAIT_SECONDS = 300.0
 
 _HERE = os.path.dirname(os.path.abspath(__file__))
 #: the source files of compiled functions that call each other (one cache stamp)
-KERNEL_FILES = tuple(os.path.join(_HERE, f) for f in ("coulomb.py", "theta_block.py"))
+KERNEL_FILES = tuple(
+    os.path.join(_HERE, f) for f in ("coulomb.py", "theta_block.py", "wear_map.py", "rub_block.py")
+)
 
 
 def _stamp() -> bytes:

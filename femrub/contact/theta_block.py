@@ -2,8 +2,10 @@
 
 A run's steps are recorded in chunks (:mod:`femrub.output.recorder`); on a dense model
 whose contact terms do not depend on the run's history (no wear, no casing heat, constant
-heat coefficient, no ``"power"`` heat law) :class:`~femrub.steppers.theta.ThetaMethod`
-advances a whole chunk with one call of a kernel below, writing each step's state and
+heat coefficient, no ``"power"`` heat law; those with a history:
+:mod:`femrub.contact.rub_block`, on :func:`friction_step`)
+:class:`~femrub.steppers.theta.ThetaMethod` advances a whole chunk with one call of a
+kernel below, writing each step's state and
 impulses into the recorder's rows. The step is the θ-method's (paper Eq. 16a)::
 
     X_p     = T X_k + Y1 s_{k+1} + Y0 s_k          free prediction (T = I + D⁻¹ h B)
@@ -25,7 +27,13 @@ import numpy as np
 from .coulomb import frictional_fixed_point
 from .jit import njit
 
-__all__ = ["ONE_RULES", "impulse_one_code", "one_contact_block", "friction_block"]
+__all__ = [
+    "ONE_RULES",
+    "impulse_one_code",
+    "one_contact_block",
+    "friction_step",
+    "friction_block",
+]
 
 #: codes of the activation rules for :func:`impulse_one_code`
 ONE_RULES = {"position": 0, "capped": 1, "paper": 2, "plain": 3, "predicted": 4}
@@ -90,6 +98,33 @@ def one_contact_block(X, T, Y1, Y0, sig, code, g0, gr, gv, z, w, gz, e, h, gamma
 
 
 @njit
+def friction_step(Xk, Xp, S, ok, o1, GZ, W, code, mu, e3, U, warm, use_warm, h, gamma, tol,
+                  max_iter):  # fmt: skip
+    """The frictional contact solve of one step from ``X_k`` with the prediction ``X_p``.
+
+    Local rows ``y = S X + o`` (``[g, ġ, w_t]``, casing terms ``o_k``, ``o_{k+1}``), Newton's
+    law with ``e = 1`` on separating contacts (``ġ_k > 0``), then the active-set fixed point
+    :func:`~femrub.contact.coulomb.frictional_fixed_point` with the bounds ``U``.
+
+    Returns ``(y_k, q, e, ġ_k, active, P, u, state, residual, status)`` (``q`` (n, 3): the
+    free local velocities at ``t_{k+1}``).
+    """
+    n = mu.size
+    yk = np.dot(S, Xk) + ok
+    yp = np.dot(S, Xp) + o1
+    gdk, e = np.empty(n), np.empty(n)
+    for i in range(n):
+        gdk[i] = yk[n + 3 * i]
+        e[i] = 1.0 if gdk[i] > 0.0 else e3[i]
+    q = yp[n:].copy().reshape((n, 3))
+    active, P, u, st, res, it, status = frictional_fixed_point(
+        code, yk[:n].copy(), gdk.copy(), yp[:n].copy(), GZ, W, q, mu, e.copy(), gdk.copy(),
+        U, warm, use_warm, h, gamma, tol, max_iter,
+    )  # fmt: skip
+    return yk, q, e, gdk, active, P, u, st, res, status
+
+
+@njit
 def friction_block(
     X, T, Y1, Y0, sig, S, off, Z, W, GZ, code, mu, e3, U, warm, use_warm, h, gamma, alpha, tol,
     max_iter, Xout, Pout, Ptout, heat_out, state_out,
@@ -99,18 +134,11 @@ def friction_block(
     step whose solve failed (status ≠ 0) is not written, and the block stops there."""
     n = mu.size
     Xk = X
-    gdk, e = np.empty(n), np.empty(n)
     for j in range(Xout.shape[0]):
         Xp = _predict(T, Y1, Y0, sig, j, Xk)
-        yk = np.dot(S, Xk) + off[j]
-        yp = np.dot(S, Xp) + off[j + 1]
-        for i in range(n):
-            gdk[i] = yk[n + 3 * i]
-            e[i] = 1.0 if gdk[i] > 0.0 else e3[i]
-        q = yp[n:].copy().reshape((n, 3))
-        active, P, u, st, res, it, status = frictional_fixed_point(
-            code, yk[:n].copy(), gdk.copy(), yp[:n].copy(), GZ, W, q, mu, e.copy(), gdk.copy(),
-            U, warm, use_warm, h, gamma, tol, max_iter,
+        yk, q, e, gdk, active, P, u, st, res, status = friction_step(
+            Xk, Xp, S, off[j], off[j + 1], GZ, W, code, mu, e3, U, warm, use_warm, h, gamma,
+            tol, max_iter,
         )  # fmt: skip
         if status != 0:
             return j, status, res, warm

@@ -35,10 +35,12 @@ heat input of the same step; its effect on the step's velocities through the the
 coupling is fed back into the contact solve by a fixed point (contact solve, heat, contact
 solve with the heat's velocity shift ``W_θ Q``, ...) until the heat repeats to 1e-12.
 
-``run()`` on a dense model whose contacts carry no history (no wear, no casing heat,
-constant α, no ``"power"`` heat with a thermal field) advances whole chunks of steps in one
-compiled call (:mod:`femrub.steppers.theta_blocks`): the same step, the same contact
-algebra, written into the recorder's rows. ``step()`` and ``iterate()`` go step by step.
+``run()`` on a dense model advances whole chunks of steps in one compiled call
+(:mod:`femrub.steppers.theta_blocks`): the same step, the same contact algebra, written into
+the recorder's rows; with frictional contacts this includes the ``"power"`` heat fixed
+point above and an abradable coating's wear map (:mod:`femrub.contact.rub_block`). Casing
+heat, a time-dependent α, frictionless contacts beyond the one-contact case and sparse
+models go step by step, as do ``step()`` and ``iterate()``.
 """
 
 from __future__ import annotations
@@ -57,6 +59,7 @@ from ..contact.activation import (
     rule_code,
 )
 from ..contact.friction import check_status, solve_frictional_contact
+from ..contact.rub_block import MAX_HEAT_ITERATIONS
 from ..fem.linalg import Factorised, compact
 from .base import Stepper
 from .theta_blocks import advance_block, prepare
@@ -64,8 +67,6 @@ from .theta_blocks import advance_block, prepare
 __all__ = ["ThetaMethod", "ACTIVATION_RULES"]
 
 ACTIVATION_RULES = RULES
-#: fixed-point iterations between the contact solve and the frictional heat of a step
-MAX_HEAT_ITERATIONS = 20
 
 
 class ThetaMethod(Stepper):
@@ -86,8 +87,9 @@ class ThetaMethod(Stepper):
 
     name = "theta"
     supports_wear = True
-    #: ``run()`` advances dense models with history-free contacts in compiled blocks of
-    #: steps (:mod:`femrub.steppers.theta_blocks`); ``False``: step by step (same results)
+    #: ``run()`` advances dense models in compiled blocks of steps where
+    #: :func:`~femrub.steppers.theta_blocks.block_kind` allows (``False``: step by step,
+    #: same results)
     block_steps = True
 
     def __init__(
