@@ -182,13 +182,11 @@ def sparse_lu(M, *, symmetric: bool = False, what: str = "matrix", pardiso: bool
 def project(left: np.ndarray, Q, right: np.ndarray, chunk: int = 8192) -> np.ndarray:
     """``leftᵀ Q right`` (dense) for a sparse ``Q`` and dense bases ``left``, ``right``.
 
-    ``Q`` is cut in blocks of ``chunk`` rows and of runs of columns on which the same
-    columns of ``right`` are not zero (:func:`_column_groups`), and each block is multiplied
-    by those columns of ``right`` and by the columns of ``left`` not zero on its rows: the
-    operators of a first-order model are block-sparse (``A = diag(I, M, C^θθ)``; ``B``
-    couples ``u``, ``v``, ``θ`` by blocks; energy forms act on one block) and a reduction
-    basis is block-structured (a ``v`` row only has ``v`` shapes), so this skips most of
-    the dense work of ``leftᵀ (Q right)``.
+    Row blocks of ``chunk`` rows are projected one at a time on the columns of the bases
+    that are not zero there: the operators of a first-order model are block-sparse
+    (``A = diag(I, M, C^θθ)``; ``B`` couples ``u``, ``v``, ``θ`` by blocks; energy forms
+    act on one block) and a reduction basis is block-structured (a ``v`` row only has ``v``
+    shapes), so this skips most of the dense work of ``leftᵀ (Q right)``.
     """
     if not sp.issparse(Q):
         return left.T @ (np.asarray(Q) @ right)
@@ -196,38 +194,19 @@ def project(left: np.ndarray, Q, right: np.ndarray, chunk: int = 8192) -> np.nda
         return left.T @ np.asarray(Q @ right)
     Q = sp.csr_matrix(Q)
     out = np.zeros((left.shape[1], right.shape[1]))
-    groups = _column_groups(right, chunk)
+    nonzero = right != 0.0  # one boolean pattern: a chunk copies only the block it needs
     for s in range(0, Q.shape[0], chunk):
         Qs = Q[s : s + chunk]
         if Qs.nnz == 0:
             continue
         Ls = left[s : s + chunk]
         lc = np.flatnonzero(np.any(Ls != 0.0, axis=0))
-        if lc.size == 0:
-            continue
-        Qs = Qs.tocsc()
-        QR = np.zeros((Qs.shape[0], right.shape[1]))
-        for c0, c1, rc in groups:
-            block = Qs[:, c0:c1]
-            if rc.size and block.nnz:
-                QR[:, rc] += block @ right[c0:c1, rc]
-        rc = np.flatnonzero(np.any(QR != 0.0, axis=0))
-        if rc.size:
-            out[np.ix_(lc, rc)] += Ls[:, lc].T @ QR[:, rc]
+        cols = np.unique(Qs.indices)
+        rc = np.flatnonzero(np.any(nonzero[cols], axis=0))
+        if lc.size and rc.size:
+            QR = Qs[:, cols] @ right[np.ix_(cols, rc)]
+            out[np.ix_(lc, rc)] += Ls[:, lc].T @ QR
     return out
-
-
-def _column_groups(right: np.ndarray, chunk: int) -> list:
-    """``(start, stop, columns)``: runs of rows of ``right`` (of ``chunk`` rows, merged while
-    the same columns are not zero on them) with those columns."""
-    groups = []
-    for c in range(0, right.shape[0], chunk):
-        rc = np.flatnonzero(np.any(right[c : c + chunk] != 0.0, axis=0))
-        if groups and np.array_equal(groups[-1][2], rc):
-            groups[-1][1] = c + chunk
-        else:
-            groups.append([c, c + chunk, rc])
-    return groups
 
 
 def compact(M, dense_below: int = DENSE_BELOW):
