@@ -50,10 +50,11 @@ def test_block_lowest_rejects_a_basis_larger_than_half_the_problem():
 
 
 def test_lowest_modes_block_path_equals_arpack_path(monkeypatch):
-    K, M = _grid(30)  # 900 unknowns
-    lam_a, V_a = eigen.lowest_modes(K, M, 12)  # ARPACK (below BLOCK_EIGEN_ABOVE)
+    K, M = _grid(34)  # 1156 unknowns
+    lam_a, V_a = eigen.lowest_modes(K, M, 20)  # ARPACK (below BLOCK_EIGEN_ABOVE)
     monkeypatch.setattr(eigen, "BLOCK_EIGEN_ABOVE", 500)
-    lam_b, V_b = eigen.lowest_modes(K, M, 12)
+    monkeypatch.setattr(eigen, "BLOCK_EIGEN_MODES", 3)
+    lam_b, V_b = eigen.lowest_modes(K, M, 20)
     np.testing.assert_allclose(lam_b, lam_a, rtol=1e-11)
     np.testing.assert_allclose(V_b, V_a, atol=1e-8)  # same normalisation: same shapes
     # a free structure (singular K) is shifted as on the ARPACK path

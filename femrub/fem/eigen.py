@@ -3,8 +3,9 @@
 * :func:`lowest_modes`: the ``k`` lowest eigenpairs of ``K x = λ M x`` (``K``, ``M``
   symmetric, ``M`` positive): LAPACK ``eigh`` on dense matrices below
   :data:`DENSE_EIGEN_BELOW` unknowns, else shift-invert about σ = 0, by block Lanczos
-  (:mod:`femrub.fem.block_eigen`) from :data:`BLOCK_EIGEN_ABOVE` unknowns and ARPACK
-  ``eigsh`` below, reusing a given factorisation of ``K`` (``solve``) or factorising ``K`` with
+  (:mod:`femrub.fem.block_eigen`) for many modes of a large problem (from
+  :data:`BLOCK_EIGEN_MODES` modes and :data:`BLOCK_EIGEN_ABOVE` unknowns), otherwise by
+  ARPACK ``eigsh``, reusing a given factorisation of ``K`` (``solve``) or factorising ``K`` with
   :func:`~femrub.fem.linalg.sparse_lu` (Pardiso's Cholesky on large problems). Shapes are
   normalised to a unit largest amplitude, with that entry positive
   (:func:`normalise_columns`), so modal coordinates carry the units of the physical dofs and
@@ -42,9 +43,13 @@ DENSE_EIGEN_BELOW = 400
 #: Shift used when the stiffness is singular (free structure): σ = −1 rad²/s².
 FREE_SHIFT = -1.0
 #: Problem sizes from which block shift-invert Lanczos (:mod:`femrub.fem.block_eigen`)
-#: replaces ARPACK: where the factorisation is Pardiso's, whose solves of a block of
-#: right-hand sides cost a small multiple of one.
+#: replaces ARPACK for :data:`BLOCK_EIGEN_MODES` modes or more: where the factorisation is
+#: Pardiso's, whose solves of a block of right-hand sides cost a small multiple of one,
+#: and ARPACK's vector-by-vector reorthogonalisation of a basis of ``2 k + 1`` vectors costs
+#: as much as its solves (docs/performance.md).
 BLOCK_EIGEN_ABOVE = PARDISO_ABOVE
+#: Fewest modes for which the block solver is used (fewer: ARPACK is as fast).
+BLOCK_EIGEN_MODES = 16
 
 
 def _dense(M) -> np.ndarray:
@@ -107,7 +112,8 @@ def lowest_modes(K, M, k: int, solve=None, *, tol: float = 1e-12, vectors: bool 
             )
         lam, V = (out, None) if not vectors else out
     else:
-        block = n >= BLOCK_EIGEN_ABOVE and block_sizes(k)[2] <= n // 2
+        b, _, p = block_sizes(k)
+        block = n >= BLOCK_EIGEN_ABOVE and k >= BLOCK_EIGEN_MODES and p + b <= n // 2
         name = "block shift-invert Lanczos" if block else "ARPACK"
         with progress.phase(f"eigen-solve: {k} lowest modes of {n} unknowns ({name})"):
             lam, V = _shift_invert_lowest(K, M, k, solve, tol, vectors, block)
