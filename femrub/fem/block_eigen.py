@@ -40,7 +40,7 @@ def block_sizes(k: int) -> tuple[int, int, int]:
     """``(b, keep, p)``: block size, Ritz vectors kept on a restart and largest basis for
     ``k`` eigenpairs."""
     keep = k + max(4, k // 4)
-    return BLOCK, keep, keep + 10 * BLOCK
+    return BLOCK, keep, keep + max(4, min(10, keep // 10)) * BLOCK
 
 
 def _m_orthonormal(W, M):
