@@ -2,8 +2,10 @@
 
 * :func:`lowest_modes`: the ``k`` lowest eigenpairs of ``K x = λ M x`` (``K``, ``M``
   symmetric, ``M`` positive): LAPACK ``eigh`` on dense matrices below
-  :data:`DENSE_EIGEN_BELOW` unknowns, else ARPACK ``eigsh`` in shift-invert mode about
-  σ = 0, reusing a given factorisation of ``K`` (``solve``) or factorising ``K`` with
+  :data:`DENSE_EIGEN_BELOW` unknowns, else shift-invert about σ = 0, by block Lanczos
+  (:mod:`femrub.fem.block_eigen`) for many modes of a large problem (from
+  :data:`BLOCK_EIGEN_MODES` modes and :data:`BLOCK_EIGEN_ABOVE` unknowns), otherwise by
+  ARPACK ``eigsh``, reusing a given factorisation of ``K`` (``solve``) or factorising ``K`` with
   :func:`~femrub.fem.linalg.sparse_lu` (Pardiso's Cholesky on large problems). Shapes are
   normalised to a unit largest amplitude, with that entry positive
   (:func:`normalise_columns`), so modal coordinates carry the units of the physical dofs and
@@ -23,7 +25,8 @@ import scipy.sparse.linalg as spla
 from threadpoolctl import threadpool_limits
 
 from .. import progress
-from .linalg import sparse_lu
+from .block_eigen import block_lowest, block_sizes
+from .linalg import PARDISO_ABOVE, sparse_lu
 
 __all__ = [
     "DENSE_EIGEN_BELOW",
@@ -39,6 +42,14 @@ __all__ = [
 DENSE_EIGEN_BELOW = 400
 #: Shift used when the stiffness is singular (free structure): σ = −1 rad²/s².
 FREE_SHIFT = -1.0
+#: Problem sizes from which block shift-invert Lanczos (:mod:`femrub.fem.block_eigen`)
+#: replaces ARPACK for :data:`BLOCK_EIGEN_MODES` modes or more: where the factorisation is
+#: Pardiso's, whose solves of a block of right-hand sides cost a small multiple of one,
+#: and ARPACK's vector-by-vector reorthogonalisation of a basis of ``2 k + 1`` vectors costs
+#: as much as its solves (docs/performance.md).
+BLOCK_EIGEN_ABOVE = PARDISO_ABOVE
+#: Fewest modes for which the block solver is used (fewer: ARPACK is as fast).
+BLOCK_EIGEN_MODES = 16
 
 
 def _dense(M) -> np.ndarray:
@@ -101,28 +112,35 @@ def lowest_modes(K, M, k: int, solve=None, *, tol: float = 1e-12, vectors: bool 
             )
         lam, V = (out, None) if not vectors else out
     else:
-        with progress.phase(f"eigen-solve: {k} lowest modes of {n} unknowns (ARPACK)"):
-            lam, V = _arpack_lowest(K, M, k, solve, tol, vectors)
+        b, _, p = block_sizes(k)
+        block = n >= BLOCK_EIGEN_ABOVE and k >= BLOCK_EIGEN_MODES and p + b <= n // 2
+        name = "block shift-invert Lanczos" if block else "ARPACK"
+        with progress.phase(f"eigen-solve: {k} lowest modes of {n} unknowns ({name})"):
+            lam, V = _shift_invert_lowest(K, M, k, solve, tol, vectors, block)
     lam = np.asarray(lam)
     return (lam, normalise_columns(V)) if vectors else lam
 
 
-def _arpack_lowest(K, M, k, solve, tol, vectors):
-    """ARPACK in shift-invert mode about σ = 0 (or :data:`FREE_SHIFT`), sorted."""
+def _shift_invert_lowest(K, M, k, solve, tol, vectors, block):
+    """Shift-invert about σ = 0 (or :data:`FREE_SHIFT` when ``K`` is singular) with
+    ``solve`` or a factorisation made here; block Lanczos (``block``) or ARPACK, sorted."""
     n = K.shape[0]
     Kc, Mc = sp.csc_matrix(K), sp.csc_matrix(M)
-    kw = dict(k=k, M=Mc, which="LM", tol=tol, return_eigenvectors=vectors)
-    if solve is not None:
-        opinv = spla.LinearOperator((n, n), matvec=solve, dtype=float)
-        out = spla.eigsh(Kc, sigma=0.0, OPinv=opinv, **kw)
-    else:
+    sigma = 0.0
+    if solve is None:
         try:
-            sigma, lu = 0.0, sparse_lu(Kc, symmetric=True, what="stiffness")
+            solve = sparse_lu(Kc, symmetric=True, what="stiffness").solve
         except ValueError:  # singular stiffness: a free structure
             sigma = FREE_SHIFT
             lu = sparse_lu(Kc - FREE_SHIFT * Mc, symmetric=True, what="shifted stiffness")
-        opinv = spla.LinearOperator((n, n), matvec=lu.solve, dtype=float)
-        out = spla.eigsh(Kc, sigma=sigma, OPinv=opinv, **kw)
+            solve = lu.solve
+    if block:
+        out = block_lowest(Kc, Mc, k, solve, tol=tol, vectors=vectors)
+        lam, V = out if vectors else (out, None)
+        return lam + sigma, V
+    opinv = spla.LinearOperator((n, n), matvec=solve, dtype=float)
+    kw = dict(k=k, M=Mc, which="LM", tol=tol, return_eigenvectors=vectors)
+    out = spla.eigsh(Kc, sigma=sigma, OPinv=opinv, **kw)
     lam, V = out if vectors else (out, None)
     order = np.argsort(lam)
     return lam[order], None if V is None else V[:, order]
