@@ -132,8 +132,10 @@ def test_blocks_run_as_python_without_jit():
     jit = json.loads(run.stdout.splitlines()[-1])
     assert not py["jit"] and jit["jit"] and py["kind"] == jit["kind"] == "friction"
     _close(np.array(py["bar"]), np.array(jit["bar"]), 1e-12)
-    _close(np.array(py["P"]), np.array(jit["P"]), 1e-9)
-    _close(np.array(py["Pt"]), np.array(jit["Pt"]), 1e-9)
+    # LLVM may contract a*b + c into one FMA on CPUs that have it (CI's did): the stick-slip
+    # trajectory of the blade carries those last-bit differences to ~1e-9 after 300 steps.
+    _close(np.array(py["P"]), np.array(jit["P"]), 1e-7)
+    _close(np.array(py["Pt"]), np.array(jit["Pt"]), 1e-7)
 
 
 def test_a_block_interrupted_or_failing_keeps_the_checked_rows(monkeypatch):
