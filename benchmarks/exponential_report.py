@@ -130,6 +130,13 @@ def markdown(doc) -> str:
                 ],
             ),
         ]
+    if doc.get("blade_friction"):
+        b = doc["blade_friction"]
+        out += [
+            f"\n## Reduced twisted NACA blade with Coulomb friction (μ = {b['mu']:g}, power "
+            f"heat), {b['t_end']} s; reference θ {b['T_ref']:.6g} K\n",
+            C.md_table(b["rows"], _FRICTION_COLS),
+        ]
     if doc.get("floor"):
         out += [
             "\n## Cost floor of the exponential stepper (CPU s, best of 5)\n",
@@ -199,6 +206,20 @@ _FLOOR_COLS = [
     ("bound", "run − steps without event"),
     ("best", "best other at 1 %"),
     ("target", "3× target"),
+]
+
+
+_FRICTION_COLS = [
+    ("method", "method"),
+    ("h", "h (s)"),
+    ("u_L2", "u L2"),
+    ("u_L2_nodes", "u L2 nodes"),
+    ("T_end", "T end"),
+    ("status", "status"),
+    ("energy_error", "energy error"),
+    ("heat_error", "heat error"),
+    ("coulomb_direction", "Coulomb direction"),
+    ("cpu", "CPU (s)"),
 ]
 
 
@@ -312,6 +333,20 @@ def section(doc) -> str:
                 _level_rows(b["rows"], ("u_L2", "u_L2_nodes", "T_end"), (0.01,), OTHERS),
                 [*cols[:3], (THETA_BLOCKS, THETA_BLOCKS), *cols[3:]],
             ),
+        ]
+    if doc.get("blade_friction"):
+        b = doc["blade_friction"]
+        exp = [r for r in b["rows"] if r["method"] == "exponential"]
+        lines += [
+            f"**Reduced twisted NACA blade with its Coulomb friction** (μ = {b['mu']:g}, "
+            f'"power" heat law, {b["n_dofs"]} coordinates, {b["t_end"]} s; every method on '
+            f"this model, θ on its compiled friction blocks; θ reference h = "
+            f"{doc['config']['blade_ref_h']:g} s, tip temperature {b['T_ref']:.6g} K; "
+            f"Carpenter's limit {b['carpenter_limit']:.3g} s).",
+            C.md_table(_level_rows(b["rows"], ("u_L2", "u_L2_nodes", "T_end"), (0.01,)), cols),
+            "Exponential runs (status, balances, and how far the fixed slip direction of held "
+            "contacts puts the recorded friction off Coulomb's direction, `1 + cos`):",
+            C.md_table(exp, _FRICTION_COLS),
         ]
     if doc.get("floor"):
         lines += [
