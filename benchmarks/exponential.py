@@ -66,6 +66,7 @@ FULL = {
     "blade_theta_block_h": (1e-4, 2e-5, 1e-5, 5e-6, 2e-6, 1e-6, 5e-7, 2.5e-7),
     "blade_carpenter_f": (0.9, 0.5, 0.2),
     "fric_theta_h": (1e-4, 2e-5, 1e-5, 5e-6, 2e-6, 1e-6, 5e-7, 2.5e-7),
+    "fric_exp_h": (2e-4, 1e-4, 5e-5, 2e-5, 1e-5, 5e-6),
     "floor_u_h": 2.5e-4,  # the exponential's coarsest step within 1 % u_L2 (paper case)
 }
 QUICK = {
@@ -86,6 +87,7 @@ QUICK = {
     "blade_theta_block_h": (),
     "blade_carpenter_f": (),
     "fric_theta_h": (),
+    "fric_exp_h": (),
     "floor_u_h": 1e-4,
 }
 
@@ -263,7 +265,7 @@ def blade_friction(cfg, log) -> dict:
         ("θ paper", cfg["fric_theta_h"], lambda h: fr.ThetaMethod(model, h)),
         ("Carpenter", tuple(f * h_lim for f in cfg["blade_carpenter_f"]),
          lambda h: fr.Carpenter(model, h)),
-        ("exponential", cfg["blade_exp_h"], lambda h: fr.ExponentialMoreau(model, h)),
+        ("exponential", cfg["fric_exp_h"], lambda h: fr.ExponentialMoreau(model, h)),
     )  # fmt: skip
     return {
         "n_dofs": model.n_dofs,
@@ -338,6 +340,9 @@ def main(argv=None) -> dict:
 
         old = json.loads(out.with_suffix(".json").read_text())
         doc = {**{k: v for k, v in old.items() if k in args.skip}, **doc}
+        # the 1-minute load (start, end) of the run each kept study was measured in
+        kept = old.get("study_load", {})
+        doc["study_load"] = {k: v for k, v in kept.items() if k in args.skip and k in doc}
     for name, fn in (
         ("accuracy", accuracy),
         ("work_precision", work_precision),
@@ -347,8 +352,10 @@ def main(argv=None) -> dict:
         ("floor", floor),
     ):
         if name not in args.skip:
+            load0 = C.machine()["load_average"]
             with threadpool_limits(limits=1, user_api="blas"):
                 doc[name] = fn(cfg, log)
+            doc.setdefault("study_load", {})[name] = [load0, C.machine()["load_average"]]
     doc["machine"]["load_average_end"] = C.machine()["load_average"]
     out.parent.mkdir(parents=True, exist_ok=True)
     C.write_json(out.with_suffix(".json"), doc)
