@@ -14,8 +14,10 @@ Four studies, one command (``python benchmarks/exponential.py [--quick]``):
   error against the exact solution at the run's output times;
 * ``blade``: the reduced twisted NACA blade scene (``twisted-naca``), short window, against a
   fine θ-method step; its Coulomb friction replaced by the α law of the same heat at full slip
-  (``α = η μ Ω r_tip``), since the exponential stepper is frictionless (every method runs this
-  same model).
+  (``α = η μ Ω r_tip``) for every method (the comparison made before the exponential stepper
+  had friction, kept);
+* ``blade_friction``: the same scene with its Coulomb friction and "power" heat law, every
+  method (θ on its compiled friction blocks, Carpenter, exponential) against a fine θ step.
 
 Every method runs with one BLAS thread (``threadpoolctl``): on these small dense systems more
 threads only add spinning worker threads to the process's CPU time.
@@ -63,6 +65,8 @@ FULL = {
     # θ on its compiled friction blocks (μ = 1e-9: no compiled frictionless multi-contact path)
     "blade_theta_block_h": (1e-4, 2e-5, 1e-5, 5e-6, 2e-6, 1e-6, 5e-7, 2.5e-7),
     "blade_carpenter_f": (0.9, 0.5, 0.2),
+    "fric_theta_h": (1e-4, 2e-5, 1e-5, 5e-6, 2e-6, 1e-6, 5e-7, 2.5e-7),
+    "fric_exp_h": (2e-4, 1e-4, 5e-5, 2e-5, 1e-5, 5e-6),
     "floor_u_h": 2.5e-4,  # the exponential's coarsest step within 1 % u_L2 (paper case)
 }
 QUICK = {
@@ -82,6 +86,8 @@ QUICK = {
     "blade_exp_h": (),
     "blade_theta_block_h": (),
     "blade_carpenter_f": (),
+    "fric_theta_h": (),
+    "fric_exp_h": (),
     "floor_u_h": 1e-4,
 }
 
@@ -224,13 +230,60 @@ def blade(cfg, log) -> dict:
     h_lim = fr.Carpenter(model, 1e-9).stability_limit()
     carpenter_h = tuple(f * h_lim for f in cfg["blade_carpenter_f"])
     log(f"blade: Carpenter stability limit {h_lim:.3g} s")
-    rows = []
-    for name, hs, make in (
+    runs = (
         ("θ paper", cfg["blade_theta_h"], lambda h: fr.ThetaMethod(model, h)),
         (THETA_BLOCKS, cfg["blade_theta_block_h"], lambda h: fr.ThetaMethod(blocks, h)),
         ("Carpenter", carpenter_h, lambda h: fr.Carpenter(model, h)),
         ("exponential", cfg["blade_exp_h"], lambda h: fr.ExponentialMoreau(model, h)),
-    ):
+    )
+    return {
+        "n_dofs": model.n_dofs,
+        "t_end": T,
+        "ref_cpu": ref_cpu,
+        "carpenter_limit": h_lim,
+        "rows": _blade_rows(runs, T, t_ref, u_ref, T_ref, log),
+    }
+
+
+def blade_friction(cfg, log) -> dict:
+    """The reduced twisted NACA blade with its Coulomb friction ("power" heat), every method
+    on that model, against a fine θ step (its compiled friction blocks)."""
+    if not cfg["blade_t"]:
+        return {}
+    from femrub.app.simulation import Simulation
+    from femrub.scene import load_scene
+
+    scene = load_scene("twisted-naca", {"outputs.vtk_stride": 0})
+    model, T = Simulation.from_scene(scene).model, cfg["blade_t"]
+    c = model.contact
+    ref_res, ref_cpu = _run(lambda: fr.ThetaMethod(model, cfg["blade_ref_h"]), T, energy=False)
+    t_ref, u_ref = ref_res.t, ref_res.signal("tip_displacement")
+    T_ref = ref_res.signals["tip_temperature"][-1, 0]
+    log(f"blade friction: μ = {c.friction}, reference θ ({ref_cpu:.1f} s), T {T_ref:.6g} K")
+    h_lim = fr.Carpenter(model, 1e-9).stability_limit()
+    runs = (
+        ("θ paper", cfg["fric_theta_h"], lambda h: fr.ThetaMethod(model, h)),
+        ("Carpenter", tuple(f * h_lim for f in cfg["blade_carpenter_f"]),
+         lambda h: fr.Carpenter(model, h)),
+        ("exponential", cfg["fric_exp_h"], lambda h: fr.ExponentialMoreau(model, h)),
+    )  # fmt: skip
+    return {
+        "n_dofs": model.n_dofs,
+        "t_end": T,
+        "mu": float(np.max(c.friction)),
+        "ref_cpu": ref_cpu,
+        "T_ref": float(T_ref),
+        "carpenter_limit": h_lim,
+        "rows": _blade_rows(runs, T, t_ref, u_ref, T_ref, log),
+    }
+
+
+def _blade_rows(runs, T, t_ref, u_ref, T_ref, log) -> list[dict]:
+    """Errors and CPU of ``runs`` ((method, steps, make), ...) against the reference."""
+    from femrub.contact.friction import coulomb_check
+
+    rows = []
+    for name, hs, make in runs:
         for h in hs:
             res, cpu = _run(lambda h=h, make=make: make(h), T)
             u = res.signal("tip_displacement")
@@ -249,18 +302,20 @@ def blade(cfg, log) -> dict:
                 "u_L2_nodes": _nodal_l2(res.t, u, t_ref, u_ref),
                 "T_end": abs(Th - T_ref) / abs(T_ref),
                 "min_gap": float(res.gap.min()),
+                "energy_error": float(res.energy_error()),
+                "heat_error": float(res.heat_error()),
             }
+            if res.friction_limit is not None and np.any(res.friction_limit > 0):
+                ch = coulomb_check(res.force, res.friction_force, res.slip_velocity,
+                                   res.contact_state, res.friction_limit)  # fmt: skip
+                row["coulomb_direction"] = ch["direction"]
+                row["coulomb_sliding"] = ch["slip_equality"]
             rows.append(row)
             log(
-                f"blade {name} h={h:g}: u_L2 {row['u_L2']:.3g} T_end {row['T_end']:.3g} {cpu:.2f} s"
+                f"blade {name} h={h:g}: u_L2 {row['u_L2']:.3g} T_end {row['T_end']:.3g} "
+                f"{cpu:.2f} s {res.status}"
             )
-    return {
-        "n_dofs": model.n_dofs,
-        "t_end": T,
-        "ref_cpu": ref_cpu,
-        "carpenter_limit": h_lim,
-        "rows": rows,
-    }
+    return rows
 
 
 def main(argv=None) -> dict:
@@ -285,16 +340,22 @@ def main(argv=None) -> dict:
 
         old = json.loads(out.with_suffix(".json").read_text())
         doc = {**{k: v for k, v in old.items() if k in args.skip}, **doc}
+        # the 1-minute load (start, end) of the run each kept study was measured in
+        kept = old.get("study_load", {})
+        doc["study_load"] = {k: v for k, v in kept.items() if k in args.skip and k in doc}
     for name, fn in (
         ("accuracy", accuracy),
         ("work_precision", work_precision),
         ("impact", impact),
         ("blade", blade),
+        ("blade_friction", blade_friction),
         ("floor", floor),
     ):
         if name not in args.skip:
+            load0 = C.machine()["load_average"]
             with threadpool_limits(limits=1, user_api="blas"):
                 doc[name] = fn(cfg, log)
+            doc.setdefault("study_load", {})[name] = [load0, C.machine()["load_average"]]
     doc["machine"]["load_average_end"] = C.machine()["load_average"]
     out.parent.mkdir(parents=True, exist_ok=True)
     C.write_json(out.with_suffix(".json"), doc)

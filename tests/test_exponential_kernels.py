@@ -108,13 +108,13 @@ def test_flight_reads_state_integrals_and_grid_off_one_product():
     F, u = rng.standard_normal((3 + 2 * 4 + 2 + 2 * 2, 4)), rng.standard_normal(4)
     act, works = np.array([1, 3]), np.zeros(6)
     k = 3 + 2 * 4 + 2
-    g0 = np.full((2, 1), 10.0)
-    y, V, calm = flight(F, u, k, 1, g0, np.zeros(1, dtype=np.bool_), 3, act, True, works)
+    g0, off = np.full((2, 1), 10.0), np.array([0.5])
+    y, V, calm = flight(F, u, k, 1, g0, off, np.zeros(1, dtype=np.bool_), 3, act, True, works)
     ref = F @ u
     assert y[:k] == pytest.approx(ref[:k])  # (the rows past k: V, maybe shared)
     assert works[1] == pytest.approx(ref[3:7] @ u) and works[3] == pytest.approx(ref[7:11] @ u)
     assert works[4:] == pytest.approx(ref[11:13]) and works[0] == works[2] == 0.0
-    assert V == pytest.approx(ref[k:].reshape(2, 2) + np.c_[g0, np.zeros(2)])
+    assert V == pytest.approx(ref[k:].reshape(2, 2) + np.c_[g0, np.full(2, 0.5)])
     assert calm == quiet(V, 1, np.zeros(1, dtype=np.bool_))
 
 

@@ -22,8 +22,10 @@ dissipation::
 
     ΔW_c,t = ΔW_casing − ΔW_friction,   ΔW_casing = P_t · v_c,   ΔW_friction = −P_t · w_t,m
 
-(``w_t,m = Gvtᵀ X_m − v_c``, the mid-step slip velocity). ``friction_heat`` is then the heat
-the stepper put into the blade and ``heat_to_casing = friction_work − friction_heat``.
+(``w_t,m = Gvtᵀ X_m − v_c``, the mid-step slip velocity; a scheme that integrates the
+tangential work ``∫ λ_t · Gvtᵀ X dt`` itself hands it as ``tangential_work``).
+``friction_heat`` is then the heat the stepper put into the blade and
+``heat_to_casing = friction_work − friction_heat``.
 """
 
 from __future__ import annotations
@@ -44,6 +46,7 @@ SCHEME_INTEGRALS = (
     "damping_work",
     "heat_load",
     "heat_outflow",
+    "tangential_work",
 )
 
 # a balance residual this many times the energy exchanged so far is created from nothing
@@ -142,8 +145,10 @@ class EnergyMeter:
             if friction is not None:
                 Pt, heat = friction
                 if Pt.shape[1]:
-                    vt = (Xm @ c.Gvt).reshape(Pt.shape)
-                    wt = np.einsum("kij,kij->k", Pt, vt)
+                    wt = own.get("tangential_work")
+                    if wt is None:  # P_t · Gvtᵀ X_m
+                        vt = (Xm @ c.Gvt).reshape(Pt.shape)
+                        wt = np.einsum("kij,kij->k", Pt, vt)
                     inc["contact_work"] = dwc + wt
                     inc["casing_work"] = np.einsum("kij,ij->k", Pt, c.casing_velocity)
                     inc["friction_work"] = inc["casing_work"] - wt

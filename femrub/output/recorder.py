@@ -37,13 +37,18 @@ from .limits import limit_index as _limit_index
 from .results import Results
 from .state import State
 
-__all__ = ["CHUNK_STEPS", "CHUNK_VALUES", "Recorder", "State"]
+__all__ = ["CHUNK_STEPS", "CHUNK_VALUES", "Recorder", "State", "StepRefused"]
 
 # steps post-processed together: long enough for efficient row products, short enough that
 # a blow-up is reported soon after it starts
 CHUNK_STEPS = 512
 # largest number of state values buffered per chunk (16 MB of float64) on large models
 CHUNK_VALUES = 2_000_000
+
+
+class StepRefused(ValueError):
+    """A stepper cannot go on (its model of the contact no longer applies): the run ends
+    ``failed`` with this message, the steps before it kept."""
 
 
 class _Stop(Exception):
@@ -173,6 +178,9 @@ class Recorder:
                         except (FloatingPointError, ArithmeticError) as exc:
                             i_end = self._flush(i0, j)
                             raise _Stop("unstable", f"{type(exc).__name__}: {exc}", i_end) from None
+                        except StepRefused as exc:
+                            i_end = self._flush(i0, j)
+                            raise _Stop("failed", f"{self.scheme}: {exc}", i_end) from None
                         j += 1
                         buf[j], t[i] = X, ti
                         if nc:

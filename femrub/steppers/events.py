@@ -1,9 +1,11 @@
 """Contact events inside a step of the exponential stepper, located on its exact flows.
 
-The exact gaps ``g = g0(t) + Gᵀ X`` and the multipliers ``λ_S`` of held contacts are checked on
+The exact gaps ``g = g0(t) + Gᵀ X``, the multipliers ``λ_S`` of held contacts and the slips of
+held contacts sliding with friction (:mod:`~.exponential_friction`) are checked on
 a grid of ``probes`` points per step (probe rows: one product per step,
 :meth:`~femrub.steppers.flows.FlowFamily.probe`); at the first sign change of a gap below
-``min(g(a), 0)`` (a closing) or of a multiplier (a release) the time is found on the exact
+``min(g(a), 0)`` (a closing), of a multiplier (a release) or of a slip (a stick) the time is
+found on the exact
 flow by :func:`~femrub.steppers.flows.first_zero` (cubic Hermite start, safeguarded Newton),
 each evaluation composed of cached sub-step flows from the latest state computed before it
 (:meth:`~femrub.steppers.flows.FlowFamily.advance_z`). Event times are exact to ``1e-10 h``.
@@ -63,18 +65,25 @@ class EventLocation:
                 return c.gap(t + tau, X)[i] - ref, rate + c.GT[i] @ dX
 
             cand.append((1 + int(np.argmax(f_cl[1:, i] < 0.0)), "closing", int(i), f))
+        slides = flows.sliding(S)
         for k in np.flatnonzero(np.any(lv < 0.0, axis=0)):
             j = int(np.argmax(lv[:, k] < 0.0))
-            if j == 0:  # pulled away already: release now
-                return a, "release", S[k], Xa, np.zeros(n_s)
+            i = S[k] if k < n_s else slides[k - n_s]  # a multiplier, or a slip (stick)
+            kind = "release" if k < n_s else "stick"
+            if j == 0:  # pulled away (or stopped sliding) already: now
+                return a, kind, i, Xa, np.zeros(n_s)
 
             def f(tau, X, k=k):
-                u, du = self._u(b, tau / h), self._du(b, tau / h)
+                u = self._u(b, tau / h)
+                if k >= n_s:  # the slip σ = R_σ X + σ0 of a sliding held contact
+                    r = flows.slip[0][slides[k - n_s]]
+                    return r @ X + flows.slip[1][slides[k - n_s]], r @ flows.rate(S, X, u)
+                du = self._du(b, tau / h)
                 lx, lu = lam[k, :c_n], lam[k, c_n:]
                 val = lx @ X + (lu @ u if lu.size else 0.0)
                 return val, lx @ flows.rate(S, X, u) + (lu @ du if lu.size else 0.0)
 
-            cand.append((j, "release", S[k], f))
+            cand.append((j, kind, i, f))
         if not cand:
             return None
         j = min(x[0] for x in cand)
@@ -104,9 +113,17 @@ class EventLocation:
         c, h, t, flows, q = self.model.contact, self.h, self.t, self._flows, self.probes
         n_s, d = len(S), h / self.probes
 
+        slides = flows.sliding(S)
+
         def values(tau, X):
             g = c.gap(t + tau, X)
-            return np.concatenate([g, flows.multiplier(S, X, self._u(b, tau / h))]) if S else g
+            if not S:
+                return g
+            lam = flows.multiplier(S, X, self._u(b, tau / h))
+            if not slides:
+                return np.concatenate([g, lam])
+            sig = flows.slip[0][list(slides)] @ X + flows.slip[1][list(slides)]
+            return np.concatenate([g, lam, sig])
 
         # grid: a, the next multiples of d, h; rows of gaps and multipliers on it (blocks)
         grid, rows, states = [[a]], [values(a, Xa)[None]], {0: (Xa, np.zeros(n_s))}
@@ -133,6 +150,8 @@ class EventLocation:
                 V = V.reshape(nj, r)
                 taus = start + d * np.arange(1, nj + 1)
                 V[:, : c.n] += c.gap_at(t + taus) if callable(c.gap0) else c.gap0
+                if slides:
+                    V[:, c.n :] += flows.check_offsets(S)
                 grid.append(taus)
                 rows.append(V)
         grid.append([h])

@@ -28,12 +28,17 @@ heat integrated exactly, until ``λ`` vanishes (located the same way). Without e
 after :data:`MAX_EVENTS` in a step, impulses are given at the step end on penetrating,
 approaching contacts (velocity-level Moreau) and releases happen at step ends.
 
+Coulomb friction (:mod:`~.exponential_friction`): the impulses solve Signorini–Coulomb with
+Newton's law (the θ-method's solve); held contacts slide along the casing's direction, their
+slip checked like a multiplier (a stick ends the hold).
+
 Dense: at most :data:`MAX_COORDINATES` coordinates (reduce larger models first).
 """
 
 from __future__ import annotations
 
 import math
+from types import SimpleNamespace
 
 import numpy as np
 
@@ -41,9 +46,11 @@ from ..contact.impulses import solve_impulses
 from ..fem.linalg import Factorised
 from .base import Stepper
 from .events import EventLocation
+from .exponential_friction import FrictionalContact
 from .exponential_kernels import flight, warm_up
+from .exponential_loads import LoadPolynomial
 from .flows import FlowFamily
-from .work import WorkIntegrals
+from .work import METER_ORDER, NQ, WorkIntegrals
 
 __all__ = ["ExponentialMoreau", "MAX_COORDINATES"]
 
@@ -57,7 +64,7 @@ MAX_PROBES = 512
 ZENO_HITS = 3
 
 
-class ExponentialMoreau(EventLocation, Stepper):
+class ExponentialMoreau(EventLocation, FrictionalContact, LoadPolynomial, Stepper):
     """Exact-in-time Moreau stepper for moderate-size models (see module docstring).
 
     Parameters
@@ -94,12 +101,6 @@ class ExponentialMoreau(EventLocation, Stepper):
                 f"the exponential stepper is dense: the model has {n} coordinates "
                 f"(> {MAX_COORDINATES}); reduce it first (scene: reduction.method = "
                 "'craig-bampton'; API: ThermoelasticCraigBampton(model, ...).reduce())"
-            )
-        c = getattr(model, "contact", None)
-        if c is not None and c.has_friction:
-            raise ValueError(
-                "the exponential stepper has no Coulomb friction yet; use scheme.name = "
-                "'theta' or 'carpenter', or contact.friction = 0"
             )
         if not isinstance(events, bool):
             raise ValueError(f"events must be true or false, got {events!r}")
@@ -138,18 +139,21 @@ class ExponentialMoreau(EventLocation, Stepper):
             # held contacts need a constant α and the casing's motion (fixed, or ġ0 known)
             moving = callable(c.gap0) or c.gap_rate is not None
             self._hold = not callable(c.heat_coefficient) and (not moving or c.gap_rate is not None)
-            if self._hold:
+            self._friction_setup(lu)
+            if self._fric:  # held contacts slide: constant columns (or none)
+                AinvH = self._held_columns(lu)
+                self._hold = self._hold and AinvH is not None
+            elif self._hold:
                 AinvH = self._Zm + self._Zt * c.heat_coefficient
+            if self._hold:
                 self._n_a = c.n if moving else 0
         self._m0 = len(self._signals)
         G = np.hstack([G, np.zeros((m.n_dofs, self._n_a))])
         p = self.load_degree if G.shape[1] else 0
-        self._nodes = 0.5 * (1.0 - np.cos(np.pi * np.arange(p + 1) / max(p, 1)))  # Lobatto
-        self._Vinv = np.linalg.inv(self._nodes[:, None] ** np.arange(p + 1))
-        self._T01 = np.diag([float(math.factorial(i)) for i in range(p + 1)])
-        self._Dinv = np.linalg.inv(self._T01)
-        self._sk = self._signal_values(self.t)
+        self._loads_setup(p)
         self._flows = FlowFamily(L, G, AinvH, GvT, h, p, n_acc=self._n_a)
+        if self._fric and self._hold:
+            self._flows.slip = self._slip
         self._flows.flow((), h)  # the free step: one augmented exponential
         if self.probes is None:  # four checks per shortest period of the model
             w_max = float(np.max(np.abs(np.linalg.eigvals(L).imag), initial=0.0))
@@ -159,56 +163,31 @@ class ExponentialMoreau(EventLocation, Stepper):
         self._warm = None
         self._work = 0.0
         # exact works and heats of the energy balance (with run(energy=True))
-        self._integrals = self._Wth = None
+        self._integrals = self._Wth = self._rest = None
+        held_f = self._fric and self._hold  # held contacts' tangential work and heat rest
+        tang, rest = (self._T, self._rest_rows) if held_f else (None, None)
+        powers = (
+            np.column_stack([term.power for term in m.loads])
+            if m.loads
+            else np.zeros((m.n_dofs, 0))
+        )
         if m.energy is not None:
-            powers = (
-                np.column_stack([term.power for term in m.loads])
-                if m.loads
-                else np.zeros((m.n_dofs, 0))
-            )
             heats = [term.heat for term in m.loads]
-            self._integrals = WorkIntegrals(self._flows, m.energy, powers, heats, GvT)
+            self._integrals = WorkIntegrals(
+                self._flows, m.energy, powers, heats, GvT, tangential=tang, rest_heat=rest
+            )
             self._Wth = None if m.energy.Wth is None else self._integrals.Wth
+        if rest is not None:  # the heat rest moves the state: integrated in every run
+            zero = np.zeros((m.n_dofs, m.n_dofs))
+            forms = SimpleNamespace(Pth=zero, Wth=None, Pd=zero, heat_outflow=zero[0])
+            self._rest = WorkIntegrals(
+                self._flows, forms, 0 * powers, np.zeros(powers.shape[1]), rest_heat=rest
+            )
         self._measure = False  # step() / iterate(): no meter to hand them to
         self._fused: dict[tuple, tuple] = {}  # (S, measure) -> whole-step matrix (_flight)
         self._probe_rows: dict[tuple, np.ndarray] = {}  # the check grids' rows (events)
         self._masks: dict[tuple, np.ndarray] = {}  # held sets as masks
         self._g0grid = None  # a fixed casing's gaps on the check grid
-
-    def _signal_values(self, t):
-        """Load signals, then the casing's gap rates ``ġ0`` (moving casing, held contacts)."""
-        s = [float(sig(t)) for sig in self._signals]
-        if self._n_a:
-            return np.r_[s, self.model.contact.rate_at(t)]
-        return np.array(s)
-
-    def _load_poly(self, t):
-        """Monomial coefficients ``b`` (p+1, m) of the step's load, ``s = Σ b_i σ^i``."""
-        h, nodes = self.h, self._nodes
-        S = np.empty((nodes.size, self._m0 + self._n_a))
-        S[0] = self._sk
-        times = t + nodes[1:] * h
-        for k, sig in enumerate(self._signals):
-            S[1:, k] = [sig(tj) for tj in times]
-        if self._n_a:
-            S[1:, self._m0 :] = self.model.contact.rate_at(times)
-        self._sk = S[-1]
-        b = self._Vinv @ S
-        if self._n_a:  # g̈0 = dġ0/dt: the derivative of the rates' interpolant
-            i = np.arange(1, b.shape[0])[:, None]
-            rates = b[:, self._m0 :].copy()
-            b[:, self._m0 :] = 0.0
-            b[:-1, self._m0 :] = i * rates[1:] / h
-        return b
-
-    def _u(self, b, sigma):
-        """Load signals at the fraction ``sigma`` of the step."""
-        return (sigma ** np.arange(b.shape[0])) @ b
-
-    def _du(self, b, sigma):
-        """Their time derivative (1/s) at the fraction ``sigma`` of the step."""
-        i = np.arange(1, b.shape[0])
-        return ((i * sigma ** (i - 1)) @ b[1:]) / self.h
 
     # -- one step ------------------------------------------------------------------------------
     def run(self, t_end, *, energy: bool = True, **kwargs):
@@ -224,9 +203,22 @@ class ExponentialMoreau(EventLocation, Stepper):
         t, X, P, extra = super()._advance()
         out = {**(extra or {}), "contact_work": self._work}
         if self._measure:  # the scheme's exact integrals replace the meter's quadrature
-            out["works"] = self._w  # SCHEME_INTEGRALS order, impulses' work added below
+            out["works"] = self._w[METER_ORDER]  # SCHEME_INTEGRALS order, impulses' work added
             out["works"][0] += self._work
+            out["works"][6] += self._work_t
         return t, X, P, out
+
+    def _integ(self, S):
+        """The work integrals the flight of ``S`` needs: all of them with the energy balance,
+        the held heat rest of sliding contacts (it moves the state), or none."""
+        if self._measure:
+            return self._integrals
+        return self._rest if self._rest is not None and self._flows.sliding(S) else None
+
+    def _jump(self, X, Xn) -> None:
+        """A jump of the state (impulse, heat): a reduced model's expansion shapes' work."""
+        if self._measure and self._Wth is not None:
+            self._w[2] += float((Xn - X) @ self._Wth @ (Xn + X)) / 2
 
     def _step(self):
         h, t, c = self.h, self.t, self.model.contact
@@ -234,19 +226,21 @@ class ExponentialMoreau(EventLocation, Stepper):
         X, S, a = self.X, self._S, 0.0
         P = np.zeros(self.model.n_contacts)
         hits = np.zeros(self.model.n_contacts, dtype=int)
-        self._work = 0.0
-        self._w = np.zeros(6)
+        self._work = self._work_t = 0.0
+        self._w = np.zeros(NQ + 2)
+        if self._fric:
+            self._friction_step_start()
         for n_events in range(MAX_EVENTS + 1):
             rest = V = None  # the flight's integrals to the step end and its check grid
             calm = False  # a whole step whose check grid shows no event
             if a == 0.0:  # the whole step, its integrals and check grid in one product
                 Xe, PS, rest, V, calm = self._flight(S, X, b)
-            elif self._measure:  # after an event: the flight and its integrals at once
+            elif self._integ(S) is not None:  # after an event: flight and integrals at once
                 Xe, PS, rest = self._integrate(S, X, a, h, b, state=True)
             else:  # after an event: cached sub-step flows
                 Xe, PS = self._flows.advance(S, X, a, h, b, h / self.probes)
             if c is None:
-                self._w += self._integrate(S, X, a, h, b) if rest is None else rest
+                self._add(self._integrate(S, X, a, h, b) if rest is None else rest)
                 return Xe, P
             ev = None
             if self.events and n_events < MAX_EVENTS and not calm:
@@ -254,23 +248,38 @@ class ExponentialMoreau(EventLocation, Stepper):
             if ev is None:
                 break
             tau, kind, i, Xn, PSa = ev
-            self._w += self._integrate(S, X, a, tau, b)
+            w = self._add(self._integrate(S, X, a, tau, b))
             a, X = tau, Xn
             P[list(S)] += PSa
+            if self._fric:
+                X = self._held_segment(S, PSa, w, X)
+            if kind == "stick":
+                self._refuse_stick(i, t + a, X)
             if kind == "release":
                 S = tuple(j for j in S if j != i)
             else:  # a third bounce of one contact in a step: Zeno, end it plastically
                 hits[i] += 1
                 X, S = self._impact(t + a, X, S, P, forced=i, plastic=hits >= ZENO_HITS)
-        self._w += self._integrate(S, X, a, h, b) if rest is None else rest
+        w = self._add(self._integrate(S, X, a, h, b) if rest is None else rest)
         X = Xe
         P[list(S)] += PS
-        if S and not self.events:  # releases at step ends
+        if self._fric:
+            X = self._held_segment(S, PS, w, X)
+        if S and not self.events:  # releases (and stops of sliding) at step ends
             lam = self._flows.multiplier(S, X, self._u(b, 1.0))
             S = tuple(j for j, lj in zip(S, lam) if lj > 0.0)
+            for j in S:
+                if not self._still_sliding(j, X):
+                    self._refuse_stick(j, t + h, X)
         X, S = self._impact(t + h, X, S, P)
         self._S = S
-        return X, P
+        return (X, P, self._friction_extra(S)) if self._fric else (X, P)
+
+    def _add(self, w):
+        """Add a flight segment's integrals (or ``None``) to the step's; return them."""
+        if w is not None:
+            self._w += w
+        return w
 
     def _flight(self, S, X, b):
         """The exact flight of ``S`` over the whole step from ``X`` with the load polynomial
@@ -281,25 +290,27 @@ class ExponentialMoreau(EventLocation, Stepper):
         gaps) when events are located and whether it shows no event (:meth:`_quiet`)."""
         key = (S, self._measure)
         q, n, nz = self.probes, self.model.n_dofs, self.model.n_dofs + len(S)
-        c = self.model.contact
+        c, integ = self.model.contact, self._integ(S)
         if key not in self._fused:
             f = self._flows.flow(S, self.h)
             act = np.zeros(0, dtype=np.int64)
-            if self._measure:
-                F, act = self._integrals.flight_matrix(S, q, self.h / q)[:2]
+            if integ is not None:
+                F, act = integ.flight_matrix(S, q, self.h / q)[:2]
             else:
                 F = np.hstack([f.Phi, f.Psi])
             k = F.shape[0]  # the rows past k: the check grid
             if self.events and c is not None:
                 F = np.vstack([F, self._grid_rows(S, f)])
-            self._fused[key] = (np.ascontiguousarray(F), k, np.asarray(act, dtype=np.int64))
-        F, k, act = self._fused[key]
+            off = self._flows.check_offsets(S) if self.events else np.zeros(0)
+            act = np.asarray(act, dtype=np.int64)
+            self._fused[key] = (np.ascontiguousarray(F), k, act, np.ascontiguousarray(off))
+        F, k, act, off = self._fused[key]
         u = np.concatenate([X, (self._T01 @ b).ravel()])
-        works = np.zeros(6)
+        works = np.zeros(NQ + 2)
         y, V, calm = flight(
-            F, u, k, q, self._gap_grid(), self._held(S), nz, act, self._measure, works
+            F, u, k, q, self._gap_grid(), off, self._held(S), nz, act, integ is not None, works
         )
-        rest = works if self._measure else None
+        rest = works if integ is not None else None
         return y[:n], y[n:nz], rest, (V if V.size else None), calm
 
     def _held(self, S) -> np.ndarray:
@@ -326,21 +337,26 @@ class ExponentialMoreau(EventLocation, Stepper):
         (:class:`~.work.WorkIntegrals`; held contacts' work included); with ``state`` also
         the flight itself, ``(X(τ), P_S, integrals)`` (composed as
         :meth:`~.flows.FlowFamily.advance`)."""
+        integ = self._integ(S)
+        if integ is None or (tau <= a and not state):
+            return None
         z = np.concatenate([X, np.zeros(len(S)), self._flows.chain(b, a / self.h)])
         unit = self.h / self.probes
         if state:
-            z, w = self._integrals.over(S, z, tau - a, unit, state=True)
+            z, w = integ.over(S, z, tau - a, unit, state=True)
             n = self.model.n_dofs
             return z[:n], z[n : n + len(S)], w
-        if not self._measure or tau <= a:
-            return 0.0
         if a == 0.0 and tau == self.h:
-            return self._integrals.step(S, z, self.probes, unit)
-        return self._integrals.over(S, z, tau - a, unit)
+            return integ.step(S, z, self.probes, unit)
+        return integ.over(S, z, tau - a, unit)
 
     # -- impulses ------------------------------------------------------------------------------
     def _impact(self, te, X, S, P, forced=None, plastic=None):
-        """Newton impulses at time ``te`` (shared LCP); update ``P`` in place; new held set."""
+        """Newton impulses at time ``te`` (shared LCP; with friction
+        :meth:`~.exponential_friction.FrictionalContact._impact_friction`); update ``P`` in
+        place; new held set."""
+        if self._fric:
+            return self._impact_friction(te, X, S, P, forced, plastic)
         c = self.model.contact
         touch = c.gap(te, X) <= 0.0
         touch[list(S)] = False
@@ -364,8 +380,7 @@ class ExponentialMoreau(EventLocation, Stepper):
         self._warm = Pi > 0.0
         Xn = X + (self._Zm + self._Zt * alpha) @ Pi
         self._work += float(Pi @ (c.structure_velocity(X) + c.structure_velocity(Xn))) / 2
-        if self._measure and self._Wth is not None:  # a reduced model's expansion shapes jump
-            self._w[2] += float((Xn - X) @ self._Wth @ (Xn + X)) / 2
+        self._jump(X, Xn)
         P += Pi
         if not self._hold:
             return Xn, ()

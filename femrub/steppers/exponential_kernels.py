@@ -125,21 +125,23 @@ def double_integrals(g, j, Z, flush):
 
 @njit
 def form_values(y, u, nz, act, out):
-    """The integrals of a whole step into ``out`` (6,) from ``y = F u``
-    (:meth:`~.work.WorkIntegrals.flight_matrix`): the quadratic forms ``uᵀ (EᵀΓE)_f u`` of the
-    non-zero forms ``act`` (rows ``nz + f len(u)`` on), then the two heats as read."""
+    """The integrals of a whole step into ``out`` (quadratic forms, then two heats) from
+    ``y = F u`` (:meth:`~.work.WorkIntegrals.flight_matrix`): the quadratic forms
+    ``uᵀ (EᵀΓE)_f u`` of the non-zero forms ``act`` (rows ``nz + f len(u)`` on), then the
+    two heats as read (the last two entries of ``out``)."""
     nu = u.size
     for f in range(act.size):
         out[act[f]] = y[nz + f * nu : nz + (f + 1) * nu] @ u
     kn = act.size * nu
-    out[4] = y[nz + kn]
-    out[5] = y[nz + kn + 1]
+    out[out.size - 2] = y[nz + kn]
+    out[out.size - 1] = y[nz + kn + 1]
 
 
 @njit
 def quiet(V, n_c, held):
-    """No event on the check grid ``V`` (q + 1, n_c + s) of exact gaps, then held multipliers:
-    no free gap falls below ``min(g(0), 0)`` and no held multiplier is negative."""
+    """No event on the check grid ``V`` (q + 1, n_c + r) of exact gaps, then held multipliers
+    and slips: no free gap falls below ``min(g(0), 0)`` and no held multiplier or slip is
+    negative."""
     for i in range(n_c):
         if held[i]:
             continue
@@ -155,11 +157,12 @@ def quiet(V, n_c, held):
 
 
 @njit
-def flight(F, u, k, q, gap0, held, nz, act, measure, works):
+def flight(F, u, k, q, gap0, off, held, nz, act, measure, works):
     """A whole step's exact flight in one product ``y = F u`` (``F``: the state rows, the
     integrals' rows with ``measure``, then from row ``k`` the check grid's rows): the
     integrals into ``works`` (:func:`form_values`), the check grid ``V`` (q + 1, r) with the
-    casing's gaps ``gap0`` (q + 1, n_c) added, and whether the step is :func:`quiet`.
+    casing's gaps ``gap0`` (q + 1, n_c) added to its first columns and the constants ``off``
+    (r − n_c,) to the others (held slips), and whether the step is :func:`quiet`.
     Returns ``(y, V, quiet)`` (``V``: ``y``'s rows past ``k``, which may share its memory; empty
     and quiet without grid rows)."""
     y = F @ u
@@ -170,6 +173,8 @@ def flight(F, u, k, q, gap0, held, nz, act, measure, works):
     V = np.ascontiguousarray(y[k:]).reshape(q + 1, (y.size - k) // (q + 1))
     n_c = gap0.shape[1]
     V[:, :n_c] += gap0
+    if off.size:
+        V[:, n_c:] += off
     return y, V, quiet(V, n_c, held)
 
 
@@ -182,5 +187,6 @@ def warm_up() -> None:
     compose(Z, np.zeros(2), 1)
     compose_integrals(np.zeros((2, 6, 2)), np.zeros(2), 1, 0, 1)
     double_integrals(np.zeros((1, 2, 2)), np.zeros((2, 2)), Z, 1e-150)
-    act, held, w = np.zeros(1, dtype=np.int64), np.zeros(1, dtype=np.bool_), np.zeros(6)
-    flight(np.zeros((10, 2)), np.zeros(2), 6, 1, np.zeros((2, 1)), held, 2, act, True, w)
+    act, held, w = np.zeros(1, dtype=np.int64), np.zeros(1, dtype=np.bool_), np.zeros(8)
+    off = np.zeros(0)
+    flight(np.zeros((10, 2)), np.zeros(2), 6, 1, np.zeros((2, 1)), off, held, 2, act, True, w)

@@ -22,7 +22,10 @@ so the held flow is again linear, ``Ẋ = Π (L X + G s)`` with ``Π = I − A�
 and its impulse ``P_S = ∫ λ_S dt`` is integrated exactly by appending ``P_S`` to the state
 (``K = [[ΠL, 0], [Λx, 0]]``, ``E = [[ΠG], [Λs]]``). ``S = ()`` is the free flow. On a
 moving casing the held contacts keep ``ġ = ġ0(t) + Gvᵀ X = 0`` and ``λ_S`` gets
-``−W_S⁻¹ g̈0_S(t)``: the casing's accelerations are extra inputs (``n_acc``).
+``−W_S⁻¹ g̈0_S(t)``: the casing's accelerations are extra inputs (``n_acc``). A held contact
+sliding with Coulomb friction along a fixed direction has its tangential force in its column
+``H_S`` (:mod:`~.exponential_friction`); its slip along that direction, ``σ = R_σ X + σ0``,
+is checked with the multipliers (:attr:`FlowFamily.slip`: rows after ``λ_S``, must stay > 0).
 
 Event times are found on these flows by :func:`first_zero` (safeguarded Newton), the states
 at arbitrary times by :meth:`FlowFamily.advance` (cached dyadic sub-step flows).
@@ -123,6 +126,20 @@ class FlowFamily:
         self._flows: dict[tuple, Flow] = {}  # (S, τ) -> Flow
         self._probe: dict[tuple, tuple] = {}
         self._levels: dict[tuple, list] = {}
+        #: ``(R_σ (n_c, N), σ0 (n_c,), sliding (n_c,) bool)``: the slip rows of held contacts
+        #: that slide (checked with λ_S, > 0 while they slide), or ``None``
+        self.slip = None
+
+    def sliding(self, S: tuple) -> tuple:
+        """The contacts of ``S`` that slide (their slip rows follow ``λ_S`` in the checks)."""
+        if self.slip is None:
+            return ()
+        return tuple(i for i in S if self.slip[2][i])
+
+    def check_offsets(self, S: tuple) -> np.ndarray:
+        """Constant parts of the check rows after the gaps: 0 for ``λ_S``, ``σ0`` for slips."""
+        f = self.sliding(S)
+        return np.r_[np.zeros(len(S)), self.slip[1][list(f)] if f else np.zeros(0)]
 
     def generator(self, S: tuple) -> tuple[np.ndarray, np.ndarray, np.ndarray | None]:
         """``(K, E, Λ)`` of held set ``S``; ``Λ = [Λx, Λs]`` gives ``λ_S = Λx X + Λs s``."""
@@ -244,23 +261,26 @@ class FlowFamily:
         return out
 
     def end_rows(self, S: tuple, GT: np.ndarray) -> tuple[np.ndarray, np.ndarray | None]:
-        """``(Ex, Eu)``: ``[Gᵀ X; λ_S] = Ex X + Eu u`` at a state ``X`` and load signals ``u``
-        (``Eu`` is ``None`` without held contacts or loads; cached)."""
+        """``(Ex, Eu)``: ``[Gᵀ X; λ_S; R_σ X] = Ex X + Eu u`` at a state ``X`` and load
+        signals ``u`` (``Eu`` is ``None`` without held contacts or loads; cached)."""
         key = ("ends", S)
         if key not in self._probe:
             _, _, lam = self.generator(S)
             if lam is None:
                 self._probe[key] = (GT, None)
             else:
-                n = self.L.shape[0]
-                Eu = np.vstack([np.zeros((GT.shape[0], lam.shape[1] - n)), lam[:, n:]])
-                self._probe[key] = (np.vstack([GT, lam[:, :n]]), Eu if Eu.shape[1] else None)
+                n, f = self.L.shape[0], self.sliding(S)
+                m = lam.shape[1] - n
+                Eu = np.vstack([np.zeros((GT.shape[0], m)), lam[:, n:], np.zeros((len(f), m))])
+                Ex = np.vstack([GT, lam[:, :n], self.slip[0][list(f)] if f else np.zeros((0, n))])
+                self._probe[key] = (Ex, Eu if Eu.shape[1] else None)
         return self._probe[key]
 
     def probe(self, S: tuple, GT: np.ndarray, q: int) -> tuple[np.ndarray, np.ndarray]:
-        """Gaps ``Gᵀ X`` and held multipliers ``λ_S`` at ``τ_j = j h / q``, j = 1 .. q − 1.
+        """Gaps ``Gᵀ X``, held multipliers ``λ_S`` and slips at ``τ_j = j h / q``, j = 1 .. q − 1.
 
-        Returns ``(Rx, Rb)``: rows ``[Gᵀ X(τ_j); λ_S(τ_j)]`` stacked over ``j`` equal
+        Returns ``(Rx, Rb)``: rows ``[Gᵀ X(τ_j); λ_S(τ_j); R_σ X(τ_j)]`` (slip rows without
+        their constant ``σ0``, :meth:`check_offsets`) stacked over ``j`` equal
         ``Rx X(0) + Rb b`` for the load polynomial ``s(σ) = Σ b_i σ^i`` (σ in units of h)
         from time 0. Built by recursion on the sub-step flow over ``h / q`` (cached).
         """
@@ -268,12 +288,14 @@ class FlowFamily:
             _, _, lam = self.generator(S)
             n, h, p, m = self.L.shape[0], self.h, self.degree, self.G.shape[1]
             Z = self.levels(S, h / q)[-LEVEL_MIN]  # the flow over h / q
-            nz = n + len(S)
-            R = np.zeros((GT.shape[0] + (0 if lam is None else lam.shape[0]), Z.shape[0]))
-            R[: GT.shape[0], :n] = GT
+            nz, nc, f = n + len(S), GT.shape[0], self.sliding(S)
+            R = np.zeros((nc + (0 if lam is None else lam.shape[0]) + len(f), Z.shape[0]))
+            R[:nc, :n] = GT
             if lam is not None:  # λ_S = Λx X + Λs s, s: the chain's first block
-                R[GT.shape[0] :, :n] = lam[:, :n]
-                R[GT.shape[0] :, nz : nz + m] = lam[:, n:]
+                R[nc : nc + len(S), :n] = lam[:, :n]
+                R[nc : nc + len(S), nz : nz + m] = lam[:, n:]
+                if f:  # slip rows of sliding held contacts
+                    R[nc + len(S) :, :n] = self.slip[0][list(f)]
             # b -> chain at σ = 0: s^(l) = l! b_l / h^l
             scale = np.repeat([math.factorial(i) / h**i for i in range(p + 1)], m)
             rz = []

@@ -6,6 +6,8 @@ Between events the augmented state ``z = [X; P_S; s, ṡ, …, s^(p)]`` of a hel
 
     external   Σ_j s_j p_jᵀ X               thermal   Xᵀ P_th X   (or Ẋᵀ W_th X, reduced)
     damping    Xᵀ P_d X                     held contacts  λ_Sᵀ Gv_Sᵀ X   (λ_S = Λ z)
+    held friction, tangential   Σ_i λ_i T_i X     (T_i = −μ_i ŝ_iᵀ Gvt_iᵀ: λ_t · Gvtᵀ X)
+    held friction heat (rest)   Σ_i λ_i R_i X     (R_i = −η_i T_i, "power" heat law)
     heat load  Σ_j s_j q_j                  heat outflow   rᵀ X
 
 so their integrals over ``[0, τ]`` are exact (Van Loan)::
@@ -33,11 +35,22 @@ import scipy.sparse as sp
 from .exponential_kernels import compose, compose_integrals, double_integrals, form_values
 from .flows import _FLUSH, LEVEL_MIN
 
-__all__ = ["QUADRATIC", "LINEAR", "WorkIntegrals"]
+__all__ = ["QUADRATIC", "LINEAR", "METER_ORDER", "NQ", "WorkIntegrals"]
 
 #: the quadratic (works, J) and linear (heats, J) integrals, in this order
-QUADRATIC = ("contact_work", "external_work", "thermal_work", "damping_work")
+QUADRATIC = (
+    "contact_work",
+    "external_work",
+    "thermal_work",
+    "damping_work",
+    "tangential_work",
+    "held_friction_heat",
+)
 LINEAR = ("heat_load", "heat_outflow")
+NQ = len(QUADRATIC)
+#: ``(QUADRATIC + LINEAR)[METER_ORDER]`` is the meter's
+#: :data:`~femrub.output.energy.SCHEME_INTEGRALS` (the held friction heat goes to the state)
+METER_ORDER = np.array([0, 1, 2, 3, NQ, NQ + 1, 4])
 _TERMS = 8  # terms of the Taylor series of the integrals over short durations
 _FACTORIALS = np.array([math.factorial(k + 1) for k in range(_TERMS)], dtype=float)
 
@@ -55,11 +68,16 @@ class WorkIntegrals:
     flows : the stepper's :class:`~.flows.FlowFamily`.
     energy : the model's :class:`~femrub.model.first_order.EnergyForms`.
     powers : (N, m0) load power vectors ``p_j``; ``heats`` (m0,) their heat ``q_j``.
-    GvT : (n_c, N) gap-velocity rows (held contacts' work), or ``None``.
+    GvT : (n_c, N) gap-velocity rows (held contacts' normal work), or ``None``.
+    tangential : (n_c, N) rows ``T_i``: a held contact's tangential work rate ``λ_i T_i X``
+        (sliding with friction), or ``None``.
+    rest_heat : (n_c, N) rows ``R_i``: the part ``λ_i R_i X`` of a held contact's frictional
+        heat rate that is not in its flow, or ``None``.
     """
 
-    def __init__(self, flows, energy, powers, heats, GvT=None):
+    def __init__(self, flows, energy, powers, heats, GvT=None, tangential=None, rest_heat=None):
         self.flows, self.GvT = flows, GvT
+        self.tangential, self.rest_heat = tangential, rest_heat
         self.Pth = _dense(energy.Pth)
         self.Wth = None if energy.Wth is None else _dense(energy.Wth)
         self.Pd = _dense(energy.Pd)
@@ -72,17 +90,19 @@ class WorkIntegrals:
 
     # -- forms on the augmented state -----------------------------------------------------------
     def forms(self, S: tuple, M: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """``(Q (4, N, N), C (2, N))``: the powers and heat rates of :data:`QUADRATIC` and
+        """``(Q (NQ, N, N), C (2, N))``: the powers and heat rates of :data:`QUADRATIC` and
         :data:`LINEAR` on ``z`` of held set ``S`` (``M``: its generator)."""
         n, s, m0 = self.Pth.shape[0], len(S), self.powers.shape[1]
         N, nz = M.shape[0], n + s
-        Q, C = np.zeros((4, N, N)), np.zeros((2, N))
+        Q, C = np.zeros((NQ, N, N)), np.zeros((2, N))
         if S:  # λ_S = Λ z, structure velocity Gv_Sᵀ X
             _, _, lam = self.flows.generator(S)
             Lz = np.zeros((s, N))
             Lz[:, :n] = lam[:, :n]
             Lz[:, nz : nz + lam.shape[1] - n] = lam[:, n:]
-            Q[0, :, :n] = Lz.T @ self.GvT[list(S)]
+            for k, rows in ((0, self.GvT), (4, self.tangential), (5, self.rest_heat)):
+                if rows is not None:
+                    Q[k, :, :n] = Lz.T @ rows[list(S)]
         if m0:
             Q[1, :n, nz : nz + m0] = self.powers
             C[0, nz : nz + m0] = self.heats
@@ -147,7 +167,7 @@ class WorkIntegrals:
 
     # -- integrals over segments ----------------------------------------------------------------
     def over(self, S: tuple, z, rest: float, unit: float, state: bool = False):
-        """The integrals (6,) of :data:`QUADRATIC` + :data:`LINEAR` over ``rest`` from ``z``,
+        """The integrals (NQ + 2,) of :data:`QUADRATIC` + :data:`LINEAR` over ``rest`` from ``z``,
         on the segments of :meth:`~.flows.FlowFamily.advance_z` (binary expansion of
         ``rest / unit`` down to ``2^LEVEL_MIN``): its levels from ``lo`` up, then the series
         for the rest. With ``state``: ``(z(rest), integrals)``, ``z`` composed exactly as
@@ -163,18 +183,18 @@ class WorkIntegrals:
             c = d ** np.arange(1, _TERMS + 1) / _FACTORIALS
             wq = wq + c @ ((A @ z) @ z)
             wl = wl + c @ (B @ z)
-        w = np.zeros(6)
-        w[act], w[4:] = wq, wl
+        w = np.zeros(NQ + 2)
+        w[act], w[NQ:] = wq, wl
         if not state:
             return w
         return (compose(self.flows.levels(S, unit), z, k) if k else z), w
 
     def step(self, S: tuple, z, q: int, unit: float) -> np.ndarray:
-        """The integrals (6,) over a whole step ``h = q unit`` from ``z`` (one form each)."""
+        """The integrals (NQ + 2,) over a whole step ``h = q unit`` from ``z`` (one form each)."""
         Y, act = self._step_forms(S, q, unit)
         y, k_q = Y @ z, act.size
-        w = np.zeros(6)
-        w[act], w[4:] = y[: k_q * z.size].reshape(k_q, z.size) @ z, y[k_q * z.size :]
+        w = np.zeros(NQ + 2)
+        w[act], w[NQ:] = y[: k_q * z.size].reshape(k_q, z.size) @ z, y[k_q * z.size :]
         return w
 
     def _step_forms(self, S: tuple, q: int, unit: float) -> tuple[np.ndarray, np.ndarray]:
@@ -202,7 +222,7 @@ class WorkIntegrals:
 
     def flight(self, S: tuple, X, w, q: int, unit: float):
         """A whole step ``h = q unit`` of held set ``S`` and its integrals in one product:
-        ``(X(h), P_S, integrals (6,))`` for the flow's inputs ``(X, w)``
+        ``(X(h), P_S, integrals (NQ + 2,))`` for the flow's inputs ``(X, w)``
         (:class:`~.flows.Flow`; ``w_l = h^l s^(l)``)."""
         big, _, n, nz = self.flight_matrix(S, q, unit)
         u = np.concatenate([X, w.ravel()])
@@ -231,10 +251,10 @@ class WorkIntegrals:
         return self._flight[key]
 
     def flight_integrals(self, S: tuple, q: int, unit: float, y, u) -> np.ndarray:
-        """The integrals (6,) of a whole step from ``y = F u`` (:meth:`flight_matrix`; rows
-        of ``y`` past ``F``'s are ignored): the forms ``uᵀ (EᵀΓE) u``, the heats as read."""
+        """The integrals (NQ + 2,) of a whole step from ``y = F u`` (:meth:`flight_matrix`;
+        rows of ``y`` past ``F``'s are ignored): the forms ``uᵀ (EᵀΓE) u``, the heats as read."""
         _, act, _, nz = self._flight[(S, unit)]
-        out = np.zeros(6)
+        out = np.zeros(NQ + 2)
         form_values(y, u, nz, act, out)
         return out
 
