@@ -158,15 +158,16 @@ class _Slow(VTKSeries):
 
     delay = 0.004
 
-    def _write_frames(self, frames):
+    def _write_frames(self, frames, vtu):
         time.sleep(self.delay * len(frames))
-        super()._write_frames(frames)
+        super()._write_frames(frames, vtu)
 
 
 def test_a_writer_behind_the_stepping_holds_it_back_and_loses_nothing(rub, tmp_path):
     model, fields = rub
     series = _Slow(tmp_path, model, fields, h=H, stride=STRIDE, batch=3, min_batch=2)
     res = _run(model, series)
+    assert res.status == "ok"
     frames = _frames(series)
     rows = np.rint(res.state_times / H).astype(int)
     assert [f for _, f in frames] == [f"rub_{i:06d}.vtu" for i in range(len(rows))]

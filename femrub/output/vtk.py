@@ -23,6 +23,7 @@ from pathlib import Path
 from xml.sax.saxutils import quoteattr
 
 import numpy as np
+from threadpoolctl import ThreadpoolController
 
 from ..model.rub import FieldMap
 from .frame_fields import FrameFields
@@ -44,6 +45,33 @@ _UNITS_COMMENT = (
     + ", ".join(f"{k} [{v}]" for k, v in FIELD_UNITS.items())
     + " ; time in s -->"
 )
+
+
+class _OneBLASThread:
+    """Context: BLAS libraries on one thread while any thread is inside it (the last one
+    out restores their limits), so that a writer's products leave the other core to the
+    stepping."""
+
+    def __init__(self):
+        self._lock, self._inside, self._limiter = threading.Lock(), 0, None
+        self._controller: ThreadpoolController | None = None  # found once: a few ms
+
+    def __enter__(self):
+        with self._lock:
+            if not self._inside:
+                self._controller = self._controller or ThreadpoolController()
+                self._limiter = self._controller.limit(limits=1, user_api="blas")
+            self._inside += 1
+
+    def __exit__(self, *exc) -> None:
+        with self._lock:
+            self._inside -= 1
+            if not self._inside:
+                self._limiter.restore_original_limits()
+                self._limiter = None
+
+
+_one_blas_thread = _OneBLASThread()
 
 
 class VTKSeries:
@@ -108,8 +136,10 @@ class VTKSeries:
                               ["von_mises"], _UNITS_COMMENT, dtype)  # fmt: skip
         self.batch, self.min_batch = int(batch), min(int(min_batch), int(batch))
         self.flush_seconds = float(flush_seconds)
+        self._vtu_main: VTUWriter | None = None
         self._waiting: list[tuple] = []  # frames taken, not handed to the writer yet
-        self._taken = 0  # frames handed to the writer
+        self._taken = 0  # frames taken: the index of the next
+        self._pvd_lock = threading.Lock()
         self._error: BaseException | None = None
         self._reported = self._busy = self._draining = self._closing = False
         self._cond = threading.Condition()
@@ -143,10 +173,11 @@ class VTKSeries:
         try:
             self._raise_error()
             fi = getattr(state, "friction_impulse", None)
-            frame = (float(state.t), np.array(state.X, dtype=float),
+            frame = (self._taken, float(state.t), np.array(state.X, dtype=float),
                      np.array(state.impulse, dtype=float),
                      None if fi is None or not np.size(fi) else np.array(fi, dtype=float),
                      t0)  # fmt: skip
+            self._taken += 1
             if self._thread is None:
                 self._waiting.append(frame)
                 if len(self._waiting) >= self.batch or t0 - self._waiting[0][-1] > (
@@ -181,12 +212,20 @@ class VTKSeries:
             else:
                 with self._cond:
                     self._draining = True
+                    # the frames waiting are split with the writer (all of them if it is
+                    # busy): the end of a run waits for half as many frames
+                    keep = 0 if self._busy else (len(self._waiting) + 1) // 2
+                    mine, self._waiting = self._waiting[keep:], self._waiting[:keep]
                     self._cond.notify_all()
-                    try:
+                try:
+                    if mine and self._error is None:
+                        with _one_blas_thread:  # the other core is the writer's
+                            self._write_frames(mine, self._own_vtu())
+                    with self._cond:
                         while (self._waiting or self._busy) and self._error is None:
                             self._cond.wait()
-                    finally:
-                        self._draining = False
+                finally:
+                    self._draining = False
             self._raise_error()
         finally:
             self.seconds += time.perf_counter() - t0
@@ -227,7 +266,8 @@ class VTKSeries:
             c0 = time.thread_time()
             try:
                 if self._error is None:
-                    self._write_frames(frames)
+                    with _one_blas_thread:  # the other core is the stepping's
+                        self._write_frames(frames, self._vtu)
             except BaseException as exc:  # raised in the stepping thread
                 self._error = exc
             finally:
@@ -239,27 +279,34 @@ class VTKSeries:
     def _write_waiting(self) -> None:
         """Write the frames waiting, in this thread (no background writer)."""
         frames, self._waiting = self._waiting, []
-        for i in range(0, len(frames), self.batch):
-            self._write_frames(frames[i : i + self.batch])
+        self._write_frames(frames, self._vtu)
 
-    def _write_frames(self, frames: list[tuple]) -> None:
-        """Reconstruct the frames at once, write their files, then the ``.pvd``."""
-        t = [f[0] for f in frames]
-        X, imp = np.stack([f[1] for f in frames]), np.stack([f[2] for f in frames])
-        fi = None
-        if any(f[3] is not None for f in frames):
-            shape = next(f[3] for f in frames if f[3] is not None).shape
-            fi = np.stack([np.zeros(shape) if f[3] is None else f[3] for f in frames])
+    def _own_vtu(self) -> VTUWriter:
+        """The file buffer of the stepping thread when it writes beside the writer."""
+        if self._vtu_main is None:
+            self._vtu_main = self._vtu.copy()
+        return self._vtu_main
+
+    def _write_frames(self, frames: list[tuple], vtu: VTUWriter) -> None:
+        """Reconstruct the frames, ``batch`` at once, write their files with ``vtu``, then
+        the ``.pvd`` (the frames complete on disk, in order)."""
         for start in range(0, len(frames), self.batch):
-            part = slice(start, start + self.batch)
-            c = self._fields.compact(X[part], imp[part], None if fi is None else fi[part])
-            for b in range(len(t[part])):
-                fname = f"{self.name}_{self._taken:06d}.vtu"
-                self._fields.store(c, b, self._vtu.data)
-                self._vtu.write(self.dir / fname)
-                self.frames.append((t[start + b], fname))
-                self._taken += 1
-        self._write_pvd()  # every frame it lists is complete on disk
+            part = frames[start : start + self.batch]
+            X, imp = np.stack([f[2] for f in part]), np.stack([f[3] for f in part])
+            fi = None
+            if any(f[4] is not None for f in part):
+                shape = next(f[4] for f in part if f[4] is not None).shape
+                fi = np.stack([np.zeros(shape) if f[4] is None else f[4] for f in part])
+            c = self._fields.compact(X, imp, fi)
+            for b, f in enumerate(part):
+                fname = f"{self.name}_{f[0]:06d}.vtu"
+                self._fields.store(c, b, vtu.data)
+                vtu.write(self.dir / fname)
+                with self._pvd_lock:
+                    self.frames.append((f[1], fname))
+        with self._pvd_lock:
+            self.frames.sort(key=lambda tf: tf[1])
+            self._write_pvd()
 
     def _raise_error(self) -> None:
         """Raise the writer's error here, once (the writer writes nothing after it)."""
@@ -275,7 +322,7 @@ class VTKSeries:
             "<Collection>",
         ]
         for t, f in self.frames:
-            lines.append(f'<DataSet timestep="{t:.9g}" part="0" file={quoteattr(f)}/>')
+            lines.append(f'<DataSet timestep="{t!r}" part="0" file={quoteattr(f)}/>')
         lines += ["</Collection>", "</VTKFile>", ""]
         tmp = self.pvd_path.with_suffix(".pvd.tmp")
         tmp.write_text("\n".join(lines))

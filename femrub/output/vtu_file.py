@@ -12,6 +12,7 @@ frame. The units comment is placed right after the XML declaration.
 
 from __future__ import annotations
 
+import copy
 import os
 from pathlib import Path
 
@@ -118,12 +119,23 @@ class VTUWriter:
         head = "\n".join(line for line in xml if line).encode()
         self._file = bytearray(b"".join([head, *blobs, b"\n</AppendedData>\n</VTKFile>\n"]))
         le = self.dtype.newbyteorder("<")
+        self._offsets = {name: len(head) + slots[name] for name in shapes}
         #: the fields of the next frame: views into the file's bytes, by name
         self.data = {
-            name: np.frombuffer(self._file, le, int(np.prod(shape)), len(head) + slots[name])
+            name: np.frombuffer(self._file, le, int(np.prod(shape)), self._offsets[name])
             .reshape(shape)
             for name, shape in shapes.items()
         }  # fmt: skip
+
+    def copy(self) -> VTUWriter:
+        """A writer of the same files with a buffer of its own (for another thread)."""
+        twin = copy.copy(self)
+        twin._file = bytearray(self._file)
+        twin.data = {
+            k: np.frombuffer(twin._file, v.dtype, v.size, self._offsets[k]).reshape(v.shape)
+            for k, v in self.data.items()
+        }
+        return twin
 
     @property
     def nbytes(self) -> int:
