@@ -1,12 +1,15 @@
 """Batched VTK frames (femrub.output.vtk, frame_fields, vtu_file): same fields as one
-frame at a time, interruption and writer errors."""
+frame at a time, a series ParaView's reader opens, interruption, a writer behind or idle,
+writer errors."""
 
 import dataclasses
+import time
 import xml.etree.ElementTree as ET
 
 import meshio
 import numpy as np
 import pytest
+import pyvista as pv
 
 import femrub as fr
 from femrub.contact.casing import Lobed
@@ -60,6 +63,13 @@ def _reference(model, fields, X, impulse):
     }
 
 
+def _run(model, series, **kw):
+    """A run of 0.003 s feeding ``series``, with the states of its frames kept."""
+    res = fr.ThetaMethod(model, H).run(0.003, on_state=series, store_every=STRIDE, **kw)
+    series.close()
+    return res
+
+
 def _frames(series):
     root = ET.parse(series.pvd_path).getroot()
     return [(float(d.get("timestep")), d.get("file")) for d in root.iter("DataSet")]
@@ -107,6 +117,83 @@ def test_batched_frames_equal_the_per_frame_fields(rub, tmp_path, dense):
     assert b"femrub units:" in (tmp_path / "f32" / frames[-1][1]).read_bytes()[:400]
 
 
+@pytest.mark.parametrize("dense", [False, True])
+def test_default_series_reads_in_pyvista_and_equals_the_direct_fields(rub, tmp_path, dense):
+    """The series as ``femrub run`` writes it (float32, background writer, default
+    batches): VTK's own reader opens the .pvd with every frame at its time, and every field
+    of every frame equals the direct reconstruction to float32 round-off."""
+    model, fields = rub
+    if dense:
+        model = dataclasses.replace(model, to_full=model.to_full.toarray())
+    series = VTKSeries(tmp_path, model, fields, h=H, stride=STRIDE)
+    res = _run(model, series)
+    assert res.status == "ok" and res.impulse.max() > 0
+    frames = _frames(series)
+    rows = np.rint(res.state_times / H).astype(int)
+    assert [f for _, f in frames] == [f"rub_{i:06d}.vtu" for i in range(len(rows))] != []
+    assert [t for t, _ in frames] == pytest.approx(res.t[rows], rel=1e-9)
+    reader = pv.get_reader(str(series.pvd_path))
+    assert reader.number_time_points == len(frames)
+    assert np.asarray(reader.time_values) == pytest.approx(res.t[rows], rel=1e-9)
+    eps = np.finfo(np.float32).eps
+    for i, (X, r) in enumerate(zip(res.states, rows)):
+        reader.set_active_time_point(i)
+        grid = reader.read()[0]
+        assert grid.n_points == fields.mesh.p.shape[1] and grid.n_cells == fields.mesh.t.shape[1]
+        ref = _reference(model, fields, X, res.impulse[r])
+        fric = np.zeros((grid.n_points, 3))
+        np.add.at(fric, fields.contacts.vertices, res.friction_force[r])
+        ref["friction_force"] = fric
+        m = meshio.read(tmp_path / frames[i][1])
+        for k, a in ref.items():
+            got = m.cell_data[k][0] if k == "von_mises" else m.point_data[k]
+            vtk_got = grid.cell_data[k] if k == "von_mises" else grid.point_data[k]
+            assert got.dtype == np.float32 and np.array_equal(vtk_got, got), k
+            scale = max(np.abs(a).max(), 1e-300)
+            assert np.abs(got.reshape(a.shape) - a).max() <= 50 * eps * scale, k
+
+
+class _Slow(VTKSeries):
+    """A series whose every frame file takes ``delay`` seconds more to write."""
+
+    delay = 0.004
+
+    def _write_frames(self, frames, vtu):
+        time.sleep(self.delay * len(frames))
+        super()._write_frames(frames, vtu)
+
+
+def test_a_writer_behind_the_stepping_holds_it_back_and_loses_nothing(rub, tmp_path):
+    model, fields = rub
+    series = _Slow(tmp_path, model, fields, h=H, stride=STRIDE, batch=3, min_batch=2)
+    res = _run(model, series)
+    assert res.status == "ok"
+    frames = _frames(series)
+    rows = np.rint(res.state_times / H).astype(int)
+    assert [f for _, f in frames] == [f"rub_{i:06d}.vtu" for i in range(len(rows))]
+    assert [t for t, _ in frames] == pytest.approx(res.t[rows], rel=1e-9)
+    for (_, f), X in zip(frames, res.states):
+        u = meshio.read(tmp_path / f).point_data["displacement"]
+        ref = _reference(model, fields, X, np.zeros(model.n_contacts))["displacement"]
+        assert np.abs(u - ref).max() <= 1e-5 * max(np.abs(ref).max(), 1e-300)
+
+
+def test_an_idle_writer_takes_a_few_frames_after_flush_seconds(rub, tmp_path):
+    model, fields = rub
+    series = VTKSeries(tmp_path, model, fields, h=H, stride=1, min_batch=8, flush_seconds=0.05)
+    states = iter(fr.ThetaMethod(model, H).iterate(0.001))
+    for _ in range(2):
+        series.take(next(states))
+    for _ in range(200):  # no flush: the writer takes the two frames by itself
+        if len(series.frames) == 2:
+            break
+        time.sleep(0.01)
+    assert [f for _, f in _frames(series)] == ["rub_000000.vtu", "rub_000001.vtu"]
+    series.take(next(states))
+    series.close()
+    assert len(_frames(series)) == 3
+
+
 class _Interrupted(VTKSeries):
     """A series whose run is interrupted (Ctrl-C) when the frame of step ``k_stop`` comes."""
 
@@ -118,15 +205,17 @@ class _Interrupted(VTKSeries):
         super().take(state)
 
 
-@pytest.mark.parametrize("background", [True, False])
-def test_interrupted_run_keeps_every_frame_taken(rub, tmp_path, background):
+@pytest.mark.parametrize("background,batch", [(True, 5), (False, 5), (True, 32)])
+def test_interrupted_run_keeps_every_frame_taken(rub, tmp_path, background, batch):
+    """Also when the frames taken are fewer than the writer's ``min_batch`` (batch 32)."""
     model, fields = rub
-    series = _Interrupted(tmp_path, model, fields, h=H, stride=STRIDE, batch=5,
+    series = _Interrupted(tmp_path, model, fields, h=H, stride=STRIDE, batch=batch,
                           background=background)  # fmt: skip
     res = fr.ThetaMethod(model, H).run(0.003, on_state=series)
     assert res.status == "interrupted"
     frames = _frames(series)  # written by the recorder's flush, before close
     assert [f for _, f in frames] == [f"rub_{i:06d}.vtu" for i in range(7)]
+    assert [t for t, _ in frames] == pytest.approx(res.t[: 7 * STRIDE : STRIDE], rel=1e-9)
     assert sorted(p.name for p in tmp_path.iterdir()) == sorted([*dict(frames).values(), "rub.pvd"])
     for _, f in frames:
         assert meshio.read(tmp_path / f).point_data["displacement"].shape[1] == 3
@@ -137,7 +226,7 @@ def test_the_background_writers_error_surfaces(rub, tmp_path, monkeypatch):
     model, fields = rub
     series = VTKSeries(tmp_path, model, fields, h=H, stride=STRIDE, batch=3)
 
-    def full_disk(path, point, cell):
+    def full_disk(path, *fields):
         raise OSError(28, "No space left on device")
 
     monkeypatch.setattr(series._vtu, "write", full_disk)

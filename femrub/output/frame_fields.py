@@ -131,21 +131,24 @@ class FrameFields:
                 self._ops.append(((name,), (rows.size,), c,
                                   np.ascontiguousarray(T[rows][:, c].T, dtype=dtype)))  # fmt: skip
         c = fields.contacts
+        #: the vertices that carry a contact (sorted, unique); forces are zero elsewhere
+        self.contact_vertices, which = np.unique(np.asarray(c.vertices), return_inverse=True)
         nc = c.vertices.size
         self._scatter = sp.csr_matrix(
-            (np.ones(nc), (c.vertices, np.arange(nc))), shape=(self.n_points, nc)
+            (np.ones(nc), (which.ravel(), np.arange(nc))), shape=(self.contact_vertices.size, nc)
         )
         self._normals = np.asarray(c.normals)  # (dim, n_contacts)
         self._contact = model.contact
         self.h = float(h)
 
-    def compute(self, X, impulse, friction=None) -> dict[str, np.ndarray]:
-        """Fields of ``B`` frames: states ``X`` (B × N), impulses (B × n_c), friction
-        impulses (B × n_c × 2, or ``None``).
+    def compact(self, X, impulse, friction=None) -> dict[str, np.ndarray | None]:
+        """Fields of ``B`` frames as computed: states ``X`` (B × N), impulses (B × n_c),
+        friction impulses (B × n_c × 2, or ``None``).
 
-        Returns point data ``displacement``, ``velocity``, ``contact_force``,
-        ``friction_force`` (B × n_points × 3), ``temperature`` (B × n_points) and cell data
-        ``von_mises`` (B × n_cells).
+        Returns ``displacement`` and ``velocity`` (B × n_points × dim), ``temperature``
+        (B × n_points, ``None`` without a thermal part), ``von_mises`` (B × n_cells) and
+        ``contact_force``, ``friction_force`` (B × n_contact_vertices × dim, at
+        :attr:`contact_vertices`; the latter ``None`` without friction).
         """
         X = np.atleast_2d(np.asarray(X, dtype=float))
         B, npt, d = X.shape[0], self.n_points, self.dim
@@ -159,18 +162,47 @@ class FrameFields:
             for name, n in zip(names, sizes):
                 raw[name] = full[:, start : start + n]
                 start += n
-        out = {
-            "displacement": _pad3(raw["displacement"].reshape(B, npt, d)),
-            "velocity": _pad3(raw["velocity"].reshape(B, npt, d)),
+        return {
+            "displacement": raw["displacement"].reshape(B, npt, d),
+            "velocity": raw["velocity"].reshape(B, npt, d),
+            "temperature": raw["temperature"] if self._has_t else None,
+            "von_mises": self._norm(raw["von_mises"].reshape(B, self._k, self.n_cells)),
+            "contact_force": self._forces(impulse, B),
+            "friction_force": self._friction(friction, B),
         }
-        if self._has_t:
-            out["temperature"] = raw["temperature"]
-        else:
-            out["temperature"] = np.zeros((B, self._nt_points))
-        out["contact_force"] = self._forces(impulse, B)
-        out["friction_force"] = self._friction(friction, B)
-        out["von_mises"] = self._norm(raw["von_mises"].reshape(B, self._k, self.n_cells))
+
+    def compute(self, X, impulse, friction=None) -> dict[str, np.ndarray]:
+        """Fields of ``B`` frames (arguments as :meth:`compact`) on the whole mesh.
+
+        Returns point data ``displacement``, ``velocity``, ``contact_force``,
+        ``friction_force`` (B × n_points × 3), ``temperature`` (B × n_points) and cell data
+        ``von_mises`` (B × n_cells).
+        """
+        c = self.compact(X, impulse, friction)
+        B = c["von_mises"].shape[0]
+        out = {k: np.zeros((B, self.n_points, 3)) for k in _VECTORS}
+        out["temperature"] = np.zeros((B, self._nt_points))
+        out["von_mises"] = c["von_mises"]
+        for b in range(B):
+            self.store(c, b, {k: v[b] for k, v in out.items()})
         return out
+
+    def store(self, compact: dict, b: int, data: dict[str, np.ndarray]) -> None:
+        """Write frame ``b`` of ``compact`` into the arrays ``data`` (by field name: vectors
+        n_points × 3, temperature n_points, von_mises n_cells, e.g. the views of a
+        :class:`~femrub.output.vtu_file.VTUWriter`). Entries no frame sets (the third
+        component in 2D, the temperature of a model without one, the forces away from
+        :attr:`contact_vertices`) are left as they are (zero in a fresh file buffer and
+        in :meth:`compute`)."""
+        d, cv = self.dim, self.contact_vertices
+        for k in ("displacement", "velocity"):
+            data[k][:, :d] = compact[k][b]
+        if compact["temperature"] is not None:
+            data["temperature"][:] = compact["temperature"][b]
+        data["von_mises"][:] = compact["von_mises"][b]
+        for k in ("contact_force", "friction_force"):
+            if cv.size:
+                data[k][cv, :d] = 0.0 if compact[k] is None else compact[k][b]
 
     @staticmethod
     def _norm(s: np.ndarray) -> np.ndarray:
@@ -183,32 +215,25 @@ class FrameFields:
     def _forces(self, impulse, B: int) -> np.ndarray:
         """Normal contact force (N) at the contact vertices, ``-λ n / h`` summed per vertex."""
         lam = np.asarray(impulse, dtype=float).reshape(B, -1)
-        f = np.zeros((B, self.n_points, 3))
-        if lam.shape[1]:
-            per = -(lam[:, :, None] / self.h) * self._normals.T[None]  # (B, n_c, dim)
-            f[..., : self.dim] = _scatter(self._scatter, per)
-        return f
+        if not lam.shape[1]:
+            return np.zeros((B, 0, self.dim))
+        per = -(lam[:, :, None] / self.h) * self._normals.T[None]  # (B, n_c, dim)
+        return _scatter(self._scatter, per)
 
-    def _friction(self, friction, B: int) -> np.ndarray:
-        """Friction force (N) at the contact vertices, in global axes."""
-        f = np.zeros((B, self.n_points, 3))
+    def _friction(self, friction, B: int) -> np.ndarray | None:
+        """Friction force (N) at the contact vertices, in global axes (``None``: none)."""
         c = self._contact
         if friction is None or c is None or c.frames is None or not np.size(friction):
-            return f
+            return None
         g = c.to_global(np.asarray(friction, dtype=float) / self.h)[..., : self.dim]
-        f[..., : self.dim] = _scatter(self._scatter, g)
-        return f
+        return _scatter(self._scatter, g)
+
+
+_VECTORS = ("displacement", "velocity", "contact_force", "friction_force")
 
 
 def _scatter(S: sp.csr_matrix, per: np.ndarray) -> np.ndarray:
-    """Sum per-contact vectors ``per`` (B × n_c × k) onto the vertices (B × n_v × k)."""
+    """Sum per-contact vectors ``per`` (B × n_c × k) onto their vertices (B × n_v × k)."""
     B, nc, k = per.shape
     out = S @ per.transpose(1, 0, 2).reshape(nc, B * k)
     return out.reshape(S.shape[0], B, k).transpose(1, 0, 2)
-
-
-def _pad3(a: np.ndarray) -> np.ndarray:
-    """``(B, n, dim)`` vectors as ``(B, n, 3)`` (zeros after ``dim``), as ParaView wants."""
-    if a.shape[-1] == 3:
-        return a
-    return np.concatenate([a, np.zeros((*a.shape[:-1], 3 - a.shape[-1]))], axis=-1)

@@ -17,13 +17,13 @@ fields (an XML comment ``femrub units: ...``; :data:`FIELD_UNITS`).
 from __future__ import annotations
 
 import os
-import queue
 import threading
 import time
 from pathlib import Path
 from xml.sax.saxutils import quoteattr
 
 import numpy as np
+from threadpoolctl import ThreadpoolController
 
 from ..model.rub import FieldMap
 from .frame_fields import FrameFields
@@ -47,20 +47,50 @@ _UNITS_COMMENT = (
 )
 
 
+class _OneBLASThread:
+    """Context: BLAS libraries on one thread while any thread is inside it (the last one
+    out restores their limits), so that a writer's products leave the other core to the
+    stepping."""
+
+    def __init__(self):
+        self._lock, self._inside, self._limiter = threading.Lock(), 0, None
+        self._controller: ThreadpoolController | None = None  # found once: a few ms
+
+    def __enter__(self):
+        with self._lock:
+            if not self._inside:
+                self._controller = self._controller or ThreadpoolController()
+                self._limiter = self._controller.limit(limits=1, user_api="blas")
+            self._inside += 1
+
+    def __exit__(self, *exc) -> None:
+        with self._lock:
+            self._inside -= 1
+            if not self._inside:
+                self._limiter.restore_original_limits()
+                self._limiter = None
+
+
+_one_blas_thread = _OneBLASThread()
+
+
 class VTKSeries:
     """Stream a run to ``directory/name_XXXXXX.vtu`` plus ``directory/name.pvd``.
 
     A frame is taken every ``stride`` steps (the initial state included): the call only
-    copies the (reduced) state, impulses and time into a batch. A full batch of ``batch``
-    frames, or one older than ``flush_seconds``, goes to the writer (a background thread
-    when ``background``, which overlaps the stepping and whose error is raised here at the
-    next frame or at :meth:`flush`), which reconstructs the whole batch at once
-    (:class:`~femrub.output.frame_fields.FrameFields`) and writes its files
-    (:class:`~femrub.output.vtu_file.VTUWriter`), each renamed when complete, then
-    rewrites the ``.pvd`` atomically. :meth:`flush` (called by the recorder at the end
-    of a run, also an interrupted or failed one) writes every frame taken; a killed
-    process loses at most the frames not yet written: the batch being filled, one queued
-    batch and the rest of the batch being written.
+    copies the (reduced) state, impulses and time. With ``background`` (the default) a
+    writer thread takes every frame waiting as soon as it is free and there are at least
+    ``min_batch`` of them (or the oldest waited ``flush_seconds``): it reconstructs them
+    at once (:class:`~femrub.output.frame_fields.FrameFields`; its products and the file
+    writes release the GIL, so it runs beside the stepping on a second core), writes
+    their files (:class:`~femrub.output.vtu_file.VTUWriter`), each renamed when complete,
+    then rewrites the ``.pvd`` atomically; the stepping thread waits only when ``batch``
+    frames are waiting (the writer is slower than the stepping). The writer's error is
+    raised in the stepping thread at the next frame or at :meth:`flush`. Without
+    ``background`` the frames are written in the calling thread, ``batch`` at a time.
+    :meth:`flush` (called by the recorder at the end of a run, also an interrupted or
+    failed one) writes every frame taken; a killed process loses at most the frames not
+    yet written: those waiting and those being written.
 
     Parameters
     ----------
@@ -69,23 +99,28 @@ class VTKSeries:
     fields : the :class:`~femrub.model.rub.FieldMap` of the full model.
     h : the run's time step (s), to turn contact impulses into forces.
     stride : write every ``stride``-th step (the initial state is always written).
-    batch : frames reconstructed and written together.
-    background : write the batches in a background thread.
-    flush_seconds : a batch is handed to the writer after at most this wall time.
+    batch : most frames waiting (then the stepping waits for the writer) and most frames
+        reconstructed together.
+    min_batch : fewest frames the background writer takes at once (the products cost
+        less per frame in larger batches), but at :meth:`flush` or after ``flush_seconds``;
+        at most ``batch``.
+    background : write the frames in a background thread.
+    flush_seconds : a frame waits at most this wall time for ``min_batch - 1`` others.
     dtype : type of the field data in the files (``float32`` or ``float64``).
     """
 
     def __init__(
         self, directory, model, fields: FieldMap, *, h: float, stride: int = 10, name="rub",
-        batch: int = 32, background: bool = True, flush_seconds: float = 10.0,
-        dtype=np.float32,
+        batch: int = 32, min_batch: int = 8, background: bool = True,
+        flush_seconds: float = 10.0, dtype=np.float32,
     ):  # fmt: skip
         if model.to_full is None:
             raise ValueError("this model has no map to the full mesh (model.to_full)")
         if int(stride) < 1:
             raise ValueError(f"VTK output stride must be >= 1, got {stride!r}")
-        if int(batch) < 1:
-            raise ValueError(f"VTK output batch must be >= 1, got {batch!r}")
+        if min(int(batch), int(min_batch)) < 1:
+            raise ValueError(f"VTK output batch and min_batch must be >= 1, got {batch!r}, "
+                             f"{min_batch!r}")  # fmt: skip
         self.dir = Path(directory)
         self.dir.mkdir(parents=True, exist_ok=True)
         self.model, self.fields, self.stride, self.name = model, fields, int(stride), name
@@ -99,15 +134,17 @@ class VTKSeries:
         point |= {"contact_force": 3, "friction_force": 3}
         self._vtu = VTUWriter(fields.mesh.p.T, fields.mesh.t.T, VTK_TETRA, point,
                               ["von_mises"], _UNITS_COMMENT, dtype)  # fmt: skip
-        self.batch, self.flush_seconds = int(batch), float(flush_seconds)
-        self._taken = 0
-        self._new_batch()
+        self.batch, self.min_batch = int(batch), min(int(min_batch), int(batch))
+        self.flush_seconds = float(flush_seconds)
+        self._vtu_main: VTUWriter | None = None
+        self._waiting: list[tuple] = []  # frames taken, not handed to the writer yet
+        self._taken = 0  # frames taken: the index of the next
+        self._pvd_lock = threading.Lock()
         self._error: BaseException | None = None
-        self._reported = False
-        self._queue: queue.Queue | None = None
+        self._reported = self._busy = self._draining = self._closing = False
+        self._cond = threading.Condition()
         self._thread: threading.Thread | None = None
         if background:
-            self._queue = queue.Queue(maxsize=1)
             self._thread = threading.Thread(target=self._work, name="femrub-vtk", daemon=True)
             self._thread.start()
 
@@ -131,19 +168,30 @@ class VTKSeries:
         self.close()
 
     def take(self, state) -> None:
-        """Copy the frame of ``state`` (t, X, impulse, friction impulse) into the batch."""
+        """Copy the frame of ``state`` (t, X, impulse, friction impulse) for the writer."""
         t0, c0 = time.perf_counter(), time.thread_time()
         try:
             self._raise_error()
-            n = self._n
-            self._X[n], self._t[n], self._imp[n] = state.X, state.t, state.impulse
             fi = getattr(state, "friction_impulse", None)
-            if fi is not None and np.size(fi):
-                self._fi = np.zeros((self.batch, *np.shape(fi))) if self._fi is None else self._fi
-                self._fi[n] = fi
-            self._n = n + 1
-            if self._n == self.batch or t0 - self._since > self.flush_seconds:
-                self._hand_over()
+            frame = (self._taken, float(state.t), np.array(state.X, dtype=float),
+                     np.array(state.impulse, dtype=float),
+                     None if fi is None or not np.size(fi) else np.array(fi, dtype=float),
+                     t0)  # fmt: skip
+            self._taken += 1
+            if self._thread is None:
+                self._waiting.append(frame)
+                if len(self._waiting) >= self.batch or t0 - self._waiting[0][-1] > (
+                    self.flush_seconds
+                ):
+                    self._write_waiting()
+                return
+            with self._cond:
+                self._waiting.append(frame)
+                if len(self._waiting) in (1, self.min_batch):  # its deadline, or ready
+                    self._cond.notify_all()
+                while len(self._waiting) >= self.batch and self._error is None:
+                    self._cond.wait()  # the writer is behind: wait for it
+            self._raise_error()
         finally:
             self.seconds += time.perf_counter() - t0
             self._main_cpu += time.thread_time() - c0
@@ -159,9 +207,25 @@ class VTKSeries:
         t0, c0 = time.perf_counter(), time.thread_time()
         try:
             self._raise_error()
-            self._hand_over()
-            if self._queue is not None:
-                self._queue.join()
+            if self._thread is None:
+                self._write_waiting()
+            else:
+                with self._cond:
+                    self._draining = True
+                    # the frames waiting are split with the writer (all of them if it is
+                    # busy): the end of a run waits for half as many frames
+                    keep = 0 if self._busy else (len(self._waiting) + 1) // 2
+                    mine, self._waiting = self._waiting[keep:], self._waiting[:keep]
+                    self._cond.notify_all()
+                try:
+                    if mine and self._error is None:
+                        with _one_blas_thread:  # the other core is the writer's
+                            self._write_frames(mine, self._own_vtu())
+                    with self._cond:
+                        while (self._waiting or self._busy) and self._error is None:
+                            self._cond.wait()
+                finally:
+                    self._draining = False
             self._raise_error()
         finally:
             self.seconds += time.perf_counter() - t0
@@ -173,59 +237,76 @@ class VTKSeries:
             self.flush()
         finally:
             if self._thread is not None:
-                self._queue.put(None)
+                with self._cond:
+                    self._closing = True
+                    self._cond.notify_all()
                 self._thread.join()
                 self._thread = None
 
     # -- the writer --------------------------------------------------------------------
-    def _new_batch(self) -> None:
-        N, nc = self.model.n_dofs, self.model.n_contacts
-        self._X, self._t = np.empty((self.batch, N)), np.empty(self.batch)
-        self._imp, self._fi, self._n = np.empty((self.batch, nc)), None, 0
-        self._since = time.perf_counter()
-
-    def _hand_over(self) -> None:
-        """Send the frames taken to the writer (or write them here) and start a batch."""
-        n = self._n
-        if not n:
-            return
-        job = (self._taken, self._t[:n], self._X[:n], self._imp[:n],
-               None if self._fi is None else self._fi[:n])  # fmt: skip
-        self._taken += n
-        self._new_batch()
-        if self._queue is None:
-            self._write_batch(*job)
-        else:
-            self._queue.put(job)
+    def _ready(self) -> float | None:
+        """Under the lock: 0 if the writer should take the waiting frames now, else the
+        seconds until the oldest one has waited ``flush_seconds`` (``None``: no frame)."""
+        if not self._waiting:
+            return None
+        if self._draining or len(self._waiting) >= self.min_batch:
+            return 0.0
+        return max(0.0, self._waiting[0][-1] + self.flush_seconds - time.perf_counter())
 
     def _work(self) -> None:
-        """The writer thread: write the batches it receives until ``None``."""
+        """The writer thread: take the waiting frames when ready, until closed."""
         while True:
-            job = self._queue.get()
+            with self._cond:
+                while (wait := self._ready()) != 0.0 and not self._closing:
+                    self._cond.wait(wait)
+                if self._closing and not self._waiting:
+                    return
+                frames, self._waiting, self._busy = self._waiting, [], True
+                self._cond.notify_all()  # a stepping thread waiting for room goes on
+            c0 = time.thread_time()
             try:
-                if job is not None and self._error is None:
-                    c0 = time.thread_time()
-                    try:
-                        self._write_batch(*job)
-                    finally:
-                        self._writer_cpu += time.thread_time() - c0
+                if self._error is None:
+                    with _one_blas_thread:  # the other core is the stepping's
+                        self._write_frames(frames, self._vtu)
             except BaseException as exc:  # raised in the stepping thread
                 self._error = exc
             finally:
-                self._queue.task_done()
-            if job is None:
-                return
+                self._writer_cpu += time.thread_time() - c0
+                with self._cond:
+                    self._busy = False
+                    self._cond.notify_all()
 
-    def _write_batch(self, first: int, t, X, impulse, friction) -> None:
-        """Reconstruct a batch, write its frames, then the ``.pvd`` listing them."""
-        data = self._fields.compute(X, impulse, friction)
-        cells = ("von_mises",)
-        for b in range(len(t)):
-            fname = f"{self.name}_{first + b:06d}.vtu"
-            point = {k: v[b] for k, v in data.items() if k not in cells}
-            self._vtu.write(self.dir / fname, point, {k: data[k][b] for k in cells})
-            self.frames.append((float(t[b]), fname))
-        self._write_pvd()  # once per batch: every frame it lists is complete on disk
+    def _write_waiting(self) -> None:
+        """Write the frames waiting, in this thread (no background writer)."""
+        frames, self._waiting = self._waiting, []
+        self._write_frames(frames, self._vtu)
+
+    def _own_vtu(self) -> VTUWriter:
+        """The file buffer of the stepping thread when it writes beside the writer."""
+        if self._vtu_main is None:
+            self._vtu_main = self._vtu.copy()
+        return self._vtu_main
+
+    def _write_frames(self, frames: list[tuple], vtu: VTUWriter) -> None:
+        """Reconstruct the frames, ``batch`` at once, write their files with ``vtu``, then
+        the ``.pvd`` (the frames complete on disk, in order)."""
+        for start in range(0, len(frames), self.batch):
+            part = frames[start : start + self.batch]
+            X, imp = np.stack([f[2] for f in part]), np.stack([f[3] for f in part])
+            fi = None
+            if any(f[4] is not None for f in part):
+                shape = next(f[4] for f in part if f[4] is not None).shape
+                fi = np.stack([np.zeros(shape) if f[4] is None else f[4] for f in part])
+            c = self._fields.compact(X, imp, fi)
+            for b, f in enumerate(part):
+                fname = f"{self.name}_{f[0]:06d}.vtu"
+                self._fields.store(c, b, vtu.data)
+                vtu.write(self.dir / fname)
+                with self._pvd_lock:
+                    self.frames.append((f[1], fname))
+        with self._pvd_lock:
+            self.frames.sort(key=lambda tf: tf[1])
+            self._write_pvd()
 
     def _raise_error(self) -> None:
         """Raise the writer's error here, once (the writer writes nothing after it)."""
@@ -241,7 +322,7 @@ class VTKSeries:
             "<Collection>",
         ]
         for t, f in self.frames:
-            lines.append(f'<DataSet timestep="{t:.9g}" part="0" file={quoteattr(f)}/>')
+            lines.append(f'<DataSet timestep="{t!r}" part="0" file={quoteattr(f)}/>')
         lines += ["</Collection>", "</VTKFile>", ""]
         tmp = self.pvd_path.with_suffix(".pvd.tmp")
         tmp.write_text("\n".join(lines))

@@ -2,15 +2,17 @@
 
 :class:`VTUWriter` writes VTK XML UnstructuredGrid files with every array in the
 ``AppendedData`` section as raw binary (``encoding="raw"``, ``header_type="UInt64"``, little
-endian), which ParaView, VTK and meshio read. The XML header and the bytes of the
-geometry (points, connectivity, offsets, cell types) are built once; a frame only encodes
-its fields (float32 by default) and writes header, fields and geometry in one call. Each
-file is written to ``name.tmp`` and renamed when complete, so a reader never sees half a
+endian), which ParaView, VTK and meshio read. The whole file of a frame is one byte buffer
+built once: the XML header, the fields' byte counts, the geometry (points, connectivity,
+offsets, cell types) and the closing tags are in place, and the fields are writable numpy
+views into it (:attr:`VTUWriter.data`, float32 by default). A frame fills the views and is
+written with one system call, to ``name.tmp`` then renamed, so a reader never sees half a
 frame. The units comment is placed right after the XML declaration.
 """
 
 from __future__ import annotations
 
+import copy
 import os
 from pathlib import Path
 
@@ -45,6 +47,11 @@ class VTUWriter:
     """Frames on a fixed mesh of ``points`` (n × 3) and cells (``cells``: n_c × k vertex
     indices, VTK type ``cell_type``).
 
+    The fields of the next frame are :attr:`data` (writable views into the file's bytes; a
+    value written there stays until overwritten, so fields that change in a few entries
+    only, e.g. forces at the contact vertices, need only those entries rewritten). One
+    writer's buffer serves one thread at a time.
+
     Parameters
     ----------
     points, cells, cell_type : the mesh (points are written as float64, the connectivity as
@@ -69,28 +76,30 @@ class VTUWriter:
         self.n_points, self.n_cells = pts.shape[0], cells.shape[0]
         self.dtype = np.dtype(dtype)
         self.point_fields, self.cell_fields = dict(point_fields), list(cell_fields)
-        item = self.dtype.itemsize
-        tags, offset = {"point": [], "cell": []}, 0
-        for name, comps in self.point_fields.items():
-            shape = (self.n_points, comps) if comps > 1 else (self.n_points,)
-            tags["point"].append(_array_tag(name, np.empty(shape, self.dtype)[:0], offset))
-            offset += 8 + item * int(np.prod(shape))
-        for name in self.cell_fields:
-            tags["cell"].append(_array_tag(name, np.empty(0, self.dtype), offset))
-            offset += 8 + item * self.n_cells
+        shapes = {
+            n: (self.n_points, c) if c > 1 else (self.n_points,) for n, c in point_fields.items()
+        }
+        shapes |= {n: (self.n_cells,) for n in self.cell_fields}
+        tags, offset, blobs, slots = {"point": [], "cell": []}, 0, [], {}
+        for name, shape in shapes.items():
+            a = np.zeros(shape, self.dtype)
+            tags["point" if name in self.point_fields else "cell"].append(
+                _array_tag(name, a[:0], offset)
+            )
+            slots[name] = offset + 8  # after the block's byte count
+            blobs.append(_block(a))
+            offset += len(blobs[-1])
         geometry = [
             ("Points", "", pts),
             ("Cells", "connectivity", cells.ravel()),
             ("Cells", "offsets", np.arange(1, self.n_cells + 1, dtype=index) * cells.shape[1]),
             ("Cells", "types", np.full(self.n_cells, cell_type, dtype=np.uint8)),
         ]
-        geo_tags, blobs = {"Points": [], "Cells": []}, []
+        geo_tags = {"Points": [], "Cells": []}
         for section, name, a in geometry:
             geo_tags[section].append(_array_tag(name, a, offset))
-            blob = _block(a)
-            blobs.append(blob)
-            offset += len(blob)
-        self._geometry = b"".join(blobs)
+            blobs.append(_block(a))
+            offset += len(blobs[-1])
         xml = [
             '<?xml version="1.0"?>',
             comment,
@@ -107,30 +116,45 @@ class VTUWriter:
             '<AppendedData encoding="raw">',
             "_",
         ]  # fmt: skip
-        self._head = "\n".join(line for line in xml if line).encode()
-        self._tail = b"\n</AppendedData>\n</VTKFile>\n"
+        head = "\n".join(line for line in xml if line).encode()
+        self._file = bytearray(b"".join([head, *blobs, b"\n</AppendedData>\n</VTKFile>\n"]))
+        le = self.dtype.newbyteorder("<")
+        self._offsets = {name: len(head) + slots[name] for name in shapes}
+        #: the fields of the next frame: views into the file's bytes, by name
+        self.data = {
+            name: np.frombuffer(self._file, le, int(np.prod(shape)), self._offsets[name])
+            .reshape(shape)
+            for name, shape in shapes.items()
+        }  # fmt: skip
 
-    def encode(self, point_data: dict, cell_data: dict) -> list[bytes]:
-        """The byte chunks of one file with these fields (every declared one)."""
-        chunks = [self._head]
-        for name, comps in self.point_fields.items():
-            a = np.asarray(point_data[name], dtype=self.dtype)
-            if a.shape != ((self.n_points, comps) if comps > 1 else (self.n_points,)):
-                raise ValueError(f"point field {name!r} has shape {a.shape}")
-            chunks.append(_block(a))
-        for name in self.cell_fields:
-            a = np.asarray(cell_data[name], dtype=self.dtype)
-            if a.shape != (self.n_cells,):
-                raise ValueError(f"cell field {name!r} has shape {a.shape}")
-            chunks.append(_block(a))
-        chunks += [self._geometry, self._tail]
-        return chunks
+    def copy(self) -> VTUWriter:
+        """A writer of the same files with a buffer of its own (for another thread)."""
+        twin = copy.copy(self)
+        twin._file = bytearray(self._file)
+        twin.data = {
+            k: np.frombuffer(twin._file, v.dtype, v.size, self._offsets[k]).reshape(v.shape)
+            for k, v in self.data.items()
+        }
+        return twin
 
-    def write(self, path, point_data: dict, cell_data: dict) -> Path:
-        """Write ``path`` (via ``path.tmp`` and an atomic rename) and return it."""
+    @property
+    def nbytes(self) -> int:
+        """Bytes of one file."""
+        return len(self._file)
+
+    def write(self, path, point_data: dict | None = None, cell_data: dict | None = None) -> Path:
+        """Copy the given fields into :attr:`data` (each must have its declared shape),
+        then write the frame to ``path`` (via ``path.tmp`` and an atomic rename)."""
+        for name, a in {**(point_data or {}), **(cell_data or {})}.items():
+            view = self.data[name]
+            a = np.asarray(a)
+            if a.shape != view.shape:
+                kind = "point" if name in self.point_fields else "cell"
+                raise ValueError(f"{kind} field {name!r} has shape {a.shape}")
+            np.copyto(view, a, casting="same_kind")
         path = Path(path)
         tmp = path.with_name(path.name + ".tmp")
-        with open(tmp, "wb") as f:
-            f.writelines(self.encode(point_data, cell_data))
+        with open(tmp, "wb") as f:  # large writes go straight to the file
+            f.write(self._file)
         os.replace(tmp, path)
         return path
