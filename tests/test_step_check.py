@@ -63,6 +63,11 @@ def test_the_verdict_follows_the_estimate(tmp_path, h):
     if err["estimate"] > err["tolerance"]:
         assert doc["status"] == "inaccurate"
         assert "scheme.h <=" in doc["message"] and "time-step error" in doc["message"]
+        # the suggested step brings an order-1 error to the tolerance
+        suggested = float(doc["message"].split("scheme.h <= ")[1].split()[0])
+        assert suggested == pytest.approx(
+            min(0.5, err["tolerance"] / err["estimate"]) * h, rel=2e-3
+        )
     else:
         assert doc["status"] == "ok"
     if h == 1e-3:  # 30 steps per load period: far from converged

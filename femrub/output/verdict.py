@@ -108,11 +108,15 @@ def time_step(res, tol):
     est, bound = err.get("estimate", 0.0), err.get("tolerance")
     if bound is None or est <= bound:
         return None
+    h = err.get("h", res.h)
+    order = err.get("order", 1.0)
+    # the step whose error the same rate would bring to the tolerance (never above h/2)
+    needed = h * min(0.5, (bound / est) ** (1.0 / order))
     return (
         f"estimated time-step error {100 * est:.3g} % ({err.get('decided_by', '?')}: twice "
         f"the difference to the run at h/2) exceeds scheme.step_tolerance {100 * bound:.3g} "
-        "%: use scheme.h <= "
-        f"{0.5 * err.get('h', res.h):.3g} s"
+        f"%: use scheme.h <= {needed:.3g} s if the error falls as h^{order:g} (the check "
+        "tells)"
     )
 
 
