@@ -140,12 +140,12 @@ class Stages:
         self._keep("prestress", key, ps, f"{method} at {omega:g} rad/s")
         return ps
 
-    def _model_key(self, model, *extra) -> str:
+    def _model_key(self, model) -> str:
         n = model.n_dofs
         return content_key(
             self._mats_key, model.layout, model.boundary, model.x0, model.A, model.B,
             _state_arrays(model.contact, n), [_state_arrays(t, n) for t in model.loads],
-            model.observations, model.energy, model.to_full, *extra,
+            model.observations, model.energy, model.to_full,
         )  # fmt: skip
 
     def reduce(self, model, scene, log=None, make_stepper=None, limits=None, on_run=None):
@@ -170,11 +170,12 @@ class Stages:
             run = [dict(scene[k]) for k in ("scheme", "loads", "contact")] + [dict(limits or {})]
             for key in ("step_check", "step_tolerance"):  # the time-step check's keys
                 run[0].pop(key, None)
-        key = self._model_key(model, "reduction", opts, t_end, run)
+        model_key = self._model_key(model)  # hashed once: both keys below derive from it
+        key = content_key(model_key, "reduction", opts, t_end, run)
         hit = self._fetch("reduction", key)
         if hit is not None:
             return _attach(hit, model), None, dict(hit["report"], cache="hit")
-        bases = self._model_key(model, "bases", opts) if opts["method"] != "auto" else None
+        bases = content_key(model_key, "bases", opts) if opts["method"] != "auto" else None
         kept = _REDUCTORS.get(bases)
         if kept is None and bases is not None:  # built by another process (sweep worker)
             kept = self._fetch("bases", bases)
