@@ -80,3 +80,24 @@ def test_sweep_rejects_an_invalid_point_before_any_work(tmp_path, capsys):
     assert main(args) == 2
     assert "contact.restitution = 2: must be" in capsys.readouterr().err
     assert not (tmp_path / "s").exists()
+
+
+def test_the_map_draws_temperature_and_wear_only_where_the_scene_models_them():
+    from femrub.output.interaction import panels
+    from femrub.scene import load_scene
+
+    names = lambda rows, scene: [p[0] for p in panels(rows, scene)]  # noqa: E731
+    cold = [{"max_temperature": 0.0, "max_wear_depth": 0.0}] * 2
+    rigid = load_scene("paper", {"physics.thermal": "off"})
+    assert "max_temperature" not in names(cold, rigid)
+    assert "max_wear_depth" not in names(cold, rigid)
+    assert names(cold, rigid)[:3] == ["max_tip_displacement", "rms_tip_displacement",
+                                      "max_contact_force"]  # fmt: skip
+    hot = [{"max_temperature": 0.0}, {"max_temperature": 3.5}]
+    assert "max_temperature" in names(hot, rigid)  # a point that heated is shown
+    thermal = load_scene("paper", {"physics.thermal": "on"})
+    assert "max_temperature" in names(cold, thermal)
+    coated = load_scene(
+        "paper", {"contact.abradable.thickness": "1 mm", "contact.abradable.yield": 10.0}
+    )
+    assert "max_wear_depth" in names(cold, coated)

@@ -1,7 +1,8 @@
 """Interaction map of a sweep: response peaks against the swept parameter, Campbell diagram.
 
 Panels: maximum and RMS tip displacement, maximum contact force, maximum temperature and
-maximum abradable wear depth against the first swept parameter (one curve per combination
+maximum abradable wear depth (these two only when the scene models them: see
+:func:`panels`) against the first swept parameter (one curve per combination
 of the others) and, when that parameter is the rotation speed, the Campbell diagram: the
 natural frequencies of each point's model (prestressed at its speed) against the
 engine-order lines ``k Ω / 2π`` of the casing lobes (and of the tip force), with the
@@ -16,7 +17,7 @@ import numpy as np
 
 from .plots import plt, savefig
 
-__all__ = ["engine_orders", "plot_interaction_map"]
+__all__ = ["engine_orders", "panels", "plot_interaction_map"]
 
 _PANELS = [
     ("max_tip_displacement", "max |tip displacement| (µm)", 1e6),
@@ -25,6 +26,16 @@ _PANELS = [
     ("max_temperature", "max temperature rise (K)", 1.0),
     ("max_wear_depth", "max wear depth (µm)", 1e6),
 ]
+
+
+def panels(rows, scene) -> list[tuple]:
+    """The panels of a map: the temperature only with ``physics.thermal = "on"`` or a point
+    that heated, the wear only with an abradable coating or a point that wore."""
+    models = {
+        "max_temperature": scene["physics"]["thermal"] == "on",
+        "max_wear_depth": scene["contact"]["abradable"]["thickness"] > 0.0,
+    }
+    return [p for p in _PANELS if models.get(p[0], True) or any(r.get(p[0]) for r in rows)]
 
 
 def engine_orders(scene) -> list[int]:
@@ -51,10 +62,11 @@ def plot_interaction_map(rows, keys, scene, path) -> None:
     """Draw the interaction map of sweep ``rows`` (see :func:`femrub.app.sweep.run_sweep`)."""
     x_key = keys[0]
     campbell = x_key == "loads.rotation_speed"
-    n = len(_PANELS) + int(campbell)
+    shown = panels(rows, scene)
+    n = len(shown) + int(campbell)
     fig, axes = plt.subplots(n, 1, sharex=True, figsize=(7.5, 2.2 * n + 0.6))
     groups = _groups(rows, keys)
-    for ax, (name, label, scale) in zip(axes, _PANELS):
+    for ax, (name, label, scale) in zip(axes, shown):
         for glabel, grp in groups.items():
             grp = sorted((r for r in grp if r.get(name) is not None), key=lambda r: r["x"])
             xs = [r["x"] for r in grp]
