@@ -104,6 +104,9 @@ class ThermoelasticCraigBampton:
         projection of the heat equation; ``docs/reduction.md`` section 8).
     keep_solver : keep the interior factorisations for later solves (``solver``); ``False``
         releases them before the dense bases are allocated (lower peak memory).
+    stiffness : an :class:`~femrub.reduction.interior.InteriorStiffness` of this model's
+        ``K_ii`` (e.g. made for its modal damping, :mod:`femrub.reduction.modal_damping`),
+        used instead of a new factorisation (checked entry for entry).
 
     Attributes
     ----------
@@ -133,6 +136,7 @@ class ThermoelasticCraigBampton:
         boundary=None,
         thermal="boundary",
         keep_solver=True,
+        stiffness=None,
     ):
         if projection not in PROJECTIONS:
             raise ValueError(f"unknown projection {projection!r}; use one of {PROJECTIONS}")
@@ -176,7 +180,7 @@ class ThermoelasticCraigBampton:
         self.timings = {}
         self._largest = None  # the largest reduced operators, projected on first use
         t0 = time.perf_counter()
-        self.solver = solver = InteriorSolver(blocks, mi, ti)
+        self.solver = solver = InteriorSolver(blocks, mi, ti, stiffness)
         self._bnd = np.r_[mb, nu + mb, 2 * nu + tb].astype(int)
         self._int = np.r_[mi, nu + mi, 2 * nu + ti].astype(int)
         psi = solver.solve(-B[self._int][:, self._bnd])  # Eq. (11), sparse right-hand sides

@@ -30,8 +30,10 @@ __all__ = ["projected", "sliced"]
 def projected(fom, R, left, layout, n_boundary_u: int) -> dict:
     """Operators of ``fom`` projected on the right basis ``R`` and left basis ``left``
     (``R̃``; ``R`` itself for a Galerkin projection), of reduced ``layout``."""
-    Ar = project(left, fom.A, R)
-    Br = project(left, fom.B, R)
+    L = fom.layout
+    parts = [0, L.u.stop, L.v.stop, L.n]  # the u, v, θ rows of the bases
+    Ar = project(left, fom.A, R, parts=parts)
+    Br = project(left, fom.B, R, parts=parts)
     loads = [
         LoadTerm(left.T @ t.vector, t.signal, power=R.T @ t.power, heat=t.heat, name=t.name)
         for t in fom.loads

@@ -1,0 +1,119 @@
+"""Sparse (CSR) × dense products on every core, compiled with numba.
+
+scipy's CSR × dense product runs on one thread; the projections of a reduction
+(:func:`~femrub.fem.linalg.project`) spend most of their time in it. :func:`csr_dense`
+computes ``Q[:, in block b] @ X[in block b][:, columns of b]`` summed over row blocks ``b``
+of ``X``, rows of ``Q`` spread over the threads (``numba.prange``): each block of ``X``
+(the ``u``, ``v``, ``θ`` rows of a reduction basis) multiplies only the columns it is not
+zero on, so a stiffness acting on ``u`` does not multiply the velocity shapes' zeros.
+
+With ``NUMBA_DISABLE_JIT=1`` (or without numba) the kernel runs as plain Python (the same
+code, tested both ways); :func:`csr_dense` then uses scipy instead, whose result is the same
+to round-off (only the order of the sums differs).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import scipy.sparse as sp
+
+try:  # numba is a dependency; the fallback keeps a broken install importable
+    import numba
+    from numba import prange
+except ImportError:  # pragma: no cover
+    numba, prange = None, range
+
+__all__ = ["block_columns", "compiled", "csr_dense"]
+
+
+def compiled() -> bool:
+    """Whether the kernel runs as machine code (numba present and JIT enabled)."""
+    if numba is None:  # pragma: no cover
+        return False
+    from numba.core import config
+
+    return not config.DISABLE_JIT
+
+
+def _parallel(fn):
+    """``fn`` compiled with threads over ``prange`` (cached on disk), or ``fn`` itself."""
+    if numba is None:  # pragma: no cover
+        return fn
+    return numba.njit(cache=True, parallel=True, nogil=True)(fn)
+
+
+@_parallel
+def _csr_dense_runs(indptr, indices, data, X, bounds, run_ptr, starts, stops, offsets, out):
+    """``out[i, offsets[r] + j - starts[r]] += Q[i, c] X[c, j]`` for ``j`` in the runs ``r``
+    of the row block of ``c`` (``bounds[b] <= c < bounds[b + 1]``: runs
+    ``run_ptr[b] … run_ptr[b + 1]``)."""
+    n_blocks = bounds.size - 1
+    for i in prange(indptr.size - 1):
+        for p in range(indptr[i], indptr[i + 1]):
+            c = indices[p]
+            v = data[p]
+            b = 0
+            while b < n_blocks - 1 and c >= bounds[b + 1]:
+                b += 1
+            for r in range(run_ptr[b], run_ptr[b + 1]):
+                o = offsets[r] - starts[r]
+                for j in range(starts[r], stops[r]):
+                    out[i, o + j] += v * X[c, j]
+
+
+def _runs(columns: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Starts and stops of the contiguous runs of sorted ``columns``."""
+    if columns.size == 0:
+        return np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64)
+    cut = np.flatnonzero(np.diff(columns) != 1) + 1
+    return columns[np.r_[0, cut]].astype(np.int64), columns[np.r_[cut - 1, -1]].astype(np.int64) + 1
+
+
+def block_columns(nonzero: np.ndarray, bounds) -> list[np.ndarray]:
+    """The columns of each row block ``bounds[b]:bounds[b + 1]`` of the boolean pattern
+    ``nonzero`` (rows × columns) that are not zero in that block."""
+    b = np.asarray(bounds, dtype=np.int64)
+    return [np.flatnonzero(np.any(nonzero[b[k] : b[k + 1]], axis=0)) for k in range(b.size - 1)]
+
+
+def csr_dense(Q, X: np.ndarray, columns: list[np.ndarray], bounds, out_columns: np.ndarray):
+    """``Σ_b Q[:, block b] @ X[block b][:, columns[b]]`` into the ``out_columns`` layout.
+
+    Parameters
+    ----------
+    Q : (m, n) CSR matrix (sorted indices not needed).
+    X : (n, k) dense array.
+    columns : per row block ``b`` of ``X`` (``bounds[b]:bounds[b + 1]``), the sorted columns
+        of ``X`` it multiplies (the others are zero there).
+    bounds : (n_blocks + 1,) row bounds of the blocks, ``bounds[0] = 0``, last ``n``.
+    out_columns : sorted union of ``columns``: the columns of ``X`` the result holds.
+
+    Returns
+    -------
+    (m, out_columns.size) array: ``(Q @ X)[:, out_columns]``.
+    """
+    Q = sp.csr_matrix(Q)
+    out = np.zeros((Q.shape[0], out_columns.size))
+    if Q.nnz == 0 or out_columns.size == 0:
+        return out
+    if not compiled():  # plain Python would be slow: scipy, block by block
+        b = np.asarray(bounds, dtype=np.int64)
+        for k, cols in enumerate(columns):
+            if cols.size:
+                part = Q[:, b[k] : b[k + 1]] @ X[b[k] : b[k + 1]][:, cols]
+                out[:, np.searchsorted(out_columns, cols)] += part
+        return out
+    run_ptr, starts, stops, offsets = [0], [], [], []
+    for cols in columns:
+        s, e = _runs(cols)
+        starts.append(s)
+        stops.append(e)
+        offsets.append(np.searchsorted(out_columns, s))
+        run_ptr.append(run_ptr[-1] + s.size)
+    cat = lambda a: np.concatenate(a).astype(np.int64)  # noqa: E731
+    _csr_dense_runs(
+        Q.indptr, Q.indices, np.asarray(Q.data, dtype=float), X,
+        np.asarray(bounds, dtype=np.int64), np.asarray(run_ptr, dtype=np.int64),
+        cat(starts), cat(stops), cat(offsets), out,
+    )  # fmt: skip
+    return out
