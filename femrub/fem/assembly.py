@@ -20,7 +20,7 @@ from skfem import Basis
 
 from .. import progress
 from . import forms
-from .lumping import lump
+from .lumping import hrz_of, lump
 from .material import Material, check_finite_positive
 from .monotone import conduction_operator
 
@@ -113,6 +113,18 @@ def _stiffness_bases(basis_u: Basis, basis_t: Basis) -> tuple[Basis, Basis]:
     return bu, bu.with_element(basis_t.elem)
 
 
+def _lumped_mass(basis_u: Basis, rho: float, area: float, lumping: str, n_comp: int):
+    """The mass lumped by ``lumping``; row-sum and HRZ lumping need only the consistent
+    matrix's row sums and diagonal (two vectors: :func:`~.forms.mass_row_sums`,
+    :func:`~.forms.mass_diagonal`), so it is assembled only when kept consistent."""
+    if lumping not in ("row-sum", "hrz"):
+        return lump(forms.mass.assemble(basis_u, rho=rho, area=area), lumping, n_comp)
+    rows = forms.mass_row_sums.assemble(basis_u, rho=rho, area=area)
+    if lumping == "row-sum":
+        return sp.diags(rows).tocsr()
+    return hrz_of(forms.mass_diagonal.assemble(basis_u, rho=rho, area=area), rows, n_comp)
+
+
 def _free(n: int, fixed) -> np.ndarray:
     mask = np.ones(n, dtype=bool)
     if fixed is not None:
@@ -175,7 +187,7 @@ def assemble_thermoelastic(
     n_comp = basis_u.elem.dim if hasattr(basis_u.elem, "dim") else 1
 
     with progress.phase(f"mass matrix ({basis_u.N} dofs)", start=False):
-        M = lump(forms.mass.assemble(basis_u, rho=material.rho, area=area), lumping, n_comp)
+        M = _lumped_mass(basis_u, material.rho, area, lumping, n_comp)
     # stiffness and coupling integrate gradients: the lowest exact quadrature is enough
     # (order 2 for P2 on straight elements), several times cheaper than the mass's
     with progress.phase(f"stiffness matrix ({basis_u.N} dofs)", start=False):

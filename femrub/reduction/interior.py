@@ -102,12 +102,13 @@ class InteriorSolver:
         self.Ctt = sub(blocks.Ctt, ti, ti)
         self.Ktt = sub(blocks.Ktt, ti, ti)
         self.n_u, self.n_t = mi.size, ti.size
+        self._stiffness = None
         if stiffness is None:
             self._lu_K = _splu(self.K, "interior stiffness K_ii (is the structure clamped?)")
         elif not stiffness.same(self.K):
             raise ValueError("the interior stiffness given is not this model's K_ii")
-        else:
-            self._lu_K, self.K = stiffness.lu, stiffness.K  # one copy of K_ii
+        else:  # one copy of K_ii, released with the solver's (free)
+            self._lu_K, self.K, self._stiffness = stiffness.lu, stiffness.K, stiffness
         self._lu_T = _splu(self.Ktt, "interior conductivity K^θθ_ii (is a temperature fixed?)")
 
     def free(self) -> None:
@@ -119,6 +120,8 @@ class InteriorSolver:
             if hasattr(lu, "free"):
                 lu.free()
             setattr(self, name, _Freed())
+        if self._stiffness is not None:  # its copies of K_ii and of the factor's matrix
+            self._stiffness.free()
         self.K = self.M = self.C = self.Kut = self.Ctu = self.Ctt = self.Ktt = None
 
     def solve_K(self, rhs, trans: bool = False) -> np.ndarray:
