@@ -16,10 +16,11 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 import scipy.sparse as sp
-from skfem import Basis
+from skfem import Basis, ElementVector
 
 from .. import progress
 from . import forms
+from .elasticity import isotropic_stiffness
 from .lumping import hrz_of, lump
 from .material import Material, check_finite_positive
 from .monotone import conduction_operator
@@ -192,7 +193,10 @@ def assemble_thermoelastic(
     # (order 2 for P2 on straight elements), several times cheaper than the mass's
     with progress.phase(f"stiffness matrix ({basis_u.N} dofs)", start=False):
         bu_k, bt_k = _stiffness_bases(basis_u, basis_t)
-        K = forms.stiffness.assemble(bu_k, lam=lam, mu=mu, area=area)
+        if isinstance(bu_k.elem, ElementVector):  # batched element products
+            K = isotropic_stiffness(bu_k, lam, mu, area)
+        else:
+            K = forms.stiffness.assemble(bu_k, lam=lam, mu=mu, area=area)
     with progress.phase(f"heat matrices ({basis_t.N} dofs)", start=False):
         Ctt = forms.heat_capacity.assemble(basis_t, rho_c=material.rho_c, area=area)
         Ctt = lump(Ctt, heat_lumping or lumping, 1)
