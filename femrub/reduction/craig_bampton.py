@@ -69,6 +69,11 @@ from .thermal_inputs import input_basis, input_distributions
 __all__ = ["PROJECTIONS", "ThermoelasticCraigBampton", "craig_bampton_thermal"]
 
 PROJECTIONS = ("petrov-galerkin", "static-mass", "galerkin", "adjoint", "second-order")
+#: Relative residual asked of the clamped modes (ARPACK's ``tol``,
+#: :func:`~femrub.fem.eigen.lowest_modes`): the shapes are a basis, not results; the block
+#: solver converges by restart cycles, and one cycle fewer than at 1e-12 leaves eigenvalues
+#: and shapes within about 1e-11 of those (docs/performance.md).
+MODE_TOL = 1e-10
 #: Thermal reductions: the paper's boundary temperature dofs, or one input distribution each.
 THERMAL = ("inputs", "boundary")
 
@@ -188,7 +193,7 @@ class ThermoelasticCraigBampton:
         velocity_static_shapes(psi, projection, n_i, mb.size)
         self.timings["static_shapes"] = time.perf_counter() - t0
         t0 = time.perf_counter()
-        self.omega2, phi = lowest_modes(solver.K, solver.M, self.n_qv, solver.solve_K)
+        self.omega2, phi = lowest_modes(solver.K, solver.M, self.n_qv, solver.solve_K, tol=MODE_TOL)
         if thermal == "inputs":
             Q = input_distributions(fom)
             chi, self.n_theta_b, self.mu = input_basis(
@@ -197,7 +202,9 @@ class ThermoelasticCraigBampton:
             self.n_theta = self.mu.size
             self.n_inputs = Q.shape[1]
         else:
-            self.mu, chi = lowest_modes(solver.Ktt, solver.Ctt, self.n_theta, solver.solve_T)
+            self.mu, chi = lowest_modes(
+                solver.Ktt, solver.Ctt, self.n_theta, solver.solve_T, tol=MODE_TOL
+            )
             chi, self.n_theta_b, self.n_inputs = orient_columns(chi), tb.size, tb.size
         phi = orient_columns(phi)
         phi_ut = -solver.solve_K(solver.Kut @ chi)  # K_ii Φ^uθ = −K^uθ_ii Φ^θθ
