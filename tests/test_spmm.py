@@ -41,17 +41,18 @@ def _kernel(Q, X, bounds, out_columns, columns):
     """:func:`_csr_dense_runs` called as ``csr_dense`` calls it (every JIT setting)."""
     from femrub.fem.spmm import _runs
 
-    run_ptr, starts, stops, offsets = [0], [], [], []
-    for cols in columns:
+    lows, highs, starts, stops, offsets = [], [], [], [], []
+    for k, cols in enumerate(columns):
         s, e = _runs(cols)
+        lows.append(np.full(s.size, bounds[k]))
+        highs.append(np.full(s.size, bounds[k + 1]))
         starts.append(s)
         stops.append(e)
         offsets.append(np.searchsorted(out_columns, s))
-        run_ptr.append(run_ptr[-1] + s.size)
     out = np.zeros((Q.shape[0], out_columns.size))
     cat = lambda a: np.concatenate(a).astype(np.int64)  # noqa: E731
-    _csr_dense_runs(Q.indptr, Q.indices, Q.data, X, bounds, np.array(run_ptr),
-                    cat(starts), cat(stops), cat(offsets), out)  # fmt: skip
+    _csr_dense_runs(Q.indptr, Q.indices, Q.data, X, cat(lows), cat(highs), cat(starts),
+                    cat(stops), cat(offsets), out)  # fmt: skip
     return out
 
 

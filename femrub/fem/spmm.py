@@ -43,22 +43,26 @@ def _parallel(fn):
 
 
 @_parallel
-def _csr_dense_runs(indptr, indices, data, X, bounds, run_ptr, starts, stops, offsets, out):
-    """``out[i, offsets[r] + j - starts[r]] += Q[i, c] X[c, j]`` for ``j`` in the runs ``r``
-    of the row block of ``c`` (``bounds[b] <= c < bounds[b + 1]``: runs
-    ``run_ptr[b] … run_ptr[b + 1]``)."""
-    n_blocks = bounds.size - 1
+def _csr_dense_runs(indptr, indices, data, X, lows, highs, starts, stops, offsets, out):
+    """``out[i, offsets[r] + j − starts[r]] = Σ_c Q[i, c] X[c, j]`` over the columns ``c``
+    of run ``r``'s row block (``lows[r] <= c < highs[r]``), for ``j`` in
+    ``starts[r] … stops[r]``: a row of ``out`` summed in a local array, a contiguous run of
+    ``X``'s row per term."""
+    width = out.shape[1]
     for i in prange(indptr.size - 1):
-        for p in range(indptr[i], indptr[i + 1]):
-            c = indices[p]
-            v = data[p]
-            b = 0
-            while b < n_blocks - 1 and c >= bounds[b + 1]:
-                b += 1
-            for r in range(run_ptr[b], run_ptr[b + 1]):
-                o = offsets[r] - starts[r]
-                for j in range(starts[r], stops[r]):
-                    out[i, o + j] += v * X[c, j]
+        acc = np.zeros(width)
+        for r in range(starts.size):
+            lo, hi, s, o = lows[r], highs[r], starts[r], offsets[r]
+            n = stops[r] - s
+            for p in range(indptr[i], indptr[i + 1]):
+                c = indices[p]
+                if c >= lo and c < hi:
+                    v = data[p]
+                    x = X[c, s : s + n]  # views: 1D loops the compiler vectorises
+                    a = acc[o : o + n]
+                    for j in range(n):
+                        a[j] += v * x[j]
+        out[i, :] = acc
 
 
 def _runs(columns: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -103,17 +107,18 @@ def csr_dense(Q, X: np.ndarray, columns: list[np.ndarray], bounds, out_columns: 
                 part = Q[:, b[k] : b[k + 1]] @ X[b[k] : b[k + 1]][:, cols]
                 out[:, np.searchsorted(out_columns, cols)] += part
         return out
-    run_ptr, starts, stops, offsets = [0], [], [], []
-    for cols in columns:
+    b = np.asarray(bounds, dtype=np.int64)
+    lows, highs, starts, stops, offsets = [], [], [], [], []
+    for k, cols in enumerate(columns):
         s, e = _runs(cols)
+        lows.append(np.full(s.size, b[k]))
+        highs.append(np.full(s.size, b[k + 1]))
         starts.append(s)
         stops.append(e)
         offsets.append(np.searchsorted(out_columns, s))
-        run_ptr.append(run_ptr[-1] + s.size)
     cat = lambda a: np.concatenate(a).astype(np.int64)  # noqa: E731
     _csr_dense_runs(
-        Q.indptr, Q.indices, np.asarray(Q.data, dtype=float), X,
-        np.asarray(bounds, dtype=np.int64), np.asarray(run_ptr, dtype=np.int64),
+        Q.indptr, Q.indices, np.asarray(Q.data, dtype=float), X, cat(lows), cat(highs),
         cat(starts), cat(stops), cat(offsets), out,
     )  # fmt: skip
     return out
