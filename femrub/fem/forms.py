@@ -62,7 +62,7 @@ def mass(u, v, w):
 def mass_row_sums(v, w):
     """Row sums of the mass, ``Σ_j M_ij = ∫ ρ A N_i · Σ_j N_j dx``: the sum of a shape's
     components (the shapes of each component sum to one); parameters ``rho``, ``area``."""
-    return w.rho * w.area * dot(v, np.ones_like(v.value))
+    return w.rho * w.area * dot(v, np.ones_like(np.asarray(v)))
 
 
 @LinearForm
