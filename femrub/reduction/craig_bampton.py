@@ -168,7 +168,7 @@ class ThermoelasticCraigBampton:
         if coords is not None:
             blocks, B = coords.blocks(blocks), coords.operator(fom.B, L)
         else:
-            B = fom.B.tocsr()
+            B = fom.B  # CSC (the model's): its boundary columns are cut out cheaply
         if thermal == "inputs":
             tb = np.zeros(0, dtype=int)  # heat enters through its distributions, not dofs
         mi, ti = np.setdiff1d(np.arange(nu), mb), np.setdiff1d(np.arange(nt), tb)
@@ -188,7 +188,8 @@ class ThermoelasticCraigBampton:
         self.solver = solver = InteriorSolver(blocks, mi, ti, stiffness)
         self._bnd = np.r_[mb, nu + mb, 2 * nu + tb].astype(int)
         self._int = np.r_[mi, nu + mi, 2 * nu + ti].astype(int)
-        psi = solver.solve(-B[self._int][:, self._bnd])  # Eq. (11), sparse right-hand sides
+        B_ib = sp.csc_matrix(B)[:, self._bnd][self._int]  # columns first: no copy of B
+        psi = solver.solve(-B_ib)  # Eq. (11), sparse right-hand sides
         n_i = mi.size
         velocity_static_shapes(psi, projection, n_i, mb.size)
         self.timings["static_shapes"] = time.perf_counter() - t0
@@ -216,7 +217,7 @@ class ThermoelasticCraigBampton:
         if projection not in ("galerkin", "second-order"):
             psi_l = left_static_shapes(
                 psi, projection, n_i, mb.size,
-                lambda: solver.solve_transposed(-B[self._bnd][:, self._int].T),
+                lambda: solver.solve_transposed(-sp.csr_matrix(B)[self._bnd][:, self._int].T),
             )  # fmt: skip
             mphi = orient_columns(normalise_columns(solver.M @ phi[:, : self.n_qu]))
             left = (psi_l, mphi, phi, chi, solver.Ctu.T @ chi)
