@@ -224,7 +224,9 @@ def assemble_thermoelastic(
     else:
         Ctu = sp.csr_matrix((basis_t.N, basis_u.N))
     a_r, b_r = (float(x) for x in rayleigh)
-    C = a_r * M + b_r * K
+    # no damping: an empty C, not a copy of K's pattern holding zeros (the modal damping of
+    # the pipeline sets C later, these undamped blocks stay alive beside the model)
+    C = a_r * M + b_r * K if a_r or b_r else sp.csr_matrix(M.shape)
 
     fu, ft = _free(basis_u.N, fixed_u), _free(basis_t.N, fixed_t)
 
