@@ -85,6 +85,19 @@ def test_csr_dense_is_scipy():
     assert empty.shape == (4, 23) and not empty.any()
 
 
+def test_rows_split_between_threads(monkeypatch):
+    import femrub.fem.spmm as spmm
+
+    Q, X, bounds = _case(3)
+    cols = block_columns(X != 0.0, bounds)
+    whole = csr_dense(Q, X, cols, bounds, np.arange(X.shape[1]))
+    for threads in (2, 3, 7):
+        monkeypatch.setattr(spmm, "THREADS", threads)
+        monkeypatch.setattr(spmm, "NNZ_PER_THREAD", 100)
+        split = csr_dense(Q, X, cols, bounds, np.arange(X.shape[1]))
+        assert np.array_equal(split, whole)  # each row summed by one thread, in order
+
+
 def test_project_with_blocks_is_the_dense_product():
     Q, X, _ = _case(1, n=2000, k=31)
     L = X.copy()

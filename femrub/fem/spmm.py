@@ -3,9 +3,11 @@
 scipy's CSR × dense product runs on one thread; the projections of a reduction
 (:func:`~femrub.fem.linalg.project`) spend most of their time in it. :func:`csr_dense`
 computes ``Q[:, in block b] @ X[in block b][:, columns of b]`` summed over row blocks ``b``
-of ``X``, rows of ``Q`` spread over the threads (``numba.prange``): each block of ``X``
-(the ``u``, ``v``, ``θ`` rows of a reduction basis) multiplies only the columns it is not
-zero on, so a stiffness acting on ``u`` does not multiply the velocity shapes' zeros.
+of ``X``: each block of ``X`` (the ``u``, ``v``, ``θ`` rows of a reduction basis)
+multiplies only the columns it is not zero on, so a stiffness acting on ``u`` does not
+multiply the velocity shapes' zeros. The rows of ``Q`` are split between threads, each
+running the compiled kernel without the GIL (plain threads, not numba's OpenMP layer, whose
+idle workers spin and slow the BLAS calls around the kernel on a busy machine).
 
 With ``NUMBA_DISABLE_JIT=1`` (or without numba) the kernel runs as plain Python (the same
 code, tested both ways); :func:`csr_dense` then uses scipy instead, whose result is the same
@@ -14,14 +16,16 @@ to round-off (only the order of the sums differs).
 
 from __future__ import annotations
 
+import os
+from concurrent.futures import ThreadPoolExecutor
+
 import numpy as np
 import scipy.sparse as sp
 
 try:  # numba is a dependency; the fallback keeps a broken install importable
     import numba
-    from numba import prange
 except ImportError:  # pragma: no cover
-    numba, prange = None, range
+    numba = None
 
 __all__ = ["block_columns", "compiled", "csr_dense"]
 
@@ -35,21 +39,29 @@ def compiled() -> bool:
     return not config.DISABLE_JIT
 
 
-def _parallel(fn):
-    """``fn`` compiled with threads over ``prange`` (cached on disk), or ``fn`` itself."""
+def _compile(fn):
+    """``fn`` compiled without the GIL (cached on disk), or ``fn`` itself without numba."""
     if numba is None:  # pragma: no cover
         return fn
-    return numba.njit(cache=True, parallel=True, nogil=True)(fn)
+    return numba.njit(cache=True, nogil=True)(fn)
 
 
-@_parallel
+#: Threads the rows are split between (the cores this process may use, at most 8).
+THREADS = max(1, min(8, len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity")
+                     else (os.cpu_count() or 1)))  # fmt: skip
+#: Nonzeros of ``Q`` per thread below which fewer threads are used (small products).
+NNZ_PER_THREAD = 100_000
+_POOL: dict = {}
+
+
+@_compile
 def _csr_dense_runs(indptr, indices, data, X, lows, highs, starts, stops, offsets, out):
     """``out[i, offsets[r] + j − starts[r]] = Σ_c Q[i, c] X[c, j]`` over the columns ``c``
     of run ``r``'s row block (``lows[r] <= c < highs[r]``), for ``j`` in
     ``starts[r] … stops[r]``: a row of ``out`` summed in a local array, a contiguous run of
     ``X``'s row per term."""
     width = out.shape[1]
-    for i in prange(indptr.size - 1):
+    for i in range(indptr.size - 1):
         acc = np.zeros(width)
         for r in range(starts.size):
             lo, hi, s, o = lows[r], highs[r], starts[r], offsets[r]
@@ -117,8 +129,20 @@ def csr_dense(Q, X: np.ndarray, columns: list[np.ndarray], bounds, out_columns: 
         stops.append(e)
         offsets.append(np.searchsorted(out_columns, s))
     cat = lambda a: np.concatenate(a).astype(np.int64)  # noqa: E731
-    _csr_dense_runs(
-        Q.indptr, Q.indices, np.asarray(Q.data, dtype=float), X, cat(lows), cat(highs),
-        cat(starts), cat(stops), cat(offsets), out,
-    )  # fmt: skip
+    runs = (cat(lows), cat(highs), cat(starts), cat(stops), cat(offsets))
+    data = np.asarray(Q.data, dtype=float)
+    m = Q.shape[0]
+    parts = min(THREADS, max(1, Q.nnz // NNZ_PER_THREAD))
+    cuts = np.searchsorted(Q.indptr, np.linspace(0, Q.nnz, parts + 1)[1:-1])  # equal nnz
+    bounds_rows = np.r_[0, np.clip(cuts, 0, m), m]
+
+    def rows(k):
+        r0, r1 = bounds_rows[k], bounds_rows[k + 1]
+        _csr_dense_runs(Q.indptr[r0 : r1 + 1], Q.indices, data, X, *runs, out[r0:r1])
+
+    if parts == 1:
+        rows(0)
+    else:
+        pool = _POOL.get(parts) or _POOL.setdefault(parts, ThreadPoolExecutor(parts))
+        list(pool.map(rows, range(parts)))
     return out
