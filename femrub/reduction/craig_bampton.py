@@ -41,11 +41,7 @@ arbitrarily q^uv", after Eq. 15)::
 
 ``n_uv`` counts real first-order mechanical shapes as the paper does (``2 n_i`` for the full
 interior): mode ``φ_j`` gives a displacement shape (in ``q_u``) and a velocity shape (in
-``q_v``). ``n_qu = ⌊n_uv/2⌋`` and ``n_qv = ⌈n_uv/2⌉``: an odd ``n_uv`` adds mode
-``(n_uv + 1)/2`` as a velocity shape only. With no displacement partner that coordinate is
-inert for every projection (its momentum row sees no force), so an odd ``n_uv`` behaves as
-``n_uv − 1``; as a displacement shape only it would instead stiffen the boundary row of the
-Petrov–Galerkin model (a frozen interior displacement with no inertia).
+``q_v``); ``n_qu = ⌊n_uv/2⌋``, ``n_qv = ⌈n_uv/2⌉`` (an odd ``n_uv``: docs/reduction.md).
 """
 
 from __future__ import annotations
@@ -69,10 +65,8 @@ from .thermal_inputs import input_basis, input_distributions
 __all__ = ["PROJECTIONS", "ThermoelasticCraigBampton", "craig_bampton_thermal"]
 
 PROJECTIONS = ("petrov-galerkin", "static-mass", "galerkin", "adjoint", "second-order")
-#: Relative residual asked of the clamped modes (ARPACK's ``tol``,
-#: :func:`~femrub.fem.eigen.lowest_modes`): the shapes are a basis, not results; the block
-#: solver converges by restart cycles, and one cycle fewer than at 1e-12 leaves eigenvalues
-#: and shapes within about 1e-11 of those (docs/performance.md).
+#: Relative residual of the clamped modes (``lowest_modes``' ``tol``): a basis, not results;
+#: modes within ~1e-11 of those at 1e-12, one restart cycle fewer (docs/performance.md §8).
 MODE_TOL = 1e-10
 #: Thermal reductions: the paper's boundary temperature dofs, or one input distribution each.
 THERMAL = ("inputs", "boundary")
@@ -106,12 +100,11 @@ class ThermoelasticCraigBampton:
         mechanics) or ``"inputs"`` (no temperature dof is kept: the thermal basis of
         :func:`~femrub.reduction.thermal_inputs.input_basis`, ``2 m + 1`` input shapes for
         ``m`` heat distributions plus ``max_n_theta`` modes of the whole blade, Galerkin
-        projection of the heat equation; ``docs/reduction.md`` section 8).
+        projection of the heat equation; docs/reduction.md §8).
     keep_solver : keep the interior factorisations for later solves (``solver``); ``False``
         releases them before the dense bases are allocated (lower peak memory).
-    stiffness : an :class:`~femrub.reduction.interior.InteriorStiffness` of this model's
-        ``K_ii`` (e.g. made for its modal damping, :mod:`femrub.reduction.modal_damping`),
-        used instead of a new factorisation (checked entry for entry).
+    stiffness : an :class:`~femrub.reduction.interior.InteriorStiffness` of this model's ``K_ii``
+        (its modal damping's), used instead of a new factorisation (checked entry for entry).
 
     Attributes
     ----------
@@ -123,12 +116,10 @@ class ThermoelasticCraigBampton:
     boundary : ``{"u": ..., "theta": ...}`` boundary dofs used (Eq. 10).
     omega2 : (n_qv,) clamped mechanical eigenvalues ω² (rad²/s²) of the shapes kept.
     mu : (n_theta,) clamped thermal eigenvalues (1/s) of ``K^θθ χ = μ C^θθ χ``.
-    solver : the :class:`~femrub.reduction.interior.InteriorSolver` (LU factorisations of
-        ``K_ii`` and ``K^θθ_ii``), kept for further solves on the same interior (the full
-        model's modes, :func:`~femrub.reduction.interior.condensed_solve`);
+    solver : the :class:`~femrub.reduction.interior.InteriorSolver` (factorisations of ``K_ii``,
+        ``K^θθ_ii``), kept for further solves (the full model's modes, ``condensed_solve``);
         :func:`~femrub.reduction.sizes.reduce_model` releases it once the sizes are chosen.
-    timings : seconds spent in the static shapes, the modes and the bases (the projection
-        time of a reduced model is in its ``info["timings"]``).
+    timings : seconds of the static shapes, modes, bases (projection: the model's ``info``).
     """
 
     def __init__(
@@ -188,8 +179,7 @@ class ThermoelasticCraigBampton:
         self.solver = solver = InteriorSolver(blocks, mi, ti, stiffness)
         self._bnd = np.r_[mb, nu + mb, 2 * nu + tb].astype(int)
         self._int = np.r_[mi, nu + mi, 2 * nu + ti].astype(int)
-        B_ib = sp.csc_matrix(B)[:, self._bnd][self._int]  # columns first: no copy of B
-        psi = solver.solve(-B_ib)  # Eq. (11), sparse right-hand sides
+        psi = solver.solve(-sp.csc_matrix(B)[:, self._bnd][self._int])  # Eq. 11, columns first
         n_i = mi.size
         velocity_static_shapes(psi, projection, n_i, mb.size)
         self.timings["static_shapes"] = time.perf_counter() - t0
@@ -200,8 +190,7 @@ class ThermoelasticCraigBampton:
             chi, self.n_theta_b, self.mu = input_basis(
                 solver.Ctt, solver.Ktt, solver.solve_T, Q, self.n_theta
             )
-            self.n_theta = self.mu.size
-            self.n_inputs = Q.shape[1]
+            self.n_theta, self.n_inputs = self.mu.size, Q.shape[1]
         else:
             self.mu, chi = lowest_modes(
                 solver.Ktt, solver.Ctt, self.n_theta, solver.solve_T, tol=MODE_TOL
