@@ -3,10 +3,10 @@
 :class:`Stages` wraps the three expensive, deterministic stages of the pipeline; with no
 cache it only calls them:
 
-* ``assemble``: the Eq. (2) blocks (:func:`femrub.fem.discretisation.assemble`); key: the
-  mesh itself (vertices, cells, element, clamped dofs: the content of the mesh file as
-  read) and every argument of the assembly (material, lumping, coupling, Rayleigh or modal
-  damping, ...);
+* ``assemble``: the Eq. (2) blocks (:func:`femrub.fem.discretisation.assemble`) without
+  modal damping; key: the mesh itself (vertices, cells, element, clamped dofs: the content
+  of the mesh file as read) and every argument of the assembly (material, lumping,
+  coupling, Rayleigh coefficients, ...);
 * ``damping``: the modal Rayleigh damping (:func:`femrub.reduction.modal_damping.modal_rayleigh`),
   set once the contacts' boundary is known, its frequencies taken through the interior
   factorisation that the reduction then reuses (``reduce`` hands it on); key: the assembly
@@ -203,8 +203,8 @@ class Stages:
         opts = dict(scene["reduction"])
         if opts["method"] == "none":
             return reduce_model(model, scene, log, make_stepper, **kw)  # nothing stored
-        run = None  # what the estimate's runs depend on
         t_end = scene["scheme"]["t_end"] if opts["method"] == "auto" else None
+        run = None  # what the estimate's runs depend on
         if make_stepper:
             run = [dict(scene[k]) for k in ("scheme", "loads", "contact")] + [dict(limits or {})]
             for key in ("step_check", "step_tolerance"):  # the time-step check's keys
