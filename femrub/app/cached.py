@@ -3,10 +3,15 @@
 :class:`Stages` wraps the three expensive, deterministic stages of the pipeline; with no
 cache it only calls them:
 
-* ``assemble``: the Eq. (2) blocks (:func:`femrub.fem.discretisation.assemble`, damping
-  eigen-solve included); key: the mesh itself (vertices, cells, element, clamped dofs: the
-  content of the mesh file as read) and every argument of the assembly (material, lumping,
-  coupling, Rayleigh or modal damping, ...);
+* ``assemble``: the Eq. (2) blocks (:func:`femrub.fem.discretisation.assemble`) without
+  modal damping; key: the mesh itself (vertices, cells, element, clamped dofs: the content
+  of the mesh file as read) and every argument of the assembly (material, lumping,
+  coupling, Rayleigh coefficients, ...);
+* ``damping``: the modal Rayleigh damping (:func:`femrub.reduction.modal_damping.modal_rayleigh`),
+  set once the contacts' boundary is known, its frequencies taken through the interior
+  factorisation that the reduction then reuses (``reduce`` hands it on); key: the assembly
+  key, the boundary, ζ and the two modes; stored: ``(a, b)`` and the frequencies (on a hit
+  ``C = a M + b K`` is formed, nothing is factorised);
 * ``reduce``: the reduced model (:func:`femrub.reduction.sizes.reduce_model`) and its
   report; key: the assembly key, every state-space array of the full model the reduction
   projects (``A``, ``B``, contact rows, load vectors, observations, energy forms, map to the
@@ -51,6 +56,7 @@ import numpy as np
 
 from ..fem.discretisation import assemble
 from ..fem.prestress import centrifugal_prestress
+from ..reduction.modal_damping import modal_rayleigh
 from ..reduction.sizes import natural_frequencies, reduce_model
 from .cache import content_key
 
@@ -78,6 +84,7 @@ class Stages:
         self.cache, self.log = cache, log
         self.hits: dict[str, bool] = {}
         self._mats_key = None
+        self._stiffness = None  # the interior factorisation of the damping, for ``reduce``
         if cache is not None and log is not None and cache.log is None:
             cache.log = log
 
@@ -124,6 +131,37 @@ class Stages:
             _ASSEMBLED[key] = mats
         return dataclasses.replace(mats, basis_u=disc.basis_u, basis_t=disc.basis_t)
 
+    def damping(self, zeta: float, modes: tuple[int, int]):
+        """``(mats, boundary) -> mats`` with the modal Rayleigh damping of ratio ``zeta`` at
+        ``modes`` (``rub_model``'s ``damping``), through the cache; keeps the interior
+        factorisation it makes for :meth:`reduce`."""
+
+        def damp(mats, boundary):
+            key = None
+            if self.cache is not None and self._mats_key is not None:
+                key = content_key(self._mats_key, "damping", boundary, float(zeta), modes)
+                hit = self._fetch("damping", key)
+                if hit is not None:
+                    a, b = hit["rayleigh"]
+                    C = (a * mats.M + b * mats.K).tocsr()
+                    damped = dataclasses.replace(mats, C=C, info=dict(mats.info))
+                    damped.info["rayleigh"] = (a, b)
+                    return damped
+            t0 = time.perf_counter()
+            damped, self._stiffness, omega = modal_rayleigh(mats, zeta, modes, boundary)
+            a, b = damped.info["rayleigh"]
+            self._say(
+                f"modal damping {zeta:g} at modes {modes[0]}, {modes[1]} ("
+                f"{omega[modes[0] - 1] / (2 * np.pi):.6g} Hz, "
+                f"{omega[modes[1] - 1] / (2 * np.pi):.6g} Hz) in {time.perf_counter() - t0:.2f} s"
+            )
+            if key is not None:
+                value = {"rayleigh": (a, b), "omega": np.asarray(omega)}
+                self._keep("damping", key, value, f"Rayleigh ({a:.4g}, {b:.4g})")
+            return damped
+
+        return damp
+
     def prestress(self, disc, material, omega: float, method: str):
         """:func:`~femrub.fem.prestress.centrifugal_prestress` of ``disc``, through the cache."""
         if self.cache is None:
@@ -156,7 +194,8 @@ class Stages:
         applies to its runs into the key. ``on_run``: see ``reduce_model`` (not called on a
         cache hit: nothing is stepped).
         """
-        kw = {"limits": limits, "on_run": on_run}
+        stiffness, self._stiffness = self._stiffness, None
+        kw = {"limits": limits, "on_run": on_run, "stiffness": stiffness}
         if self.cache is None or self._mats_key is None:
             out = reduce_model(model, scene, log, make_stepper, **kw)
             _say_phases(self._say, out[0].info.get("timings", {}))
@@ -174,6 +213,8 @@ class Stages:
         key = content_key(model_key, "reduction", opts, t_end, run)
         hit = self._fetch("reduction", key)
         if hit is not None:
+            if stiffness is not None:
+                stiffness.free()
             return _attach(hit, model), None, dict(hit["report"], cache="hit")
         bases = content_key(model_key, "bases", opts) if opts["method"] != "auto" else None
         kept = _REDUCTORS.get(bases)

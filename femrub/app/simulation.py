@@ -200,9 +200,13 @@ def _build(scene, log, modes, stages, with_stepper=True) -> Simulation:
             disc, material, area=tr.area_of(scene), lumping=p["lumping"],
             conduction=p["conduction"],
             coupling=tr.coupling_of(scene), beta=p["beta"], strain_heating=p["strain_heating"],
-            rayleigh=tuple(p["rayleigh"]), damping_ratio=p["damping_ratio"],
-            damping_modes=tuple(p["damping_modes"]), prestress=prestress,
+            rayleigh=tuple(p["rayleigh"]), prestress=prestress,
         )  # fmt: skip
+        # modal damping once the contacts' boundary is known: its frequencies come through
+        # the interior factorisation the reduction reuses (femrub.reduction.modal_damping)
+        damping = p["damping_ratio"] and stages.damping(
+            p["damping_ratio"], tuple(p["damping_modes"])
+        )
         candidates = locate_contacts(disc, spread=c["spread"])
         growth = prestress.growth(candidates) if prestress is not None else np.zeros(candidates.n)
         force = tr.force_law(scene)
@@ -237,6 +241,7 @@ def _build(scene, log, modes, stages, with_stepper=True) -> Simulation:
             friction=mu, heat_law="power" if law == "power" else "alpha",
             heat_partition=eta, wear=abradable_of(scene, grid),
             casing_heat=casing_heat_of(scene, grid, eta, alpha, mu if law == "power" else 0.0),
+            damping=damping or None,
         )  # fmt: skip
         report["friction"] = {"mu": mu, "heat_law": law, "heat_partition": eta}
         _initial_penetration(full, report, log)

@@ -16,11 +16,12 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 import scipy.sparse as sp
-from skfem import Basis
+from skfem import Basis, ElementVector
 
 from .. import progress
 from . import forms
-from .lumping import lump
+from .elasticity import isotropic_stiffness
+from .lumping import hrz_of, lump
 from .material import Material, check_finite_positive
 from .monotone import conduction_operator
 
@@ -113,6 +114,18 @@ def _stiffness_bases(basis_u: Basis, basis_t: Basis) -> tuple[Basis, Basis]:
     return bu, bu.with_element(basis_t.elem)
 
 
+def _lumped_mass(basis_u: Basis, rho: float, area: float, lumping: str, n_comp: int):
+    """The mass lumped by ``lumping``; row-sum and HRZ lumping need only the consistent
+    matrix's row sums and diagonal (two vectors: :func:`~.forms.mass_row_sums`,
+    :func:`~.forms.mass_diagonal`), so it is assembled only when kept consistent."""
+    if lumping not in ("row-sum", "hrz"):
+        return lump(forms.mass.assemble(basis_u, rho=rho, area=area), lumping, n_comp)
+    rows = forms.mass_row_sums.assemble(basis_u, rho=rho, area=area)
+    if lumping == "row-sum":
+        return sp.diags(rows).tocsr()
+    return hrz_of(forms.mass_diagonal.assemble(basis_u, rho=rho, area=area), rows, n_comp)
+
+
 def _free(n: int, fixed) -> np.ndarray:
     mask = np.ones(n, dtype=bool)
     if fixed is not None:
@@ -175,12 +188,15 @@ def assemble_thermoelastic(
     n_comp = basis_u.elem.dim if hasattr(basis_u.elem, "dim") else 1
 
     with progress.phase(f"mass matrix ({basis_u.N} dofs)", start=False):
-        M = lump(forms.mass.assemble(basis_u, rho=material.rho, area=area), lumping, n_comp)
+        M = _lumped_mass(basis_u, material.rho, area, lumping, n_comp)
     # stiffness and coupling integrate gradients: the lowest exact quadrature is enough
     # (order 2 for P2 on straight elements), several times cheaper than the mass's
     with progress.phase(f"stiffness matrix ({basis_u.N} dofs)", start=False):
         bu_k, bt_k = _stiffness_bases(basis_u, basis_t)
-        K = forms.stiffness.assemble(bu_k, lam=lam, mu=mu, area=area)
+        if isinstance(bu_k.elem, ElementVector):  # batched element products
+            K = isotropic_stiffness(bu_k, lam, mu, area)
+        else:
+            K = forms.stiffness.assemble(bu_k, lam=lam, mu=mu, area=area)
     with progress.phase(f"heat matrices ({basis_t.N} dofs)", start=False):
         Ctt = forms.heat_capacity.assemble(basis_t, rho_c=material.rho_c, area=area)
         Ctt = lump(Ctt, heat_lumping or lumping, 1)
@@ -208,7 +224,9 @@ def assemble_thermoelastic(
     else:
         Ctu = sp.csr_matrix((basis_t.N, basis_u.N))
     a_r, b_r = (float(x) for x in rayleigh)
-    C = a_r * M + b_r * K
+    # no damping: an empty C, not a copy of K's pattern holding zeros (the modal damping of
+    # the pipeline sets C later, these undamped blocks stay alive beside the model)
+    C = a_r * M + b_r * K if a_r or b_r else sp.csr_matrix(M.shape)
 
     fu, ft = _free(basis_u.N, fixed_u), _free(basis_t.N, fixed_t)
 

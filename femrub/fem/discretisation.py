@@ -157,7 +157,8 @@ def assemble(
     if prestress is not None:
         if not np.array_equal(prestress.free_u, mats.free_u):
             raise ValueError("the prestress was computed on another discretisation")
-        C = (rayleigh[0] * mats.M + rayleigh[1] * prestress.K).tocsr()
+        a, b = rayleigh
+        C = (a * mats.M + b * prestress.K).tocsr() if a or b else mats.C  # (empty when 0)
         mats = replace(mats, K=prestress.K, C=C)
         mats.info["prestress_speed"] = prestress.omega
     if damping_ratio:

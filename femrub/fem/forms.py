@@ -22,12 +22,15 @@ Units: SI throughout (m, kg, s, K, N, W).
 
 from __future__ import annotations
 
-from skfem import BilinearForm
+import numpy as np
+from skfem import BilinearForm, LinearForm
 from skfem.helpers import ddot, dot, eye, grad, sym_grad, trace
 
 __all__ = [
     "lame_parameters",
     "mass",
+    "mass_diagonal",
+    "mass_row_sums",
     "stiffness",
     "thermal_stress",
     "heat_capacity",
@@ -53,6 +56,20 @@ def lame_parameters(young: float, poisson: float, dim: int) -> tuple[float, floa
 def mass(u, v, w):
     """Mass ``M_ij = ∫ ρ A N_i · N_j dx`` (paper Eq. 2a); parameters ``rho``, ``area``."""
     return w.rho * w.area * dot(u, v)
+
+
+@LinearForm
+def mass_row_sums(v, w):
+    """Row sums of the mass, ``Σ_j M_ij = ∫ ρ A N_i · Σ_j N_j dx``: the sum of a shape's
+    components (the shapes of each component sum to one); parameters ``rho``, ``area``."""
+    return w.rho * w.area * dot(v, np.ones_like(np.asarray(v)))
+
+
+@LinearForm
+def mass_diagonal(v, w):
+    """Diagonal of the mass, ``M_ii = ∫ ρ A N_i · N_i dx`` (not a linear form in ``v``: each
+    test function is integrated against itself); parameters ``rho``, ``area``."""
+    return w.rho * w.area * dot(v, v)
 
 
 @BilinearForm

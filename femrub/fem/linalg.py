@@ -17,6 +17,7 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 from .. import progress
+from .spmm import block_columns, csr_dense
 
 __all__ = [
     "DENSE_BELOW",
@@ -179,14 +180,18 @@ def sparse_lu(M, *, symmetric: bool = False, what: str = "matrix", pardiso: bool
         raise ValueError(f"the {what} is singular ({exc})") from None
 
 
-def project(left: np.ndarray, Q, right: np.ndarray, chunk: int = 8192) -> np.ndarray:
+def project(left: np.ndarray, Q, right: np.ndarray, chunk: int = 8192, parts=None) -> np.ndarray:
     """``leftᵀ Q right`` (dense) for a sparse ``Q`` and dense bases ``left``, ``right``.
 
     Row blocks of ``chunk`` rows are projected one at a time on the columns of the bases
     that are not zero there: the operators of a first-order model are block-sparse
     (``A = diag(I, M, C^θθ)``; ``B`` couples ``u``, ``v``, ``θ`` by blocks; energy forms
     act on one block) and a reduction basis is block-structured (a ``v`` row only has ``v``
-    shapes), so this skips most of the dense work of ``leftᵀ (Q right)``.
+    shapes), so this skips most of the dense work of ``leftᵀ (Q right)``. ``parts``: row
+    bounds of the blocks of ``right`` (e.g. ``[0, n_u, 2 n_u, n]``, the full state's ``u``,
+    ``v``, ``θ``): the columns of ``Q`` in a block multiply only the columns of ``right``
+    not zero in it. The sparse × dense products run on every core
+    (:func:`~femrub.fem.spmm.csr_dense`).
     """
     if not sp.issparse(Q):
         return left.T @ (np.asarray(Q) @ right)
@@ -194,17 +199,25 @@ def project(left: np.ndarray, Q, right: np.ndarray, chunk: int = 8192) -> np.nda
         return left.T @ np.asarray(Q @ right)
     Q = sp.csr_matrix(Q)
     out = np.zeros((left.shape[1], right.shape[1]))
-    nonzero = right != 0.0  # one boolean pattern: a chunk copies only the block it needs
+    nonzero = right != 0.0  # one boolean pattern
+    bounds = np.asarray([0, right.shape[0]] if parts is None else parts, dtype=np.int64)
+    columns = block_columns(nonzero, bounds) if parts is not None else None
+    none = np.zeros(0, dtype=np.int64)
     for s in range(0, Q.shape[0], chunk):
         Qs = Q[s : s + chunk]
         if Qs.nnz == 0:
             continue
         Ls = left[s : s + chunk]
         lc = np.flatnonzero(np.any(Ls != 0.0, axis=0))
-        cols = np.unique(Qs.indices)
-        rc = np.flatnonzero(np.any(nonzero[cols], axis=0))
+        if columns is None:  # one block: the columns not zero on the rows this chunk reads
+            touched = [np.flatnonzero(np.any(nonzero[np.unique(Qs.indices)], axis=0))]
+        else:  # the blocks of right this chunk reads
+            lo, hi = Qs.indices.min(), Qs.indices.max()
+            touched = [c if bounds[b] <= hi and lo < bounds[b + 1] else none
+                       for b, c in enumerate(columns)]  # fmt: skip
+        rc = np.unique(np.concatenate(touched))
         if lc.size and rc.size:
-            QR = Qs[:, cols] @ right[np.ix_(cols, rc)]
+            QR = csr_dense(Qs, right, touched, bounds, rc)
             out[np.ix_(lc, rc)] += Ls[:, lc].T @ QR
     return out
 

@@ -15,7 +15,7 @@ from __future__ import annotations
 import numpy as np
 import scipy.sparse as sp
 
-__all__ = ["row_sum", "hrz", "lump"]
+__all__ = ["row_sum", "hrz", "hrz_of", "lump"]
 
 
 def row_sum(matrix: sp.spmatrix) -> sp.csr_matrix:
@@ -36,12 +36,26 @@ def hrz(matrix: sp.spmatrix, n_components: int = 1) -> sp.csr_matrix:
     """
     diag = matrix.diagonal().astype(float)
     ones = np.ones(matrix.shape[0])
-    out = np.empty_like(diag)
+    totals = []
     for c in range(n_components):
         sel = np.zeros_like(ones)
         sel[c::n_components] = 1.0
-        total = sel @ (matrix @ sel)
-        out[c::n_components] = diag[c::n_components] * total / diag[c::n_components].sum()
+        totals.append(sel @ (matrix @ sel))
+    return _hrz(diag, totals, n_components)
+
+
+def hrz_of(diagonal: np.ndarray, row_sums: np.ndarray, n_components: int = 1) -> sp.csr_matrix:
+    """:func:`hrz` from the consistent matrix's ``diagonal`` and ``row_sums`` alone (a mass
+    without coupling between components: component ``c``'s total is the sum of its rows),
+    so that the consistent matrix need not be assembled."""
+    d, r = np.asarray(diagonal, dtype=float), np.asarray(row_sums, dtype=float)
+    return _hrz(d, [r[c::n_components].sum() for c in range(n_components)], n_components)
+
+
+def _hrz(diag: np.ndarray, totals, n_components: int) -> sp.csr_matrix:
+    out = np.empty_like(diag)
+    for c in range(n_components):
+        out[c::n_components] = diag[c::n_components] * totals[c] / diag[c::n_components].sum()
     if np.any(out <= 0.0):
         raise ValueError("HRZ lumping produced a non-positive mass; check the density and mesh")
     return sp.diags(out).tocsr()

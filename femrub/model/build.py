@@ -22,7 +22,7 @@ from ..contact.patches import patch_masters
 from ..fem.assembly import ThermoelasticMatrices
 from .first_order import Contact, EnergyForms, FirstOrderModel, Layout, LoadTerm
 
-__all__ = ["ContactSpec", "Load", "first_order_model"]
+__all__ = ["ContactSpec", "Load", "contact_boundary", "first_order_model"]
 
 
 @dataclass
@@ -86,6 +86,21 @@ def _rows(a, n_cols):
     if a.shape[1] != n_cols:
         raise ValueError(f"contact normals must have {n_cols} columns, got {a.shape[1]}")
     return a
+
+
+def contact_boundary(contact: ContactSpec | None, n_u: int) -> dict:
+    """The displacement boundary of a model with ``contact`` (the model's ``boundary``
+    without ``"theta"``): ``{"u": dofs the normal and tangent rows act on}``, or with
+    patches ``{"u": one master dof per row, "u_rows": the patch rows}``."""
+    if contact is None:
+        return {"u": np.zeros(0, dtype=int)}
+    if contact.patches is not None:  # boundary coordinates: the patch means
+        P = _rows(contact.patches, n_u)
+        return {"u": patch_masters(P), "u_rows": P}
+    u = np.unique(_rows(contact.normals, n_u).indices).astype(int)
+    if contact.tangents is not None:
+        u = np.union1d(u, _rows(contact.tangents, n_u).indices).astype(int)
+    return {"u": u}
 
 
 def first_order_model(
@@ -169,13 +184,11 @@ def first_order_model(
         G[L.u] = -N.T.toarray()
         Gv = np.zeros((n, nc))
         Gv[L.v] = -N.T.toarray()
-        boundary["u"] = np.unique(N.indices).astype(int)
         Gvt = None
         if contact.tangents is not None:
             T = _rows(contact.tangents, nu)
             Gvt = np.zeros((n, T.shape[0]))
             Gvt[L.v] = T.T.toarray()
-            boundary["u"] = np.union1d(boundary["u"], T.indices).astype(int)
         Ht = np.zeros((n, nc))
         if nt and contact.heat_dofs is not None:
             hd = np.asarray(contact.heat_dofs)
@@ -183,10 +196,8 @@ def first_order_model(
                 Ht[L.t.start + hd.astype(int), np.arange(nc)] = 1.0
             else:
                 Ht[L.t] = hd.T
+        boundary.update(contact_boundary(contact, nu))
         boundary["theta"] = np.flatnonzero(np.any(Ht[L.t] != 0.0, axis=1))
-        if contact.patches is not None:  # boundary coordinates: the patch means
-            P = _rows(contact.patches, nu)
-            boundary["u"], boundary["u_rows"] = patch_masters(P), P
         con = Contact(
             G=G,
             Gv=Gv,

@@ -97,11 +97,14 @@ class EnergyForms:
     heat_outflow: np.ndarray
     Wth: sp.spmatrix | None = None
 
-    def project(self, R) -> EnergyForms:
+    def project(self, R, parts=None) -> EnergyForms:
+        """The forms on the basis ``R`` (``parts``: row blocks of ``R``, see
+        :func:`~femrub.fem.linalg.project`)."""
+
         def pr(Q):
             if sp.issparse(R):
                 return sp.csr_matrix(R.T @ (Q @ R))
-            return sp.csr_matrix(project(R, Q, R))
+            return sp.csr_matrix(project(R, Q, R, parts=parts))
 
         return EnergyForms(
             Qk=pr(self.Qk),

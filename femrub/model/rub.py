@@ -28,7 +28,7 @@ from ..contact.points import ContactPoints, locate_contacts
 from ..fem.discretisation import Discretisation, assemble, discretise
 from ..fem.forms import lame_parameters
 from ..fem.material import Material
-from .build import ContactSpec, Load, first_order_model
+from .build import ContactSpec, Load, contact_boundary, first_order_model
 from .first_order import FirstOrderModel
 
 __all__ = ["DEFAULT_CLEARANCE", "FieldMap", "rub_model", "solid_model", "tip_load"]
@@ -125,6 +125,7 @@ def rub_model(
     heat_partition: float = 1.0,
     wear=None,
     casing_heat=None,
+    damping=None,
 ) -> tuple[FirstOrderModel, FieldMap]:
     """First-order model of ``disc`` rubbing ``casing`` at ``points`` (module docstring).
 
@@ -145,6 +146,10 @@ def rub_model(
         ``η = heat_partition``).
     wear : :class:`~femrub.contact.abradable.Abradable` coating over ``points``, or None.
     casing_heat : :class:`~femrub.contact.casing_heat.CasingHeat` of the casing, or None.
+    damping : ``(mats, boundary) -> mats`` with their damping ``C^uu`` set, called once the
+        contacts' displacement boundary (:func:`~femrub.model.build.contact_boundary`) is
+        known and before the model is built (the pipeline's modal damping, which takes the
+        frequencies through the reduction's interior factorisation), or None.
     """
     N, Q = points.normal_rows(mats), points.heat_rows(mats)
     if observe_at is None or observe_at is points:
@@ -171,6 +176,8 @@ def rub_model(
             patches=None if points.patch is None else points.mean_rows(mats),
         )
     )
+    if damping is not None:
+        mats = damping(mats, contact_boundary(spec, mats.n_u))
     model = first_order_model(mats, contact=spec, loads=loads, observe=observe, thermal=thermal)
     lam, mu = lame_parameters(material.young, material.poisson, disc.dim)
     model.info.update(

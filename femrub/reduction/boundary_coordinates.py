@@ -50,12 +50,15 @@ class BoundaryCoordinates:
 
     def blocks(self, b):
         """The Eq. (2) blocks ``b`` (a ``ThermoelasticMatrices``) in the coordinates ``u'``."""
-        T, Tt = self.T, sp.csr_matrix(self.T.T)
-        congruent = lambda X: sp.csr_matrix(Tt @ sp.csr_matrix(X) @ T)  # noqa: E731
+        T, Tt, congruent = self.T, sp.csr_matrix(self.T.T), self.congruent
         return replace(
             b, K=congruent(b.K), M=congruent(b.M), C=congruent(b.C),
             Kut=sp.csr_matrix(Tt @ b.Kut), Ctu=sp.csr_matrix(sp.csr_matrix(b.Ctu) @ T),
         )  # fmt: skip
+
+    def congruent(self, X) -> sp.csr_matrix:
+        """``Tᵀ X T`` of a u-block matrix (``K' = Tᵀ K T``)."""
+        return sp.csr_matrix(sp.csr_matrix(self.T.T) @ sp.csr_matrix(X) @ self.T)
 
     def _diag(self, layout, u, v) -> sp.csr_matrix:
         return sp.block_diag([u, v] + ([sp.identity(layout.n_t)] if layout.n_t else []), "csr")

@@ -41,11 +41,7 @@ arbitrarily q^uv", after Eq. 15)::
 
 ``n_uv`` counts real first-order mechanical shapes as the paper does (``2 n_i`` for the full
 interior): mode ``φ_j`` gives a displacement shape (in ``q_u``) and a velocity shape (in
-``q_v``). ``n_qu = ⌊n_uv/2⌋`` and ``n_qv = ⌈n_uv/2⌉``: an odd ``n_uv`` adds mode
-``(n_uv + 1)/2`` as a velocity shape only. With no displacement partner that coordinate is
-inert for every projection (its momentum row sees no force), so an odd ``n_uv`` behaves as
-``n_uv − 1``; as a displacement shape only it would instead stiffen the boundary row of the
-Petrov–Galerkin model (a frozen interior displacement with no inertia).
+``q_v``); ``n_qu = ⌊n_uv/2⌋``, ``n_qv = ⌈n_uv/2⌉`` (an odd ``n_uv``: docs/reduction.md).
 """
 
 from __future__ import annotations
@@ -69,6 +65,9 @@ from .thermal_inputs import input_basis, input_distributions
 __all__ = ["PROJECTIONS", "ThermoelasticCraigBampton", "craig_bampton_thermal"]
 
 PROJECTIONS = ("petrov-galerkin", "static-mass", "galerkin", "adjoint", "second-order")
+#: Relative residual of the clamped modes (``lowest_modes``' ``tol``): a basis, not results;
+#: modes within ~1e-11 of those at 1e-12, one restart cycle fewer (docs/performance.md §8).
+MODE_TOL = 1e-10
 #: Thermal reductions: the paper's boundary temperature dofs, or one input distribution each.
 THERMAL = ("inputs", "boundary")
 
@@ -101,9 +100,11 @@ class ThermoelasticCraigBampton:
         mechanics) or ``"inputs"`` (no temperature dof is kept: the thermal basis of
         :func:`~femrub.reduction.thermal_inputs.input_basis`, ``2 m + 1`` input shapes for
         ``m`` heat distributions plus ``max_n_theta`` modes of the whole blade, Galerkin
-        projection of the heat equation; ``docs/reduction.md`` section 8).
+        projection of the heat equation; docs/reduction.md §8).
     keep_solver : keep the interior factorisations for later solves (``solver``); ``False``
         releases them before the dense bases are allocated (lower peak memory).
+    stiffness : an :class:`~femrub.reduction.interior.InteriorStiffness` of this model's ``K_ii``
+        (its modal damping's), used instead of a new factorisation (checked entry for entry).
 
     Attributes
     ----------
@@ -115,12 +116,10 @@ class ThermoelasticCraigBampton:
     boundary : ``{"u": ..., "theta": ...}`` boundary dofs used (Eq. 10).
     omega2 : (n_qv,) clamped mechanical eigenvalues ω² (rad²/s²) of the shapes kept.
     mu : (n_theta,) clamped thermal eigenvalues (1/s) of ``K^θθ χ = μ C^θθ χ``.
-    solver : the :class:`~femrub.reduction.interior.InteriorSolver` (LU factorisations of
-        ``K_ii`` and ``K^θθ_ii``), kept for further solves on the same interior (the full
-        model's modes, :func:`~femrub.reduction.interior.condensed_solve`);
+    solver : the :class:`~femrub.reduction.interior.InteriorSolver` (factorisations of ``K_ii``,
+        ``K^θθ_ii``), kept for further solves (the full model's modes, ``condensed_solve``);
         :func:`~femrub.reduction.sizes.reduce_model` releases it once the sizes are chosen.
-    timings : seconds spent in the static shapes, the modes and the bases (the projection
-        time of a reduced model is in its ``info["timings"]``).
+    timings : seconds of the static shapes, modes, bases (projection: the model's ``info``).
     """
 
     def __init__(
@@ -133,6 +132,7 @@ class ThermoelasticCraigBampton:
         boundary=None,
         thermal="boundary",
         keep_solver=True,
+        stiffness=None,
     ):
         if projection not in PROJECTIONS:
             raise ValueError(f"unknown projection {projection!r}; use one of {PROJECTIONS}")
@@ -159,7 +159,7 @@ class ThermoelasticCraigBampton:
         if coords is not None:
             blocks, B = coords.blocks(blocks), coords.operator(fom.B, L)
         else:
-            B = fom.B.tocsr()
+            B = fom.B  # CSC (the model's): its boundary columns are cut out cheaply
         if thermal == "inputs":
             tb = np.zeros(0, dtype=int)  # heat enters through its distributions, not dofs
         mi, ti = np.setdiff1d(np.arange(nu), mb), np.setdiff1d(np.arange(nt), tb)
@@ -176,24 +176,25 @@ class ThermoelasticCraigBampton:
         self.timings = {}
         self._largest = None  # the largest reduced operators, projected on first use
         t0 = time.perf_counter()
-        self.solver = solver = InteriorSolver(blocks, mi, ti)
+        self.solver = solver = InteriorSolver(blocks, mi, ti, stiffness)
         self._bnd = np.r_[mb, nu + mb, 2 * nu + tb].astype(int)
         self._int = np.r_[mi, nu + mi, 2 * nu + ti].astype(int)
-        psi = solver.solve(-B[self._int][:, self._bnd])  # Eq. (11), sparse right-hand sides
+        psi = solver.solve(-sp.csc_matrix(B)[:, self._bnd][self._int])  # Eq. 11, columns first
         n_i = mi.size
         velocity_static_shapes(psi, projection, n_i, mb.size)
         self.timings["static_shapes"] = time.perf_counter() - t0
         t0 = time.perf_counter()
-        self.omega2, phi = lowest_modes(solver.K, solver.M, self.n_qv, solver.solve_K)
+        self.omega2, phi = lowest_modes(solver.K, solver.M, self.n_qv, solver.solve_K, tol=MODE_TOL)
         if thermal == "inputs":
             Q = input_distributions(fom)
             chi, self.n_theta_b, self.mu = input_basis(
                 solver.Ctt, solver.Ktt, solver.solve_T, Q, self.n_theta
             )
-            self.n_theta = self.mu.size
-            self.n_inputs = Q.shape[1]
+            self.n_theta, self.n_inputs = self.mu.size, Q.shape[1]
         else:
-            self.mu, chi = lowest_modes(solver.Ktt, solver.Ctt, self.n_theta, solver.solve_T)
+            self.mu, chi = lowest_modes(
+                solver.Ktt, solver.Ctt, self.n_theta, solver.solve_T, tol=MODE_TOL
+            )
             chi, self.n_theta_b, self.n_inputs = orient_columns(chi), tb.size, tb.size
         phi = orient_columns(phi)
         phi_ut = -solver.solve_K(solver.Kut @ chi)  # K_ii Φ^uθ = −K^uθ_ii Φ^θθ
@@ -205,7 +206,7 @@ class ThermoelasticCraigBampton:
         if projection not in ("galerkin", "second-order"):
             psi_l = left_static_shapes(
                 psi, projection, n_i, mb.size,
-                lambda: solver.solve_transposed(-B[self._bnd][:, self._int].T),
+                lambda: solver.solve_transposed(-sp.csr_matrix(B)[self._bnd][:, self._int].T),
             )  # fmt: skip
             mphi = orient_columns(normalise_columns(solver.M @ phi[:, : self.n_qu]))
             left = (psi_l, mphi, phi, chi, solver.Ctu.T @ chi)

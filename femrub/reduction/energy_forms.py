@@ -9,6 +9,8 @@ the forms that rest on ``Ā⁻¹ B̄`` (:func:`energy_rates`).
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 import scipy.sparse as sp
 from scipy.linalg import eigh
@@ -43,14 +45,22 @@ def reduced_energy(fom, n_boundary_u: int, R, Ar, Br, layout):
     """
     m = fom
     L = m.layout
+    parts = [0, L.u.stop, L.v.stop, L.n]  # the u, v, θ rows of the bases
     Rz = elastic_basis(fom, n_boundary_u, R, layout)
-    forms = m.energy.project(R)
+    # forms rebuilt below are not projected here: the damping power (``energy_rates``, when
+    # damped) and the elastic form on ``R_z``
+    zero = sp.csr_matrix((L.n, L.n))
+    damped = sp.csr_matrix(m.energy.Pd).count_nonzero() > 0
+    given = dataclasses.replace(
+        m.energy, Pd=zero if damped else m.energy.Pd, Qe=m.energy.Qe if Rz is R else zero
+    )
+    forms = given.project(R, parts)
     if Rz is not R:  # else the projected Qe is already the elastic energy's
-        forms.Qe = sp.csr_matrix(project(Rz, m.energy.Qe, Rz))
+        forms.Qe = sp.csr_matrix(project(Rz, m.energy.Qe, Rz, parts=parts))
     if L.n_t:
         P = sp.csr_matrix(m.energy.Pth)
         P_u = sp.vstack([P[L.v], P[L.u], P[L.t]], format="csr")  # v-rows moved to u-rows
-        forms.Wth = sp.csr_matrix(np.asarray(project(Rz, P_u, R)))
+        forms.Wth = sp.csr_matrix(np.asarray(project(Rz, P_u, R, parts=parts)))
     return energy_rates(fom, forms, Ar, Br, layout)
 
 

@@ -12,7 +12,10 @@ operators are::
 the boundary dofs of Eq. 10) by block elimination with two sparse LU factorisations
 (``K^uu_ii`` and ``K^θθ_ii``), never forming a dense inverse. :func:`condensed_solve` reuses
 the ``K_ii`` factorisation to solve with the whole stiffness (boundary dofs free) by static
-condensation. SI units: m, m/s, K; forces in N, heat rates in W.
+condensation. :class:`InteriorStiffness` is that factorisation alone: it can be made before
+the model exists (the modal damping takes the full model's frequencies through it,
+:mod:`femrub.reduction.modal_damping`) and handed to the solver, which then does not
+factorise ``K_ii`` again. SI units: m, m/s, K; forces in N, heat rates in W.
 """
 
 from __future__ import annotations
@@ -25,7 +28,45 @@ import scipy.sparse as sp
 from ..fem.assembly import ThermoelasticMatrices
 from ..fem.linalg import sparse_lu
 
-__all__ = ["InteriorSolver", "condensed_solve"]
+__all__ = ["InteriorSolver", "InteriorStiffness", "condensed_solve"]
+
+
+class InteriorStiffness:
+    """``K_ii`` (the stiffness without the boundary dofs ``mech_b``) and its factorisation.
+
+    Parameters
+    ----------
+    K : (n_u, n_u) sparse stiffness (in the reduction's boundary coordinates, if any).
+    mech_b : boundary positions in the u-block; the interior ones are the rest.
+    """
+
+    def __init__(self, K, mech_b: np.ndarray):
+        K = sp.csr_matrix(K)
+        self.mech_b = np.asarray(mech_b, dtype=int)
+        self.mech_i = np.setdiff1d(np.arange(K.shape[0]), self.mech_b)
+        self.K = K[self.mech_i][:, self.mech_i].tocsc()
+        self.lu = _splu(self.K, "interior stiffness K_ii (is the structure clamped?)")
+
+    def same(self, K_ii) -> bool:
+        """Whether ``K_ii`` (CSC) is this stiffness, entry for entry."""
+        A = self.K
+        return (
+            A is not None and A.shape == K_ii.shape and A.nnz == K_ii.nnz
+            and all(np.array_equal(getattr(A, f), getattr(K_ii, f))
+                    for f in ("indptr", "indices", "data"))
+        )  # fmt: skip
+
+    def solve_K(self, rhs, trans: bool = False) -> np.ndarray:
+        """``K_ii⁻¹ rhs`` (or ``K_ii⁻ᵀ rhs``)."""
+        if self.lu is None:
+            return np.zeros_like(np.asarray(rhs, dtype=float))
+        return self.lu.solve(np.ascontiguousarray(rhs), trans="T" if trans else "N")
+
+    def free(self) -> None:
+        """Release the factorisation (a later solve raises ``RuntimeError``)."""
+        if hasattr(self.lu, "free"):
+            self.lu.free()
+        self.lu, self.K = _Freed(), None
 
 
 class InteriorSolver:
@@ -40,9 +81,17 @@ class InteriorSolver:
     solved by block elimination (``x_v = r_u``, then ``x_θ``, then ``x_u``) with sparse LU
     factorisations of ``K_ii`` and ``K^θθ_ii``; the transposed system likewise.
     ``solve_K`` is also the shift-invert operator of the clamped modal problem.
+    ``stiffness``: an :class:`InteriorStiffness` of the same ``K_ii`` (checked entry for
+    entry), whose factorisation is then used instead of a new one.
     """
 
-    def __init__(self, blocks: ThermoelasticMatrices, mech_i: np.ndarray, theta_i: np.ndarray):
+    def __init__(
+        self,
+        blocks: ThermoelasticMatrices,
+        mech_i: np.ndarray,
+        theta_i: np.ndarray,
+        stiffness: InteriorStiffness | None = None,
+    ):
         sub = lambda X, r, c: sp.csr_matrix(X)[r][:, c].tocsc()  # noqa: E731
         mi, ti = mech_i, theta_i
         self.K = sub(blocks.K, mi, mi)
@@ -53,7 +102,13 @@ class InteriorSolver:
         self.Ctt = sub(blocks.Ctt, ti, ti)
         self.Ktt = sub(blocks.Ktt, ti, ti)
         self.n_u, self.n_t = mi.size, ti.size
-        self._lu_K = _splu(self.K, "interior stiffness K_ii (is the structure clamped?)")
+        self._stiffness = None
+        if stiffness is None:
+            self._lu_K = _splu(self.K, "interior stiffness K_ii (is the structure clamped?)")
+        elif not stiffness.same(self.K):
+            raise ValueError("the interior stiffness given is not this model's K_ii")
+        else:  # one copy of K_ii, released with the solver's (free)
+            self._lu_K, self.K, self._stiffness = stiffness.lu, stiffness.K, stiffness
         self._lu_T = _splu(self.Ktt, "interior conductivity K^θθ_ii (is a temperature fixed?)")
 
     def free(self) -> None:
@@ -65,6 +120,8 @@ class InteriorSolver:
             if hasattr(lu, "free"):
                 lu.free()
             setattr(self, name, _Freed())
+        if self._stiffness is not None:  # its copies of K_ii and of the factor's matrix
+            self._stiffness.free()
         self.K = self.M = self.C = self.Kut = self.Ctu = self.Ctt = self.Ktt = None
 
     def solve_K(self, rhs, trans: bool = False) -> np.ndarray:

@@ -30,8 +30,10 @@ __all__ = ["projected", "sliced"]
 def projected(fom, R, left, layout, n_boundary_u: int) -> dict:
     """Operators of ``fom`` projected on the right basis ``R`` and left basis ``left``
     (``R̃``; ``R`` itself for a Galerkin projection), of reduced ``layout``."""
-    Ar = project(left, fom.A, R)
-    Br = project(left, fom.B, R)
+    L = fom.layout
+    parts = [0, L.u.stop, L.v.stop, L.n]  # the u, v, θ rows of the bases
+    Ar = project(left, fom.A, R, parts=parts)
+    Br = project(left, fom.B, R, parts=parts)
     loads = [
         LoadTerm(left.T @ t.vector, t.signal, power=R.T @ t.power, heat=t.heat, name=t.name)
         for t in fom.loads
@@ -55,6 +57,12 @@ def sliced(largest: dict, fom, cols, layout) -> dict:
     """The operators of the columns ``cols`` as blocks of the ``largest`` model's
     (:func:`projected` on every column), with ``fom``'s gap, heat and load functions."""
     A, B = largest["A"][np.ix_(cols, cols)], largest["B"][np.ix_(cols, cols)]
+    every = cols.size == A.shape[0] == largest["A"].shape[0] and np.array_equal(
+        cols, np.arange(cols.size)
+    )
+    to_full = largest["to_full"]
+    if to_full is not None and not every:  # the map to the mesh of the largest model is
+        to_full = to_full[:, cols]  # shared, not copied (n × r dense: 0.4 GB on Rotor 37)
     energy, growth = None, 0.0
     if largest["energy"] is not None:
         energy, growth = energy_rates(fom, sliced_energy(largest["energy"], cols), A, B, layout)
@@ -66,5 +74,5 @@ def sliced(largest: dict, fom, cols, layout) -> dict:
         "observations": {k: O[:, cols] for k, O in largest["observations"].items()},
         "energy": energy,
         "growth": growth,
-        "to_full": None if largest["to_full"] is None else largest["to_full"][:, cols],
+        "to_full": to_full,
     }

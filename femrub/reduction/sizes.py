@@ -217,8 +217,9 @@ def lobe_passage(scene) -> float:
 
 
 def reduce_model(
-    model, scene, log=None, make_stepper=None, reductor=None, limits=None, on_run=None
-):
+    model, scene, log=None, make_stepper=None, reductor=None, limits=None, on_run=None,
+    stiffness=None,
+):  # fmt: skip
     """Reduce ``model`` as ``scene["reduction"]`` asks; return ``(model, reductor, report)``.
 
     ``reductor`` is the one reductor built (at the largest sizes for ``"auto"``, at
@@ -234,10 +235,16 @@ def reduce_model(
     models over the part of the run that the run itself can reach. ``on_run(results,
     seconds, states)``: called with the estimate's run of the returned model's sizes (its
     :class:`~femrub.output.results.Results`, judged without the reduction rule, and its wall
-    time), which is the scene's run: the caller need not step it again.
+    time), which is the scene's run: the caller need not step it again. ``stiffness``: an
+    :class:`~femrub.reduction.interior.InteriorStiffness` of the model's ``K_ii`` already
+    factorised (its modal damping, :mod:`femrub.reduction.modal_damping`), for the reductor
+    built here; released when unused.
     """
     opts = scene["reduction"]
     method = opts["method"]
+    if stiffness is not None and (method == "none" or reductor is not None):
+        stiffness.free()  # no reductor is built here
+        stiffness = None
     if method == "none":
         return model, None, {"method": "none"}
     if model.layout.n_t and scene["material"]["conductivity"] == 0.0:
@@ -271,9 +278,13 @@ def reduce_model(
             red = ThermoelasticCraigBampton(
                 model, n_uv, n_theta, projection=opts["projection"], thermal=opts["thermal"],
                 keep_solver=method == "auto",  # only "auto" solves again (_auto_sizes)
+                stiffness=stiffness,
             )  # fmt: skip
+            stiffness = None  # the reductor's now
     except ValueError as exc:
         text = str(exc)
+        if stiffness is not None:
+            stiffness.free()
         key = next((f"reduction.{k}" for k in ("n_theta", "n_uv") if k in text), None)
         raise SceneError(f"{key or f'reduction.method = {method!r}'}: {text}") from None
     if want is not None:
