@@ -66,7 +66,8 @@ def test_the_verdict_follows_the_estimate(tmp_path, h):
         # the suggested step brings an order-1 error to the tolerance
         suggested = float(doc["message"].split("scheme.h <= ")[1].split()[0])
         assert suggested == pytest.approx(
-            min(0.5, err["tolerance"] / err["estimate"]) * h, rel=2e-3
+            min(0.5, err["tolerance"] / err["estimate"]) * h,
+            rel=5e-3,  # 3 digits
         )
     else:
         assert doc["status"] == "ok"
