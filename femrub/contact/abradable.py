@@ -204,6 +204,8 @@ class Abradable:
     # -- results ------------------------------------------------------------------------
     @property
     def max_depth(self) -> float:
+        """The largest coefficient of the map (m): the surface's deepest point or above it
+        (the weights sum to 1), equal to it where a cut raised a whole support."""
         return float(self.depth.max())
 
     @property
