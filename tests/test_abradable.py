@@ -280,3 +280,48 @@ def test_a_sweep_cuts_every_centre_it_crosses(n_angle):
     assert wear.worn_volume == pytest.approx(
         reach * 0.3 * swept * width, rel=4.0 / (swept / (2 * math.pi / n_angle))
     )
+
+
+def test_the_bound_of_a_step_entering_the_coating_is_the_part_of_the_step_on_it():
+    """``h F_y`` for a contact closed at ``t_k``; ``F_y`` times the part of the step after the
+    free motion reaches the worn surface for one open at ``t_k``; ``inf`` worn through."""
+    cell = 2 * math.pi / 16
+    grid = CasingGrid((np.arange(0, 16, 4) + 0.5) * cell, [0.0] * 4, 0.3, 100.0, n_angle=16,
+                      n_axial=1)  # fmt: skip
+    wear = Abradable(1e-4, 10.0, grid)
+    wear.reset(h=1e-6)
+    wear.depth[11:14, 0] = 1e-4  # around the fourth contact (centre 12) at t = 0: worn through
+    g_k = np.array([3e-6, -1e-7, 2e-6, 1e-6])
+    g_p = np.array([-1e-6, -2e-6, 1e-6, -1e-6])
+    U = wear.impulse_cap(0.0, 1e-6, g_k, g_p)
+    assert U[0] == pytest.approx(1e-5 * 0.25, rel=1e-14)  # a quarter of the step on it
+    assert U[1] == pytest.approx(1e-5) and U[2] == pytest.approx(1e-5)
+    assert np.isinf(U[3])
+    np.testing.assert_array_equal(wear.bound(0.0, 1e-6), U)  # the yield test's bound
+    assert wear.bound(1e-6, 1e-6)[0] == pytest.approx(1e-5)  # another step: h F_y
+
+
+def test_a_mass_entering_the_coating_is_held_only_after_it_reaches_it():
+    """A free mass m at speed v meets a fresh coating (yield F_y) at t_c inside a step: that
+    step's impulse is F_y (t_{k+1} − t_c), then F_y h per step until the mass has lost m v;
+    the cut depth is the plastic stopping distance m v² / (2 F_y) to O(h v)."""
+    from femrub.model.first_order import FirstOrderModel, Layout
+    from femrub.steppers import make_stepper
+
+    m, v, F_y, d, h = 2.0, 0.5, 400.0, 1.3e-6, 1e-6  # stops in m v / F_y = 2.5 ms
+    grid = CasingGrid([0.0], [0.0], 0.3, 0.0, n_angle=1, n_axial=1)
+    wear = Abradable(1e-2, F_y, grid)
+    c = Contact(G=[[-1.0], [0.0]], Gv=[[0.0], [-1.0]], Hm=[[0.0], [-1.0]], Ht=[[0.0], [0.0]],
+                gap0=d, wear=wear)  # fmt: skip
+    A = np.diag([1.0, m])
+    B = np.array([[0.0, 1.0], [0.0, 0.0]])
+    model = FirstOrderModel(A, B, Layout(n_u=1, n_v=1, n_t=0), contact=c, x0=np.array([0.0, v]))
+    st = make_stepper("theta", model, h)
+    P = np.array([st.step().impulse[0] for _ in range(3000)])
+    k = int(np.flatnonzero(P > 0)[0])
+    t_c = d / v
+    assert k * h < t_c <= (k + 1) * h
+    assert P[k] == pytest.approx(F_y * ((k + 1) * h - t_c), rel=1e-9)
+    assert np.all(P[k + 1 : k + 2000] == pytest.approx(F_y * h, rel=1e-12))
+    assert P.sum() == pytest.approx(m * v, rel=1e-3)  # stopped: its momentum
+    assert wear.max_depth == pytest.approx(m * v**2 / (2 * F_y), abs=2 * h * v)

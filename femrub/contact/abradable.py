@@ -43,7 +43,7 @@ import math
 import numpy as np
 
 from ..fem.material import check_finite_positive
-from .wear_map import cut_sweeps
+from .wear_map import cut_sweeps, entry_bounds
 
 __all__ = ["Abradable", "CasingGrid"]
 
@@ -145,6 +145,7 @@ class Abradable:
         self.history = [(0.0, 0.0)]
         self.h = h
         self._last = None  # (t, reach) of the previous update: the start of the next sweep
+        self._bound = None  # (t, bounds) of the last step's impulse_cap
 
     def cells(self, t: float) -> np.ndarray:
         return self.grid.cells(t)
@@ -169,8 +170,26 @@ class Abradable:
             return 0.0
         return (self.depth_at(t) - self.depth_at(t - self.h)) / self.h
 
-    def impulse_cap(self, t: float, h: float) -> np.ndarray:
-        """Largest impulse ``h F_y`` per contact over a step; ``inf`` where worn through."""
+    def impulse_cap(self, t: float, h: float, gap_k=None, gap_p=None) -> np.ndarray:
+        """Largest impulse per contact over the step ending at ``t``: ``h F_y``, ``inf`` where
+        worn through; with the gaps at ``t_k`` and of the free step at ``t``, less for a
+        contact entering the coating within the step (``F_y`` times the part of the step
+        after it reaches it, :func:`~femrub.contact.wear_map.entry_bounds`). The bound is
+        kept for the step's :meth:`bound` (the yield test after the step)."""
+        worn = self.depth_at(t) >= self.thickness
+        U = np.where(worn, math.inf, h * self.yield_force)
+        if gap_k is not None:
+            g_k = np.ascontiguousarray(gap_k, dtype=float)
+            entry_bounds(U, g_k, np.ascontiguousarray(gap_p, dtype=float))
+        self._bound = (float(t), U.copy())
+        return U
+
+    def bound(self, t: float, h: float) -> np.ndarray:
+        """The bound of the step ending at ``t`` as :meth:`impulse_cap` last gave it (``h F_y``
+        or ``inf`` when it gave none for that step)."""
+        b = self._bound
+        if b is not None and abs(b[0] - t) <= 1e-9 * h:
+            return b[1]
         worn = self.depth_at(t) >= self.thickness
         return np.where(worn, math.inf, h * self.yield_force)
 

@@ -32,6 +32,17 @@ meet the coating again. :meth:`Abradable.update` and the θ-method's compiled bl
 steps (:mod:`femrub.contact.rub_block`) both cut through :func:`cut_sweeps`;
 :func:`depth_under` is :meth:`CasingGrid.interpolate` written per contact, the same
 operations in the same order.
+
+The bound of a step's normal impulse is the yield force times the time the contact spends
+on the coating within the step: ``U = h F_y`` for a contact closed at ``t_k``, and for one
+open at ``t_k`` (``g_k > 0``) whose free motion ends the step inside the worn surface
+(``g_p < 0``) the part of the step after it reaches it, the gap linear over the step
+(:func:`entry_bounds`)::
+
+    U = h F_y (−g_p) / (g_k − g_p)
+
+A first cutting step no longer carries the yield force over the part of the step the
+blade spent in the air (``docs/rotor37.md``, session 9).
 """
 
 from __future__ import annotations
@@ -42,7 +53,7 @@ import numpy as np
 
 from .jit import njit
 
-__all__ = ["positions", "depth_under", "cut_sweeps"]
+__all__ = ["positions", "depth_under", "cut_sweeps", "entry_bounds"]
 
 
 @njit
@@ -101,3 +112,15 @@ def cut_sweeps(flat, axial_cell, x0, x1, r0, r1, thickness, n_angle, n_axial):
                 flat[c] = level
             deepest = max(deepest, level)
     return deepest
+
+
+@njit
+def entry_bounds(U, g_k, g_p):
+    """The bounds ``U`` (n,) of a step's normal impulses, in place, for the contacts that
+    enter the coating within the step (module docstring): finite ``U``, ``g_k > 0`` (open at
+    ``t_k``) and ``g_p < 0`` (the free motion ends inside) take ``U (−g_p) / (g_k − g_p)``.
+    Returns ``U``."""
+    for i in range(U.size):
+        if U[i] < math.inf and g_k[i] > 0.0 and g_p[i] < 0.0:
+            U[i] = U[i] * (-g_p[i] / (g_k[i] - g_p[i]))
+    return U
