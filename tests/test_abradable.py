@@ -191,20 +191,69 @@ def test_frictional_blade_cuts_the_coating_at_the_yield_force(tmp_path):
 
 
 def test_worn_surface_rate_enters_the_gap_rate():
-    """The worn surface is linear between cell centres: a contact sliding towards a less worn
-    centre meets the coating approaching at ``Ω ∂w/∂ψ`` (any step inside the segment)."""
+    """The worn surface is the quadratic B-spline of the map: a contact sliding towards a
+    less worn centre meets the coating approaching at ``Ω ∂w/∂ψ`` (hand-derived spline)."""
     grid = CasingGrid([0.0], [0.0], 0.3, 100.0, n_angle=4, n_axial=1)
     wear = Abradable(1e-3, 10.0, grid)
+    c0 = 2e-4
     wear.reset(h=1e-3)
-    wear.depth[0, 0] = 2e-4  # centre at 45 deg worn, the others not
-    slope = -2e-4 / (math.pi / 2)  # ∂w/∂ψ between the centres at 45 and 135 deg
-    t = (math.pi / 2) / 100.0  # the contact at 90 deg, half way
-    assert wear.rate_at(t) == pytest.approx([100.0 * slope])
-    assert wear.depth_at(t) == pytest.approx([1e-4])
-    assert wear.rate_at(math.pi / 100.0) == pytest.approx([0.0], abs=1e-12)  # 135-225 deg
+    wear.depth[0, 0] = c0  # the coefficient at 45 deg, the others 0
+    t = (math.pi / 2) / 100.0  # the contact at 90 deg: half way between the centres
+    # x = 1/2: nearest centre 1, u = -1/2, weights (1/2, 1/2, 0) on centres (0, 1, 2)
+    assert wear.depth_at(t) == pytest.approx([c0 / 2], rel=1e-12)
+    # at t - h (0.1 rad earlier): x = 1/2 - 0.2/pi, nearest centre 0, weight 3/4 - u^2
+    u = 0.5 - 0.2 / math.pi
+    assert wear.rate_at(t) == pytest.approx([(c0 / 2 - (0.75 - u * u) * c0) / 1e-3], rel=1e-9)
+    # the spline's slope at the knot, -c0 per cell, is the limit of the rate as h -> 0
+    slope = -c0 / (math.pi / 2)  # d w / d psi (m/rad)
+    wear.reset(h=1e-7)
+    wear.depth[0, 0] = c0
+    assert wear.rate_at(t) == pytest.approx([100.0 * slope], rel=1e-5)
+    assert wear.rate_at(1.25 * math.pi / 100.0) == pytest.approx([0.0], abs=1e-12)  # 225 deg
     c = Contact(G=[[1.0]], Gv=[[1.0]], Hm=[[1.0]], Ht=[[0.0]], gap0=0.0, wear=wear)
-    assert c.rate_at(t) == pytest.approx([100.0 * slope])
-    assert c.gap_at(t) == pytest.approx([1e-4])
+    assert c.rate_at(t) == pytest.approx([100.0 * slope], rel=1e-5)
+    assert c.gap_at(t) == pytest.approx([c0 / 2])
+
+
+def test_worn_surface_has_a_continuous_slope():
+    """At the knots (half way between centres) and at the centres the one-sided slopes of
+    the worn surface agree (a piecewise-linear map jumps there): no impact at a centre."""
+    rng = np.random.default_rng(7)
+    n = 12
+    grid = CasingGrid([0.0], [0.0], 0.3, 1.0, n_angle=n, n_axial=1)
+    c = rng.uniform(0.0, 1e-4, n)
+    cell = 2 * math.pi / n
+    eps = 1e-7 * cell
+    for k in range(n):
+        for psi in ((k + 0.5) * cell, (k + 1.0) * cell):  # a centre, a knot
+            left = (grid.interpolate(c, psi) - grid.interpolate(c, psi - eps)) / eps
+            right = (grid.interpolate(c, psi + eps) - grid.interpolate(c, psi)) / eps
+            scale = np.abs(np.diff(c)).max() / cell
+            assert abs(left[0] - right[0]) <= 1e-5 * scale
+    assert grid.interpolate(c, rng.uniform(0, 2 * math.pi)).item() <= c.max()
+
+
+def test_a_contact_retracing_its_cut_does_not_meet_the_coating():
+    """A contact cutting along a curved reach (a groove deepening then receding, many steps
+    per cell) leaves a surface at or beyond its reach all along its path: the same path
+    again finds a gap >= 0 everywhere (the map does not undercut between the centres)."""
+    omega, h, n_angle = 100.0, 2e-5, 360  # 0.002 rad per step, ~8.7 steps per cell
+    grid = CasingGrid([0.0], [0.0], 0.3, omega, n_angle=n_angle, n_axial=1)
+    wear = Abradable(1e-3, 10.0, grid)
+    wear.reset(h=h)
+    steps = 400
+    reach = lambda k: 3e-4 * math.sin(math.pi * k / steps)  # noqa: E731
+    wear.update(0.0, np.array([-reach(0)]), np.array([False]))
+    for k in range(1, steps + 1):
+        wear.update(k * h, wear.depth_at(k * h) - reach(k), np.array([True]))
+    for k in range(steps + 1):
+        for s in (0.0, 0.25, 0.5, 0.75):  # between step ends too (reach linear there)
+            t = (k + s) * h
+            r = (1 - s) * reach(k) + s * reach(min(k + 1, steps))
+            assert wear.depth_at(t)[0] - r >= -1e-18
+    # and the cut stays local: no more than two cells beyond either end of the groove
+    cut = np.flatnonzero(wear.depth[:, 0] > 0)
+    assert cut.size <= steps * omega * h / (2 * math.pi / n_angle) + 5
 
 
 @pytest.mark.parametrize("n_angle", [36, 360, 3600])
@@ -225,9 +274,54 @@ def test_a_sweep_cuts_every_centre_it_crosses(n_angle):
     d = wear.depth[:, 0]
     assert d.max() == pytest.approx(reach) and d.min() == 0.0
     swept = steps * omega * h  # rad
-    n_cut = np.count_nonzero(d)  # every centre swept, and the bracketing ones at each end
-    assert swept / (2 * math.pi / n_angle) - 1 <= n_cut <= swept / (2 * math.pi / n_angle) + 3
+    n_cut = np.count_nonzero(d)  # every centre swept, and the supports' reach at each end
+    assert swept / (2 * math.pi / n_angle) - 1 <= n_cut <= swept / (2 * math.pi / n_angle) + 4
     width = grid.z_edges[1] - grid.z_edges[0]
     assert wear.worn_volume == pytest.approx(
-        reach * 0.3 * swept * width, rel=3.0 / (swept / (2 * math.pi / n_angle))
+        reach * 0.3 * swept * width, rel=4.0 / (swept / (2 * math.pi / n_angle))
     )
+
+
+def test_the_bound_of_a_step_entering_the_coating_is_the_part_of_the_step_on_it():
+    """``h F_y`` for a contact closed at ``t_k``; ``F_y`` times the part of the step after the
+    free motion reaches the worn surface for one open at ``t_k``; ``inf`` worn through."""
+    cell = 2 * math.pi / 16
+    grid = CasingGrid((np.arange(0, 16, 4) + 0.5) * cell, [0.0] * 4, 0.3, 100.0, n_angle=16,
+                      n_axial=1)  # fmt: skip
+    wear = Abradable(1e-4, 10.0, grid)
+    wear.reset(h=1e-6)
+    wear.depth[11:14, 0] = 1e-4  # around the fourth contact (centre 12) at t = 0: worn through
+    g_k = np.array([3e-6, -1e-7, 2e-6, 1e-6])
+    g_p = np.array([-1e-6, -2e-6, 1e-6, -1e-6])
+    U = wear.impulse_cap(0.0, 1e-6, g_k, g_p)
+    assert U[0] == pytest.approx(1e-5 * 0.25, rel=1e-14)  # a quarter of the step on it
+    assert U[1] == pytest.approx(1e-5) and U[2] == pytest.approx(1e-5)
+    assert np.isinf(U[3])
+    np.testing.assert_array_equal(wear.bound(0.0, 1e-6), U)  # the yield test's bound
+    assert wear.bound(1e-6, 1e-6)[0] == pytest.approx(1e-5)  # another step: h F_y
+
+
+def test_a_mass_entering_the_coating_is_held_only_after_it_reaches_it():
+    """A free mass m at speed v meets a fresh coating (yield F_y) at t_c inside a step: that
+    step's impulse is F_y (t_{k+1} − t_c), then F_y h per step until the mass has lost m v;
+    the cut depth is the plastic stopping distance m v² / (2 F_y) to O(h v)."""
+    from femrub.model.first_order import FirstOrderModel, Layout
+    from femrub.steppers import make_stepper
+
+    m, v, F_y, d, h = 2.0, 0.5, 400.0, 1.3e-6, 1e-6  # stops in m v / F_y = 2.5 ms
+    grid = CasingGrid([0.0], [0.0], 0.3, 0.0, n_angle=1, n_axial=1)
+    wear = Abradable(1e-2, F_y, grid)
+    c = Contact(G=[[-1.0], [0.0]], Gv=[[0.0], [-1.0]], Hm=[[0.0], [-1.0]], Ht=[[0.0], [0.0]],
+                gap0=d, wear=wear)  # fmt: skip
+    A = np.diag([1.0, m])
+    B = np.array([[0.0, 1.0], [0.0, 0.0]])
+    model = FirstOrderModel(A, B, Layout(n_u=1, n_v=1, n_t=0), contact=c, x0=np.array([0.0, v]))
+    st = make_stepper("theta", model, h)
+    P = np.array([st.step().impulse[0] for _ in range(3000)])
+    k = int(np.flatnonzero(P > 0)[0])
+    t_c = d / v
+    assert k * h < t_c <= (k + 1) * h
+    assert P[k] == pytest.approx(F_y * ((k + 1) * h - t_c), rel=1e-9)
+    assert np.all(P[k + 1 : k + 2000] == pytest.approx(F_y * h, rel=1e-12))
+    assert P.sum() == pytest.approx(m * v, rel=1e-3)  # stopped: its momentum
+    assert wear.max_depth == pytest.approx(m * v**2 / (2 * F_y), abs=2 * h * v)

@@ -168,7 +168,8 @@ def test_a_failed_solve_in_a_rub_block_keeps_the_coating_of_the_steps_before(bla
 
 def test_wear_kernels_equal_the_grid_and_a_vectorised_cut():
     """``depth_under`` is ``CasingGrid.interpolate`` (bitwise); ``cut_sweeps`` is the
-    vectorised cut along the sweeps (centres ``⌊min x⌋ .. ⌊max x⌋ + 1``)."""
+    vectorised cut along the sweeps (coefficients ``⌊min x + 1/2⌋ − 1 .. ⌊max x + 1/2⌋ + 1``,
+    each to the largest reach of the sweep over its support ``|x − k| <= 3/2``)."""
     rng = np.random.default_rng(3)
     grid = CasingGrid(rng.uniform(0, 6.3, 9), rng.uniform(0, 0.01, 9), 0.3, 500.0, 37, 4)
     w = Abradable(1e-3, 10.0, grid)
@@ -185,13 +186,17 @@ def test_wear_kernels_equal_the_grid_and_a_vectorised_cut():
     got = flat.copy()
     deepest = cut_sweeps(got, grid.axial_cell, x0, x1, r0, r1, w.thickness, 37, 4)
     ref = flat.copy()
-    lo, hi = np.floor(np.minimum(x0, x1)).astype(int), np.floor(np.maximum(x0, x1)).astype(int)
+    lo, hi = np.minimum(x0, x1), np.maximum(x0, x1)
     levels = []
     for a in range(9):
-        k = np.arange(lo[a], hi[a] + 2)
+        k = np.arange(np.floor(lo[a] + 0.5) - 1, np.floor(hi[a] + 0.5) + 2).astype(int)
         dx = x1[a] - x0[a]
-        frac = np.ones(k.size) if dx == 0 else np.clip((k - x0[a]) / dx, 0, 1)
-        level = np.minimum(w.thickness, r0[a] + frac * (r1[a] - r0[a]))
+        if dx == 0:
+            top = np.full(k.size, r1[a])
+        else:  # the reach is linear along the sweep: its largest value at an end
+            ends = np.stack([np.maximum(lo[a], k - 1.5), np.minimum(hi[a], k + 1.5)])
+            top = (r0[a] + np.clip((ends - x0[a]) / dx, 0, 1) * (r1[a] - r0[a])).max(axis=0)
+        level = np.minimum(w.thickness, top)
         np.maximum.at(ref, np.mod(k, 37) * 4 + grid.axial_cell[a], level)
         levels.append(level)
     np.testing.assert_array_equal(got, ref)

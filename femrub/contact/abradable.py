@@ -1,11 +1,12 @@
 """Abradable coating on the casing: a wear map that deepens where the blade cuts it.
 
 The coating (thickness ``e``) lines the casing. Its current wear depth ``w(ψ, z) ∈ [0, e]``
-is stored at the centres of a grid of casing angle ``ψ`` (``n_angle`` cells over a
-revolution) × axial position ``z`` (``n_axial`` cells over the contacts' axial extent), and
-read between centres by periodic linear interpolation in ``ψ`` (so the worn surface a contact
-slides on is continuous, and its rate ``Ω ∂w/∂ψ`` is finite: the time step does not decide
-how hard a contact meets the edge of a cell). Contact ``i`` (angle ``φ_i``, axial position
+is stored as one coefficient per cell of a grid of casing angle ``ψ`` (``n_angle`` cells
+over a revolution) × axial position ``z`` (``n_axial`` cells over the contacts' axial
+extent), and read in ``ψ`` as the periodic quadratic B-spline of the coefficients
+(:mod:`femrub.contact.wear_map`): the worn surface a contact slides on is continuous with a
+continuous slope, and its rate ``Ω ∂w/∂ψ`` is continuous too, so neither the time step nor
+the cell size puts an impact at the centres. Contact ``i`` (angle ``φ_i``, axial position
 ``z_i``) meets the worn surface, so its gap is::
 
     g_i(t, X) = g0_i(t) + w(Ω t + φ_i, z_i) − n_i · u(p_i)
@@ -16,17 +17,18 @@ impulse of a step is bounded, ``0 <= P_i <= h F_y`` (:func:`femrub.contact.impul
 and below that bound contact complementarity holds on the worn surface. When the bound is
 reached the coating yields: the blade penetrates the current surface and the material it
 penetrates is removed permanently (after each step, :meth:`Abradable.update`). With the
-blade's reach into the coating ``r_i = w(ψ_i) − g_i``, every cell centre the contact swept
-over the step (from ``ψ_i(t − h)`` to ``ψ_i(t)``, and the centre just beyond) is cut to the
-reach interpolated linearly along the sweep::
+blade's reach into the coating ``r_i = w(ψ_i) − g_i``, the reach linear along the sweep of
+the step (from ``ψ_i(t − h)`` to ``ψ_i(t)``), every coefficient whose support meets the
+sweep is raised to the largest reach of the sweep over its support::
 
-    w(ψ_k, z_i) <- min(e, max(w(ψ_k, z_i), r_i(t − h) + s_k (r_i(t) − r_i(t − h))))
+    c(ψ_k, z_i) <- min(e, max(c(ψ_k, z_i), max_{|ψ − ψ_k| <= 3/2 cell} r_i(ψ)))
 
-``s_k ∈ [0, 1]`` the fraction of the sweep at centre ``k`` (1 beyond its end), so that
-after the update ``g_i(t) >= 0`` on the new surface. A contact that crosses several cells in
-a step cuts all of them: the worn volume does not depend on how the time step compares with
-the cell size. Once the surface is worn through (``w = e``) the rigid casing behind it takes
-any force. Wear is monotone, never negative and never deeper than ``e``.
+so that after the update ``w >= r_i`` all along the sweep (``g_i(t) >= 0`` on the new
+surface, and a contact that retraces its own cut does not meet the coating again). A
+contact that crosses several cells in a step cuts all of them: the worn volume does not
+depend on how the time step compares with the cell size. Once the surface is worn through
+(``w = e``) the rigid casing behind it takes any force. Wear is monotone, never negative
+and never deeper than ``e``.
 
 The wear map is casing state that evolves during a run: a stepper calls :meth:`reset` when
 it starts. ``history`` keeps ``(t, max depth)`` at every step that removed material. The
@@ -41,7 +43,7 @@ import math
 import numpy as np
 
 from ..fem.material import check_finite_positive
-from .wear_map import cut_sweeps
+from .wear_map import cut_sweeps, entry_bounds
 
 __all__ = ["Abradable", "CasingGrid"]
 
@@ -91,13 +93,18 @@ class CasingGrid:
         return np.mod(k, self.n_angle) * self.n_axial + axial_cell
 
     def interpolate(self, values: np.ndarray, t: float) -> np.ndarray:
-        """``values`` (flat, per cell) at the contacts at ``t``, linear between centres."""
+        """``values`` (flat, per cell) at the contacts at ``t``: the periodic quadratic
+        B-spline of the values (:func:`femrub.contact.wear_map.depth_under`)."""
         x = self.position(t)
-        k = np.floor(x)
-        s = x - k
-        k = k.astype(np.int64)
-        return (1.0 - s) * values[self.flat(k, self.axial_cell)] + s * values[
-            self.flat(k + 1, self.axial_cell)
+        kf = np.floor(x + 0.5)
+        u = x - kf
+        k = kf.astype(np.int64)
+        bm = 0.5 * (0.5 - u) * (0.5 - u)
+        b0 = 0.75 - u * u
+        bp = 0.5 * (0.5 + u) * (0.5 + u)
+        a = self.axial_cell
+        return (bm * values[self.flat(k - 1, a)] + b0 * values[self.flat(k, a)]) + bp * values[
+            self.flat(k + 1, a)
         ]
 
     @property
@@ -138,13 +145,14 @@ class Abradable:
         self.history = [(0.0, 0.0)]
         self.h = h
         self._last = None  # (t, reach) of the previous update: the start of the next sweep
+        self._bound = None  # (t, bounds) of the last step's impulse_cap
 
     def cells(self, t: float) -> np.ndarray:
         return self.grid.cells(t)
 
     def depth_at(self, t: float) -> np.ndarray:
         """Wear depth under each contact at ``t`` (m): what the worn surface adds to the gap
-        (linear between cell centres)."""
+        (the quadratic B-spline of the map, :mod:`femrub.contact.wear_map`)."""
         return self.grid.interpolate(self.depth.ravel(), t)
 
     def rate_at(self, t: float) -> np.ndarray | float:
@@ -155,15 +163,33 @@ class Abradable:
         (:meth:`~femrub.contact.gap.Contact.rate_at`) so a velocity-level contact law stops
         the blade there and the coating yields (as the casing profile's own rate does on a
         continuous lobe); without it, the blade would cross the unworn coating with no force
-        and no wear wherever the profile recedes. The map is linear between cell centres, so
-        the rate tends to ``Ω ∂w/∂ψ`` as ``h → 0``.
+        and no wear wherever the profile recedes. The surface has a continuous slope, so the
+        rate tends to ``Ω ∂w/∂ψ`` as ``h → 0``.
         """
         if not self.h:
             return 0.0
         return (self.depth_at(t) - self.depth_at(t - self.h)) / self.h
 
-    def impulse_cap(self, t: float, h: float) -> np.ndarray:
-        """Largest impulse ``h F_y`` per contact over a step; ``inf`` where worn through."""
+    def impulse_cap(self, t: float, h: float, gap_k=None, gap_p=None) -> np.ndarray:
+        """Largest impulse per contact over the step ending at ``t``: ``h F_y``, ``inf`` where
+        worn through; with the gaps at ``t_k`` and of the free step at ``t``, less for a
+        contact entering the coating within the step (``F_y`` times the part of the step
+        after it reaches it, :func:`~femrub.contact.wear_map.entry_bounds`). The bound is
+        kept for the step's :meth:`bound` (the yield test after the step)."""
+        worn = self.depth_at(t) >= self.thickness
+        U = np.where(worn, math.inf, h * self.yield_force)
+        if gap_k is not None:
+            g_k = np.ascontiguousarray(gap_k, dtype=float)
+            entry_bounds(U, g_k, np.ascontiguousarray(gap_p, dtype=float))
+        self._bound = (float(t), U.copy())
+        return U
+
+    def bound(self, t: float, h: float) -> np.ndarray:
+        """The bound of the step ending at ``t`` as :meth:`impulse_cap` last gave it (``h F_y``
+        or ``inf`` when it gave none for that step)."""
+        b = self._bound
+        if b is not None and abs(b[0] - t) <= 1e-9 * h:
+            return b[1]
         worn = self.depth_at(t) >= self.thickness
         return np.where(worn, math.inf, h * self.yield_force)
 
@@ -197,6 +223,8 @@ class Abradable:
     # -- results ------------------------------------------------------------------------
     @property
     def max_depth(self) -> float:
+        """The largest coefficient of the map (m): the surface's deepest point or above it
+        (the weights sum to 1), equal to it where a cut raised a whole support."""
         return float(self.depth.max())
 
     @property

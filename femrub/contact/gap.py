@@ -152,9 +152,11 @@ class Contact:
             g0 = g0 - (_over_times(ch.closure_at, t, self.n) if rows else ch.closure_at(t))
         return g0
 
-    def impulse_cap(self, t: float, h: float):
-        """Upper bound of the impulses over the step ending at ``t`` (``None``: unbounded)."""
-        return None if self.wear is None else self.wear.impulse_cap(t, h)
+    def impulse_cap(self, t: float, h: float, gap_k=None, gap_p=None):
+        """Upper bound of the impulses over the step ending at ``t`` (``None``: unbounded);
+        ``gap_k``, ``gap_p``: the gaps at ``t_k`` and of the free step at ``t``
+        (:meth:`Abradable.impulse_cap <femrub.contact.abradable.Abradable.impulse_cap>`)."""
+        return None if self.wear is None else self.wear.impulse_cap(t, h, gap_k, gap_p)
 
     def after_step(self, t: float, X: np.ndarray, impulse: np.ndarray, h: float,
                    extra: dict | None = None) -> None:  # fmt: skip
@@ -183,7 +185,7 @@ class Contact:
             ch.update(t, heat, h)
         if self.wear is None:
             return
-        yielded = impulse >= (1.0 - 1e-9) * self.wear.impulse_cap(t, h)
+        yielded = impulse >= (1.0 - 1e-9) * self.wear.bound(t, h)
         self.wear.update(t, self.gap(t, X), yielded)  # every step: the next sweep starts here
 
     def rate_at(self, t) -> np.ndarray | float:

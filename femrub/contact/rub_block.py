@@ -18,8 +18,9 @@ block, and :func:`rub_block` adds them to the same step (the same functions:
 * **An abradable coating** (:mod:`femrub.contact.abradable`). The gap is read on the worn
   surface and its rate over the step, ``g0 += w(t)``, ``ġ0 += (w(t) − w(t − h)) / h``
   (:func:`~femrub.contact.wear_map.depth_under`), the normal impulses are bounded,
-  ``0 <= P_n <= U = h F_y`` (``U = ∞`` where the coating is worn through), and after each
-  step the contacts that yielded (``P_n >= (1 − 10⁻⁹) U``) cut the map along their sweep
+  ``0 <= P_n <= U = h F_y`` (``U = ∞`` where the coating is worn through; less for a contact
+  entering the coating within the step, :func:`~femrub.contact.wear_map.entry_bounds`), and
+  after each step the contacts that yielded (``P_n >= (1 − 10⁻⁹) U``) cut the map along their sweep
   (:func:`~femrub.contact.wear_map.cut_sweeps`), in place, with the gap at the step's end.
 
 The casing terms of step ``k`` at ``t_k`` are those computed for it as the previous step's
@@ -75,12 +76,13 @@ def power_heat(P, u, st, w_k, eta, W, q, W3t, mu, e, ub, U, active, tol, max_ite
 
 
 @njit
-def _wear_cut(depth, GT, X, P, t, g0, angles, axial_cell, grid, dims, last_r, wstate):
+def _wear_cut(depth, GT, X, P, t, g0, angles, axial_cell, grid, dims, last_r, wstate, U):
     """``Abradable.update`` at ``t`` after a step (``g0`` (n,): the casing profile's gap at
-    ``t``): the contacts that yielded cut the map; ``last_r``/``wstate`` carry the previous
-    call's reach and ``(called before, its time, deepest wear)``. Returns the deepest wear
+    ``t``): the contacts that yielded (at their bound ``U`` of the step) cut the map;
+    ``last_r``/``wstate`` carry the previous call's reach and ``(called before, its time,
+    deepest wear)``. Returns the deepest wear
     after the cut, or ``nan`` when nothing was cut."""
-    omega, scale, thickness, cap = grid[0], grid[1], grid[2], grid[3]
+    omega, scale, thickness = grid[0], grid[1], grid[2]
     n_angle, n_axial = dims[0], dims[1]
     n = angles.size
     x1 = positions(t, angles, omega, scale)
@@ -89,9 +91,8 @@ def _wear_cut(depth, GT, X, P, t, g0, angles, axial_cell, grid, dims, last_r, ws
     reach = np.empty(n)
     cut = np.zeros(n, dtype=np.bool_)
     for i in range(n):
-        upper = math.inf if d[i] >= thickness else cap
         reach[i] = d[i] - ((g0[i] + d[i]) + gx[i])
-        cut[i] = P[i, 0] >= (1.0 - 1e-9) * upper and reach[i] > d[i]
+        cut[i] = P[i, 0] >= (1.0 - 1e-9) * U[i] and reach[i] > d[i]
     out = math.nan
     idx = np.flatnonzero(cut)
     if idx.size:
@@ -171,5 +172,5 @@ def rub_block(
         hist[j] = math.nan
         if wear:
             hist[j] = _wear_cut(depth, GT, Xk, P, ta[j], g0a[j], angles, axial_cell, grid,
-                                dims, last_r, wstate)  # fmt: skip
+                                dims, last_r, wstate, U)  # fmt: skip
     return Xout.shape[0], 0, 0.0, warm

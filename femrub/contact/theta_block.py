@@ -26,6 +26,7 @@ import numpy as np
 
 from .coulomb import frictional_fixed_point
 from .jit import njit
+from .wear_map import entry_bounds
 
 __all__ = [
     "ONE_RULES",
@@ -104,7 +105,9 @@ def friction_step(Xk, Xp, S, ok, o1, GZ, W, code, mu, e3, U, warm, use_warm, h, 
 
     Local rows ``y = S X + o`` (``[g, ġ, w_t]``, casing terms ``o_k``, ``o_{k+1}``), Newton's
     law with ``e = 1`` on separating contacts (``ġ_k > 0``), then the active-set fixed point
-    :func:`~femrub.contact.coulomb.frictional_fixed_point` with the bounds ``U``.
+    :func:`~femrub.contact.coulomb.frictional_fixed_point` with the bounds ``U``, reduced in
+    place for contacts entering a coating within the step
+    (:func:`~femrub.contact.wear_map.entry_bounds`).
 
     Returns ``(y_k, q, e, ġ_k, active, P, u, state, residual, status)`` (``q`` (n, 3): the
     free local velocities at ``t_{k+1}``).
@@ -117,6 +120,7 @@ def friction_step(Xk, Xp, S, ok, o1, GZ, W, code, mu, e3, U, warm, use_warm, h, 
         gdk[i] = yk[n + 3 * i]
         e[i] = 1.0 if gdk[i] > 0.0 else e3[i]
     q = yp[n:].copy().reshape((n, 3))
+    entry_bounds(U, yk[:n], yp[:n])  # a coating's bound: the part of the step on it
     active, P, u, st, res, it, status = frictional_fixed_point(
         code, yk[:n].copy(), gdk.copy(), yp[:n].copy(), GZ, W, q, mu, e.copy(), gdk.copy(),
         U, warm, use_warm, h, gamma, tol, max_iter,

@@ -1,26 +1,48 @@
 """Compiled arithmetic of the abradable wear map (:mod:`femrub.contact.abradable`).
 
-The map stores the wear depth ``w`` at the centres of ``n_angle × n_axial`` cells, flat
-index ``j n_axial + a`` for angle centre ``j`` and axial row ``a``. A contact ``i`` at
+The map stores ``n_angle × n_axial`` coefficients ``c`` of the worn surface, one per cell,
+flat index ``j n_axial + a`` for angle centre ``j`` and axial row ``a``. A contact ``i`` at
 time ``t`` sits at the unwrapped position (in cell-centre units)::
 
     x_i(t) = (Ω t + φ_i) n_angle / 2π − 1/2
 
-and reads the map by periodic linear interpolation between the centres ``k = ⌊x_i⌋`` and
-``k + 1`` (taken modulo ``n_angle``), ``s = x_i − k``::
+and reads the wear depth as the periodic quadratic B-spline of the coefficients of its
+row: with ``k = ⌊x_i + 1/2⌋`` the nearest centre and ``u = x_i − k ∈ [−1/2, 1/2)``
+(indices modulo ``n_angle``)::
 
-    w_i(t) = (1 − s) w[k, a_i] + s w[k + 1, a_i]
+    w_i(t) = (1/2 − u)²/2 c[k − 1, a_i] + (3/4 − u²) c[k, a_i] + (1/2 + u)²/2 c[k + 1, a_i]
 
-A contact that yielded over a step cuts every centre ``k`` it swept, from ``x⁰`` (where
-the previous step left it, reach ``r⁰``) to ``x¹`` (reach ``r¹``) and the centre beyond
-each end, to the reach interpolated along the sweep::
+The surface is continuous with a continuous slope (C¹) in ``ψ``: a contact sliding over it
+meets no slope jump at the centres (a piecewise-linear surface asks for a velocity jump,
+an impact, at every centre it crosses). The weights are ``>= 0`` and sum to 1, so
+``0 <= c <= e`` keeps ``0 <= w <= e``, and the volume under the surface is ``Σ c`` times
+the cell areas.
 
-    w[k, a] <- max(w[k, a], min(e, r⁰ + s_k (r¹ − r⁰))),   s_k = clip((k − x⁰)/(x¹ − x⁰), 0, 1)
+A contact that yielded over a step cuts its sweep from ``x⁰`` (where the previous step
+left it, reach ``r⁰``) to ``x¹`` (reach ``r¹``), the reach linear along the sweep: every
+coefficient whose support ``(k − 3/2, k + 3/2)`` meets the sweep is raised to the largest
+reach of the sweep over that support::
 
-(``s_k = 1`` for a contact that did not move). :meth:`Abradable.update` and the θ-method's
-compiled blocks of steps (:mod:`femrub.contact.rub_block`) both cut through
-:func:`cut_sweeps`; :func:`depth_under` is the interpolation of
-:meth:`CasingGrid.interpolate` written per contact, the same operations in the same order.
+    c[k, a] <- max(c[k, a], min(e, max_{x in sweep, |x − k| <= 3/2} r(x)))
+
+(``r¹`` for a contact that did not move), so that afterwards ``w >= r`` all along the sweep
+(every weight that is non-zero at a point of the sweep multiplies a coefficient at least
+the reach there): the contact ends on its own cut, and retracing the path it cut does not
+meet the coating again. :meth:`Abradable.update` and the θ-method's compiled blocks of
+steps (:mod:`femrub.contact.rub_block`) both cut through :func:`cut_sweeps`;
+:func:`depth_under` is :meth:`CasingGrid.interpolate` written per contact, the same
+operations in the same order.
+
+The bound of a step's normal impulse is the yield force times the time the contact spends
+on the coating within the step: ``U = h F_y`` for a contact closed at ``t_k``, and for one
+open at ``t_k`` (``g_k > 0``) whose free motion ends the step inside the worn surface
+(``g_p < 0``) the part of the step after it reaches it, the gap linear over the step
+(:func:`entry_bounds`)::
+
+    U = h F_y (−g_p) / (g_k − g_p)
+
+A first cutting step no longer carries the yield force over the part of the step the
+blade spent in the air (``docs/rotor37.md``, session 9).
 """
 
 from __future__ import annotations
@@ -31,7 +53,7 @@ import numpy as np
 
 from .jit import njit
 
-__all__ = ["positions", "depth_under", "cut_sweeps"]
+__all__ = ["positions", "depth_under", "cut_sweeps", "entry_bounds"]
 
 
 @njit
@@ -46,15 +68,21 @@ def positions(t, angles, omega, scale):
 @njit
 def depth_under(flat, x, axial_cell, n_angle, n_axial):
     """Wear depth (n,) of the flat map ``flat`` at the positions ``x`` (n,) in the axial
-    rows ``axial_cell`` (n,): periodic linear interpolation between centres."""
+    rows ``axial_cell`` (n,): the periodic quadratic B-spline of the coefficients."""
     out = np.empty(x.size)
     for i in range(x.size):
-        kf = math.floor(x[i])
-        s = x[i] - kf
+        kf = math.floor(x[i] + 0.5)
+        u = x[i] - kf
         k = int(kf) % n_angle
-        k1 = (k + 1) % n_angle
+        km = (k - 1) % n_angle
+        kp = (k + 1) % n_angle
         a = axial_cell[i]
-        out[i] = (1.0 - s) * flat[k * n_axial + a] + s * flat[k1 * n_axial + a]
+        bm = 0.5 * (0.5 - u) * (0.5 - u)
+        b0 = 0.75 - u * u
+        bp = 0.5 * (0.5 + u) * (0.5 + u)
+        out[i] = (bm * flat[km * n_axial + a] + b0 * flat[k * n_axial + a]) + bp * flat[
+            kp * n_axial + a
+        ]
     return out
 
 
@@ -65,14 +93,34 @@ def cut_sweeps(flat, axial_cell, x0, x1, r0, r1, thickness, n_angle, n_axial):
     ``axial_cell[a]`` (module docstring). Returns the deepest level cut (``-inf``: none)."""
     deepest = -math.inf
     for a in range(x0.size):
-        lo = int(math.floor(min(x0[a], x1[a])))
-        hi = int(math.floor(max(x0[a], x1[a]))) + 1
+        lo, hi = min(x0[a], x1[a]), max(x0[a], x1[a])
         dx = x1[a] - x0[a]
-        for k in range(lo, hi + 1):
-            frac = 1.0 if dx == 0.0 else min(max((k - x0[a]) / dx, 0.0), 1.0)
-            level = min(thickness, r0[a] + frac * (r1[a] - r0[a]))
+        for k in range(int(math.floor(lo + 0.5)) - 1, int(math.floor(hi + 0.5)) + 2):
+            if dx == 0.0:
+                level = r1[a]
+            else:  # the largest reach of the sweep over the support of coefficient k
+                fa = min(max((max(lo, k - 1.5) - x0[a]) / dx, 0.0), 1.0)
+                fb = min(max((min(hi, k + 1.5) - x0[a]) / dx, 0.0), 1.0)
+                level = (
+                    r0[a] + max(fa, fb) * (r1[a] - r0[a])
+                    if r1[a] >= r0[a]
+                    else (r0[a] + min(fa, fb) * (r1[a] - r0[a]))
+                )
+            level = min(thickness, level)
             c = (k % n_angle) * n_axial + axial_cell[a]
             if level > flat[c]:
                 flat[c] = level
             deepest = max(deepest, level)
     return deepest
+
+
+@njit
+def entry_bounds(U, g_k, g_p):
+    """The bounds ``U`` (n,) of a step's normal impulses, in place, for the contacts that
+    enter the coating within the step (module docstring): finite ``U``, ``g_k > 0`` (open at
+    ``t_k``) and ``g_p < 0`` (the free motion ends inside) take ``U (−g_p) / (g_k − g_p)``.
+    Returns ``U``."""
+    for i in range(U.size):
+        if U[i] < math.inf and g_k[i] > 0.0 and g_p[i] < 0.0:
+            U[i] = U[i] * (-g_p[i] / (g_k[i] - g_p[i]))
+    return U

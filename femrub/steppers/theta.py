@@ -256,11 +256,12 @@ class ThetaMethod(Stepper):
         alpha = c.alpha_at(t1)
         Z = self._Zm + self._Zt * alpha
         W = self._Wm + self._Wt * alpha
+        g_k, g_p = c.gap(self.t, Xk), c.gap(t1, Xp)
         P = impulses(
             self.activation,
-            c.gap(self.t, Xk),
+            g_k,
             c.gap_velocity(self.t, Xk),
-            c.gap(t1, Xp),
+            g_p,
             c.gap_velocity(t1, Xp),
             W,
             c.GT @ Z,
@@ -268,7 +269,7 @@ class ThetaMethod(Stepper):
             h,
             g,
             self._warm,
-            upper=c.impulse_cap(t1, h),
+            upper=c.impulse_cap(t1, h, g_k, g_p),
         )
         self._warm = P > 0.0
         return Xp + Z @ P, P
@@ -288,7 +289,7 @@ class ThetaMethod(Stepper):
         gap_k, gdot_k, _ = self._local(self.k, self.t, Xk)
         gap_p, _, q = self._local(self.k + 1, t1, Xp)
         e = np.where(gdot_k > 0.0, 1.0, self._e3)
-        upper = c.impulse_cap(t1, h)
+        upper = c.impulse_cap(t1, h, gap_k, gap_p)
         U = self._U3 if upper is None else np.array(upper, dtype=float)  # writable, C
         use_warm = self._warm3 is not None
         warm = self._warm3 if use_warm else self._warm0

@@ -1,0 +1,193 @@
+"""Where the time-step error of a coated rub comes from: first revolution against the later ones.
+
+Builds ``SCENE`` (default ``rotor37-thermal``, through the model cache, VTK off) and steps
+its model over ``--revolutions`` at ``h / f`` for each ``--factors`` ``f`` and each wear-map
+resolution ``--n-angle`` (the scene's coating on a grid of that many angular cells; 0: the
+scene's). Per run: the total normal impulse, split into the first revolution (the blade
+cuts fresh coating) and the later ones (it re-contacts the surface it carved itself), the
+impulse of the steps held at the coating's yield bound, the number of contact episodes and
+the share of them that start in the first tenth of a cell after a cell centre (1/10 if the
+map's centres played no part), the hottest contact, the deepest wear, the worn volume. Each
+row after the first of a resolution gives the observed order ``log2(d_prev / d)`` of the
+differences between consecutive steps.
+
+Writes the table between ``<!-- abradable_order:begin -->`` and ``<!-- abradable_order:end -->``
+of ``docs/abradable.md`` with the load (``--no-write``: print it).
+
+Run: ``flock /tmp/femrub-heavy.lock python benchmarks/abradable_order.py [--scene rotor37-thermal]
+[--factors 1,2,4] [--revolutions 10] [--n-angle 0,1440] [--set KEY=VALUE ...] [--no-write]``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import os
+import time
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[1]
+DOC = ROOT / "docs" / "abradable.md"
+BEGIN, END = "<!-- abradable_order:begin -->", "<!-- abradable_order:end -->"
+
+
+def _value(text: str):
+    for kind in (int, float):
+        try:
+            return kind(text)
+        except ValueError:
+            pass
+    return text
+
+
+def with_map(model, n_angle: int):
+    """The model with its coating on a map of ``n_angle`` angular cells (same coating)."""
+    from femrub.contact.abradable import Abradable, CasingGrid
+
+    c = model.contact
+    w, g = c.wear, c.wear.grid
+    grid = CasingGrid(g.angles, g.axial, g.radius, g.omega, n_angle=n_angle, n_axial=g.n_axial)
+    c.wear = Abradable(w.thickness, w.yield_force, grid)
+    return model
+
+
+def measure(res, wear, h: float, revolution: float) -> dict:
+    """Impulse split, episodes and their phase in the map's cells for one run."""
+    P = res.impulse[1:]
+    t = res.t[1:]
+    on = P > 0.0
+    held = P >= (1.0 - 1e-9) * h * wear.yield_force
+    starts = np.argwhere(on & ~np.vstack([np.zeros((1, P.shape[1]), bool), on[:-1]]))
+    x = np.array([wear.grid.position(t[j])[c] for j, c in starts])
+    first = t < revolution * (1.0 + 1e-12)
+    temps = res.signals.get("contact_temperature")
+    return {
+        "impulse": float(P.sum()),
+        "first": float(P[first].sum()),
+        "later": float(P[~first].sum()),
+        "held": float(P[held].sum()),
+        "episodes": int(len(starts)),
+        "after_centre": float(np.mean((x - np.floor(x)) < 0.1)) if starts.size else math.nan,
+        "t_max": float(np.max(temps)) if temps is not None else math.nan,
+        "wear": wear.max_depth,
+        "volume": wear.worn_volume,
+    }
+
+
+def study(scene, factors, revolutions: float, n_angles, log=print) -> list[dict]:
+    from femrub.app.cache import ModelCache
+    from femrub.app.scheme import scheme_options
+    from femrub.app.simulation import build
+    from femrub.steppers import make_stepper
+
+    model = build(scene, log=log, cache=ModelCache()).model
+    wear0 = model.contact.wear
+    if wear0 is None:
+        raise SystemExit("the scene has no abradable coating (contact.abradable)")
+    revolution = 2 * math.pi / abs(wear0.grid.omega)
+    s, opts = scene["scheme"], scheme_options(scene)
+    rows = []
+    for na in n_angles:
+        with_map(model, na or wear0.n_angle)
+        wear = model.contact.wear
+        for f in factors:
+            st = make_stepper(s["name"], model, s["h"] / f, **opts)
+            load0, c0 = os.getloadavg()[0], time.process_time()
+            res = st.run(revolutions * revolution)
+            row = {"n_angle": wear.n_angle, "f": f, "h": s["h"] / f, "status": res.status}
+            row["cpu"] = time.process_time() - c0
+            row.update(measure(res, wear, s["h"] / f, revolution))
+            row["balances"] = (res.energy_error(), res.heat_error())
+            row["load"] = (load0, os.getloadavg()[0])
+            rows.append(row)
+            log(_line(row))
+    return rows
+
+
+def _line(r: dict) -> str:
+    return (
+        f"n_angle {r['n_angle']} h/{r['f']}: {r['status']}, impulse {r['impulse']:.4g} N s "
+        f"(first revolution {r['first']:.4g}, later {r['later']:.4g}, held {r['held']:.4g}), "
+        f"{r['episodes']} episodes ({100 * r['after_centre']:.0f} % after a centre), T_max "
+        f"{r['t_max']:.1f} K, wear {1e3 * r['wear']:.4g} mm, {r['cpu']:.1f} s CPU"
+    )
+
+
+def _order(rows, i: int, key: str) -> str:
+    """``log2(d_prev / d)`` of the differences of ``key`` between consecutive steps."""
+    if i < 2 or rows[i - 2]["n_angle"] != rows[i]["n_angle"]:
+        return "—"
+    d0 = abs(rows[i - 1][key] - rows[i - 2][key])
+    d1 = abs(rows[i][key] - rows[i - 1][key])
+    return f"{math.log2(d0 / d1):.2f}" if d0 > 0 and d1 > 0 else "—"
+
+
+def _diff(rows, i: int, key: str) -> str:
+    if i < 1 or rows[i - 1]["n_angle"] != rows[i]["n_angle"]:
+        return "—"
+    return f"{100 * (rows[i - 1][key] / rows[i][key] - 1):+.1f} %"
+
+
+def table(rows) -> str:
+    out = [
+        "| cells | step | status | total impulse (N s) | vs previous step | order | first "
+        "revolution | vs previous | order | later revolutions | vs previous | order | held at "
+        "the yield | episodes | started in the first tenth after a centre | hottest contact "
+        "(K) | vs previous | deepest wear (mm) | worn volume (mm³) | energy / heat balance | "
+        "CPU (s) | load |",
+        "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|",
+    ]
+    for i, r in enumerate(rows):
+        out.append(
+            f"| {r['n_angle']} | h/{r['f']} ({r['h']:.4g} s) | {r['status']} | "
+            f"{r['impulse']:.4g} | {_diff(rows, i, 'impulse')} | {_order(rows, i, 'impulse')} "
+            f"| {r['first']:.4g} | {_diff(rows, i, 'first')} | {_order(rows, i, 'first')} | "
+            f"{r['later']:.4g} | {_diff(rows, i, 'later')} | {_order(rows, i, 'later')} | "
+            f"{r['held']:.4g} | {r['episodes']} | {100 * r['after_centre']:.0f} % | "
+            f"{r['t_max']:.1f} | {_diff(rows, i, 't_max')} | {1e3 * r['wear']:.4g} | "
+            f"{1e9 * r['volume']:.4g} | {r['balances'][0]:.1e} / {r['balances'][1]:.1e} | "
+            f"{r['cpu']:.1f} | {r['load'][0]:.1f}–{r['load'][1]:.1f} |"
+        )
+    return "\n".join(out)
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--scene", default="rotor37-thermal")
+    ap.add_argument("--factors", default="1,2,4")
+    ap.add_argument("--revolutions", type=float, default=10.0)
+    ap.add_argument("--n-angle", default="0", help="comma-separated map resolutions (0: scene)")
+    ap.add_argument("--set", action="append", default=[], metavar="KEY=VALUE")
+    ap.add_argument("--no-write", action="store_true")
+    a = ap.parse_args(argv)
+    from femrub.scene import load_scene
+
+    shared = (ROOT.parent / "shared" / "data").is_dir() or os.environ.get("FEMRUB_SHARED_DATA")
+    if a.scene.startswith("rotor37") and not shared:
+        print("skipped: no ../shared/data (Rotor 37 mesh)")
+        return 0
+    changes = {k: _value(v) for k, v in (s.split("=", 1) for s in a.set)}
+    scene = load_scene(a.scene, {"outputs.vtk_stride": 0, **changes})
+    factors = [int(x) for x in a.factors.split(",")]
+    rows = study(scene, factors, a.revolutions, [int(x) for x in a.n_angle.split(",")])
+    text = (
+        f"`python benchmarks/abradable_order.py --scene {a.scene} --factors {a.factors} "
+        f"--revolutions {a.revolutions:g} --n-angle {a.n_angle}"
+        + "".join(f" --set {s}" for s in a.set)
+        + f"` ({time.strftime('%Y-%m-%d')}):\n\n"
+        + table(rows)
+    )
+    print(text)
+    if not a.no_write:
+        doc = DOC.read_text()
+        if BEGIN not in doc:
+            doc += f"\n## Where the step error of a coated rub comes from\n\n{BEGIN}\n{END}\n"
+        i, j = doc.index(BEGIN) + len(BEGIN), doc.index(END)
+        DOC.write_text(doc[:i] + "\n" + text + "\n" + doc[j:])
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
