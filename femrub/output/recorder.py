@@ -5,11 +5,10 @@ For the rows ``k = 0 .. n`` of a run of ``n`` steps of size ``h`` the recorder k
     t_k,   s_k = O X_k (observations),   g_k = g0(t_k) + Gᵀ X_k,   P_k (impulse of step k)
 
 and, with friction, the tangential impulses, the blade's heat and the contact state of each
-step (the stepper's ``extra``) and the slip velocity ``w_t = Gvtᵀ X_k − v_c``
-
-and the energy balance of :class:`~femrub.output.energy.EnergyMeter`. States are buffered
-in chunks and post-processed with row-wise products. A chunk is checked before anything
-leaves it: a non-finite state or energy created from nothing ends the run with status
+step (the stepper's ``extra``), the slip velocity ``w_t = Gvtᵀ X_k − v_c`` and the energy
+balance of :class:`~femrub.output.energy.EnergyMeter`. States are buffered in chunks and
+post-processed with row-wise products. A chunk is checked before anything leaves it: a
+non-finite state or energy created from nothing ends the run with status
 ``"unstable"``, a physical stop limit ``max |s| > bound`` (or ``|P / h| > bound`` for
 ``"contact_force"``) with ``"diverged-physically"``. Only checked states reach the sinks
 (the ``on_state`` callback, e.g. a VTK series, the ``on_rows`` callback, e.g. a history
@@ -39,16 +38,14 @@ from .state import State
 
 __all__ = ["CHUNK_STEPS", "CHUNK_VALUES", "Recorder", "State", "StepRefused"]
 
-# steps post-processed together: long enough for efficient row products, short enough that
-# a blow-up is reported soon after it starts
+# steps post-processed together: efficient row products, a blow-up reported soon
 CHUNK_STEPS = 512
 # largest number of state values buffered per chunk (16 MB of float64) on large models
 CHUNK_VALUES = 2_000_000
 
 
 class StepRefused(ValueError):
-    """A stepper cannot go on (its model of the contact no longer applies): the run ends
-    ``failed`` with this message, the steps before it kept."""
+    """A stepper cannot go on (its contact model no longer applies): status ``failed``."""
 
 
 class _Stop(Exception):
@@ -74,8 +71,8 @@ class Recorder:
     limits : physical stop criteria ``{signal name or "contact_force": max |value|}``.
     store_every : keep the full state every that many steps (0: never).
     on_state : callback ``f(State)`` fed each checked state (each ``on_state.stride``-th).
-    on_rows : callback ``f(arrays)`` fed each checked block of rows, ``{name: array}`` as
-        :meth:`per_step` gives them (row 0 comes with the first block).
+    on_rows : callback ``f(arrays)`` fed each checked block of rows as :meth:`per_step`
+        gives them (row 0 with the first block).
     label : name of the run (progress bar and ``Results.info``).
     blowup_check : stop on energy created from nothing (a scheme may turn it off when the
         meter's quadratures, not the scheme, would open its balance).
