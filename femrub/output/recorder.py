@@ -38,10 +38,8 @@ from .state import State
 
 __all__ = ["CHUNK_STEPS", "CHUNK_VALUES", "Recorder", "State", "StepRefused"]
 
-# steps post-processed together: efficient row products, a blow-up reported soon
-CHUNK_STEPS = 512
-# largest number of state values buffered per chunk (16 MB of float64) on large models
-CHUNK_VALUES = 2_000_000
+CHUNK_STEPS = 512  # steps post-processed together (row products; a blow-up reported soon)
+CHUNK_VALUES = 2_000_000  # most state values buffered per chunk (16 MB of float64)
 
 
 class StepRefused(ValueError):
