@@ -154,3 +154,17 @@ def test_assess_is_the_one_place_that_decides():
     res.energy["energy_error"] = res.energy["energy_error"] + 1.0  # an open balance
     assess(res)
     assert res.status == "inaccurate"
+
+
+def test_every_failed_check_is_named_in_the_message():
+    res = ThetaMethod(bar_model(), 1e-4).run(0.01)
+    tol = {"reduction": {"estimate": 0.06, "tolerance": 0.05},
+           "time_step": {"estimate": 0.19, "tolerance": 0.05, "h": 1e-4}}  # fmt: skip
+    assess(res, tolerances=tol)
+    assert res.status == "inaccurate"
+    first, second = res.message.split("; ")
+    assert first.startswith("estimated reduction error 6 %")
+    assert second.startswith("estimated time-step error 19 %")
+    one = ThetaMethod(bar_model(), 1e-4).run(0.01)
+    assess(one, tolerances={"reduction": {"estimate": 0.06, "tolerance": 0.05}})
+    assert "; " not in one.message and "reduction error" in one.message

@@ -197,12 +197,10 @@ def assess(res, *, tolerances: dict | None = None, merge_time: float | None = No
         the resolution check.
     """
     tol = {**TOLERANCES, **(tolerances or {})}
-    if res.status == "ok":
-        for rule in RULES:
-            why = rule(res, tol)
-            if why:
-                res.status, res.message = "inaccurate", why
-                break
+    if res.status == "ok":  # every rule that fails is named, in the order of RULES
+        reasons = [why for why in (rule(res, tol) for rule in RULES) if why]
+        if reasons:
+            res.status, res.message = "inaccurate", "; ".join(reasons)
     if res.status in ("ok", "inaccurate"):
         warn = resolution_warning(res, merge_time)
         if warn and res.status == "ok" and _median_steps(res, merge_time) < UNRESOLVED_STEPS:
