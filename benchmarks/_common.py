@@ -147,6 +147,17 @@ def timed(fn, *args, **kwargs):
     return out, time.process_time() - c0, time.perf_counter() - w0
 
 
+def write_between(doc: Path, name: str, text: str, heading: str = "") -> None:
+    """Put ``text`` between ``<!-- name:begin -->`` and ``<!-- name:end -->`` in ``doc``
+    (the markers appended, under ``heading``, when the document has none yet)."""
+    begin, end = f"<!-- {name}:begin -->", f"<!-- {name}:end -->"
+    page = doc.read_text()
+    if begin not in page:
+        page += f"\n{heading}{begin}\n{end}\n"
+    i, j = page.index(begin) + len(begin), page.index(end)
+    doc.write_text(page[:i] + "\n" + text + "\n" + page[j:])
+
+
 def peak_rss_mib() -> float:
     """Peak resident memory of this process (MiB)."""
     return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0

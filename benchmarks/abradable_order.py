@@ -27,10 +27,10 @@ import time
 from pathlib import Path
 
 import numpy as np
+from _common import write_between
 
 ROOT = Path(__file__).resolve().parents[1]
 DOC = ROOT / "docs" / "abradable.md"
-BEGIN, END = "<!-- abradable_order:begin -->", "<!-- abradable_order:end -->"
 
 
 def _value(text: str):
@@ -181,11 +181,8 @@ def main(argv=None) -> int:
     )
     print(text)
     if not a.no_write:
-        doc = DOC.read_text()
-        if BEGIN not in doc:
-            doc += f"\n## Where the step error of a coated rub comes from\n\n{BEGIN}\n{END}\n"
-        i, j = doc.index(BEGIN) + len(BEGIN), doc.index(END)
-        DOC.write_text(doc[:i] + "\n" + text + "\n" + doc[j:])
+        heading = "## Where the step error of a coated rub comes from\n\n"
+        write_between(DOC, "abradable_order", text, heading)
     return 0
 
 

@@ -25,10 +25,10 @@ import time
 from pathlib import Path
 
 import numpy as np
+from _common import write_between
 
 ROOT = Path(__file__).resolve().parents[1]
 DOC = ROOT / "docs" / "rotor37.md"
-BEGIN, END = "<!-- time_step_3d:begin -->", "<!-- time_step_3d:end -->"
 
 
 def _value(text: str):
@@ -165,11 +165,7 @@ def main(argv=None) -> int:
     )
     print(text)
     if not a.no_write:
-        doc = DOC.read_text()
-        if BEGIN not in doc:
-            doc += f"\n{BEGIN}\n{END}\n"
-        i, j = doc.index(BEGIN) + len(BEGIN), doc.index(END)
-        DOC.write_text(doc[:i] + "\n" + text + "\n" + doc[j:])
+        write_between(DOC, "time_step_3d", text)
     return 0
 
 
