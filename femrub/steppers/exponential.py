@@ -351,17 +351,15 @@ class ExponentialMoreau(EventLocation, FrictionalContact, LoadPolynomial, Steppe
         return integ.over(S, z, tau - a, unit)
 
     # -- impulses ------------------------------------------------------------------------------
-    def _impact(self, te, X, S, P, forced=None, plastic=None):
-        """Newton impulses at time ``te`` (shared LCP; with friction
-        :meth:`~.exponential_friction.FrictionalContact._impact_friction`); update ``P`` in
-        place; new held set."""
-        if self._fric:
-            return self._impact_friction(te, X, S, P, forced, plastic)
+    def _struck(self, te, X, S, forced=None, plastic=None):
+        """The contacts an impulse acts on at ``te``: ``(gap rates, active, restitution)``,
+        or ``None`` when no free contact touches closing (held ones in ``S`` take part with
+        e = 0; ``forced`` are triggered when closing, ``plastic`` ones get e = 0)."""
         c = self.model.contact
         touch = c.gap(te, X) <= 0.0
         touch[list(S)] = False
         if forced is None and not touch.any():  # no free contact touches
-            return X, S
+            return None
         gd = c.gap_velocity(te, X)
         held = np.zeros(c.n, dtype=bool)
         held[list(S)] = True
@@ -369,12 +367,24 @@ class ExponentialMoreau(EventLocation, FrictionalContact, LoadPolynomial, Steppe
         if forced is not None:
             trigger[forced] = gd[forced] < 0.0
         if not trigger.any():
-            return X, S
-        active = trigger | held
-        alpha = c.alpha_at(te)
+            return None
         e = np.where(held, 0.0, c.restitution)
         if plastic is not None and c.restitution < 1.0:  # e = 1 has no Zeno sequence
             e[plastic] = 0.0
+        return gd, trigger | held, e
+
+    def _impact(self, te, X, S, P, forced=None, plastic=None):
+        """Newton impulses at time ``te`` (shared LCP; with friction
+        :meth:`~.exponential_friction.FrictionalContact._impact_friction`); update ``P`` in
+        place; new held set."""
+        if self._fric:
+            return self._impact_friction(te, X, S, P, forced, plastic)
+        hit = self._struck(te, X, S, forced, plastic)
+        if hit is None:
+            return X, S
+        gd, active, e = hit
+        c = self.model.contact
+        alpha = c.alpha_at(te)
         W = self._Wm + self._Wt * alpha
         Pi = solve_impulses(W / (1.0 + e)[:, None], gd, active, self._warm)
         self._warm = Pi > 0.0

@@ -154,23 +154,11 @@ class FrictionalContact:
     def _impact_friction(self, te, X, S, P, forced=None, plastic=None):
         """Signorini–Coulomb impulses with Newton's law at ``te`` (see module docstring);
         update ``P`` and the step's friction quantities; return the state and held set."""
+        hit = self._struck(te, X, S, forced, plastic)
+        if hit is None:
+            return X, S
+        gd, active, e = hit
         c = self.model.contact
-        touch = c.gap(te, X) <= 0.0
-        touch[list(S)] = False
-        if forced is None and not touch.any():
-            return X, S
-        gd = c.gap_velocity(te, X)
-        held = np.zeros(c.n, dtype=bool)
-        held[list(S)] = True
-        trigger = touch & (gd < 0.0)
-        if forced is not None:
-            trigger[forced] = gd[forced] < 0.0
-        if not trigger.any():
-            return X, S
-        active = trigger | held
-        e = np.where(held, 0.0, c.restitution)
-        if plastic is not None and c.restitution < 1.0:
-            e[plastic] = 0.0
         power = c.heat_law == "power"
         alpha = np.zeros(c.n) if power else np.asarray(c.alpha_at(te), dtype=float)
         W = self._W3
