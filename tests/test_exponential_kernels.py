@@ -6,15 +6,12 @@ identities, and run both compiled and as plain Python (``NUMBA_DISABLE_JIT=1``) 
 bar with a held contact, the two giving the same run.
 """
 
-import json
-import os
-import subprocess
-import sys
 from pathlib import Path
 
 import numpy as np
 import pytest
 import scipy.linalg as sla
+from jit_child import child_json
 
 from femrub.contact.jit import compiled
 from femrub.steppers.exponential_kernels import (
@@ -131,17 +128,7 @@ print(json.dumps({"jit": compiled(), "status": r.status, "X": st.X.tolist(),
 
 @pytest.mark.skipif(not compiled(), reason="kernels not compiled (NUMBA_DISABLE_JIT)")
 def test_the_stepper_runs_as_python_without_jit():
-    out = {}
-    for jit in (False, True):
-        env = {**os.environ, "PYTHONPATH": str(ROOT)}
-        if jit:
-            env.pop("NUMBA_DISABLE_JIT", None)
-        else:
-            env["NUMBA_DISABLE_JIT"] = "1"
-        run = subprocess.run([sys.executable, "-c", _CHILD], env=env, cwd=ROOT,
-                             capture_output=True, text=True, check=True)  # fmt: skip
-        out[jit] = json.loads(run.stdout.splitlines()[-1])
-    py, jt = out[False], out[True]
+    py, jt = child_json(_CHILD, False), child_json(_CHILD, True)
     assert not py["jit"] and jt["jit"] and py["status"] == jt["status"] == "ok"
     assert py["levels"] == jt["levels"] >= 2  # free and held flows were composed
     X0, X1 = np.array(py["X"]), np.array(jt["X"])

@@ -5,15 +5,12 @@ kernel), with row blocks of the dense factor that are zero on some of its column
 reduction basis), and through :func:`~femrub.fem.linalg.project` against the dense product.
 """
 
-import json
-import os
-import subprocess
-import sys
 from pathlib import Path
 
 import numpy as np
 import pytest
 import scipy.sparse as sp
+from jit_child import child_json
 
 from femrub.fem.linalg import project
 from femrub.fem.spmm import _csr_dense_runs, block_columns, compiled, csr_dense
@@ -123,17 +120,8 @@ print(json.dumps({{"jit": compiled(), "err": float(np.abs(out - Q @ X).max()),
 
 @pytest.mark.skipif(not compiled(), reason="kernel not compiled (NUMBA_DISABLE_JIT)")
 def test_the_kernel_runs_as_python_without_jit():
-    out = {}
-    for jit in (False, True):
-        env = {**os.environ, "PYTHONPATH": str(ROOT)}
-        if jit:
-            env.pop("NUMBA_DISABLE_JIT", None)
-        else:
-            env["NUMBA_DISABLE_JIT"] = "1"
-        code = _CHILD.format(tests=str(ROOT / "tests"))
-        run = subprocess.run([sys.executable, "-c", code], env=env, cwd=ROOT,
-                             capture_output=True, text=True, check=True)  # fmt: skip
-        out[jit] = json.loads(run.stdout.splitlines()[-1])
+    code = _CHILD.format(tests=str(ROOT / "tests"))
+    out = {jit: child_json(code, jit) for jit in (False, True)}
     assert not out[False]["jit"] and out[True]["jit"]
     for r in out.values():
         assert r["err"] <= 1e-13 * r["scale"]

@@ -7,13 +7,11 @@ round-off, with the energy balance, and the same code must run as Python under
 """
 
 import json
-import os
-import subprocess
-import sys
 from pathlib import Path
 
 import numpy as np
 import pytest
+from jit_child import child_json
 
 import femrub as fr
 from femrub.cases.bar import bar_model
@@ -121,15 +119,8 @@ print(json.dumps({"jit": compiled(), "kind": st._block_kind, "bar": r.impulse.to
 
 @pytest.mark.skipif(not compiled(), reason="kernels not compiled (NUMBA_DISABLE_JIT)")
 def test_blocks_run_as_python_without_jit():
-    env = {**os.environ, "NUMBA_DISABLE_JIT": "1", "PYTHONPATH": str(ROOT)}
     code = _CHILD % json.dumps(NACA)
-    run = subprocess.run([sys.executable, "-c", code], env=env, cwd=ROOT, capture_output=True,
-                         text=True, check=True)  # fmt: skip
-    py = json.loads(run.stdout.splitlines()[-1])
-    env.pop("NUMBA_DISABLE_JIT")
-    run = subprocess.run([sys.executable, "-c", code], env=env, cwd=ROOT, capture_output=True,
-                         text=True, check=True)  # fmt: skip
-    jit = json.loads(run.stdout.splitlines()[-1])
+    py, jit = child_json(code, False), child_json(code, True)
     assert not py["jit"] and jit["jit"] and py["kind"] == jit["kind"] == "friction"
     _close(np.array(py["bar"]), np.array(jit["bar"]), 1e-12)
     # LLVM may contract a*b + c into one FMA on CPUs that have it (CI's did): the stick-slip
