@@ -169,7 +169,8 @@ def test_a_failed_solve_in_a_rub_block_keeps_the_coating_of_the_steps_before(bla
 def test_wear_kernels_equal_the_grid_and_a_vectorised_cut():
     """``depth_under`` is ``CasingGrid.interpolate`` (bitwise); ``cut_sweeps`` is the
     vectorised cut along the sweeps (coefficients ``⌊min x + 1/2⌋ − 1 .. ⌊max x + 1/2⌋ + 1``,
-    each to the largest reach of the sweep over its support ``|x − k| <= 3/2``)."""
+    each to the sweep's straight reach at its centre) and returns the deepest point of the
+    surface over the pieces it changed."""
     rng = np.random.default_rng(3)
     grid = CasingGrid(rng.uniform(0, 6.3, 9), rng.uniform(0, 0.01, 9), 0.3, 500.0, 37, 4)
     w = Abradable(1e-3, 10.0, grid)
@@ -187,20 +188,24 @@ def test_wear_kernels_equal_the_grid_and_a_vectorised_cut():
     deepest = cut_sweeps(got, grid.axial_cell, x0, x1, r0, r1, w.thickness, 37, 4)
     ref = flat.copy()
     lo, hi = np.minimum(x0, x1), np.maximum(x0, x1)
-    levels = []
     for a in range(9):
         k = np.arange(np.floor(lo[a] + 0.5) - 1, np.floor(hi[a] + 0.5) + 2).astype(int)
         dx = x1[a] - x0[a]
-        if dx == 0:
-            top = np.full(k.size, r1[a])
-        else:  # the reach is linear along the sweep: its largest value at an end
-            ends = np.stack([np.maximum(lo[a], k - 1.5), np.minimum(hi[a], k + 1.5)])
-            top = (r0[a] + np.clip((ends - x0[a]) / dx, 0, 1) * (r1[a] - r0[a])).max(axis=0)
-        level = np.minimum(w.thickness, top)
-        np.maximum.at(ref, np.mod(k, 37) * 4 + grid.axial_cell[a], level)
-        levels.append(level)
-    np.testing.assert_array_equal(got, ref)
-    assert deepest == np.concatenate(levels).max() and np.any(got > flat)
+        line = np.full(k.size, r1[a]) if dx == 0 else r0[a] + (k - x0[a]) / dx * (r1[a] - r0[a])
+        np.maximum.at(ref, np.mod(k, 37) * 4 + grid.axial_cell[a], np.minimum(w.thickness, line))
+    np.testing.assert_allclose(got, ref, rtol=1e-15, atol=0)
+    changed = np.flatnonzero(got != flat)
+    assert changed.size and np.all(got >= flat)
+    # the surface over the changed pieces, densely sampled: the deepest is ``deepest``
+    u = np.linspace(-0.5, 0.5, 2001)[:, None]
+    bm, b0, bp = 0.5 * (0.5 - u) ** 2, 0.75 - u * u, 0.5 * (0.5 + u) ** 2
+    top = -np.inf
+    for flat_index in changed:
+        j, a = divmod(int(flat_index), 4)
+        for p in (j - 1, j, j + 1):
+            cm, c0, cp = (got[np.mod(q, 37) * 4 + a] for q in (p - 1, p, p + 1))
+            top = max(top, float(np.max(bm * cm + b0 * c0 + bp * cp)))
+    assert deepest == pytest.approx(top, rel=1e-6)
     # the recorder's rows of gaps and rates on the worn surface: one broadcast, the same
     # values as one call per time
     from femrub.contact.gap import Contact

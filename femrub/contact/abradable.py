@@ -19,21 +19,24 @@ reached the coating yields: the blade penetrates the current surface and the mat
 penetrates is removed permanently (after each step, :meth:`Abradable.update`). With the
 blade's reach into the coating ``r_i = w(ψ_i) − g_i``, the reach linear along the sweep of
 the step (from ``ψ_i(t − h)`` to ``ψ_i(t)``), every coefficient whose support meets the
-sweep is raised to the largest reach of the sweep over its support::
+sweep is raised to that straight line at its centre (the B-spline reproduces straight
+lines, :mod:`femrub.contact.wear_map`)::
 
-    c(ψ_k, z_i) <- min(e, max(c(ψ_k, z_i), max_{|ψ − ψ_k| <= 3/2 cell} r_i(ψ)))
+    c(ψ_k, z_i) <- min(e, max(c(ψ_k, z_i), r_i(ψ_k)))
 
 so that after the update ``w >= r_i`` all along the sweep (``g_i(t) >= 0`` on the new
-surface, and a contact that retraces its own cut does not meet the coating again). A
-contact that crosses several cells in a step cuts all of them: the worn volume does not
-depend on how the time step compares with the cell size. Once the surface is worn through
-(``w = e``) the rigid casing behind it takes any force. Wear is monotone, never negative
-and never deeper than ``e``.
+surface, and a contact that retraces its own cut does not meet the coating again), beyond
+the reach only by ``O(Δ²)`` along a smooth cut and by the reach's slope over at most one and
+a half cells beyond a cut's ends. A contact
+that crosses several cells in a step cuts all of them: the worn volume does not depend on
+how the time step compares with the cell size. Once the surface is worn through (``w = e``)
+the rigid casing behind it takes any force. Wear is monotone, never negative and never
+deeper than ``e``.
 
 The wear map is casing state that evolves during a run: a stepper calls :meth:`reset` when
-it starts. ``history`` keeps ``(t, max depth)`` at every step that removed material. The
-cut is :func:`femrub.contact.wear_map.cut_sweeps` (compiled), which the θ-method's blocks
-of steps also call (:mod:`femrub.contact.rub_block`).
+it starts. ``history`` keeps ``(t, deepest point of the surface)`` at every step that
+removed material. The cut is :func:`femrub.contact.wear_map.cut_sweeps` (compiled), which
+the θ-method's blocks of steps also call (:mod:`femrub.contact.rub_block`).
 """
 
 from __future__ import annotations
@@ -215,17 +218,31 @@ class Abradable:
             x0, r0 = x1, r1
         else:
             x0, r0 = g.position(last[0])[i], last[1][i]
-        flat = self.depth.ravel()  # a view: cut in place (the deepest cut counts)
-        cut_sweeps(flat, g.axial_cell[i], x0, x1, r0, r1, self.thickness, self.n_angle,
-                   self.n_axial)  # fmt: skip
-        self.history.append((float(t), float(flat.max())))
+        flat = self.depth.ravel()  # a view: cut in place
+        deepest = cut_sweeps(flat, g.axial_cell[i], x0, x1, r0, r1, self.thickness,
+                             self.n_angle, self.n_axial)  # fmt: skip
+        self.history.append((float(t), max(self.history[-1][1], float(deepest))))
 
     # -- results ------------------------------------------------------------------------
     @property
+    def surface(self) -> np.ndarray:
+        """(n_angle, n_axial) depth of the worn surface at the cell centres (m),
+        ``(c[k − 1] + 6 c[k] + c[k + 1]) / 8``: what the wear map shows."""
+        c = self.depth
+        return (np.roll(c, 1, axis=0) + 6.0 * c + np.roll(c, -1, axis=0)) / 8.0
+
+    @property
     def max_depth(self) -> float:
-        """The largest coefficient of the map (m): the surface's deepest point or above it
-        (the weights sum to 1), equal to it where a cut raised a whole support."""
-        return float(self.depth.max())
+        """The deepest point of the worn surface (m): the largest of its pieces' maxima
+        (:func:`~femrub.contact.wear_map.piece_max`)."""
+        cm, c0, cp = np.roll(self.depth, 1, axis=0), self.depth, np.roll(self.depth, -1, axis=0)
+        best = np.maximum(0.5 * (cm + c0), 0.5 * (c0 + cp))
+        curv = cm - 2.0 * c0 + cp
+        with np.errstate(divide="ignore", invalid="ignore"):
+            u = np.where(curv < 0.0, 0.5 * (cm - cp) / curv, 1.0)
+        inner = np.abs(u) < 0.5
+        vertex = 0.5 * (0.5 - u) ** 2 * cm + (0.75 - u * u) * c0 + 0.5 * (0.5 + u) ** 2 * cp
+        return float(np.max(np.where(inner, np.maximum(best, vertex), best), initial=0.0))
 
     @property
     def cell_area(self) -> np.ndarray:

@@ -20,14 +20,16 @@ def write_wear(wear, out) -> dict:
     ``max_wear_depth`` (m) and ``worn_volume`` (m³) to ``out/summary.json``; return them.
 
     ``wear_map.csv``: one row per casing-angle cell (``angle_deg`` = its centre), one column
-    per axial cell (``z=<centre in m>``), depths in m. ``wear_history.csv``: ``t_s``,
+    per axial cell (``z=<centre in m>``): the worn surface's depth at the cell centres
+    (:attr:`~femrub.contact.abradable.Abradable.surface`), in m. ``wear_history.csv``: ``t_s``,
     ``max_wear_depth_m`` at the start and at every step that removed coating.
     """
     out = Path(out)
+    surface = wear.surface
     ang = np.degrees(wear.angle_centres())
     z = wear.axial_centres()
     header = "angle_deg," + ",".join(f"z={v:.6g}" for v in z)
-    np.savetxt(out / "wear_map.csv", np.column_stack([ang, wear.depth]), delimiter=",",
+    np.savetxt(out / "wear_map.csv", np.column_stack([ang, surface]), delimiter=",",
                header=header, comments="", fmt="%.8g")  # fmt: skip
     hist = np.array(wear.history, dtype=float)
     np.savetxt(out / "wear_history.csv", hist, delimiter=",", header="t_s,max_wear_depth_m",
@@ -35,7 +37,7 @@ def write_wear(wear, out) -> dict:
     fig, (ax, bx) = plt.subplots(1, 2, figsize=(11, 4), gridspec_kw={"width_ratios": [3, 2]})
     edges = np.degrees(np.linspace(0, 2 * np.pi, wear.n_angle + 1))
     im = ax.pcolormesh(
-        edges, wear.z_edges * 1e3, wear.depth.T * 1e6, shading="flat", cmap="magma_r"
+        edges, wear.z_edges * 1e3, surface.T * 1e6, shading="flat", cmap="magma_r"
     )
     fig.colorbar(im, ax=ax, label="wear depth (µm)")
     ax.set_xlabel("casing angle (deg)")

@@ -208,7 +208,7 @@ def _rub(st, sig, t1, off, warm, use_warm, X, P, Pt, heat, state) -> tuple:
         g0a = np.ascontiguousarray(_profile_gap(c, ta))
         last = w._last
         last_r = np.zeros(c.n) if last is None else np.array(last[1], dtype=float)
-        wstate = np.array([last is not None, 0.0 if last is None else last[0], depth.max()],
+        wstate = np.array([last is not None, 0.0 if last is None else last[0], w.history[-1][1]],
                           dtype=float)  # fmt: skip
     done, status, res, warm = rub_block(
         st.X, st._bT, st._bY1, st._bY0, sig, st._bS, off, st._bZ, st._bW, st._bGZ,
