@@ -36,9 +36,7 @@ def write_wear(wear, out) -> dict:
                comments="", fmt="%.8g")  # fmt: skip
     fig, (ax, bx) = plt.subplots(1, 2, figsize=(11, 4), gridspec_kw={"width_ratios": [3, 2]})
     edges = np.degrees(np.linspace(0, 2 * np.pi, wear.n_angle + 1))
-    im = ax.pcolormesh(
-        edges, wear.z_edges * 1e3, surface.T * 1e6, shading="flat", cmap="magma_r"
-    )
+    im = ax.pcolormesh(edges, wear.z_edges * 1e3, surface.T * 1e6, shading="flat", cmap="magma_r")
     fig.colorbar(im, ax=ax, label="wear depth (µm)")
     ax.set_xlabel("casing angle (deg)")
     ax.set_ylabel("axial position (mm)")
