@@ -256,49 +256,6 @@ def test_a_contact_retracing_its_cut_does_not_meet_the_coating():
     assert cut.size <= steps * omega * h / (2 * math.pi / n_angle) + 5
 
 
-def _cut_along(reach, n_angle, steps, omega=100.0, h=2e-5):
-    """A coating cut by one contact whose reach at step ``k`` is ``reach(k)``."""
-    grid = CasingGrid([0.0], [0.0], 0.3, omega, n_angle=n_angle, n_axial=1)
-    wear = Abradable(1e-3, 10.0, grid)
-    wear.reset(h=h)
-    wear.update(0.0, np.array([-reach(0)]), np.array([False]))
-    for k in range(1, steps + 1):
-        wear.update(k * h, wear.depth_at(k * h) - reach(k), np.array([True]))
-    return wear
-
-
-def test_a_straight_cut_is_not_widened():
-    """A contact cutting along a sloped straight reach leaves the surface on that line, not
-    beyond it: the B-spline reproduces straight lines (the largest reach of the sweep over
-    each coefficient's support, the earlier rule, cut 1.5 × slope × cell beyond it)."""
-    omega, h, steps, n_angle = 100.0, 2e-5, 300, 720
-    cell = 2 * math.pi / n_angle
-    slope = 1e-3  # m per rad of casing angle
-    wear = _cut_along(lambda k: 1e-5 + slope * omega * h * k, n_angle, steps, omega, h)
-    t = np.linspace(2 * cell / omega, steps * h, 200)  # from two cells in to the end
-    misfit = np.array([wear.depth_at(s)[0] - (1e-5 + slope * omega * s) for s in t])
-    assert np.all(misfit >= -1e-18)
-    assert misfit.max() <= 1e-9 * slope * cell  # the earlier rule: 1.5 slope cell
-
-
-def test_a_curved_cut_goes_beyond_its_reach_by_second_order_in_the_cell():
-    """A groove deepening then receding (a half sine, many steps per cell): the surface is
-    at or beyond the reach, and beyond it by ``O(Δ²)`` away from the groove's ends (the
-    overcut shrinks about 4× per halving of the cell); the worn volume converges."""
-    steps = 400
-    reach = lambda k: 3e-4 * math.sin(math.pi * k / steps)  # noqa: E731
-    over, volume = [], []
-    for n_angle in (360, 720, 1440):
-        wear = _cut_along(reach, n_angle, steps)
-        k = np.arange(steps // 10, steps - steps // 10)
-        misfit = np.array([wear.depth_at(j * 2e-5)[0] - reach(j) for j in k])
-        assert misfit.min() >= 0.0
-        over.append(misfit.max())
-        volume.append(wear.worn_volume)
-    assert over[0] / over[1] > 3.0 and over[1] / over[2] > 3.0
-    assert abs(volume[2] - volume[1]) < 0.35 * abs(volume[1] - volume[0])
-
-
 def test_max_depth_is_the_surface_s_deepest_point():
     """``max_depth`` is the deepest point of the B-spline surface (a piece's vertex, not a
     coefficient), ``surface`` its depth at the centres."""

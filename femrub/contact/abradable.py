@@ -19,19 +19,16 @@ reached the coating yields: the blade penetrates the current surface and the mat
 penetrates is removed permanently (after each step, :meth:`Abradable.update`). With the
 blade's reach into the coating ``r_i = w(ψ_i) − g_i``, the reach linear along the sweep of
 the step (from ``ψ_i(t − h)`` to ``ψ_i(t)``), every coefficient whose support meets the
-sweep is raised to that straight line at its centre (the B-spline reproduces straight
-lines, :mod:`femrub.contact.wear_map`)::
+sweep is raised to the largest reach of the sweep over its support::
 
-    c(ψ_k, z_i) <- min(e, max(c(ψ_k, z_i), r_i(ψ_k)))
+    c(ψ_k, z_i) <- min(e, max(c(ψ_k, z_i), max_{|ψ − ψ_k| <= 3/2 cell} r_i(ψ)))
 
 so that after the update ``w >= r_i`` all along the sweep (``g_i(t) >= 0`` on the new
-surface, and a contact that retraces its own cut does not meet the coating again), beyond
-the reach only by ``O(Δ²)`` along a smooth cut and by the reach's slope over at most one and
-a half cells beyond a cut's ends. A contact
-that crosses several cells in a step cuts all of them: the worn volume does not depend on
-how the time step compares with the cell size. Once the surface is worn through (``w = e``)
-the rigid casing behind it takes any force. Wear is monotone, never negative and never
-deeper than ``e``.
+surface, and a contact that retraces its own cut does not meet the coating again). A
+contact that crosses several cells in a step cuts all of them: the worn volume does not
+depend on how the time step compares with the cell size. Once the surface is worn through
+(``w = e``) the rigid casing behind it takes any force. Wear is monotone, never negative
+and never deeper than ``e``.
 
 The wear map is casing state that evolves during a run: a stepper calls :meth:`reset` when
 it starts. ``history`` keeps ``(t, deepest point of the surface)`` at every step that

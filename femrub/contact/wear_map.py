@@ -19,26 +19,21 @@ an impact, at every centre it crosses). The weights are ``>= 0`` and sum to 1, s
 the cell areas.
 
 A contact that yielded over a step cuts its sweep from ``x⁰`` (where the previous step
-left it, reach ``r⁰``) to ``x¹`` (reach ``r¹``), the reach linear along the sweep,
-``r(x) = r⁰ + (x − x⁰)(r¹ − r⁰)/(x¹ − x⁰)``: every coefficient whose support
-``(k − 3/2, k + 3/2)`` meets the sweep is raised to that line at its centre::
+left it, reach ``r⁰``) to ``x¹`` (reach ``r¹``), the reach linear along the sweep: every
+coefficient whose support ``(k − 3/2, k + 3/2)`` meets the sweep is raised to the largest
+reach of the sweep over that support::
 
-    c[k, a] <- max(c[k, a], min(e, r(k)))        (r¹ for a contact that did not move)
+    c[k, a] <- max(c[k, a], min(e, max_{x in sweep, |x − k| <= 3/2} r(x)))
 
-The quadratic B-spline reproduces straight lines (``Σ_k B(x − k) (α + β k) = α + β x``), so
-afterwards ``w >= r`` all along the sweep, with equality where the sweep set all three
-coefficients: the contact ends on its own cut, and retracing the path it cut does not meet
-the coating again. Along a smooth reach the cut goes beyond it by ``O(Δ²)`` of the cell
-size ``Δ`` (a quadratic B-spline of samples of ``r`` is off by ``Δ² r''/8``), and by the
-line's slope over at most one and a half cells only beyond the ends of a cutting episode.
-(The earlier rule raised each coefficient to the largest reach of the sweep over its
-support: the surface was beyond the reach by the slope of the reach over one and a half
-cells all along every cut, a first-order widening of the groove that made the coated rub
-depend on the map's resolution more than on the time step; ``docs/abradable.md``.)
-:meth:`Abradable.update` and the θ-method's compiled blocks of steps
-(:mod:`femrub.contact.rub_block`) both cut through :func:`cut_sweeps`; :func:`depth_under`
-is :meth:`CasingGrid.interpolate` written per contact, the same operations in the same
-order.
+(``r¹`` for a contact that did not move), so that afterwards ``w >= r`` all along the sweep
+(every weight that is non-zero at a point of the sweep multiplies a coefficient at least
+the reach there): the contact ends on its own cut, and retracing the path it cut does not
+meet the coating again. A cut goes beyond the reach by the reach's slope over up to one
+and a half cells; two rules that do not, measured on the coated Rotor 37 rub, converged
+worse (``docs/abradable.md``, "The cut rule"). :meth:`Abradable.update` and the θ-method's
+compiled blocks of steps (:mod:`femrub.contact.rub_block`) both cut through
+:func:`cut_sweeps`; :func:`depth_under` is :meth:`CasingGrid.interpolate` written per
+contact, the same operations in the same order.
 
 The bound of a step's normal impulse is the yield force times the time the contact spends
 on the coating within the step: ``U = h F_y`` for a contact closed at ``t_k``, and for one
@@ -124,8 +119,14 @@ def cut_sweeps(flat, axial_cell, x0, x1, r0, r1, thickness, n_angle, n_axial):
         for k in range(int(math.floor(lo + 0.5)) - 1, int(math.floor(hi + 0.5)) + 2):
             if dx == 0.0:
                 level = r1[a]
-            else:  # the sweep's reach, linear, at centre k (extended beyond its ends)
-                level = r0[a] + (k - x0[a]) / dx * (r1[a] - r0[a])
+            else:  # the largest reach of the sweep over the support of coefficient k
+                fa = min(max((max(lo, k - 1.5) - x0[a]) / dx, 0.0), 1.0)
+                fb = min(max((min(hi, k + 1.5) - x0[a]) / dx, 0.0), 1.0)
+                level = (
+                    r0[a] + max(fa, fb) * (r1[a] - r0[a])
+                    if r1[a] >= r0[a]
+                    else (r0[a] + min(fa, fb) * (r1[a] - r0[a]))
+                )
             level = min(thickness, level)
             c = (k % n_angle) * n_axial + axial_cell[a]
             if level > flat[c]:
