@@ -48,7 +48,9 @@ def with_map(model, n_angle: int):
 
     c = model.contact
     w, g = c.wear, c.wear.grid
-    grid = CasingGrid(g.angles, g.axial, g.radius, g.omega, n_angle=n_angle, n_axial=g.n_axial)
+    foot = g.beta * 2 * math.pi * g.radius / g.n_angle  # the same footprint, in metres
+    grid = CasingGrid(g.angles, g.axial, g.radius, g.omega, n_angle=n_angle, n_axial=g.n_axial,
+                      footprint=foot)  # fmt: skip
     c.wear = Abradable(w.thickness, w.yield_force, grid)
     return model
 

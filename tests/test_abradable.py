@@ -342,3 +342,37 @@ def test_a_mass_entering_the_coating_is_held_only_after_it_reaches_it():
     assert np.all(P[k + 1 : k + 2000] == pytest.approx(F_y * h, rel=1e-12))
     assert P.sum() == pytest.approx(m * v, rel=1e-3)  # stopped: its momentum
     assert wear.max_depth == pytest.approx(m * v**2 / (2 * F_y), abs=2 * h * v)
+
+
+@pytest.mark.parametrize("cells", [0.3, 1.0, 2.7, 10.0])
+def test_a_footprint_reads_the_mean_of_the_surface_over_it(cells):
+    """``W = (1/β) ∫ w`` over the footprint, against a dense quadrature of the point read;
+    the weights sum to 1; a zero footprint is the point read."""
+    n, radius, t = 64, 0.3, 0.37
+    foot = cells * 2 * math.pi * radius / n
+    point = CasingGrid([0.1], [0.0], radius, 1.0, n_angle=n, n_axial=1)
+    grid = CasingGrid([0.1], [0.0], radius, 1.0, n_angle=n, n_axial=1, footprint=foot)
+    assert grid.beta == pytest.approx(cells, rel=1e-12)
+    c = np.random.default_rng(0).uniform(0, 1e-4, n)
+    s = (np.arange(20000) + 0.5) / 20000 - 0.5  # midpoint rule over the footprint
+    dense = np.mean([point.interpolate(c, t + ds * foot / radius)[0] for ds in s])
+    assert grid.interpolate(c, t)[0] == pytest.approx(dense, rel=1e-7)
+    assert grid.interpolate(np.ones(n), t)[0] == pytest.approx(1.0, rel=1e-14)
+    zero = CasingGrid([0.1], [0.0], radius, 1.0, n_angle=n, n_axial=1, footprint=0.0)
+    assert zero.interpolate(c, t)[0] == point.interpolate(c, t)[0]
+    with pytest.raises(ValueError, match="footprint"):
+        CasingGrid([0.1], [0.0], radius, 1.0, n_angle=n, footprint=-1e-3)
+
+
+def test_a_footprint_ends_on_its_own_cut():
+    """Cutting a groove (a half sine, several cells per step and several steps per cell),
+    the footprint's mean of the new surface is at or beyond the reach after every step."""
+    for n_angle, h in ((360, 2e-5), (3600, 2e-5), (360, 4e-4)):
+        grid = CasingGrid([0.0], [0.0], 0.3, 100.0, n_angle=n_angle, n_axial=1, footprint=4e-3)
+        wear = Abradable(1e-3, 10.0, grid)
+        wear.reset(h=h)
+        reach = lambda k: 3e-4 * math.sin(math.pi * k / 100)  # noqa: E731
+        wear.update(0.0, np.array([-reach(0)]), np.array([False]))
+        for k in range(1, 101):
+            wear.update(k * h, wear.depth_at(k * h) - reach(k), np.array([True]))
+            assert wear.depth_at(k * h)[0] - reach(k) >= -1e-12 * 3e-4  # round-off

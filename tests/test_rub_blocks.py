@@ -117,6 +117,23 @@ def test_power_heat_and_wear_blocks_equal_the_steps(blade):
     _close(ca["last_r"], cb["last_r"], 1e-9)
 
 
+def test_footprint_blocks_equal_the_steps(blade):
+    """A coating read through a footprint 2.5 cells wide: the compiled blocks cut and read
+    it as the per-step path does."""
+    model, scheme, opts = blade
+    w = model.contact.wear
+    g = w.grid
+    cell = 2 * math.pi * g.radius / g.n_angle
+    grid = CasingGrid(g.angles, g.axial, g.radius, g.omega, g.n_angle, g.n_axial,
+                      footprint=2.5 * cell)  # fmt: skip
+    c = replace(model.contact, wear=Abradable(w.thickness, w.yield_force, grid))
+    a, sa, ca, cb = _compare(model.with_(contact=c), scheme, opts, "rub")
+    assert sa._bgrid[4] == pytest.approx(2.5, rel=1e-12)
+    assert len(ca["history"]) == len(cb["history"]) > 50
+    _close(ca["depth"], cb["depth"], 1e-9)
+    assert ca["volume"] == pytest.approx(cb["volume"], rel=1e-9)
+
+
 def test_power_heat_without_a_coating(blade):
     model, scheme, opts = blade
     bare = model.with_(contact=replace(model.contact, wear=None))
@@ -188,13 +205,13 @@ def test_wear_kernels_equal_the_grid_and_a_vectorised_cut():
     for t in (0.0, 1e-3, 0.0123, 7.5):
         x = positions(t, grid.angles, grid.omega, scale)
         np.testing.assert_array_equal(x, grid.position(t))
-        d = depth_under(flat, x, grid.axial_cell, grid.n_angle, grid.n_axial)
+        d = depth_under(flat, x, grid.axial_cell, grid.n_angle, grid.n_axial, 0.0)
         np.testing.assert_array_equal(d, grid.interpolate(flat, t))
     x0, x1 = grid.position(0.001), grid.position(0.0013)
     x1[2] = x0[2]  # a contact that did not move
     r0, r1 = rng.uniform(0, 2e-3, 9), rng.uniform(0, 2e-3, 9)
     got = flat.copy()
-    deepest = cut_sweeps(got, grid.axial_cell, x0, x1, r0, r1, w.thickness, 37, 4)
+    deepest = cut_sweeps(got, grid.axial_cell, x0, x1, r0, r1, w.thickness, 37, 4, 0.0)
     ref = flat.copy()
     lo, hi = np.minimum(x0, x1), np.maximum(x0, x1)
     for a in range(9):

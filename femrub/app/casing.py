@@ -21,8 +21,9 @@ def casing_grid(scene, blade, points, omega, growth):
         return None
     n = a if a["thickness"] > 0.0 else h
     axial = blade.axis @ points.points if blade.dim == 3 else np.zeros(points.n)
+    foot = a["footprint"] if a["thickness"] > 0.0 else 0.0
     return CasingGrid(points.angles, axial, float(np.max(points.radii + growth)), omega,
-                      n_angle=n["n_angle"], n_axial=n["n_axial"])  # fmt: skip
+                      n_angle=n["n_angle"], n_axial=n["n_axial"], footprint=foot)  # fmt: skip
 
 
 def abradable_of(scene, grid):

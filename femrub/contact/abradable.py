@@ -11,6 +11,10 @@ the cell size puts an impact at the centres. Contact ``i`` (angle ``φ_i``, axia
 
     g_i(t, X) = g0_i(t) + w(Ω t + φ_i, z_i) − n_i · u(p_i)
 
+A contact that stands for a footprint of the tip (``contact.abradable.footprint``, its
+circumferential width) reads the worn surface as its mean over that width
+(:mod:`femrub.contact.wear_map`).
+
 Removal law (rigid–perfectly plastic coating, in the spirit of the plastic abradable law
 of Batailly & Legrand): the coating carries at most the yield force ``F_y`` per contact; the
 impulse of a step is bounded, ``0 <= P_i <= h F_y`` (:func:`femrub.contact.impulses.cap`),
@@ -43,7 +47,7 @@ import math
 import numpy as np
 
 from ..fem.material import check_finite_positive
-from .wear_map import cut_sweeps, entry_bounds
+from .wear_map import cut_sweeps, depth_under, entry_bounds
 
 __all__ = ["Abradable", "CasingGrid"]
 
@@ -59,9 +63,13 @@ class CasingGrid:
     rotation_speed : Ω (rad/s).
     n_angle, n_axial : grid cells around the casing and along the axis (over the contacts'
         axial extent, half a cell beyond each end).
+    footprint : circumferential width of the tip each contact stands for (m): the contacts
+        read values as their mean over it (0: at their point).
     """
 
-    def __init__(self, angles, axial, radius, rotation_speed, n_angle=360, n_axial=16):
+    def __init__(
+        self, angles, axial, radius, rotation_speed, n_angle=360, n_axial=16, footprint=0.0
+    ):
         self.radius = check_finite_positive("casing radius", radius)
         self.omega = float(rotation_speed)
         self.angles = np.asarray(angles, dtype=float).ravel()
@@ -71,6 +79,10 @@ class CasingGrid:
         if not (int(n_angle) >= 1 and int(n_axial) >= 1):
             raise ValueError("casing grid needs n_angle >= 1 and n_axial >= 1")
         self.n_angle, self.n_axial = int(n_angle), int(n_axial)
+        if not (math.isfinite(footprint) and footprint >= 0.0):
+            raise ValueError("contact.abradable.footprint must be a length >= 0")
+        #: the footprint in cells, ``β``
+        self.beta = float(footprint) * self.n_angle / (2 * math.pi * self.radius)
         z0, z1 = (float(self.axial.min()), float(self.axial.max())) if self.axial.size else (0, 0)
         pad = 0.5 * (z1 - z0) / max(self.n_axial - 1, 1) if z1 > z0 else 0.5e-3
         self.z_edges = np.linspace(z0 - pad, z1 + pad, self.n_axial + 1)
@@ -94,8 +106,15 @@ class CasingGrid:
 
     def interpolate(self, values: np.ndarray, t: float) -> np.ndarray:
         """``values`` (flat, per cell) at the contacts at ``t``: the periodic quadratic
-        B-spline of the values (:func:`femrub.contact.wear_map.depth_under`)."""
+        B-spline of the values, or its mean over the footprint
+        (:func:`femrub.contact.wear_map.depth_under`)."""
         x = self.position(t)
+        if self.beta > 0.0:  # x: (n,) or, for several times at once, (m, n)
+            v = np.ascontiguousarray(values, dtype=float)
+            rows = np.ascontiguousarray(np.broadcast_to(self.axial_cell, x.shape)).reshape(-1)
+            xs = np.ascontiguousarray(x, dtype=float).reshape(-1)
+            out = depth_under(v, xs, rows, self.n_angle, self.n_axial, self.beta)
+            return out.reshape(x.shape)
         kf = np.floor(x + 0.5)
         u = x - kf
         k = kf.astype(np.int64)
@@ -217,7 +236,7 @@ class Abradable:
             x0, r0 = g.position(last[0])[i], last[1][i]
         flat = self.depth.ravel()  # a view: cut in place
         deepest = cut_sweeps(flat, g.axial_cell[i], x0, x1, r0, r1, self.thickness,
-                             self.n_angle, self.n_axial)  # fmt: skip
+                             self.n_angle, self.n_axial, g.beta)  # fmt: skip
         self.history.append((float(t), max(self.history[-1][1], float(deepest))))
 
     # -- results ------------------------------------------------------------------------
@@ -263,4 +282,5 @@ class Abradable:
             "n_angle": self.n_angle,
             "n_axial": self.n_axial,
             "radius": self.radius,
+            "footprint": self.grid.beta * 2 * math.pi * self.radius / self.n_angle,
         }

@@ -232,7 +232,7 @@ def compile_blocks() -> None:
     ints = np.zeros(1, dtype=np.int64)
     rub_block(
         *head, True, np.zeros((N, 1)), np.zeros((3, 1)), one * 0.5, 20, True, E(0), E(0),
-        np.zeros((0, 1)), np.zeros((1, N)), z.copy(), z.copy(), ints, np.ones(4),
+        np.zeros((0, 1)), np.zeros((1, N)), z.copy(), z.copy(), ints, np.ones(5),
         np.ones(2, dtype=np.int64), z.copy(), np.zeros(3), *rows, E(0),
     )  # fmt: skip
-    cut_sweeps(z.copy(), ints, z.copy(), one * 0.5, z.copy(), z.copy(), 1.0, 1, 1)
+    cut_sweeps(z.copy(), ints, z.copy(), one * 0.5, z.copy(), z.copy(), 1.0, 1, 1, 0.0)

@@ -44,7 +44,7 @@ __all__ = ["MAX_HEAT_ITERATIONS", "power_heat", "rub_block", "WEAR_GRID"]
 #: fixed-point iterations between the contact solve and the frictional heat of a step
 MAX_HEAT_ITERATIONS = 20
 #: entries of the float vector ``grid`` of :func:`rub_block`
-WEAR_GRID = ("omega", "scale", "thickness", "cap")
+WEAR_GRID = ("omega", "scale", "thickness", "cap", "footprint")
 
 
 @njit
@@ -86,7 +86,7 @@ def _wear_cut(depth, GT, X, P, t, g0, angles, axial_cell, grid, dims, last_r, ws
     n_angle, n_axial = dims[0], dims[1]
     n = angles.size
     x1 = positions(t, angles, omega, scale)
-    d = depth_under(depth, x1, axial_cell, n_angle, n_axial)
+    d = depth_under(depth, x1, axial_cell, n_angle, n_axial, grid[4])
     gx = np.dot(GT, X)
     reach = np.empty(n)
     cut = np.zeros(n, dtype=np.bool_)
@@ -100,7 +100,9 @@ def _wear_cut(depth, GT, X, P, t, g0, angles, axial_cell, grid, dims, last_r, ws
         if wstate[0] > 0.0 and t > wstate[1]:
             x0 = positions(wstate[1], angles, omega, scale)[idx]
             r0 = last_r[idx]
-        deepest = cut_sweeps(depth, axial_cell[idx], x0, xe, r0, r1, thickness, n_angle, n_axial)
+        deepest = cut_sweeps(
+            depth, axial_cell[idx], x0, xe, r0, r1, thickness, n_angle, n_axial, grid[4]
+        )
         wstate[2] = max(wstate[2], deepest)
         out = wstate[2]
     last_r[:] = reach
@@ -134,9 +136,9 @@ def rub_block(
         Xp = _predict(T, Y1, Y0, sig, j, Xk)
         if wear:
             d1 = depth_under(depth, positions(t1[j], angles, omega, scale), axial_cell,
-                             dims[0], dims[1])  # fmt: skip
+                             dims[0], dims[1], grid[4])  # fmt: skip
             d0 = depth_under(depth, positions(t1[j] - h, angles, omega, scale), axial_cell,
-                             dims[0], dims[1])  # fmt: skip
+                             dims[0], dims[1], grid[4])  # fmt: skip
             for i in range(n):
                 off[j + 1, i] += d1[i]
                 off[j + 1, n + 3 * i] += (d1[i] - d0[i]) / h

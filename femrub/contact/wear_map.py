@@ -18,18 +18,30 @@ an impact, at every centre it crosses). The weights are ``>= 0`` and sum to 1, s
 ``0 <= c <= e`` keeps ``0 <= w <= e``, and the volume under the surface is ``Σ c`` times
 the cell areas.
 
+A contact that stands for a footprint of the tip ``β`` cells wide (``contact.abradable.
+footprint``) reads the surface's mean over it, ``[x_i − β/2, x_i + β/2]``::
+
+    W_i = Σ_k c[k, a_i] (Φ(x_i + β/2 − k) − Φ(x_i − β/2 − k)) / β
+
+with ``Φ`` the antiderivative of the quadratic B-spline (``β = 0``: the point read above):
+weights ``>= 0`` summing to 1 over ``β + 3`` coefficients at most. The map keeps the worn
+surface; the footprint is how a finite tip reads it, so detail of the surface shorter than
+the footprint (the step-to-step jitter a point contact would carve and meet again) does not
+act on the blade, and the map's cell size is again a numerical parameter.
+
 A contact that yielded over a step cuts its sweep from ``x⁰`` (where the previous step
 left it, reach ``r⁰``) to ``x¹`` (reach ``r¹``), the reach linear along the sweep: every
-coefficient whose support ``(k − 3/2, k + 3/2)`` meets the sweep is raised to the largest
-reach of the sweep over that support::
+coefficient whose support ``(k − 3/2, k + 3/2)``, widened by ``β/2`` each side, meets the
+sweep is raised to the largest reach of the sweep over that widened support::
 
-    c[k, a] <- max(c[k, a], min(e, max_{x in sweep, |x − k| <= 3/2} r(x)))
+    c[k, a] <- max(c[k, a], min(e, max_{x in sweep, |x − k| <= 3/2 + β/2} r(x)))
 
 (``r¹`` for a contact that did not move), so that afterwards ``w >= r`` all along the sweep
 (every weight that is non-zero at a point of the sweep multiplies a coefficient at least
-the reach there): the contact ends on its own cut, and retracing the path it cut does not
-meet the coating again. A cut goes beyond the reach by the reach's slope over up to one
-and a half cells; two rules that do not, measured on the coated Rotor 37 rub, converged
+the reach there; ``W >= r`` with a footprint): the contact ends on its own cut, and
+retracing the path it cut does not meet the coating again. A cut goes beyond the reach by
+the reach's slope over up to one and a half cells (and half the footprint, as a flat tip
+of that width does); two rules that do not, measured on the coated Rotor 37 rub, converged
 worse (``docs/abradable.md``, "The cut rule"). :meth:`Abradable.update` and the θ-method's
 compiled blocks of steps (:mod:`femrub.contact.rub_block`) both cut through
 :func:`cut_sweeps`; :func:`depth_under` is :meth:`CasingGrid.interpolate` written per
@@ -55,7 +67,7 @@ import numpy as np
 
 from .jit import njit
 
-__all__ = ["positions", "depth_under", "cut_sweeps", "entry_bounds", "piece_max"]
+__all__ = ["positions", "depth_under", "cut_sweeps", "entry_bounds", "piece_max", "spline_integral"]
 
 
 @njit
@@ -68,17 +80,41 @@ def positions(t, angles, omega, scale):
 
 
 @njit
-def depth_under(flat, x, axial_cell, n_angle, n_axial):
+def spline_integral(t):
+    """``Φ(t) = ∫_{-∞}^t B(s) ds`` of the centred quadratic B-spline ``B`` (0 below −3/2, 1
+    above 3/2)."""
+    if t <= -1.5:
+        return 0.0
+    if t <= -0.5:
+        return (t + 1.5) ** 3 / 6.0
+    if t <= 0.5:
+        return 1.0 / 6.0 + 0.75 * (t + 0.5) - (t**3 + 0.125) / 3.0
+    if t < 1.5:
+        return 1.0 - (1.5 - t) ** 3 / 6.0
+    return 1.0
+
+
+@njit
+def depth_under(flat, x, axial_cell, n_angle, n_axial, beta):
     """Wear depth (n,) of the flat map ``flat`` at the positions ``x`` (n,) in the axial
-    rows ``axial_cell`` (n,): the periodic quadratic B-spline of the coefficients."""
+    rows ``axial_cell`` (n,): the periodic quadratic B-spline of the coefficients, or its
+    mean over a footprint ``beta`` cells wide (module docstring)."""
     out = np.empty(x.size)
     for i in range(x.size):
+        a = axial_cell[i]
+        if beta > 0.0:
+            lo, hi = x[i] - 0.5 * beta, x[i] + 0.5 * beta
+            acc = 0.0
+            for k in range(int(math.floor(lo - 1.5)), int(math.floor(hi + 1.5)) + 1):
+                wk = spline_integral(hi - k) - spline_integral(lo - k)
+                acc += wk * flat[(k % n_angle) * n_axial + a]
+            out[i] = acc / beta
+            continue
         kf = math.floor(x[i] + 0.5)
         u = x[i] - kf
         k = int(kf) % n_angle
         km = (k - 1) % n_angle
         kp = (k + 1) % n_angle
-        a = axial_cell[i]
         bm = 0.5 * (0.5 - u) * (0.5 - u)
         b0 = 0.75 - u * u
         bp = 0.5 * (0.5 + u) * (0.5 + u)
@@ -107,21 +143,24 @@ def piece_max(flat, k, row, n_angle, n_axial):
 
 
 @njit
-def cut_sweeps(flat, axial_cell, x0, x1, r0, r1, thickness, n_angle, n_axial):
+def cut_sweeps(flat, axial_cell, x0, x1, r0, r1, thickness, n_angle, n_axial, beta):
     """Cut the map ``flat`` (in place) along the sweeps of the contacts given: contact ``a``
     from ``x0[a]`` (reach ``r0[a]``) to ``x1[a]`` (reach ``r1[a]``) in axial row
-    ``axial_cell[a]`` (module docstring). Returns the deepest point of the surface over
-    the pieces whose coefficients it raised (``-inf``: none raised)."""
+    ``axial_cell[a]``, for a footprint ``beta`` cells wide (module docstring). Returns the
+    deepest point of the surface over the pieces whose coefficients it raised (``-inf``:
+    none raised)."""
     deepest = -math.inf
     for a in range(x0.size):
         lo, hi = min(x0[a], x1[a]), max(x0[a], x1[a])
         dx = x1[a] - x0[a]
-        for k in range(int(math.floor(lo + 0.5)) - 1, int(math.floor(hi + 0.5)) + 2):
+        hw = 1.5 + 0.5 * beta  # half the width of a coefficient's widened support
+        k0 = int(math.floor(lo - 0.5 * beta + 0.5)) - 1
+        for k in range(k0, int(math.floor(hi + 0.5 * beta + 0.5)) + 2):
             if dx == 0.0:
                 level = r1[a]
             else:  # the largest reach of the sweep over the support of coefficient k
-                fa = min(max((max(lo, k - 1.5) - x0[a]) / dx, 0.0), 1.0)
-                fb = min(max((min(hi, k + 1.5) - x0[a]) / dx, 0.0), 1.0)
+                fa = min(max((max(lo, k - hw) - x0[a]) / dx, 0.0), 1.0)
+                fb = min(max((min(hi, k + hw) - x0[a]) / dx, 0.0), 1.0)
                 level = (
                     r0[a] + max(fa, fb) * (r1[a] - r0[a])
                     if r1[a] >= r0[a]

@@ -145,6 +145,13 @@ ABRADABLE = {
     "yield": _f(0.0, "force", "force per contact at which the coating yields and is cut", **NONNEG),
     "n_angle": Spec(I, 360, lo=1, hi=100_000, doc="wear-map cells around the casing"),
     "n_axial": Spec(I, 16, lo=1, hi=10_000, doc="wear-map cells along the axis"),
+    "footprint": _f(
+        0.0,
+        "length",
+        "circumferential width of the tip each contact stands for: it reads the "
+        "worn surface as its mean over that width and cuts it to its reach there (0: a point)",
+        **NONNEG,
+    ),
 }
 
 CASING_HEAT = {

@@ -96,12 +96,13 @@ def _prepare_rub(st) -> None:
     w = c.wear
     st._bwear = w is not None
     if w is None:  # placeholders of the same types
-        st._bgrid, st._bdims = np.zeros(4), np.ones(2, dtype=np.int64)
+        st._bgrid, st._bdims = np.zeros(5), np.ones(2, dtype=np.int64)
         st._bangles, st._baxial = np.zeros(n), np.zeros(n, dtype=np.int64)
         return
     g = w.grid
     st._bgrid = np.array(
-        [g.omega, g.n_angle / (2 * math.pi), w.thickness, st.h * w.yield_force], dtype=float
+        [g.omega, g.n_angle / (2 * math.pi), w.thickness, st.h * w.yield_force, g.beta],
+        dtype=float,
     )
     st._bdims = np.array([g.n_angle, g.n_axial], dtype=np.int64)
     st._bangles = np.ascontiguousarray(g.angles, dtype=float)
