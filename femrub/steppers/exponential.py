@@ -29,8 +29,8 @@ after :data:`MAX_EVENTS` in a step, impulses are given at the step end on penetr
 approaching contacts (velocity-level Moreau) and releases happen at step ends.
 
 Coulomb friction (:mod:`~.exponential_friction`): the impulses solve Signorini–Coulomb with
-Newton's law (the θ-method's solve); held contacts slide along the casing's direction, their
-slip checked like a multiplier (a stick ends the hold).
+Newton's law (the θ-method's solve); held contacts slide along their end-of-step slip (a fixed
+point per step, :mod:`~.exponential_slide`), checked like a multiplier (a stick ends the hold).
 
 Dense: at most :data:`MAX_COORDINATES` coordinates (reduce larger models first).
 """
@@ -220,7 +220,7 @@ class ExponentialMoreau(EventLocation, FrictionalContact, LoadPolynomial, Steppe
         if self._measure and self._Wth is not None:
             self._w[2] += float((Xn - X) @ self._Wth @ (Xn + X)) / 2
 
-    def _step(self):
+    def _one_step(self):
         h, t, c = self.h, self.t, self.model.contact
         b = self._load_poly(t)
         X, S, a = self.X, self._S, 0.0

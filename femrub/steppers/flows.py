@@ -40,11 +40,18 @@ import scipy.linalg as sla
 
 from .exponential_kernels import compose, square_levels
 
-__all__ = ["Flow", "FlowFamily", "LEVEL_MIN", "first_zero", "shift"]
+__all__ = ["Flow", "FlowFamily", "LEVEL_MIN", "held_set", "first_zero", "shift"]
 
 #: Smallest sub-step flow, ``unit 2^LEVEL_MIN`` (events are located to this resolution).
 LEVEL_MIN = -36
 _FLUSH = 1e-150  # entries of sub-step flows below this are set to zero (no subnormals)
+
+
+def held_set(key: tuple) -> tuple:
+    """The held set of a cache key: the key itself, or its first tuple (``(S, τ)``, ...)."""
+    if all(isinstance(k, (int, np.integer)) for k in key):
+        return key
+    return next(k for k in key if isinstance(k, tuple))
 
 
 def shift(b: np.ndarray, alpha: float, delta: float) -> np.ndarray:
@@ -129,6 +136,10 @@ class FlowFamily:
         #: ``(R_σ (n_c, N), σ0 (n_c,), sliding (n_c,) bool)``: the slip rows of held contacts
         #: that slide (checked with λ_S, > 0 while they slide), or ``None``
         self.slip = None
+
+    def caches(self) -> list[dict]:
+        """The caches keyed by held set (generators, flows, probe rows, levels)."""
+        return [self._gen, self._flows, self._probe, self._levels]
 
     def sliding(self, S: tuple) -> tuple:
         """The contacts of ``S`` that slide (their slip rows follow ``λ_S`` in the checks)."""
