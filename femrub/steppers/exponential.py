@@ -271,7 +271,7 @@ class ExponentialMoreau(EventLocation, FrictionalContact, LoadPolynomial, Steppe
             for j in S:
                 if not self._still_sliding(j, X):
                     self._refuse_stick(j, t + h, X)
-        X, S = self._impact(t + h, X, S, P)
+        X, S = (X, S) if calm and self._opened else self._impact(t + h, X, S, P)
         self._S = S
         return (X, P, self._friction_extra(S)) if self._fric else (X, P)
 
@@ -307,7 +307,7 @@ class ExponentialMoreau(EventLocation, FrictionalContact, LoadPolynomial, Steppe
         F, k, act, off = self._fused[key]
         u = np.concatenate([X, (self._T01 @ b).ravel()])
         works = np.zeros(NQ + 2)
-        y, V, calm = flight(
+        y, V, calm, self._opened = flight(
             F, u, k, q, self._gap_grid(), off, self._held(S), nz, act, integ is not None, works
         )
         rest = works if integ is not None else None
