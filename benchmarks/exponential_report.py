@@ -228,7 +228,6 @@ _FLOOR_COLS = [
     ("target", "3× target"),
 ]
 
-
 _FRICTION_COLS = [
     ("method", "method"),
     ("h", "h (s)"),
@@ -369,9 +368,8 @@ def section(doc) -> str:
             f"{doc['config']['blade_ref_h']:g} s, tip temperature {b['T_ref']:.6g} K; "
             f"Carpenter's limit {b['carpenter_limit']:.3g} s).",
             C.md_table(_level_rows(b["rows"], ("u_L2", "u_L2_nodes", "T_end"), (0.01,)), cols),
-            "Exponential runs (status, balances, and Coulomb's law on the recorded steps: "
-            "`1 + cos` between a step's friction impulse and its end slip, and the sliding "
-            "equality `| |λ_t| − μλ | / μλ`; the verdict's bound is 1e-8):",
+            "Exponential runs (status, balances, Coulomb's law on the recorded steps: `1 + cos` "
+            "of friction impulse and end slip, sliding equality; the verdict's bound is 1e-8):",
             C.md_table(exp, _FRICTION_COLS),
         ]
     if doc.get("floor"):
