@@ -293,14 +293,15 @@ class FlowFamily:
         Returns ``(Rx, Rb)``: rows ``[Gᵀ X(τ_j); λ_S(τ_j); R_σ X(τ_j)]`` (slip rows without
         their constant ``σ0``, :meth:`check_offsets`) stacked over ``j`` equal
         ``Rx X(0) + Rb b`` for the load polynomial ``s(σ) = Σ b_i σ^i`` (σ in units of h)
-        from time 0. Built by recursion on the sub-step flow over ``h / q`` (cached).
+        from time 0. Built by doubling: the rows at ``j < 2^e`` times the sub-step flow over
+        ``2^e h / q`` are those at ``2^e <= j < 2^(e+1)`` (cached).
         """
         if S not in self._probe:
             _, _, lam = self.generator(S)
             n, h, p, m = self.L.shape[0], self.h, self.degree, self.G.shape[1]
-            Z = self.levels(S, h / q)[-LEVEL_MIN]  # the flow over h / q
+            levels = self.levels(S, h / q)  # levels[-LEVEL_MIN]: the flow over h / q
             nz, nc, f = n + len(S), GT.shape[0], self.sliding(S)
-            R = np.zeros((nc + (0 if lam is None else lam.shape[0]) + len(f), Z.shape[0]))
+            R = np.zeros((nc + (0 if lam is None else lam.shape[0]) + len(f), levels.shape[1]))
             R[:nc, :n] = GT
             if lam is not None:  # λ_S = Λx X + Λs s, s: the chain's first block
                 R[nc : nc + len(S), :n] = lam[:, :n]
@@ -309,11 +310,11 @@ class FlowFamily:
                     R[nc + len(S) :, :n] = self.slip[0][list(f)]
             # b -> chain at σ = 0: s^(l) = l! b_l / h^l
             scale = np.repeat([math.factorial(i) / h**i for i in range(p + 1)], m)
-            rz = []
-            for _ in range(1, q):
-                R = R @ Z
-                rz.append(R)
-            Rz = np.vstack(rz)
+            r, Rz, e = R.shape[0], R, 0
+            while Rz.shape[0] < q * r:  # rows at j = 0 .. 2^e − 1, doubled by Z^(2^e)
+                Rz = np.vstack([Rz, Rz @ levels[-LEVEL_MIN + e]])
+                e += 1
+            Rz = Rz[r : q * r]
             self._probe[S] = (
                 np.ascontiguousarray(Rz[:, :n]),
                 np.ascontiguousarray(Rz[:, nz:] * scale),
