@@ -87,7 +87,7 @@ class FrictionalContact(SlideDirections):
         rest = np.flatnonzero((self._mu > 0.0) & ~moving)
         if rest.size:
             raise ValueError(
-                f"the exponential stepper slides held contacts along the casing's velocity; "
+                f"the exponential stepper starts held slides along the casing's velocity; "
                 f"contact {c.names[rest[0]]!r} has friction μ = {self._mu[rest[0]]:g} on a "
                 "casing at rest (no slip direction): use scheme.name = 'theta' or "
                 "contact.friction = 0"
