@@ -19,6 +19,7 @@ from femrub.steppers.exponential_kernels import (
     compose_integrals,
     double_integrals,
     flight,
+    open_end,
     quiet,
     square_levels,
 )
@@ -106,13 +107,24 @@ def test_flight_reads_state_integrals_and_grid_off_one_product():
     act, works = np.array([1, 3]), np.zeros(6)
     k = 3 + 2 * 4 + 2
     g0, off = np.full((2, 1), 10.0), np.array([0.5])
-    y, V, calm = flight(F, u, k, 1, g0, off, np.zeros(1, dtype=np.bool_), 3, act, True, works)
+    free = np.zeros(1, dtype=np.bool_)
+    y, V, calm, opened = flight(F, u, k, 1, g0, off, free, 3, act, True, works)
     ref = F @ u
     assert y[:k] == pytest.approx(ref[:k])  # (the rows past k: V, maybe shared)
     assert works[1] == pytest.approx(ref[3:7] @ u) and works[3] == pytest.approx(ref[7:11] @ u)
     assert works[4:] == pytest.approx(ref[11:13]) and works[0] == works[2] == 0.0
     assert V == pytest.approx(ref[k:].reshape(2, 2) + np.c_[g0, np.full(2, 0.5)])
-    assert calm == quiet(V, 1, np.zeros(1, dtype=np.bool_))
+    assert calm == quiet(V, 1, free) and opened == (calm and open_end(V, 1, free))
+
+
+def test_open_end_reads_the_last_grid_row_of_free_contacts():
+    V = np.array([[1.0, -0.2, 5.0], [0.5, 1e-3, -4.0]])  # two contacts, a held multiplier
+    free, held = np.zeros(2, dtype=np.bool_), np.array([False, True])
+    assert open_end(V, 2, free)  # both gaps open at the end (the multiplier is not a gap)
+    V[1, 1] = 1e-13  # within round-off of the largest gap: not known open
+    assert not open_end(V, 2, free) and open_end(V, 2, held)
+    V[1, 0] = 0.0
+    assert not open_end(V, 2, held)
 
 
 _CHILD = """

@@ -29,8 +29,8 @@ after :data:`MAX_EVENTS` in a step, impulses are given at the step end on penetr
 approaching contacts (velocity-level Moreau) and releases happen at step ends.
 
 Coulomb friction (:mod:`~.exponential_friction`): the impulses solve Signorini–Coulomb with
-Newton's law (the θ-method's solve); held contacts slide along the casing's direction, their
-slip checked like a multiplier (a stick ends the hold).
+Newton's law (the θ-method's solve); held contacts slide along their end-of-step slip (a fixed
+point per step, :mod:`~.exponential_slide`), checked like a multiplier (a stick ends the hold).
 
 Dense: at most :data:`MAX_COORDINATES` coordinates (reduce larger models first).
 """
@@ -220,7 +220,7 @@ class ExponentialMoreau(EventLocation, FrictionalContact, LoadPolynomial, Steppe
         if self._measure and self._Wth is not None:
             self._w[2] += float((Xn - X) @ self._Wth @ (Xn + X)) / 2
 
-    def _step(self):
+    def _one_step(self):
         h, t, c = self.h, self.t, self.model.contact
         b = self._load_poly(t)
         X, S, a = self.X, self._S, 0.0
@@ -271,7 +271,7 @@ class ExponentialMoreau(EventLocation, FrictionalContact, LoadPolynomial, Steppe
             for j in S:
                 if not self._still_sliding(j, X):
                     self._refuse_stick(j, t + h, X)
-        X, S = self._impact(t + h, X, S, P)
+        X, S = (X, S) if calm and self._opened else self._impact(t + h, X, S, P)
         self._S = S
         return (X, P, self._friction_extra(S)) if self._fric else (X, P)
 
@@ -307,7 +307,7 @@ class ExponentialMoreau(EventLocation, FrictionalContact, LoadPolynomial, Steppe
         F, k, act, off = self._fused[key]
         u = np.concatenate([X, (self._T01 @ b).ravel()])
         works = np.zeros(NQ + 2)
-        y, V, calm = flight(
+        y, V, calm, self._opened = flight(
             F, u, k, q, self._gap_grid(), off, self._held(S), nz, act, integ is not None, works
         )
         rest = works if integ is not None else None

@@ -16,28 +16,29 @@ tangential impulse on the slip velocity, exact for an impulse); with the latter 
 moves the velocities (``V₃ᵀ A⁻¹ Ht ≠ 0``) is fed back into the solve by the θ-method's fixed
 point. Work of the impulse on the structure: ``P · V₃ᵀ (X⁻ + X⁺) / 2`` (normal and tangential).
 
-**Held contacts slide along the casing's direction.** A held contact (closed, ``ġ = 0``)
-with ``μ > 0`` slides against a casing moving at ``v_c``: in a blade rub ``|v_c| = Ω r``
-(hundreds of m/s) dominates the structure's tangential velocity, so the slip direction is
-taken as fixed over a flight, ``ŝ = −v_c / |v_c|``, and the friction force is
-``λ_t = −μ λ ŝ``. The held contact's force column is then constant,
-``H = Hm − μ Hmt ŝ + Ht α_h``, and its flow stays linear and exact
-(:class:`~.flows.FlowFamily`). This is an assumption on the direction only: the slip
-``w_t = Gvtᵀ X − v_c`` may turn by the small angle ``|w_⊥| / |v_c|`` about ``ŝ`` (Coulomb's
-direction is then off by that angle). It fails when the slip along ``ŝ`` stops,
-``σ = ŝ · w_t = R_σ X + |v_c| -> 0`` (stick or reversal): ``σ`` is checked with the held
-multipliers, its first zero is located as an event and the run is refused there
+**Held contacts slide along their slip, one direction per step.** A held contact (closed,
+``ġ = 0``) with ``μ > 0`` slides against a casing moving at ``v_c``. Over a flight its friction
+force is ``λ_t = −μ λ ŝ`` along a unit direction ``ŝ`` that is constant over the step, so the
+held contact's force column ``H = Hm − μ Hmt ŝ + Ht α_h`` is constant and its flow stays linear
+and exact (:class:`~.flows.FlowFamily`). ``ŝ`` is the direction of the slip
+``w_t = Gvtᵀ X − v_c`` at the end of the step's held flight, found by a fixed point over the
+step (:mod:`~.exponential_slide`: the step is repeated from its start until the direction it
+was flown with is its end slip's, up to an angle quantum), so that the recorded friction
+impulse of the step is opposite to the end slip as Coulomb's law wants; the casing's direction
+``−v_c / |v_c|`` is where the first hold starts. The slip along ``ŝ``,
+``σ = ŝ · w_t = R_σ X + σ0``, is checked with the held multipliers; its first zero (stick or
+reversal) is located as an event and the run is refused there
 (:class:`~femrub.output.recorder.StepRefused`: status ``failed`` with a message, the results
 up to the step before kept): a sticking contact would need
 a held stick (a tangential constraint) that this stepper does not have, and velocity-level
 impulses alone let a pressed contact sink by ``g̈ h² / 2`` per step. For the same reason an
-impulse that would start a hold (``e = 0``) and leaves the contact sticking, or slipping
-against ``ŝ``, is refused, and so is a contact with ``μ > 0`` on a casing at rest
-(``v_c = 0``: no slip direction), when the model is built.
+impulse that would start a hold (``e = 0``) and leaves the contact sticking is refused, and so
+is a contact with ``μ > 0`` on a casing at rest (``v_c = 0``: no direction to start from),
+when the model is built.
 
 **Heat of held contacts.** ``"alpha"``: ``α λ`` in the flow (``α_h = α``). ``"power"``: the
-heat rate ``η μ λ σ = η μ |v_c| λ + η μ λ R_σ X``; its first part is in the flow
-(``α_h = η μ |v_c|``), the second is quadratic in the state and is integrated exactly on the
+heat rate ``η μ λ σ = η μ σ0 λ + η μ λ R_σ X``; its first part is in the flow
+(``α_h = η μ σ0``), the second is quadratic in the state and is integrated exactly on the
 flight (:class:`~.work.WorkIntegrals`, ``held_friction_heat``) and put into the blade at the
 end of the flight segment (``A⁻¹ Ht`` times it, split over the sliding held contacts in
 proportion to their linear heat), so the heat entering the blade is ``η`` times the friction
@@ -51,6 +52,7 @@ import numpy as np
 
 from ..contact.friction import OPEN, SLIP, STICK, solve_frictional_contact
 from ..output.recorder import StepRefused
+from .exponential_slide import SlideDirections
 
 __all__ = ["FrictionalContact", "MAX_HEAT_ITERATIONS"]
 
@@ -58,7 +60,7 @@ __all__ = ["FrictionalContact", "MAX_HEAT_ITERATIONS"]
 MAX_HEAT_ITERATIONS = 20
 
 
-class FrictionalContact:
+class FrictionalContact(SlideDirections):
     """Coulomb friction of :class:`~femrub.steppers.exponential.ExponentialMoreau` (mixin:
     it reads the stepper's model and sets the friction operators; see module docstring)."""
 
@@ -85,33 +87,32 @@ class FrictionalContact:
         rest = np.flatnonzero((self._mu > 0.0) & ~moving)
         if rest.size:
             raise ValueError(
-                f"the exponential stepper slides held contacts along the casing's velocity; "
+                f"the exponential stepper starts held slides along the casing's velocity; "
                 f"contact {c.names[rest[0]]!r} has friction μ = {self._mu[rest[0]]:g} on a "
                 "casing at rest (no slip direction): use scheme.name = 'theta' or "
                 "contact.friction = 0"
             )
-        sliding = self._mu > 0.0
-        # slip along ŝ: σ_i = R_σ,i X + |v_c,i|; tangential work rate λ_i T_i X
-        R = np.einsum("ik,ikn->in", self._dir, c.GvtT.reshape(n, 2, N))
-        self._slip = (R, speed.copy(), sliding)
-        self._T = -self._mu[:, None] * R
-        self._rest_rows = None
+        # held slides: slip along ŝ σ_i = R_σ,i X + σ0_i, tangential work rate λ_i T_i X,
+        # "power" heat rate α_h,i λ_i + λ_i (rest rows) X, column A⁻¹ H (arrays updated in place
+        # by _set_direction: the flows and integrals hold them)
+        self._Zmt = np.asarray(lu.solve(c.Hmt))
+        self._speed, self._sliding = speed, self._mu > 0.0
+        self._slip = (np.zeros((n, N)), np.zeros(n), self._sliding)
+        self._T = np.zeros((n, N))
+        self._rest_rows = np.zeros((n, N)) if self._power else None
         if self._power:
-            self._alpha_h = self._eta * self._mu * speed
-            self._rest_rows = self._eta[:, None] * self._mu[:, None] * R
+            self._alpha_h = np.zeros(n)
         elif law == "power":  # no thermal field: no heat
             self._alpha_h = np.zeros(n)
         else:
             self._alpha_h = None if callable(c.heat_coefficient) else c.heat_coefficient
+        self._AinvH = None
+        self._slide_setup()
         self._warm3 = None
 
     def _held_columns(self, lu):
         """``A⁻¹ H`` of held contacts: ``H = Hm − μ Hmt ŝ + Ht α_h`` (``None``: no hold)."""
-        c, n = self.model.contact, self.model.contact.n
-        if self._alpha_h is None:
-            return None
-        tang = np.einsum("nik,ik->ni", c.Hmt.reshape(-1, n, 2), self._dir) * -self._mu
-        return self._Zm + np.asarray(lu.solve(tang)) + self._Zt * self._alpha_h
+        return self._AinvH
 
     def _friction_step_start(self) -> None:
         n = self.model.n_contacts
@@ -119,6 +120,7 @@ class FrictionalContact:
         self._heat = np.zeros(n)
         self._seen = np.zeros((2, n), dtype=bool)  # a stick, a slip in this step
         self._work_t = 0.0
+        self._slid = set()  # contacts with a held flight in this step
 
     def _friction_extra(self, S) -> dict:
         """The step's ``friction_impulse``, blade ``heat`` and contact ``state``."""
@@ -139,6 +141,10 @@ class FrictionalContact:
             return X
         idx = list(S)
         self._Pt[idx] += -(self._mu[idx] * PS)[:, None] * self._dir[idx]
+        if self._target is not None:  # the state at the end of the held flight
+            for i in idx:
+                self._target[int(i)] = X
+                self._slid.add(int(i))
         lin = self._alpha_h[idx] * PS
         self._heat[idx] += lin
         if self._power and w is not None and w[5] != 0.0:
@@ -202,19 +208,21 @@ class FrictionalContact:
             return Xn, ()
         gdn = c.gap_velocity(te, Xn)
         tol = 1e-9 * max(float(np.max(np.abs(gd[active]))), 1e-300)
-        ws = np.einsum("ij,ij->i", self._dir, c.slip_velocity(Xn))
-        slides = (self._mu == 0.0) | ((res.state != STICK) & (ws > 0.0))
         keep = active & (e == 0.0) & (gdn <= tol)
+        w = c.slip_velocity(Xn)
+        self._start_slides([i for i in np.flatnonzero(keep & self._sliding) if i not in S], Xn)
+        ws = np.einsum("ij,ij->i", self._dir, w)
+        slides = (self._mu == 0.0) | ((res.state != STICK) & (ws > 0.0))
         if np.any(keep & ~slides):
             self._refuse_stick(int(np.argmax(keep & ~slides)), te, Xn)
         return Xn, tuple(np.flatnonzero(keep))
 
     def _refuse_stick(self, i: int, te: float, X) -> None:
-        """A held (or to be held) contact stops sliding along the casing's direction."""
+        """A held (or to be held) contact stops sliding along its direction ``ŝ``."""
         c = self.model.contact
         sigma = float(self._dir[i] @ c.slip_velocity(X)[i])
         raise StepRefused(
-            f"contact {c.names[i]!r} stops sliding along the casing's velocity at t = "
-            f"{te:.9g} s (slip {sigma:.3g} m/s along it): the exponential stepper holds "
+            f"contact {c.names[i]!r} stops sliding at t = {te:.9g} s (slip {sigma:.3g} m/s "
+            "along its sliding direction): the exponential stepper holds "
             "sliding contacts only, not sticking ones; use scheme.name = 'theta'"
         )

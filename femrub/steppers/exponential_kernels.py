@@ -24,6 +24,7 @@ __all__ = [
     "double_integrals",
     "flight",
     "form_values",
+    "open_end",
     "quiet",
     "square_levels",
     "warm_up",
@@ -157,25 +158,40 @@ def quiet(V, n_c, held):
 
 
 @njit
+def open_end(V, n_c, held):
+    """Every free gap clearly open at the last row of the check grid ``V``: above ``1e-9`` of
+    the largest gap there (round-off of the grid's rows cannot close it)."""
+    g = 0.0
+    for i in range(n_c):
+        g = max(g, abs(V[V.shape[0] - 1, i]))
+    for i in range(n_c):
+        if not held[i] and V[V.shape[0] - 1, i] <= 1e-9 * g:
+            return False
+    return True
+
+
+@njit
 def flight(F, u, k, q, gap0, off, held, nz, act, measure, works):
     """A whole step's exact flight in one product ``y = F u`` (``F``: the state rows, the
     integrals' rows with ``measure``, then from row ``k`` the check grid's rows): the
     integrals into ``works`` (:func:`form_values`), the check grid ``V`` (q + 1, r) with the
     casing's gaps ``gap0`` (q + 1, n_c) added to its first columns and the constants ``off``
-    (r − n_c,) to the others (held slips), and whether the step is :func:`quiet`.
-    Returns ``(y, V, quiet)`` (``V``: ``y``'s rows past ``k``, which may share its memory; empty
-    and quiet without grid rows)."""
+    (r − n_c,) to the others (held slips), whether the step is :func:`quiet` and, if so,
+    whether its free gaps end :func:`open_end` (no impulse due at the step end).
+    Returns ``(y, V, quiet, open)`` (``V``: ``y``'s rows past ``k``, which may share its memory;
+    empty, quiet and not known open without grid rows)."""
     y = F @ u
     if measure:
         form_values(y, u, nz, act, works)
     if k >= y.size:
-        return y, np.empty((0, 0)), True
+        return y, np.empty((0, 0)), True, False
     V = np.ascontiguousarray(y[k:]).reshape(q + 1, (y.size - k) // (q + 1))
     n_c = gap0.shape[1]
     V[:, :n_c] += gap0
     if off.size:
         V[:, n_c:] += off
-    return y, V, quiet(V, n_c, held)
+    calm = quiet(V, n_c, held)
+    return y, V, calm, calm and open_end(V, n_c, held)
 
 
 def warm_up() -> None:

@@ -27,6 +27,9 @@ class LoadPolynomial:
         self._T01 = np.diag([float(math.factorial(i)) for i in range(p + 1)])
         self._Dinv = np.linalg.inv(self._T01)
         self._sk = self._signal_values(self.t)
+        # signals that take an array of times (checked once against one call per time)
+        probe = self.t + self.h * self._nodes[1:]
+        self._vector = [_vectorised(sig, probe) for sig in self._signals]
 
     def _signal_values(self, t):
         """Load signals, then the casing's gap rates ``ġ0`` (moving casing, held contacts)."""
@@ -42,7 +45,7 @@ class LoadPolynomial:
         S[0] = self._sk
         times = t + nodes[1:] * h
         for k, sig in enumerate(self._signals):
-            S[1:, k] = [sig(tj) for tj in times]
+            S[1:, k] = sig(times) if self._vector[k] else [sig(tj) for tj in times]
         if self._n_a:
             S[1:, self._m0 :] = self.model.contact.rate_at(times)
         self._sk = S[-1]
@@ -62,3 +65,12 @@ class LoadPolynomial:
         """Their time derivative (1/s) at the fraction ``sigma`` of the step."""
         i = np.arange(1, b.shape[0])
         return ((i * sigma ** (i - 1)) @ b[1:]) / self.h
+
+
+def _vectorised(sig, times) -> bool:
+    """``sig`` evaluated on the array ``times`` gives, bit for bit, its values one by one."""
+    try:
+        vals = np.asarray(sig(times), dtype=float)
+    except (TypeError, ValueError):
+        return False
+    return vals.shape == times.shape and np.array_equal(vals, [float(sig(t)) for t in times])

@@ -40,11 +40,18 @@ import scipy.linalg as sla
 
 from .exponential_kernels import compose, square_levels
 
-__all__ = ["Flow", "FlowFamily", "LEVEL_MIN", "first_zero", "shift"]
+__all__ = ["Flow", "FlowFamily", "LEVEL_MIN", "held_set", "first_zero", "shift"]
 
 #: Smallest sub-step flow, ``unit 2^LEVEL_MIN`` (events are located to this resolution).
 LEVEL_MIN = -36
 _FLUSH = 1e-150  # entries of sub-step flows below this are set to zero (no subnormals)
+
+
+def held_set(key: tuple) -> tuple:
+    """The held set of a cache key: the key itself, or its first tuple (``(S, τ)``, ...)."""
+    if all(isinstance(k, (int, np.integer)) for k in key):
+        return key
+    return next(k for k in key if isinstance(k, tuple))
 
 
 def shift(b: np.ndarray, alpha: float, delta: float) -> np.ndarray:
@@ -129,6 +136,10 @@ class FlowFamily:
         #: ``(R_σ (n_c, N), σ0 (n_c,), sliding (n_c,) bool)``: the slip rows of held contacts
         #: that slide (checked with λ_S, > 0 while they slide), or ``None``
         self.slip = None
+
+    def caches(self) -> list[dict]:
+        """The caches keyed by held set (generators, flows, probe rows, levels)."""
+        return [self._gen, self._flows, self._probe, self._levels]
 
     def sliding(self, S: tuple) -> tuple:
         """The contacts of ``S`` that slide (their slip rows follow ``λ_S`` in the checks)."""
@@ -282,14 +293,15 @@ class FlowFamily:
         Returns ``(Rx, Rb)``: rows ``[Gᵀ X(τ_j); λ_S(τ_j); R_σ X(τ_j)]`` (slip rows without
         their constant ``σ0``, :meth:`check_offsets`) stacked over ``j`` equal
         ``Rx X(0) + Rb b`` for the load polynomial ``s(σ) = Σ b_i σ^i`` (σ in units of h)
-        from time 0. Built by recursion on the sub-step flow over ``h / q`` (cached).
+        from time 0. Built by doubling: the rows at ``j < 2^e`` times the sub-step flow over
+        ``2^e h / q`` are those at ``2^e <= j < 2^(e+1)`` (cached).
         """
         if S not in self._probe:
             _, _, lam = self.generator(S)
             n, h, p, m = self.L.shape[0], self.h, self.degree, self.G.shape[1]
-            Z = self.levels(S, h / q)[-LEVEL_MIN]  # the flow over h / q
+            levels = self.levels(S, h / q)  # levels[-LEVEL_MIN]: the flow over h / q
             nz, nc, f = n + len(S), GT.shape[0], self.sliding(S)
-            R = np.zeros((nc + (0 if lam is None else lam.shape[0]) + len(f), Z.shape[0]))
+            R = np.zeros((nc + (0 if lam is None else lam.shape[0]) + len(f), levels.shape[1]))
             R[:nc, :n] = GT
             if lam is not None:  # λ_S = Λx X + Λs s, s: the chain's first block
                 R[nc : nc + len(S), :n] = lam[:, :n]
@@ -298,11 +310,11 @@ class FlowFamily:
                     R[nc + len(S) :, :n] = self.slip[0][list(f)]
             # b -> chain at σ = 0: s^(l) = l! b_l / h^l
             scale = np.repeat([math.factorial(i) / h**i for i in range(p + 1)], m)
-            rz = []
-            for _ in range(1, q):
-                R = R @ Z
-                rz.append(R)
-            Rz = np.vstack(rz)
+            r, Rz, e = R.shape[0], R, 0
+            while Rz.shape[0] < q * r:  # rows at j = 0 .. 2^e − 1, doubled by Z^(2^e)
+                Rz = np.vstack([Rz, Rz @ levels[-LEVEL_MIN + e]])
+                e += 1
+            Rz = Rz[r : q * r]
             self._probe[S] = (
                 np.ascontiguousarray(Rz[:, :n]),
                 np.ascontiguousarray(Rz[:, nz:] * scale),

@@ -88,6 +88,10 @@ class WorkIntegrals:
         self._full: dict[tuple, tuple] = {}
         self._flight: dict[tuple, tuple] = {}
 
+    def caches(self) -> list[dict]:
+        """The caches keyed by held set (levels, whole-step forms, flight matrices)."""
+        return [self._levels, self._full, self._flight]
+
     # -- forms on the augmented state -----------------------------------------------------------
     def forms(self, S: tuple, M: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """``(Q (NQ, N, N), C (2, N))``: the powers and heat rates of :data:`QUADRATIC` and
