@@ -24,14 +24,15 @@ def test_rotor37_scenes_are_the_published_setup(name):
     omega = s["loads"]["rotation_speed"]
     assert omega == 1344.0
     period = 2 * math.pi / omega
-    # published: about 1000 steps per revolution; the coated scene steps 8x finer, where its
+    # published: about 1000 steps per revolution; the coated scene steps 32x finer, where its
     # cutting episodes and frictional heat converge (docs/abradable.md)
-    steps = 1000 if name == "rotor37" else 8000
+    steps = 1000 if name == "rotor37" else 32000
     assert period / s["scheme"]["h"] == pytest.approx(steps, rel=1e-3)
     assert s["scheme"]["t_end"] / period == pytest.approx(50, rel=1e-4)
     assert s["physics"]["thermal"] == ("off" if name == "rotor37" else "on")
-    # the coated rub's step is judged (it is not converged at this step: docs/rotor37.md)
+    # the coated rub's step is judged; its contacts read the coating through their footprint
     assert s["scheme"]["step_check"] == (name == "rotor37-thermal")
+    assert c["abradable"]["footprint"] == (0.0 if name == "rotor37" else pytest.approx(7.6e-3))
 
 
 @pytest.mark.slow
