@@ -130,3 +130,34 @@ def test_a_sweep_worker_keeps_the_assembly(tmp_path, monkeypatch):
     assert any("assembly kept by this process" in n for n in notes)
     assert not any("assembly loaded" in n or "assembly stored" in n for n in notes)
     np.testing.assert_array_equal(again.full.A.toarray(), first.full.A.toarray())
+
+
+def test_a_sweep_worker_keeps_the_discretisation(tmp_path, monkeypatch):
+    """After ``keep_assemblies`` the next build on the same mesh reuses the bases (with its
+    own blade); the model is the one a fresh build gives; another mesh is discretised."""
+    from femrub.app import cached
+    from femrub.app.cache import ModelCache
+
+    monkeypatch.setattr(cached, "_ASSEMBLED", None)
+    monkeypatch.setattr(cached, "_DISCRETISED", {})
+    cache = ModelCache(tmp_path / "cache")
+    scene = load_scene("twisted-naca", {**SMALL, "scheme.t_end": 2e-5})
+    other = scene.with_changes({"loads.rotation_speed": 1400.0})
+    fresh = build(other, cache=cache)
+    cached.keep_assemblies()
+    notes = []
+    build(scene, cache=cache, log=notes.append)
+    assert not any("discretisation kept" in n for n in notes)
+    notes.clear()
+    kept = build(other, cache=cache, log=notes.append)
+    assert any("discretisation kept by this process" in n for n in notes)
+    (disc,) = cached._DISCRETISED.values()
+    assert kept.fields.basis_u is disc.basis_u  # the bases shared, not rebuilt
+    for name in ("A", "B"):
+        a, b = getattr(kept.full, name), getattr(fresh.full, name)
+        np.testing.assert_array_equal(a.toarray(), b.toarray())
+    np.testing.assert_array_equal(kept.full.contact.G, fresh.full.contact.G)
+    np.testing.assert_array_equal(kept.full.contact.gap_at(1e-5), fresh.full.contact.gap_at(1e-5))
+    notes.clear()
+    build(scene.with_changes({"geometry.h": 0.035}), cache=cache, log=notes.append)
+    assert not any("discretisation kept" in n for n in notes)  # another mesh

@@ -39,7 +39,7 @@ including its map to the mesh).
 
 A sweep worker keeps the last assembly it built or loaded (:func:`keep_assemblies`): the
 next point of a speed sweep on the same dask worker takes it from memory instead of the
-cache folder.
+cache folder; it keeps its discretisation (the finite-element bases of the mesh) likewise.
 
 A reduced model missing from the cache but whose bases this process already built (the
 next point of a speed sweep on a dask worker: same matrices, same ``reduction`` options,
@@ -58,7 +58,7 @@ import time
 
 import numpy as np
 
-from ..fem.discretisation import assemble
+from ..fem.discretisation import assemble, discretise
 from ..fem.prestress import centrifugal_prestress
 from ..reduction.modal_damping import modal_rayleigh
 from ..reduction.sizes import natural_frequencies, reduce_model
@@ -72,6 +72,8 @@ _REDUCTORS: dict = {}
 #: the last map to the mesh of a largest reduced model this process stored or loaded,
 #: ``{key: (n, r) array}`` (the next point of a sweep on this worker: the same map)
 _MAPS: dict = {}
+#: the last discretisation of a sweep worker (:func:`keep_assemblies`), ``{key: disc}``
+_DISCRETISED: dict = {}
 #: the last assembly this process built or loaded, ``{key: blocks without their bases}``,
 #: once :func:`keep_assemblies` is called (``None``: not kept)
 _ASSEMBLED: dict | None = None
@@ -112,6 +114,26 @@ class Stages:
         t0 = time.perf_counter()
         if self.cache.store(key, obj, stage=stage, describe=describe):
             self._say(f"cache: {stage} stored in {time.perf_counter() - t0:.2f} s ({key[:12]})")
+
+    def discretise(self, blade, order: int, clamped: bool = True):
+        """:func:`~femrub.fem.discretisation.discretise` of ``blade``; a sweep worker
+        (:func:`keep_assemblies`) keeps the last one and hands its bases to the next point
+        on the same mesh (key: vertices, cells, node sets, curved edge midpoints, order)."""
+        if _ASSEMBLED is None:
+            return discretise(blade, order, clamped=clamped)
+        mesh = blade.mesh
+        key = content_key(
+            "discretisation", type(mesh).__name__, mesh.p, mesh.t, blade.node_sets,
+            blade.info.get("edge_midpoints"), order, clamped,
+        )  # fmt: skip
+        kept = _DISCRETISED.get(key)
+        if kept is not None:
+            self._say(f"discretisation kept by this process ({key[:12]})")
+            return dataclasses.replace(kept, blade=blade)
+        disc = discretise(blade, order, clamped=clamped)
+        _DISCRETISED.clear()
+        _DISCRETISED[key] = disc
+        return disc
 
     def assemble(self, disc, material, **kw):
         """:func:`~femrub.fem.discretisation.assemble` of ``disc``, through the cache."""
