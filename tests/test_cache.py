@@ -163,6 +163,100 @@ def test_corrupt_entry_is_detected_and_rebuilt(first, tmp_path):
     assert _build(local).report["reduction"]["cache"] == "hit"  # and stored again
 
 
+def _stored(cache, stage):
+    return [e for e in cache.entries() if e["stage"] == stage]
+
+
+def test_one_map_to_the_mesh_for_every_speed(tmp_path, monkeypatch):
+    """The reduced model's map to the mesh (columns of the reductor's largest map) is stored
+    once, as its own entry, and each speed's reduction refers to it by its columns."""
+    from femrub.app import cached
+    from femrub.reduction.truncation import ColumnMap
+
+    monkeypatch.setattr(cached, "_MAPS", {})
+    local = ModelCache(tmp_path / "c")
+    a = _build(local)
+    b = _build(local, None, **{"loads.rotation_speed": 1700.0})
+    assert isinstance(a.model.to_full, ColumnMap)
+    maps, reductions = _stored(local, "map"), _stored(local, "reduction")
+    assert len(maps) == 1 and len(reductions) == 2
+    assert all(e["size"] < maps[0]["size"] for e in reductions)
+    for e in reductions:
+        entry = local.load(e["key"])
+        assert entry["model"].to_full is None
+        np.testing.assert_array_equal(entry["map"]["columns"], a.model.to_full.cols)
+    monkeypatch.setattr(cached, "_MAPS", {})  # a new process: the map from the cache
+    notes = []
+    hit = _build(local, notes, **{"loads.rotation_speed": 1700.0})
+    assert hit.report["reduction"]["cache"] == "hit"
+    assert any("map loaded" in n for n in notes)
+    _same_model(hit.model, b.model)
+
+
+@pytest.mark.parametrize("damage", ["corrupt", "missing"])
+def test_corrupt_or_missing_map_rebuilds_the_reduction(first, tmp_path, monkeypatch, damage):
+    from femrub.app import cached
+
+    cache, sim, _ = first
+    monkeypatch.setattr(cached, "_MAPS", {})
+    local = ModelCache(tmp_path / "c")
+    _build(local)
+    (entry,) = _stored(local, "map")
+    path = local.root / f"{entry['key']}.pkl"
+    if damage == "corrupt":
+        data = bytearray(path.read_bytes())
+        data[len(data) // 2] ^= 0xFF
+        path.write_bytes(bytes(data))
+    else:  # evicted (the size limit): both files gone
+        path.unlink()
+        path.with_suffix(".json").unlink()
+    monkeypatch.setattr(cached, "_MAPS", {})  # a new process: nothing kept in memory
+    notes = []
+    rebuilt = _build(local, notes)
+    assert any("map to the mesh is not in the cache; rebuilding" in n for n in notes)
+    assert any("is corrupt" in n for n in notes) == (damage == "corrupt"), notes
+    assert "cache" not in rebuilt.report["reduction"]  # rebuilt, not loaded
+    _same_model(rebuilt.model, sim.model)
+    assert len(_stored(local, "map")) == 1  # stored again
+    monkeypatch.setattr(cached, "_MAPS", {})
+    again = _build(local)
+    assert again.report["reduction"]["cache"] == "hit"
+    _same_model(again.model, sim.model)
+
+
+def test_sparse_keys_are_canonical_without_conversion_or_change(monkeypatch):
+    """A sparse matrix is hashed in its own format (a CSC model operator is not converted to
+    CSR), the same key for its canonical and duplicated forms, and the input is unchanged."""
+    import scipy.sparse as sp
+
+    rng = np.random.default_rng(2)
+    dense = rng.standard_normal((6, 5)) * (rng.random((6, 5)) < 0.5)
+    csc = sp.csc_matrix(dense)
+    assert content_key(csc) != content_key(sp.csr_matrix(dense))  # the format is part of it
+    unsorted = sp.csr_matrix(dense)
+    for i in range(unsorted.shape[0]):  # reverse each row's entries: same matrix, unsorted
+        s = slice(unsorted.indptr[i], unsorted.indptr[i + 1])
+        unsorted.indices[s], unsorted.data[s] = unsorted.indices[s][::-1], unsorted.data[s][::-1]
+    unsorted.has_sorted_indices = False
+    before = unsorted.indices.copy()
+    assert content_key(unsorted) == content_key(sp.csr_matrix(dense))
+    np.testing.assert_array_equal(unsorted.indices, before)  # not sorted in place
+    j = int(np.flatnonzero(np.diff(csc.indptr))[0])  # a column with an entry: split it in two
+    k = csc.indptr[j]
+    data = np.insert(csc.data, k, 0.25 * csc.data[k])
+    data[k + 1] *= 0.75  # the entry as two duplicates, 0.25 x and 0.75 x
+    indices = np.insert(csc.indices, k, csc.indices[k])
+    indptr = np.r_[csc.indptr[: j + 1], csc.indptr[j + 1 :] + 1]
+    dup = sp.csc_matrix((data, indices, indptr), shape=csc.shape)
+    assert not dup.has_canonical_format
+    key = content_key(csc)
+    monkeypatch.setattr(sp.csc_matrix, "tocsr", lambda *a, **k: pytest.fail("converted"))
+    assert content_key(csc) == key
+    summed = dup.copy()
+    summed.sum_duplicates()
+    assert content_key(dup) == content_key(summed)  # duplicates summed before hashing
+
+
 def test_store_load_clear_and_info(tmp_path):
     cache = ModelCache(tmp_path)
     obj = {"a": np.arange(10.0), "b": "text"}

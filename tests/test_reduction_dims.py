@@ -18,6 +18,7 @@ from femrub.geometry import box_blade
 from femrub.model.rub import solid_model
 from femrub.reduction import PROJECTIONS, ThermoelasticCraigBampton, craig_bampton_thermal
 from femrub.reduction.sizes import reduce_model
+from femrub.reduction.truncation import ColumnMap
 from femrub.scene.scene import load_scene
 
 ALPHA = 3.0
@@ -202,3 +203,33 @@ def test_sliced_models_take_the_gap_functions_of_the_reductors_model(paper):
     rom = red.for_model(other).reduce(4, 3)
     assert np.allclose(rom.contact.gap0, 2 * paper.contact.gap0)
     assert _rel(rom.contact.G, red.reduce(4, 3).contact.G) == 0.0
+
+
+def test_smaller_sizes_share_the_largest_map_to_the_mesh(paper):
+    """A smaller size's map to the mesh is the largest model's restricted to its columns,
+    shared (:class:`ColumnMap`), not copied; it acts as the dense columns would."""
+    red = ThermoelasticCraigBampton(paper, 20, 12, projection="second-order")
+    largest = red.reduce()
+    rom = red.reduce(6, 4)
+    assert isinstance(rom.to_full, ColumnMap) and rom.to_full.full is largest.to_full
+    *_, cols, _ = red._columns(6, 4)
+    dense = largest.to_full[:, cols]
+    direct = ThermoelasticCraigBampton(paper, 6, 4, projection="second-order").reduce()
+    assert _rel(np.asarray(rom.to_full), np.asarray(direct.to_full)) < TOL_DENSE
+    rng = np.random.default_rng(5)
+    x, X = rng.standard_normal(cols.size), rng.standard_normal((cols.size, 3))
+    Y = rng.standard_normal((2, dense.shape[0]))
+    M = rom.to_full
+    assert M.shape == dense.shape and M.dtype == dense.dtype
+    assert _rel(M @ x, dense @ x) < 1e-14 and _rel(M @ X, dense @ X) < 1e-14
+    assert _rel(M @ sp.csr_matrix(X), dense @ X) < 1e-14
+    assert _rel(Y @ M, Y @ dense) < 1e-14
+    rows = np.array([0, 3, 5])
+    np.testing.assert_array_equal(M[rows], dense[rows])
+    np.testing.assert_array_equal(M[2:7], dense[2:7])
+    np.testing.assert_array_equal(M[rows, 1:4], dense[rows, 1:4])
+    np.testing.assert_array_equal(np.asarray(M), dense)
+    with pytest.raises(ValueError):
+        M @ np.ones(cols.size + 1)
+    with pytest.raises(ValueError):
+        ColumnMap(dense, [0, 0])

@@ -24,12 +24,12 @@ def sim():
     return build(load_scene("twisted-naca", SMALL))
 
 
-def _write(sim, out, ran):
+def _write(sim, out, ran, csv_stride=1):
     s = sim.scene
     return run_to_folder(
         bare_stepper(s, sim.model), s["scheme"]["t_end"], out, limits=sim.limits or None,
         plots=False, reduction_error=sim.report["reduction"]["error"], ran=ran,
-        rotation_speed=s["loads"]["rotation_speed"],
+        rotation_speed=s["loads"]["rotation_speed"], csv_stride=csv_stride,
     )  # fmt: skip
 
 
@@ -59,6 +59,37 @@ def test_the_estimate_run_is_the_run(sim, tmp_path):
     assert (tmp_path / "reused/history.csv").read_text() == (
         tmp_path / "stepped/history.csv"
     ).read_text()
+
+
+def _csv(path):
+    with open(path) as fh:
+        header = fh.readline().strip().split(",")
+    return header, np.loadtxt(path, delimiter=",", skiprows=1, ndmin=2)
+
+
+@pytest.mark.parametrize("every", [7, 1000])
+def test_csv_stride_streamed_or_written_at_the_end(sim, tmp_path, every):
+    """``history.csv`` at one row in ``every``: the rows ``Results.save_csv(every=...)``
+    writes, whether streamed while the run goes or written from a run stepped elsewhere;
+    ``history.npz`` keeps every step; the impulses of the rows add up to the run's."""
+    a = _write(sim, tmp_path / "reused", sim.ran, csv_stride=every)
+    b = _write(sim, tmp_path / "stepped", None, csv_stride=every)
+    n = len(a.t)
+    assert len(b.t) == n > 2 * 7  # 7: several rows; 1000: the first and the last only
+    ha, ta = _csv(tmp_path / "reused/history.csv")
+    hb, tb = _csv(tmp_path / "stepped/history.csv")
+    a.save_csv(tmp_path / "ref.csv", every=every)
+    href, tref = _csv(tmp_path / "ref.csv")
+    rows = np.unique(np.r_[np.arange(0, n, every), n - 1])
+    assert ha == hb == href and ta.shape == tb.shape == tref.shape == (rows.size, len(href))
+    np.testing.assert_array_equal(ta, tref)  # written by save_csv itself
+    np.testing.assert_allclose(tb, tref, rtol=1e-12, atol=1e-12 * np.abs(tref).max())
+    np.testing.assert_array_equal(tb[:, 0], a.t[rows])
+    imp = [j for j, h in enumerate(hb) if h.startswith("contact_impulse")]
+    assert imp and np.abs(a.impulse).max() > 0
+    np.testing.assert_allclose(tb[:, imp].sum(axis=0), a.impulse.sum(axis=0), rtol=1e-12)
+    with np.load(tmp_path / "stepped/history.npz") as h:
+        assert h["t"].size == n  # every step
 
 
 def test_run_scene_steps_once(tmp_path, monkeypatch):
@@ -99,3 +130,34 @@ def test_a_sweep_worker_keeps_the_assembly(tmp_path, monkeypatch):
     assert any("assembly kept by this process" in n for n in notes)
     assert not any("assembly loaded" in n or "assembly stored" in n for n in notes)
     np.testing.assert_array_equal(again.full.A.toarray(), first.full.A.toarray())
+
+
+def test_a_sweep_worker_keeps_the_discretisation(tmp_path, monkeypatch):
+    """After ``keep_assemblies`` the next build on the same mesh reuses the bases (with its
+    own blade); the model is the one a fresh build gives; another mesh is discretised."""
+    from femrub.app import cached
+    from femrub.app.cache import ModelCache
+
+    monkeypatch.setattr(cached, "_ASSEMBLED", None)
+    monkeypatch.setattr(cached, "_DISCRETISED", {})
+    cache = ModelCache(tmp_path / "cache")
+    scene = load_scene("twisted-naca", {**SMALL, "scheme.t_end": 2e-5})
+    other = scene.with_changes({"loads.rotation_speed": 1400.0})
+    fresh = build(other, cache=cache)
+    cached.keep_assemblies()
+    notes = []
+    build(scene, cache=cache, log=notes.append)
+    assert not any("discretisation kept" in n for n in notes)
+    notes.clear()
+    kept = build(other, cache=cache, log=notes.append)
+    assert any("discretisation kept by this process" in n for n in notes)
+    (disc,) = cached._DISCRETISED.values()
+    assert kept.fields.basis_u is disc.basis_u  # the bases shared, not rebuilt
+    for name in ("A", "B"):
+        a, b = getattr(kept.full, name), getattr(fresh.full, name)
+        np.testing.assert_array_equal(a.toarray(), b.toarray())
+    np.testing.assert_array_equal(kept.full.contact.G, fresh.full.contact.G)
+    np.testing.assert_array_equal(kept.full.contact.gap_at(1e-5), fresh.full.contact.gap_at(1e-5))
+    notes.clear()
+    build(scene.with_changes({"geometry.h": 0.035}), cache=cache, log=notes.append)
+    assert not any("discretisation kept" in n for n in notes)  # another mesh

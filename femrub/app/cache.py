@@ -1,8 +1,9 @@
 """A content-addressed, size-limited on-disk store of built models (``femrub cache``).
 
 An entry is one pickled object under a key that is the SHA-256 of everything that built it
-(:func:`content_key`: arrays by their bytes, shape and dtype, other values by their
-``repr``, plus :func:`code_version`, the hash of femrub's model-building source). Two
+(:func:`content_key`: arrays by their bytes, shape and dtype, sparse matrices by their
+canonical CSR or CSC arrays in the format they come in (no conversion), other values by
+their ``repr``, plus :func:`code_version`, the hash of femrub's model-building source). Two
 files per entry in the cache folder: ``KEY.pkl`` (the object) and ``KEY.json`` (stage,
 size, SHA-256 of ``KEY.pkl``, creation time, femrub version, a description). Writes go to a
 temporary file renamed into place, the data before the metadata, so concurrent runs (sweep
@@ -93,10 +94,11 @@ def _feed(h, x) -> None:
         h.update(f"nd{a.dtype.str}{a.shape}".encode())
         h.update(a.view(np.uint8).reshape(-1) if a.size else b"")
     elif sp.issparse(x):
-        c = sp.csr_matrix(x)
-        c.sum_duplicates()
-        c.sort_indices()
-        h.update(f"sp{c.shape}".encode())
+        c = x if x.format in ("csr", "csc") else sp.csr_matrix(x)  # hashed in its own format
+        if not c.has_canonical_format:  # sorted, no duplicates: one matrix, one key
+            c = c.copy()
+            c.sum_duplicates()
+        h.update(f"sp{c.format}{c.shape}".encode())
         for a in (c.indptr, c.indices, c.data):
             _feed(h, a)
     elif isinstance(x, dict):

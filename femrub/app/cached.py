@@ -16,7 +16,11 @@ cache it only calls them:
   report; key: the assembly key, every state-space array of the full model the reduction
   projects (``A``, ``B``, contact rows, load vectors, observations, energy forms, map to the
   mesh, boundary dofs, initial state), the ``reduction`` options and, for ``"auto"``, the
-  end time that sets its thermal frequencies;
+  end time that sets its thermal frequencies; the map to the mesh of the reductor's largest
+  model (dense, a few hundred MB on a blade; a smaller size uses its leading columns) is its
+  own entry ``map`` (key: the same without what the run depends on), stored once for every
+  speed of a sweep, and a reduced model refers to it by its columns; a hit whose ``map`` is
+  missing or corrupt is rebuilt like a miss;
 * ``frequencies``: the natural frequencies of the full model (sweeps, ``--modes``);
 * ``prestress``: the centrifugal prestress (:func:`femrub.fem.prestress.centrifugal_prestress`,
   a Newton solve on the full mesh); key: the mesh, the material, Ω and the method. The
@@ -35,7 +39,7 @@ including its map to the mesh).
 
 A sweep worker keeps the last assembly it built or loaded (:func:`keep_assemblies`): the
 next point of a speed sweep on the same dask worker takes it from memory instead of the
-cache folder.
+cache folder; it keeps its discretisation (the finite-element bases of the mesh) likewise.
 
 A reduced model missing from the cache but whose bases this process already built (the
 next point of a speed sweep on a dask worker: same matrices, same ``reduction`` options,
@@ -54,16 +58,22 @@ import time
 
 import numpy as np
 
-from ..fem.discretisation import assemble
+from ..fem.discretisation import assemble, discretise
 from ..fem.prestress import centrifugal_prestress
 from ..reduction.modal_damping import modal_rayleigh
 from ..reduction.sizes import natural_frequencies, reduce_model
+from ..reduction.truncation import ColumnMap
 from .cache import content_key
 
 __all__ = ["Stages", "keep_assemblies"]
 
 #: the last reductor this process built, ``{key: reductor}`` (its bases are speed-free)
 _REDUCTORS: dict = {}
+#: the last map to the mesh of a largest reduced model this process stored or loaded,
+#: ``{key: (n, r) array}`` (the next point of a sweep on this worker: the same map)
+_MAPS: dict = {}
+#: the last discretisation of a sweep worker (:func:`keep_assemblies`), ``{key: disc}``
+_DISCRETISED: dict = {}
 #: the last assembly this process built or loaded, ``{key: blocks without their bases}``,
 #: once :func:`keep_assemblies` is called (``None``: not kept)
 _ASSEMBLED: dict | None = None
@@ -104,6 +114,26 @@ class Stages:
         t0 = time.perf_counter()
         if self.cache.store(key, obj, stage=stage, describe=describe):
             self._say(f"cache: {stage} stored in {time.perf_counter() - t0:.2f} s ({key[:12]})")
+
+    def discretise(self, blade, order: int, clamped: bool = True):
+        """:func:`~femrub.fem.discretisation.discretise` of ``blade``; a sweep worker
+        (:func:`keep_assemblies`) keeps the last one and hands its bases to the next point
+        on the same mesh (key: vertices, cells, node sets, curved edge midpoints, order)."""
+        if _ASSEMBLED is None:
+            return discretise(blade, order, clamped=clamped)
+        mesh = blade.mesh
+        key = content_key(
+            "discretisation", type(mesh).__name__, mesh.p, mesh.t, blade.node_sets,
+            blade.info.get("edge_midpoints"), order, clamped,
+        )  # fmt: skip
+        kept = _DISCRETISED.get(key)
+        if kept is not None:
+            self._say(f"discretisation kept by this process ({key[:12]})")
+            return dataclasses.replace(kept, blade=blade)
+        disc = discretise(blade, order, clamped=clamped)
+        _DISCRETISED.clear()
+        _DISCRETISED[key] = disc
+        return disc
 
     def assemble(self, disc, material, **kw):
         """:func:`~femrub.fem.discretisation.assemble` of ``disc``, through the cache."""
@@ -211,7 +241,10 @@ class Stages:
                 run[0].pop(key, None)
         model_key = self._model_key(model)  # hashed once: both keys below derive from it
         key = content_key(model_key, "reduction", opts, t_end, run)
+        map_key = content_key(model_key, "map", opts)  # the largest model's map: speed-free
         hit = self._fetch("reduction", key)
+        if hit is not None:
+            hit = self._with_map(hit, map_key)
         if hit is not None:
             if stiffness is not None:
                 stiffness.free()
@@ -230,8 +263,31 @@ class Stages:
                 self._keep("bases", bases, _REDUCTORS[bases], f"{reductor.n_uv} + "
                            f"{reductor.n_theta} shapes on {model.n_dofs} dofs")  # fmt: skip
         _say_phases(self._say, reduced.info.get("timings", {}))
-        self._keep("reduction", key, _detach(reduced, report), f"{reduced.n_dofs} dofs")
+        entry, shared = _detach(reduced, report, reductor.R.shape[1])
+        if shared is not None and _MAPS.get(map_key) is not shared:
+            self._keep("map", map_key, shared, f"map to the mesh {shared.shape}")
+            _MAPS.clear()
+            _MAPS[map_key] = shared
+        self._keep("reduction", key, entry, f"{reduced.n_dofs} dofs")
         return reduced, reductor, report
+
+    def _with_map(self, hit: dict, map_key: str):
+        """A stored reduction with its map to the mesh (kept by this process, or the cache's
+        ``map`` entry); ``None`` when that entry is missing or corrupt: the caller rebuilds."""
+        if hit.get("map") is None:  # stored with its own map
+            return hit
+        full = _MAPS.get(map_key)
+        if full is None:
+            full = self._fetch("map", map_key)
+            if full is None:
+                self.hits["reduction"] = False
+                self._say("cache: the reduction's map to the mesh is not in the cache; rebuilding")
+                return None
+            _MAPS.clear()
+            _MAPS[map_key] = full
+        cols = hit["map"]["columns"]
+        to_full = full if cols is None else ColumnMap(full, cols)
+        return dict(hit, model=hit["model"].with_(to_full=to_full))
 
     def frequencies(self, model, k: int) -> np.ndarray:
         """:func:`~femrub.reduction.sizes.natural_frequencies` (Hz), through the cache."""
@@ -267,15 +323,27 @@ def _state_arrays(obj, n: int) -> dict:
     }
 
 
-def _detach(reduced, report) -> dict:
-    """What to store of a reduced model: its arrays, without the run-specific functions."""
-    n = reduced.n_dofs
-    return {
-        "model": dataclasses.replace(reduced, contact=None, loads=[]),
+def _detach(reduced, report, largest: int) -> tuple[dict, np.ndarray | None]:
+    """What to store of a reduced model: its arrays, without the run-specific functions, and
+    the largest model's map to the mesh it uses (``largest``: that model's number of
+    coordinates), stored once for every speed (entry ``map``), or ``None`` (then the map is
+    stored with the model)."""
+    n, to_full, shared, ref = reduced.n_dofs, reduced.to_full, None, None
+    if isinstance(to_full, ColumnMap):
+        shared, ref = to_full.full, {"columns": to_full.cols}
+    elif isinstance(to_full, np.ndarray) and to_full.ndim == 2 and to_full.shape[1] == largest:
+        shared, ref = to_full, {"columns": None}
+    model = dataclasses.replace(reduced, contact=None, loads=[])
+    if shared is not None:
+        model = dataclasses.replace(model, to_full=None)
+    entry = {
+        "model": model,
         "contact": None if reduced.contact is None else _state_arrays(reduced.contact, n),
         "loads": [_state_arrays(t, n) for t in reduced.loads],
         "report": report,
+        "map": ref,
     }
+    return entry, shared
 
 
 def _attach(hit: dict, full):

@@ -147,6 +147,7 @@ def _run_claimed(scene, out, progress, log, on_built, modes, cache):
         reduction_error=built.report["reduction"].get("error"),
         step_error=built.report.get("time_step"),
         ran=None if stride else built.ran,  # stepped by the error estimate: not twice
+        csv_stride=o["csv_stride"],
     )
     if log:
         t = res.info.get("timings", {})

@@ -33,7 +33,6 @@ from ..contact import jit
 from ..contact.heat import heat_coefficients
 from ..contact.points import locate_contacts
 from ..contact.reach import contact_reach, normal_deflection
-from ..fem.discretisation import discretise
 from ..model.rub import rub_model, tip_load
 from ..scene.spec import SceneError, fail
 from . import translate as tr
@@ -193,8 +192,8 @@ def _build(scene, log, modes, stages, with_stepper=True) -> Simulation:
         log(f"notice: {note}")
     omega = scene["loads"]["rotation_speed"]
     try:
-        disc = discretise(blade, p["order"] if blade.dim == 3 else 1,
-                          clamped=scene["boundary"]["clamped"])  # fmt: skip
+        disc = stages.discretise(blade, p["order"] if blade.dim == 3 else 1,
+                                 clamped=scene["boundary"]["clamped"])  # fmt: skip
         prestress = _prestress(scene, disc, material, omega, log, stages)
         mats = stages.assemble(
             disc, material, area=tr.area_of(scene), lumping=p["lumping"],

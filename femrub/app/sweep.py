@@ -23,9 +23,11 @@ import csv
 import itertools
 import json
 import re
+from contextlib import nullcontext
 from pathlib import Path
 
 import numpy as np
+from threadpoolctl import threadpool_limits
 
 from ..output.folder import FINISHED, FolderError, claim, folder_status
 from ..output.jsonfile import write_json
@@ -39,8 +41,6 @@ __all__ = ["parse_param", "grid", "run_point", "point_metrics", "run_sweep"]
 _RANGE = re.compile(r"^\s*([^:]+):([^:]+):([^:]+?)\s*([A-Za-zµμ/^]+[A-Za-z0-9µμ/^]*)?\s*$")
 #: natural frequencies computed for the Campbell diagram
 N_MODES = 4
-#: a local cluster of more workers than this runs the sweep's first point alone (memory)
-SERIAL_FIRST_ABOVE = 2
 
 
 def _number(text: str, what: str) -> float:
@@ -117,15 +117,19 @@ def _rms(path, key):
 
 
 def run_point(
-    scene_data: dict, source: str, base_dir: str, changes: dict, out: str, cache=None
-) -> dict:
+    scene_data: dict, source: str, base_dir: str, changes: dict, out: str, cache=None,
+    threads: int | None = None,
+) -> dict:  # fmt: skip
     """Run one point (in a worker); never raises: failures come back as a row.
 
-    ``cache``: a :class:`~femrub.app.cache.ModelCache` shared by the points."""
+    ``cache``: a :class:`~femrub.app.cache.ModelCache` shared by the points; ``threads``:
+    BLAS and OpenMP threads of this point (``threadpoolctl``; ``None``: the worker's)."""
     keep_assemblies()  # the worker's next points load nothing the blade's blocks already hold
+    limits = threadpool_limits(limits=threads) if threads else nullcontext()
     try:
-        scene = Scene(scene_data, source, Path(base_dir)).with_changes(changes)
-        run_scene(scene, out, overwrite=True, modes=N_MODES, cache=cache)
+        with limits:
+            scene = Scene(scene_data, source, Path(base_dir)).with_changes(changes)
+            run_scene(scene, out, overwrite=True, modes=N_MODES, cache=cache)
     except Exception as exc:  # a bad point must not stop the sweep
         msg = f"{type(exc).__name__}: {exc}".splitlines()[0]
         try:
@@ -173,11 +177,10 @@ def run_sweep(
     scheduler : address of a dask scheduler; ``None``: a ``LocalCluster`` of ``workers``.
     overwrite : rerun points that already have a finished result.
     cache : a :class:`~femrub.app.cache.ModelCache` (its folder must be shared with the
-        workers): on a cluster (``scheduler``) or more than :data:`SERIAL_FIRST_ABOVE` local
-        workers the first point runs alone and stores its models, the others then load the
-        models they share with it; on fewer local workers every worker starts at once (each
-        builds its reduction bases on its first point anyway, so one point alone would only
-        spare the others an assembly, at the price of idle workers meanwhile).
+        workers): the first point runs alone and stores its models (assembly, damping,
+        reduction bases, map to the mesh), the others then load what they share with it
+        instead of building it again (:func:`_batches`); without a cache every worker starts
+        at once and builds its own.
     """
     out = Path(out)
     if scheduler is None and (isinstance(workers, bool) or not isinstance(workers, int)
@@ -234,27 +237,38 @@ def _compute(scene, todo, scheduler, workers, progress, cache=None) -> None:
 
     client, cluster = _client(scheduler, workers)
 
-    def submit(rows):
+    def submit(rows, threads):
         return {
             client.submit(
                 run_point, scene.data, scene.source, str(scene.base_dir), r["params"],
-                r["folder"], cache, pure=False, key=f"femrub-point-{r['point']}-{id(r)}",
+                r["folder"], cache, threads, pure=False,
+                key=f"femrub-point-{r['point']}-{id(r)}",
             ): r
             for r in rows
         }  # fmt: skip
 
     try:
         bar = tqdm(total=len(todo), disable=not progress, unit="point", desc="sweep")
-        first = cache is not None and len(todo) > 1
-        first = first and (scheduler is not None or workers > SERIAL_FIRST_ABOVE)
-        batches = [todo[:1], todo[1:]] if first else [todo]  # the first point fills the cache
-        for batch in batches:
-            _collect(submit(batch), bar)
+        for batch, threads in _batches(todo, cache, scheduler, workers):
+            _collect(submit(batch, threads), bar)
         bar.close()
     finally:
         client.close()
         if cluster is not None:
             cluster.close()
+
+
+def _batches(todo: list, cache, scheduler, workers: int) -> list[tuple[list, int | None]]:
+    """The points to submit together, in order, with the threads of each batch's points.
+
+    With a cache and more than one point, the first point runs alone and fills the cache
+    (assembly, damping, reduction bases, map to the mesh); every other point then loads
+    them (a sweep worker's first point would otherwise build them again: on Rotor 37 two
+    workers building at once took longer each than one alone). On a local cluster the
+    first point, alone on the machine, takes the threads of every worker."""
+    if cache is None or len(todo) < 2:
+        return [(todo, None)]
+    return [(todo[:1], workers if scheduler is None and workers > 1 else None), (todo[1:], None)]
 
 
 def _collect(futures, bar) -> None:

@@ -99,6 +99,7 @@ def run_to_folder(
     reduction_error: dict | None = None,
     ran=None,
     step_error: dict | None = None,
+    csv_stride: int = 1,
 ):
     """Run ``stepper`` to ``t_end`` and write the results folder ``out`` (module docstring).
 
@@ -116,14 +117,17 @@ def run_to_folder(
     ``summary.json["time_step_error"]`` and judged by the ``time_step`` rule. ``ran``: ``(results,
     wall seconds)`` of this very run already stepped (``stepper.model`` from its initial state
     to ``t_end`` with ``limits``, e.g. by the reduction error estimate): it is judged and
-    written instead of stepped again (no VTK: its states were not streamed). Returns the
-    :class:`~femrub.output.results.Results`.
+    written instead of stepped again (no VTK: its states were not streamed). ``csv_stride``:
+    ``history.csv`` at one row every that many steps
+    (:meth:`~femrub.output.results.Results.save_csv`'s ``every``; ``history.npz`` keeps every
+    step). Returns the :class:`~femrub.output.results.Results`.
     """
     out = Path(out)
     with nullcontext() if claimed else claim(out, "run", overwrite=overwrite):
         return _run(
             stepper, t_end, out, fields, vtk_stride, inputs, limits, progress, snapshot, plots,
             timings, n_full, rotation_speed, merge_time, reduction_error, ran, step_error,
+            csv_stride,
         )  # fmt: skip
 
 
@@ -143,7 +147,7 @@ def _judged(ran, tolerances, merge_time):
 
 def _run(
     stepper, t_end, out, fields, vtk_stride, inputs, limits, progress, snapshot, plots, timings,
-    n_full, rotation_speed, merge_time, reduction_error, ran, step_error=None,
+    n_full, rotation_speed, merge_time, reduction_error, ran, step_error=None, csv_stride=1,
 ):  # fmt: skip
     summary_path = out / "summary.json"
     model = stepper.model
@@ -174,7 +178,7 @@ def _run(
         series = VTKSeries(out / "vtk", model, fields, h=stepper.h, stride=vtk_stride)
     for stale in ("history.csv", "history.npz", "signals.png", "snapshot.png"):
         (out / stale).unlink(missing_ok=True)  # results of an earlier, unfinished run
-    history = HistoryCSV(out / "history.csv")
+    history = HistoryCSV(out / "history.csv", every=csv_stride)
     t0 = time.perf_counter()
     tolerances = {"reduction": reduction_error, "time_step": step_error}
     try:
@@ -198,18 +202,18 @@ def _run(
     with deferred():
         return _finish(
             stepper, res, out, doc, series, history, wall, snapshot, plots, timings,
-            rotation_speed, summary_path,
+            rotation_speed, summary_path, csv_stride,
         )  # fmt: skip
 
 
 def _finish(
     stepper, res, out, doc, series, history, wall, snapshot, plots, timings, rotation_speed,
-    summary_path,
+    summary_path, csv_stride=1,
 ):  # fmt: skip
     vtk_wall, vtk_cpu = (series.seconds, series.cpu_seconds) if series is not None else (0.0, 0.0)
     t_out = time.perf_counter()
-    if history.rows != len(res.t):
-        res.save_csv(out / "history.csv")
+    if history.received != len(res.t):  # not streamed (a run stepped elsewhere)
+        res.save_csv(out / "history.csv", every=csv_stride)
     res.save_npz(out / "history.npz")
     panels = [k for k in ("tip_displacement", "tip_temperature") if k in res.signals]
     if plots:

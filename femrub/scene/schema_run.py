@@ -119,6 +119,13 @@ SIGNALS = {
 OUTPUTS = {
     "signals": Spec("strs", "all", choices=("all",), doc="history signals kept"),
     "vtk_stride": Spec(I, 0, lo=0, doc="3D: write a VTK frame every that many steps (0: none)"),
+    "csv_stride": Spec(
+        I,
+        1,
+        lo=1,
+        doc="history.csv: one row every that many steps (contact impulses summed, forces "
+        "averaged over the steps between rows); history.npz keeps every step",
+    ),
     "plots": Spec(
         B,
         True,
