@@ -103,42 +103,12 @@ def test_the_map_draws_temperature_and_wear_only_where_the_scene_models_them():
     assert "max_wear_depth" in names(cold, coated)
 
 
-def test_the_first_point_fills_the_cache_alone_with_every_thread():
-    """With a cache the first point runs alone (on a local cluster with the threads of every
-    worker) and the others load what it stored; without one every point starts at once."""
+def test_the_first_point_fills_the_cache_alone():
+    """With a cache the first point runs alone and the others load what it stored; without
+    one every point starts at once."""
     from femrub.app.sweep import _batches
 
     todo, cache = [{"point": i} for i in range(4)], object()
-    assert _batches(todo, cache, None, 2) == [(todo[:1], 2), (todo[1:], None)]
-    assert _batches(todo, cache, "tcp://host:8786", 2) == [(todo[:1], None), (todo[1:], None)]
-    assert _batches(todo, cache, None, 1) == [(todo[:1], None), (todo[1:], None)]
-    assert _batches(todo, None, None, 2) == [(todo, None)]
-    assert _batches(todo[:1], cache, None, 2) == [(todo[:1], None)]
-
-
-def test_run_point_runs_within_its_thread_limits(tmp_path, monkeypatch):
-    from femrub.app import sweep
-    from femrub.scene import load_scene
-
-    seen = []
-
-    class Limits:
-        def __init__(self, limits):
-            seen.append(("limits", limits))
-
-        def __enter__(self):
-            seen.append("enter")
-
-        def __exit__(self, *exc):
-            seen.append("exit")
-
-    monkeypatch.setattr(sweep, "threadpool_limits", Limits)
-    monkeypatch.setattr(sweep, "run_scene", lambda *a, **k: seen.append("run"))
-    monkeypatch.setattr(sweep, "point_metrics", lambda out: {"status": "ok"})
-    s = load_scene("twisted-naca")
-    args = (s.data, s.source, str(s.base_dir), {}, str(tmp_path / "p"))
-    assert sweep.run_point(*args, threads=2) == {"status": "ok"}
-    assert seen == [("limits", 2), "enter", "run", "exit"]
-    seen.clear()
-    sweep.run_point(*args)
-    assert seen == ["run"]
+    assert _batches(todo, cache) == [todo[:1], todo[1:]]
+    assert _batches(todo, None) == [todo]
+    assert _batches(todo[:1], cache) == [todo[:1]]

@@ -23,11 +23,9 @@ import csv
 import itertools
 import json
 import re
-from contextlib import nullcontext
 from pathlib import Path
 
 import numpy as np
-from threadpoolctl import threadpool_limits
 
 from ..output.folder import FINISHED, FolderError, claim, folder_status
 from ..output.jsonfile import write_json
@@ -117,19 +115,15 @@ def _rms(path, key):
 
 
 def run_point(
-    scene_data: dict, source: str, base_dir: str, changes: dict, out: str, cache=None,
-    threads: int | None = None,
-) -> dict:  # fmt: skip
+    scene_data: dict, source: str, base_dir: str, changes: dict, out: str, cache=None
+) -> dict:
     """Run one point (in a worker); never raises: failures come back as a row.
 
-    ``cache``: a :class:`~femrub.app.cache.ModelCache` shared by the points; ``threads``:
-    BLAS and OpenMP threads of this point (``threadpoolctl``; ``None``: the worker's)."""
+    ``cache``: a :class:`~femrub.app.cache.ModelCache` shared by the points."""
     keep_assemblies()  # the worker's next points load nothing the blade's blocks already hold
-    limits = threadpool_limits(limits=threads) if threads else nullcontext()
     try:
-        with limits:
-            scene = Scene(scene_data, source, Path(base_dir)).with_changes(changes)
-            run_scene(scene, out, overwrite=True, modes=N_MODES, cache=cache)
+        scene = Scene(scene_data, source, Path(base_dir)).with_changes(changes)
+        run_scene(scene, out, overwrite=True, modes=N_MODES, cache=cache)
     except Exception as exc:  # a bad point must not stop the sweep
         msg = f"{type(exc).__name__}: {exc}".splitlines()[0]
         try:
@@ -237,20 +231,19 @@ def _compute(scene, todo, scheduler, workers, progress, cache=None) -> None:
 
     client, cluster = _client(scheduler, workers)
 
-    def submit(rows, threads):
+    def submit(rows):
         return {
             client.submit(
                 run_point, scene.data, scene.source, str(scene.base_dir), r["params"],
-                r["folder"], cache, threads, pure=False,
-                key=f"femrub-point-{r['point']}-{id(r)}",
+                r["folder"], cache, pure=False, key=f"femrub-point-{r['point']}-{id(r)}",
             ): r
             for r in rows
         }  # fmt: skip
 
     try:
         bar = tqdm(total=len(todo), disable=not progress, unit="point", desc="sweep")
-        for batch, threads in _batches(todo, cache, scheduler, workers):
-            _collect(submit(batch, threads), bar)
+        for batch in _batches(todo, cache):
+            _collect(submit(batch), bar)
         bar.close()
     finally:
         client.close()
@@ -258,17 +251,18 @@ def _compute(scene, todo, scheduler, workers, progress, cache=None) -> None:
             cluster.close()
 
 
-def _batches(todo: list, cache, scheduler, workers: int) -> list[tuple[list, int | None]]:
-    """The points to submit together, in order, with the threads of each batch's points.
+def _batches(todo: list, cache) -> list[list]:
+    """The points to submit together, in order.
 
     With a cache and more than one point, the first point runs alone and fills the cache
     (assembly, damping, reduction bases, map to the mesh); every other point then loads
     them (a sweep worker's first point would otherwise build them again: on Rotor 37 two
-    workers building at once took longer each than one alone). On a local cluster the
-    first point, alone on the machine, takes the threads of every worker."""
+    workers building at once took longer each than one alone). The first point keeps the
+    worker's one BLAS thread: its bases are then the same from run to run (a threaded
+    sparse factorisation is not), and so are the verdicts of the points that share them."""
     if cache is None or len(todo) < 2:
-        return [(todo, None)]
-    return [(todo[:1], workers if scheduler is None and workers > 1 else None), (todo[1:], None)]
+        return [todo]
+    return [todo[:1], todo[1:]]
 
 
 def _collect(futures, bar) -> None:
