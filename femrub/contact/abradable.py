@@ -47,7 +47,7 @@ import math
 import numpy as np
 
 from ..fem.material import check_finite_positive
-from .wear_map import cut_sweeps, depth_under, entry_bounds
+from .wear_map import cut_sweeps, depth_under, entry_bounds, surface_max
 
 __all__ = ["Abradable", "CasingGrid"]
 
@@ -250,15 +250,8 @@ class Abradable:
     @property
     def max_depth(self) -> float:
         """The deepest point of the worn surface (m): the largest of its pieces' maxima
-        (:func:`~femrub.contact.wear_map.piece_max`)."""
-        cm, c0, cp = np.roll(self.depth, 1, axis=0), self.depth, np.roll(self.depth, -1, axis=0)
-        best = np.maximum(0.5 * (cm + c0), 0.5 * (c0 + cp))
-        curv = cm - 2.0 * c0 + cp
-        with np.errstate(divide="ignore", invalid="ignore"):
-            u = np.where(curv < 0.0, 0.5 * (cm - cp) / curv, 1.0)
-        inner = np.abs(u) < 0.5
-        vertex = 0.5 * (0.5 - u) ** 2 * cm + (0.75 - u * u) * c0 + 0.5 * (0.5 + u) ** 2 * cp
-        return float(np.max(np.where(inner, np.maximum(best, vertex), best), initial=0.0))
+        (:func:`~femrub.contact.wear_map.surface_max`)."""
+        return float(surface_max(self.depth.ravel(), self.n_angle, self.n_axial))
 
     @property
     def cell_area(self) -> np.ndarray:

@@ -67,7 +67,15 @@ import numpy as np
 
 from .jit import njit
 
-__all__ = ["positions", "depth_under", "cut_sweeps", "entry_bounds", "piece_max", "spline_integral"]
+__all__ = [
+    "positions",
+    "depth_under",
+    "cut_sweeps",
+    "entry_bounds",
+    "piece_max",
+    "spline_integral",
+    "surface_max",
+]
 
 
 @njit
@@ -139,6 +147,16 @@ def piece_max(flat, k, row, n_angle, n_axial):
         if -0.5 < u < 0.5:
             vertex = 0.5 * (0.5 - u) ** 2 * cm + (0.75 - u * u) * c0 + 0.5 * (0.5 + u) ** 2 * cp
             best = max(best, vertex)
+    return best
+
+
+@njit
+def surface_max(flat, n_angle, n_axial):
+    """Deepest point of the whole worn surface: the largest :func:`piece_max` (0: empty)."""
+    best = 0.0
+    for row in range(n_axial):
+        for k in range(n_angle):
+            best = max(best, piece_max(flat, k, row, n_angle, n_axial))
     return best
 
 
