@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import json
 import math
+import os
 import platform
 import resource
 import sys
@@ -219,3 +220,27 @@ def write_json(path: Path, doc) -> Path:
     path.parent.mkdir(parents=True, exist_ok=True)
     path.write_text(json.dumps(clean(doc), indent=1))
     return path
+
+
+def _value(text: str):
+    """A ``--set`` value: an int, else a float, else the text."""
+    for kind in (int, float):
+        try:
+            return kind(text)
+        except ValueError:
+            pass
+    return text
+
+
+def cli_scene(name: str, sets: list[str]):
+    """The scene ``name`` with the ``--set KEY=VALUE`` changes ``sets`` and VTK off, or
+    ``None`` (printing why) when it is a Rotor 37 scene and ``../shared/data`` is absent."""
+    from femrub.scene import load_scene
+
+    root = Path(__file__).resolve().parents[1]
+    shared = (root.parent / "shared" / "data").is_dir() or os.environ.get("FEMRUB_SHARED_DATA")
+    if name.startswith("rotor37") and not shared:
+        print("skipped: no ../shared/data (Rotor 37 mesh)")
+        return None
+    changes = {k: _value(v) for k, v in (s.split("=", 1) for s in sets)}
+    return load_scene(name, {"outputs.vtk_stride": 0, **changes})

@@ -27,19 +27,10 @@ import time
 from pathlib import Path
 
 import numpy as np
-from _common import write_between
+from _common import cli_scene, write_between
 
 ROOT = Path(__file__).resolve().parents[1]
 DOC = ROOT / "docs" / "abradable.md"
-
-
-def _value(text: str):
-    for kind in (int, float):
-        try:
-            return kind(text)
-        except ValueError:
-            pass
-    return text
 
 
 def with_map(model, n_angle: int):
@@ -164,14 +155,9 @@ def main(argv=None) -> int:
     ap.add_argument("--set", action="append", default=[], metavar="KEY=VALUE")
     ap.add_argument("--no-write", action="store_true")
     a = ap.parse_args(argv)
-    from femrub.scene import load_scene
-
-    shared = (ROOT.parent / "shared" / "data").is_dir() or os.environ.get("FEMRUB_SHARED_DATA")
-    if a.scene.startswith("rotor37") and not shared:
-        print("skipped: no ../shared/data (Rotor 37 mesh)")
+    scene = cli_scene(a.scene, a.set)
+    if scene is None:
         return 0
-    changes = {k: _value(v) for k, v in (s.split("=", 1) for s in a.set)}
-    scene = load_scene(a.scene, {"outputs.vtk_stride": 0, **changes})
     factors = [int(x) for x in a.factors.split(",")]
     rows = study(scene, factors, a.revolutions, [int(x) for x in a.n_angle.split(",")])
     text = (

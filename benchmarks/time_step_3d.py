@@ -25,17 +25,10 @@ import time
 from pathlib import Path
 
 import numpy as np
-from _common import write_between
+from _common import cli_scene, write_between
 
 ROOT = Path(__file__).resolve().parents[1]
 DOC = ROOT / "docs" / "rotor37.md"
-
-
-def _value(text: str):
-    try:
-        return float(text)
-    except ValueError:
-        return text
 
 
 def ladder(scene, factors, gammas, log=print) -> list[dict]:
@@ -144,18 +137,13 @@ def main(argv=None) -> int:
     ap.add_argument("--set", action="append", default=[], metavar="KEY=VALUE")
     ap.add_argument("--no-write", action="store_true")
     a = ap.parse_args(argv)
-    from femrub.scene import load_scene
-
-    shared = (ROOT.parent / "shared" / "data").is_dir() or os.environ.get("FEMRUB_SHARED_DATA")
-    if a.scene.startswith("rotor37") and not shared:
-        print("skipped: no ../shared/data (Rotor 37 mesh)")
+    scene = cli_scene(a.scene, a.set)
+    if scene is None:
         return 0
-    changes = {k: _value(v) for k, v in (s.split("=", 1) for s in a.set)}
-    scene = load_scene(a.scene, {"outputs.vtk_stride": 0, **changes})
     factors = [int(x) for x in a.factors.split(",")]
     gammas = [float(x) for x in a.gamma_thermal.split(",")] if a.gamma_thermal else [None]
     rows = ladder(scene, factors, gammas)
-    settings = ", ".join(f"`{k} = {v}`" for k, v in changes.items()) or "as built in"
+    settings = ", ".join(f"`{s.replace('=', ' = ', 1)}`" for s in a.set) or "as built in"
     text = (
         f"`python benchmarks/time_step_3d.py --scene {a.scene} --factors {a.factors}"
         + "".join(f" --set {s}" for s in a.set)
