@@ -232,6 +232,19 @@ def _value(text: str):
     return text
 
 
+def ladder_arguments(doc: str):
+    """The parser of a step-ladder benchmark: ``--scene`` (default ``rotor37-thermal``),
+    ``--factors``, ``--set KEY=VALUE`` (repeatable), ``--no-write``; add the study's own."""
+    import argparse
+
+    ap = argparse.ArgumentParser(description=doc.splitlines()[0])
+    ap.add_argument("--scene", default="rotor37-thermal")
+    ap.add_argument("--factors", default="1,2,4")
+    ap.add_argument("--set", action="append", default=[], metavar="KEY=VALUE")
+    ap.add_argument("--no-write", action="store_true")
+    return ap
+
+
 def cli_scene(name: str, sets: list[str]):
     """The scene ``name`` with the ``--set KEY=VALUE`` changes ``sets`` and VTK off, or
     ``None`` (printing why) when it is a Rotor 37 scene and ``../shared/data`` is absent."""

@@ -20,14 +20,13 @@ Run: ``flock /tmp/femrub-heavy.lock python benchmarks/abradable_order.py [--scen
 
 from __future__ import annotations
 
-import argparse
 import math
 import os
 import time
 from pathlib import Path
 
 import numpy as np
-from _common import cli_scene, write_between
+from _common import cli_scene, ladder_arguments, write_between
 
 ROOT = Path(__file__).resolve().parents[1]
 DOC = ROOT / "docs" / "abradable.md"
@@ -39,9 +38,8 @@ def with_map(model, n_angle: int):
 
     c = model.contact
     w, g = c.wear, c.wear.grid
-    foot = g.beta * 2 * math.pi * g.radius / g.n_angle  # the same footprint, in metres
     grid = CasingGrid(g.angles, g.axial, g.radius, g.omega, n_angle=n_angle, n_axial=g.n_axial,
-                      footprint=foot)  # fmt: skip
+                      footprint=g.footprint)  # fmt: skip
     c.wear = Abradable(w.thickness, w.yield_force, grid)
     return model
 
@@ -147,13 +145,9 @@ def table(rows) -> str:
 
 
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--scene", default="rotor37-thermal")
-    ap.add_argument("--factors", default="1,2,4")
+    ap = ladder_arguments(__doc__)
     ap.add_argument("--revolutions", type=float, default=10.0)
     ap.add_argument("--n-angle", default="0", help="comma-separated map resolutions (0: scene)")
-    ap.add_argument("--set", action="append", default=[], metavar="KEY=VALUE")
-    ap.add_argument("--no-write", action="store_true")
     a = ap.parse_args(argv)
     scene = cli_scene(a.scene, a.set)
     if scene is None:

@@ -19,13 +19,12 @@ Run: ``flock /tmp/femrub-heavy.lock python benchmarks/time_step_3d.py [--scene r
 
 from __future__ import annotations
 
-import argparse
 import os
 import time
 from pathlib import Path
 
 import numpy as np
-from _common import cli_scene, write_between
+from _common import cli_scene, ladder_arguments, write_between
 
 ROOT = Path(__file__).resolve().parents[1]
 DOC = ROOT / "docs" / "rotor37.md"
@@ -130,12 +129,8 @@ def table(rows) -> str:
 
 
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--scene", default="rotor37-thermal")
-    ap.add_argument("--factors", default="1,2,4")
+    ap = ladder_arguments(__doc__)
     ap.add_argument("--gamma-thermal", default="", help="comma-separated γ_θ variants")
-    ap.add_argument("--set", action="append", default=[], metavar="KEY=VALUE")
-    ap.add_argument("--no-write", action="store_true")
     a = ap.parse_args(argv)
     scene = cli_scene(a.scene, a.set)
     if scene is None:

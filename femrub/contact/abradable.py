@@ -81,8 +81,9 @@ class CasingGrid:
         self.n_angle, self.n_axial = int(n_angle), int(n_axial)
         if not (math.isfinite(footprint) and footprint >= 0.0):
             raise ValueError("contact.abradable.footprint must be a length >= 0")
+        self.footprint = float(footprint)
         #: the footprint in cells, ``β``
-        self.beta = float(footprint) * self.n_angle / (2 * math.pi * self.radius)
+        self.beta = self.footprint * self.n_angle / (2 * math.pi * self.radius)
         z0, z1 = (float(self.axial.min()), float(self.axial.max())) if self.axial.size else (0, 0)
         pad = 0.5 * (z1 - z0) / max(self.n_axial - 1, 1) if z1 > z0 else 0.5e-3
         self.z_edges = np.linspace(z0 - pad, z1 + pad, self.n_axial + 1)
@@ -275,5 +276,5 @@ class Abradable:
             "n_angle": self.n_angle,
             "n_axial": self.n_axial,
             "radius": self.radius,
-            "footprint": self.grid.beta * 2 * math.pi * self.radius / self.n_angle,
+            "footprint": self.grid.footprint,
         }
