@@ -22,9 +22,9 @@ import numpy as np
 import scipy.linalg as sla
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
-from threadpoolctl import threadpool_limits
 
 from .. import progress
+from ..blas import one_blas_thread
 from .block_eigen import block_lowest, block_sizes
 from .linalg import PARDISO_ABOVE, sparse_lu
 
@@ -106,7 +106,7 @@ def lowest_modes(K, M, k: int, solve=None, *, tol: float = 1e-12, vectors: bool 
     if k == 0:
         return (np.zeros(0), np.zeros((n, 0))) if vectors else np.zeros(0)
     if n < DENSE_EIGEN_BELOW or k >= n - 1:
-        with threadpool_limits(limits=1, user_api="blas"):  # threads only slow small problems
+        with one_blas_thread:  # threads only slow small problems
             out = sla.eigh(
                 _dense(K), _dense(M), subset_by_index=[0, k - 1], eigvals_only=not vectors
             )

@@ -25,9 +25,9 @@ from collections.abc import Callable
 
 import numpy as np
 import scipy.sparse as sp
-from threadpoolctl import threadpool_limits
 from tqdm.auto import tqdm
 
+from ..blas import one_blas_thread
 from ..fem.linalg import compact
 from ..model.first_order import FirstOrderModel
 from .energy import SCHEME_INTEGRALS, EnergyMeter
@@ -147,7 +147,7 @@ class Recorder:
         # 2-core machine showed 0.4-17 ms for a 20000-long dot product with two threads);
         # a blow-up overflows before the next check, and non-finite states are reported
         with (
-            threadpool_limits(limits=1, user_api="blas"),
+            one_blas_thread,
             np.errstate(over="ignore", invalid="ignore"),
         ):
             try:

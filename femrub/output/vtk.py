@@ -23,8 +23,8 @@ from pathlib import Path
 from xml.sax.saxutils import quoteattr
 
 import numpy as np
-from threadpoolctl import ThreadpoolController
 
+from ..blas import one_blas_thread
 from ..model.rub import FieldMap
 from .frame_fields import FrameFields
 from .vtu_file import VTK_TETRA, VTUWriter
@@ -45,33 +45,6 @@ _UNITS_COMMENT = (
     + ", ".join(f"{k} [{v}]" for k, v in FIELD_UNITS.items())
     + " ; time in s -->"
 )
-
-
-class _OneBLASThread:
-    """Context: BLAS libraries on one thread while any thread is inside it (the last one
-    out restores their limits), so that a writer's products leave the other core to the
-    stepping."""
-
-    def __init__(self):
-        self._lock, self._inside, self._limiter = threading.Lock(), 0, None
-        self._controller: ThreadpoolController | None = None  # found once: a few ms
-
-    def __enter__(self):
-        with self._lock:
-            if not self._inside:
-                self._controller = self._controller or ThreadpoolController()
-                self._limiter = self._controller.limit(limits=1, user_api="blas")
-            self._inside += 1
-
-    def __exit__(self, *exc) -> None:
-        with self._lock:
-            self._inside -= 1
-            if not self._inside:
-                self._limiter.restore_original_limits()
-                self._limiter = None
-
-
-_one_blas_thread = _OneBLASThread()
 
 
 class VTKSeries:
@@ -219,7 +192,7 @@ class VTKSeries:
                     self._cond.notify_all()
                 try:
                     if mine and self._error is None:
-                        with _one_blas_thread:  # the other core is the writer's
+                        with one_blas_thread:  # the other core is the writer's
                             self._write_frames(mine, self._own_vtu())
                     with self._cond:
                         while (self._waiting or self._busy) and self._error is None:
@@ -266,7 +239,7 @@ class VTKSeries:
             c0 = time.thread_time()
             try:
                 if self._error is None:
-                    with _one_blas_thread:  # the other core is the stepping's
+                    with one_blas_thread:  # the other core is the stepping's
                         self._write_frames(frames, self._vtu)
             except BaseException as exc:  # raised in the stepping thread
                 self._error = exc

@@ -19,6 +19,7 @@ import math
 
 import numpy as np
 
+from ..blas import SERIAL_SETUP_DOFS, one_blas_thread
 from ..model.first_order import FirstOrderModel
 from ..output.recorder import Recorder, State
 from ..output.results import Results
@@ -80,7 +81,11 @@ class Stepper:
         if model.contact is not None and model.contact.casing_heat is not None:
             model.contact.casing_heat.reset()
         self._check_initial_gap()
-        self._setup()
+        if model.n_dofs <= SERIAL_SETUP_DOFS:  # no BLAS worker left spinning into the steps
+            with one_blas_thread:
+                self._setup()
+        else:
+            self._setup()
 
     def _check_initial_gap(self) -> None:
         """Refuse a model that starts inside the casing (no scheme can undo it honestly)."""
