@@ -376,3 +376,29 @@ def test_a_footprint_ends_on_its_own_cut():
         for k in range(1, 101):
             wear.update(k * h, wear.depth_at(k * h) - reach(k), np.array([True]))
             assert wear.depth_at(k * h)[0] - reach(k) >= -1e-12 * 3e-4  # round-off
+
+
+def test_steppers_of_one_coated_model_each_start_on_a_fresh_coating(tmp_path):
+    """A stepper built before another stepper of the same model ran still starts on a fresh
+    coating (the time-step check builds its h/2 stepper before it runs at h); steppers that
+    interleave their steps on one coating are refused."""
+    from femrub.app.scheme import scheme_options
+    from femrub.app.simulation import build
+    from femrub.steppers import make_stepper
+
+    path = tmp_path / "bar.toml"
+    path.write_text(SCENE.format(e=50e-6))
+    scene = load_scene(str(path))
+    model = build(scene, stepper=False).model
+    make = lambda: make_stepper("theta", model, 2e-5, **scheme_options(scene))  # noqa: E731
+    early = make()
+    reference = make().run(0.15)
+    assert model.contact.wear.max_depth > 1e-7  # the reference run wore the coating
+    again = early.run(0.15)
+    assert again.status == reference.status == "ok"
+    np.testing.assert_array_equal(again.impulse, reference.impulse)
+    a, b = make(), make()
+    b.step()
+    a.step()  # a's first step: the coating is started afresh for it
+    with pytest.raises(RuntimeError, match="one after the other"):
+        b.step()

@@ -85,15 +85,17 @@ def _compare(model, scheme, opts, kind):
     _close(sa.X, sb.X, 1e-9)
     assert (sa.k, sa.t) == (sb.k, sb.t)
     # the stepper goes on from where the block left it, as after step() calls (both
-    # steppers share the model's coating: each steps from the state the runs left it in)
+    # steppers share the model's coating: each steps from the state the runs left it in,
+    # handed to it as its own, which steppers otherwise refuse mid-run)
     w = model.contact.wear
     if w is not None:
         last = None if w._last is None else (w._last[0], w._last[1].copy())
         kept = (w.depth.copy(), list(w.history), last)
+        w.owner = sa._token
     after_blocks = sa.step().X
     if w is not None:
         w.depth[:], w.history = kept[0], kept[1]
-        w._last = kept[2]
+        w._last, w.owner = kept[2], sb._token
     _close(after_blocks, sb.step().X, 1e-9)
     return a, sa, ca, cb
 

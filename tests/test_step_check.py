@@ -99,3 +99,16 @@ def test_off_by_default_and_bad_input():
         load_scene("paper", {"scheme.step_tolerance": 0.0})
     with pytest.raises(SceneError, match="scheme.step_check"):
         load_scene("paper", {"scheme.step_check": "sometimes"})
+
+
+def test_a_coated_run_is_checked_against_a_fresh_coating(tmp_path):
+    """The check builds its h/2 stepper before it runs at h: on an abradable coating that
+    run must still start on a fresh coating, not on the one the run at h wore."""
+    from test_abradable import SCENE
+
+    path = tmp_path / "bar.toml"
+    path.write_text(SCENE.format(e=50e-6))
+    scene = load_scene(str(path), {"scheme.step_check": True, "scheme.t_end": 0.12})
+    err = build(scene).report["time_step"]
+    assert err["status_reference"] == "ok"
+    assert err["estimate"] < 0.05  # a quasi-static cut: converged in h

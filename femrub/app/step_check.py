@@ -47,7 +47,8 @@ def coarsen(res, factor: int):
 
     Times and signals every ``factor`` rows; the impulse of each coarse step is the sum of
     the fine impulses in it (so impulses per window and mean forces are preserved); the
-    checkpoint states are kept (the fine run stores them at the same times).
+    checkpoint states are kept (the fine run stores them at the same times). Every array is
+    a copy: none keeps the fine run's per-step arrays alive.
     """
     factor = int(factor)
     if factor == 1:
@@ -58,10 +59,10 @@ def coarsen(res, factor: int):
     return dataclasses.replace(
         res,
         h=res.h * factor,
-        t=res.t[rows],
+        t=res.t[rows].copy(),
         impulse=np.vstack([res.impulse[:1], impulse]),
-        gap=res.gap[rows],
-        signals={k: v[rows] for k, v in res.signals.items()},
+        gap=res.gap[rows].copy(),
+        signals={k: v[rows].copy() for k, v in res.signals.items()},
         energy={},
         friction_force=None,
         slip_velocity=None,

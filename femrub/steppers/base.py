@@ -15,6 +15,7 @@ starts inside the casing (initial penetration) and a run longer than :data:`MAX_
 
 from __future__ import annotations
 
+import itertools
 import math
 
 import numpy as np
@@ -28,6 +29,8 @@ from ..scene.validate import MAX_STEPS
 
 __all__ = ["MAX_STEPS", "PENETRATION_TOLERANCE", "State", "Stepper", "check_step"]
 
+#: identifies the stepper that owns a contact's state (:meth:`Stepper._check_owner`)
+_TOKENS = itertools.count(1)
 #: initial gaps below minus this (m) are an initial penetration
 PENETRATION_TOLERANCE = 1e-12
 
@@ -77,15 +80,46 @@ class Stepper:
                     f"an abradable coating needs scheme.name = 'theta' (the {self.name} "
                     "scheme does not bound its contact impulses)"
                 )
-            wear.reset(self.h)
-        if model.contact is not None and model.contact.casing_heat is not None:
-            model.contact.casing_heat.reset()
+        self._token = next(_TOKENS)
+        self._owned_states = bool(self._contact_states())
+        self._claim_contact_state()
         self._check_initial_gap()
         if model.n_dofs <= SERIAL_SETUP_DOFS:  # no BLAS worker left spinning into the steps
             with one_blas_thread:
                 self._setup()
         else:
             self._setup()
+
+    def _contact_states(self) -> list:
+        """The contact's state carried from step to step outside ``X`` (an abradable
+        coating's wear map, the casing's heat), which every run starts afresh."""
+        c = self.model.contact
+        return [] if c is None else [s for s in (c.wear, c.casing_heat) if s is not None]
+
+    def _claim_contact_state(self) -> None:
+        """Start the contact's states afresh for this stepper (a fresh coating, a cold
+        casing) and mark them as its own."""
+        for state in self._contact_states():
+            if state is self.model.contact.wear:
+                state.reset(self.h)
+            else:
+                state.reset()
+            state.owner = self._token
+
+    def _check_owner(self) -> None:
+        """Before stepping: the contact's states are this stepper's. Another stepper of the
+        same model built or run since this one was built has reset or worn them: before the
+        first step they are started afresh again, after it the run cannot go on."""
+        for state in self._contact_states():
+            if getattr(state, "owner", None) != self._token:
+                if self.k:
+                    raise RuntimeError(
+                        "another stepper of this model has used its contact's state (wear "
+                        "map, casing heat) since this run started; run the steppers of one "
+                        "model one after the other"
+                    )
+                self._claim_contact_state()
+                return
 
     def _check_initial_gap(self) -> None:
         """Refuse a model that starts inside the casing (no scheme can undo it honestly)."""
@@ -146,6 +180,8 @@ class Stepper:
 
     def _advance(self) -> tuple:
         """One step; return the new ``(t, X, impulse, extra)`` (``extra``: see ``_step``)."""
+        if self._owned_states:
+            self._check_owner()
         out = self._step()
         X, impulse = out[0], out[1]
         self.extra = out[2] if len(out) > 2 else None
@@ -212,6 +248,7 @@ class Stepper:
             tolerances; contact impulses closer than ``merge_time`` s form one episode of
             the resolution check, ``None``: no check).
         """
+        self._check_owner()
         recorder = Recorder(
             self.model,
             self.h,
