@@ -358,8 +358,8 @@ class Recorder:
             return a[:m] if m == a.shape[0] else a[:m].copy()
 
         signals, col = {}, 0
-        for name, size in zip(self.names, self.sizes):
-            signals[name] = self.obs[:m, col : col + size].copy()
+        for name, size in zip(self.names, self.sizes):  # views of a complete run's rows
+            signals[name] = reached(self.obs[:, col : col + size])
             col += size
         states = times = None
         if self._stored:
