@@ -271,9 +271,10 @@ def _build(scene, log, modes, stages, with_stepper=True) -> Simulation:
         clock.exclude(ran[1])
     clock.done("reduction", f"{reduced.n_dofs} dofs")
     if scene["scheme"]["step_check"]:
+        given = chosen and chosen.pop()  # compared only, unless it is the run: kept whole
+        given = given and (given[0] if ran is not None else given[0].lean(), given[2])
         report["time_step"], run_h, wall_h = check_step(
-            scene, reduced, full, lambda m, h: bare_stepper(scene, m, h), limits,
-            run=(chosen[0][0], chosen[0][2]) if chosen else None,
+            scene, reduced, full, lambda m, h: bare_stepper(scene, m, h), limits, run=given or None
         )  # fmt: skip
         if ran is None and wall_h is not None and reusable_run(model):
             ran = (run_h[0], wall_h)  # the check stepped the run itself

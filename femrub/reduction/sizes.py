@@ -30,7 +30,6 @@ The chosen model is then projected on the leading columns of that reductor's bas
 
 from __future__ import annotations
 
-import dataclasses
 import time
 
 import numpy as np
@@ -147,16 +146,11 @@ def _timed(*args, **kw):
 
 def _lean(sim):
     """``(results, full states, wall)`` of a reference or twin run, with only what
-    :func:`~femrub.reduction.estimate.estimate` reads of the results (times, impulses,
-    signals, checkpoint times, status): the gaps, the friction rows in global axes, the
-    energy balance and the extra rows are dropped, so that the runs the estimate holds
+    :func:`~femrub.reduction.estimate.estimate` reads of the results
+    (:meth:`~femrub.output.results.Results.lean`), so that the runs the estimate holds
     together (reference, run, twin) stay small. Never the run kept as the scene's run."""
     res, *rest = sim
-    lean = dataclasses.replace(
-        res, gap=res.gap[:, :0], energy={}, friction_force=None, slip_velocity=None,
-        contact_state=None, extra={},
-    )  # fmt: skip
-    return (lean, *rest)
+    return (res.lean(), *rest)
 
 
 def _checked(red, model, want, make_stepper, scene, report, log, limits, on_run=None):
