@@ -146,6 +146,10 @@ def solve_frictional_contact(
     return FrictionResult(P, u, state, float(res), int(it))
 
 
+#: rows of a run checked together by :func:`coulomb_check` (bounds its temporaries)
+CHECK_ROWS = 65536
+
+
 def coulomb_check(normal_force, friction_force, slip_velocity, state, mu) -> dict:
     """How well recorded forces satisfy Coulomb's law, over every step and contact.
 
@@ -159,11 +163,30 @@ def coulomb_check(normal_force, friction_force, slip_velocity, state, mu) -> dic
     dict with ``cone`` (largest ``(|λ_t| − μ λ) / (μ λ)``, <= 0 inside the cone),
     ``slip_equality`` (largest ``| |λ_t| − μ λ | / (μ λ)`` where a contact slips) and
     ``direction`` (largest ``1 + cos`` of the angle between ``λ_t`` and the slip velocity
-    where a contact slips: 0 when exactly opposite).
+    where a contact slips: 0 when exactly opposite). Checked :data:`CHECK_ROWS` rows at a
+    time, so that a long run's check needs little memory beyond its arrays.
     """
+    mu = np.asarray(mu, dtype=float)
+    parts = [
+        _check_rows(normal_force[r], friction_force[r], slip_velocity[r], state[r], mu)
+        for r in (slice(k, k + CHECK_ROWS) for k in range(0, max(len(normal_force), 1), CHECK_ROWS))
+    ]  # fmt: skip
+    closed = [p for p in parts if p["closed"]]
+    return {
+        "cone": max(p["cone"] for p in closed) if closed else 0.0,
+        "force_without_normal": max(p["force_without_normal"] for p in parts),
+        "slip_equality": max(p["slip_equality"] for p in parts),
+        "direction": max(p["direction"] for p in parts),
+        "stick_steps": sum(p["stick_steps"] for p in parts),
+        "slip_steps": sum(p["slip_steps"] for p in parts),
+    }
+
+
+def _check_rows(normal_force, friction_force, slip_velocity, state, mu) -> dict:
+    """:func:`coulomb_check` on some rows (``closed``: whether any contact is closed)."""
     lam = np.asarray(normal_force, dtype=float)
     ft = np.linalg.norm(friction_force, axis=-1)
-    bound = np.asarray(mu, dtype=float)[None, :] * lam
+    bound = mu[None, :] * lam
     closed = (lam > 0.0) & (bound > 0.0)
     rel = np.where(closed, (ft - bound) / np.where(closed, bound, 1.0), 0.0)
     open_force = float(np.max(np.where(~closed, ft, 0.0), initial=0.0))
@@ -174,9 +197,8 @@ def coulomb_check(normal_force, friction_force, slip_velocity, state, mu) -> dic
         slip_dir, ft * vs, 1.0
     )
     return {
-        "cone": float(np.max(np.where(closed, rel, -np.inf), initial=-np.inf))
-        if closed.any()
-        else 0.0,
+        "closed": bool(closed.any()),
+        "cone": float(np.max(np.where(closed, rel, -np.inf), initial=-np.inf)),
         "force_without_normal": open_force,
         "slip_equality": float(np.max(np.abs(rel[slip]), initial=0.0)),
         "direction": float(np.max(1.0 + cos[slip_dir], initial=0.0)),

@@ -266,6 +266,7 @@ class Stepper:
         res = recorder.record(
             self.state, self._advance, progress=progress, block=self._block_writer()
         )
+        del recorder  # its per-step arrays that the results do not hold: before the checks
         if self.locates_events:
             merge_time = None
         return assess(res, tolerances=tolerances, merge_time=merge_time)
