@@ -161,3 +161,18 @@ def test_a_sweep_worker_keeps_the_discretisation(tmp_path, monkeypatch):
     notes.clear()
     build(scene.with_changes({"geometry.h": 0.035}), cache=cache, log=notes.append)
     assert not any("discretisation kept" in n for n in notes)  # another mesh
+
+
+def test_a_coated_reduced_run_is_estimated_on_lean_runs_and_stepped_again():
+    """A run that carries state outside X (a coating) is not reused: the estimate keeps its
+    runs lean (times, impulses, signals), and the time-step check compares them."""
+    from test_rub_blocks import SCENE
+
+    scene = load_scene("twisted-naca", {**SCENE, "scheme.step_check": True})
+    kept = []
+    sim = build(scene, log=kept.append)
+    assert not reusable_run(sim.full) and sim.ran is None
+    assert sim.report["reduction"]["error"]["estimate"] < 1.0
+    err = sim.report["time_step"]
+    assert err["status_reference"] == "ok" and np.isfinite(err["estimate"])
+    assert any("time-step check: run at h/2" in line for line in kept)

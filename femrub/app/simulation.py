@@ -299,8 +299,7 @@ def reusable_run(model) -> bool:
     kept unless the contact carries state across runs that a later run of the estimate (its
     reference's twin) would overwrite: an abradable coating's wear or the casing's heat.
     """
-    c = model.contact
-    return c is None or (c.wear is None and c.casing_heat is None)
+    return model.contact is None or not model.contact.carried_state
 
 
 def _prestress(scene, disc, material, omega, log, stages):

@@ -239,6 +239,12 @@ class Contact:
             return self.has_friction and bool(np.any(self.heat_partition > 0) and np.any(self.Ht))
         return callable(a) or bool(np.any(np.asarray(a) > 0) and np.any(self.Ht))
 
+    @property
+    def carried_state(self) -> list:
+        """The state a run carries outside ``X`` (an abradable coating's wear map, the
+        casing's heat): each run starts it afresh and leaves it as its last step did."""
+        return [s for s in (self.wear, self.casing_heat) if s is not None]
+
     # -- friction --------------------------------------------------------------------------
     @property
     def has_friction(self) -> bool:

@@ -148,7 +148,7 @@ def _lean(sim):
     """``(results, full states, wall)`` of a reference or twin run, with only what
     :func:`~femrub.reduction.estimate.estimate` reads of the results
     (:meth:`~femrub.output.results.Results.lean`), so that the runs the estimate holds
-    together (reference, run, twin) stay small. Never the run kept as the scene's run."""
+    together (reference, run, twin) stay small. Never a run that may be the scene's run."""
     res, *rest = sim
     return (res.lean(), *rest)
 
@@ -167,15 +167,19 @@ def _checked(red, model, want, make_stepper, scene, report, log, limits, on_run=
     tol, t_end = scene["reduction"]["tolerance"], scene["scheme"]["t_end"]
     window = lobe_passage(scene)
     most = (red.n_uv, red.n_theta)
+    # a run that carries state outside X (wear, casing heat) is stepped again as the
+    # scene's run (the estimate's later runs restart that state): every run here kept lean
+    whole = model.contact is None or not model.contact.carried_state
     *ref, ref_wall = _timed(red, most, make_stepper, t_end, limits=limits)
     cands = [want] if want is not None else _ladder(most)
-    if want is not None and want != most:  # the reference is never the run: keep it lean
+    if not whole or (want is not None and want != most):  # never the run: keep it lean
         ref = list(_lean(ref))
     chosen, err, tried, tw = None, None, [], None
     for c in cands:
         if c == most:
             break
         *run, wall = _timed(red, c, make_stepper, t_end, limits=limits)
+        run = run if whole else list(_lean(run))
         kept = (run[0], wall, run[1])
         err = estimate((c, *run), (most, *ref), model, window=window)
         if err["estimate"] > SAFETY * tol:  # measure how sensitive the response is
@@ -229,7 +233,9 @@ def reduce_model(
     models over the part of the run that the run itself can reach. ``on_run(results,
     seconds, states)``: called with the estimate's run of the returned model's sizes (its
     :class:`~femrub.output.results.Results`, judged without the reduction rule, and its wall
-    time), which is the scene's run: the caller need not step it again. ``stiffness``: an
+    time), which is the scene's run: the caller need not step it again (lean, and to be
+    stepped again, when the contact carries state outside ``X``:
+    :attr:`~femrub.contact.gap.Contact.carried_state`). ``stiffness``: an
     :class:`~femrub.reduction.interior.InteriorStiffness` of the model's ``K_ii`` already
     factorised (its modal damping, :mod:`femrub.reduction.modal_damping`), for the reductor
     built here; released when unused.

@@ -91,10 +91,9 @@ class Stepper:
             self._setup()
 
     def _contact_states(self) -> list:
-        """The contact's state carried from step to step outside ``X`` (an abradable
-        coating's wear map, the casing's heat), which every run starts afresh."""
+        """:attr:`~femrub.contact.gap.Contact.carried_state` of the model's contact."""
         c = self.model.contact
-        return [] if c is None else [s for s in (c.wear, c.casing_heat) if s is not None]
+        return [] if c is None else c.carried_state
 
     def _claim_contact_state(self) -> None:
         """Start the contact's states afresh for this stepper (a fresh coating, a cold
