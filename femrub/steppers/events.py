@@ -17,8 +17,8 @@ import math
 
 import numpy as np
 
-from .exponential_kernels import quiet
-from .flows import first_zero, shift
+from .exponential_kernels import first_zero_row, quiet
+from .flows import LEVEL_MIN, first_zero, shift
 
 __all__ = ["EventLocation"]
 
@@ -54,17 +54,21 @@ class EventLocation:
             closing[list(S)] = False
         elif not closing.any():  # the common case: free flight, nothing closes
             return None
-        cand = []  # (bracket j, kind, contact, f(τ, X) -> (value, d/dτ))
+        # (bracket j, kind, contact, f(τ, X) -> (value, d/dτ), row): ``row = (r, c0)`` when
+        # f is linear on the augmented state, ``f = r·z + c0`` (a compiled root search)
+        cand = []
         lam, c_n = (flows.generator(S)[2], self.model.n_dofs) if S else (None, 0)
+        g0 = self._fixed_gap()
         for i in np.flatnonzero(closing):
             ref = min(gv[0, i], 0.0)
+            row = None if g0 is None else (self._z_row(S, x=c.GT[i]), g0[i] - ref)
 
             def f(tau, X, i=i, ref=ref):
                 rate = c.rate_at(t + tau)[i] if callable(c.gap_rate) else 0.0
                 dX = flows.rate(S, X, self._u(b, tau / h))
                 return c.gap(t + tau, X)[i] - ref, rate + c.GT[i] @ dX
 
-            cand.append((1 + int(np.argmax(f_cl[1:, i] < 0.0)), "closing", int(i), f))
+            cand.append((1 + int(np.argmax(f_cl[1:, i] < 0.0)), "closing", int(i), f, row))
         slides = flows.sliding(S)
         for k in np.flatnonzero(np.any(lv < 0.0, axis=0)):
             j = int(np.argmax(lv[:, k] < 0.0))
@@ -83,7 +87,11 @@ class EventLocation:
                 val = lx @ X + (lu @ u if lu.size else 0.0)
                 return val, lx @ flows.rate(S, X, u) + (lu @ du if lu.size else 0.0)
 
-            cand.append((j, kind, i, f))
+            if k >= n_s:
+                row = (self._z_row(S, x=flows.slip[0][i]), flows.slip[1][i])
+            else:
+                row = (self._z_row(S, x=lam[k, :c_n], u=lam[k, c_n:]), 0.0)
+            cand.append((j, kind, i, f, row))
         if not cand:
             return None
         j = min(x[0] for x in cand)
@@ -95,10 +103,10 @@ class EventLocation:
             states[j - 1] = (Xj, Pk + Pj)
         X0, P0 = states[j - 1]
         best = None
-        for jj, kind, i, f in cand:
+        for jj, kind, i, f, row in cand:
             if jj != j:
                 continue
-            found = self._root(S, f, lo, grid[j], X0, b)
+            found = self._root(S, f, lo, grid[j], X0, b, row)
             if found is not None and (best is None or found[0] < best[0]):
                 best = (*found, kind, i)
         if best is None:
@@ -192,14 +200,45 @@ class EventLocation:
         common case; compiled, :func:`~.exponential_kernels.quiet`)."""
         return quiet(V, self.model.contact.n, self._held(S))
 
-    def _root(self, S, f, lo, hi, X_lo, b):
+    def _fixed_gap(self):
+        """The casing's gaps ``g0`` (n_c,) when they are constant (fixed casing, no wear, no
+        casing heat: a closing is then a row event), else ``None``."""
+        c = self.model.contact
+        if callable(c.gap0) or c.gap_rate is not None or c.wear is not None:
+            return None
+        if c.casing_heat is not None:
+            return None
+        return np.broadcast_to(np.asarray(c.gap0, dtype=float), (c.n,))
+
+    def _z_row(self, S, x, u=None) -> np.ndarray:
+        """A row ``r`` on the augmented state ``z = [X; P_S; s, …]`` of held set ``S``:
+        ``r·z = x·X + u·s`` (``s``: the load signals, the chain's first block)."""
+        n, nz = self.model.n_dofs, self.model.n_dofs + len(S)
+        r = np.zeros(self._flows.generator_z(S).shape[0])
+        r[:n] = x
+        if u is not None and u.size:
+            r[nz : nz + u.size] = u
+        return r
+
+    def _root(self, S, f, lo, hi, X_lo, b, row=None):
         """First zero of ``f`` in ``(lo, hi]`` on the exact flow from ``(lo, X_lo)``
         (:func:`~femrub.steppers.flows.first_zero`): ``(τ, X(τ), P_S(lo..τ))`` or ``None``.
         Each evaluation starts from the latest state already computed before it (the open
-        side of the bracket), so Newton's shrinking corrections compose few sub-step flows."""
+        side of the bracket), so Newton's shrinking corrections compose few sub-step flows.
+        A row event ``f = r·z + c0`` (``row = (r, c0)``) is searched in one compiled call
+        (:func:`~.exponential_kernels.first_zero_row`, the same iteration)."""
         h, flows, d = self.h, self._flows, self.h / self.probes
         n, s = self.model.n_dofs, len(S)
-        known = [(lo, np.concatenate([X_lo, np.zeros(s), flows.chain(b, lo / h)]))]
+        z_lo = np.concatenate([X_lo, np.zeros(s), flows.chain(b, lo / h)])
+        if row is not None:
+            r, c0 = row
+            Z = flows.levels(S, d)
+            rM = r @ flows.generator_z(S)
+            found, tau, z = first_zero_row(
+                Z, z_lo, r, rM, float(c0), lo, hi, _XTOL * h, d * 2.0**LEVEL_MIN
+            )
+            return (tau, z[:n], z[n : n + s]) if found else None
+        known = [(lo, z_lo)]
 
         def at(tau):
             t0, z0 = max((k for k in known if k[0] <= tau), key=lambda k: k[0])

@@ -23,7 +23,10 @@ __all__ = [
     "compose_integrals",
     "double_integrals",
     "flight",
+    "first_zero_row",
     "form_values",
+    "hermite_root",
+    "integrals_over",
     "open_end",
     "quiet",
     "square_levels",
@@ -90,6 +93,31 @@ def compose_integrals(Y, z, k, lo, n_forms):
             k -= 1 << e
         e -= 1
     return wq, wl, z, k
+
+
+@njit
+def integrals_over(Y, lo, A, B, Z, z, k, n_forms, d_min, state):
+    """The integrals over ``k`` smallest units ``d_min`` from ``z``: the levels ``e >= lo``
+    by :func:`compose_integrals`, the bits below ``lo`` (duration ``d``) by the Taylor series
+    ``Σ_t d^{t+1}/(t+1)! (zᵀ A_t z, B_t z)`` of their coefficients stacked as rows ``A``
+    (terms × n_forms × N, N) and ``B`` (terms × 2, N). Returns ``(w_forms, w_lin, z)``, ``z``
+    at the end of the duration with ``state`` (else at the end of the levels' part)."""
+    wq, wl, z, k = compose_integrals(Y, z, k, lo, n_forms)
+    if k:
+        n = z.size
+        d = k * d_min
+        az = A @ z
+        bz = B @ z
+        c = 1.0
+        for t in range(B.shape[0] // 2):
+            c *= d / (t + 1)
+            for f in range(n_forms):
+                r = (t * n_forms + f) * n
+                wq[f] += c * (az[r : r + n] @ z)
+            wl += c * bz[2 * t : 2 * t + 2]
+        if state:
+            z = compose(Z, z, k)
+    return wq, wl, z
 
 
 @njit
@@ -194,6 +222,107 @@ def flight(F, u, k, q, gap0, off, held, nz, act, measure, works):
     return y, V, calm, calm and open_end(V, n_c, held)
 
 
+@njit
+def hermite_root(a, fa, dfa, b, fb, dfb):
+    """First guess of the zero in ``(a, b)``: Newton on the cubic Hermite interpolant of
+    ``f`` from its values and slopes at the ends (``fa > 0 > fb``); NaN if it fails."""
+    if fa == fb:
+        return np.nan
+    d = b - a
+    p0, p1, q0, q1 = fa, d * dfa, fb, d * dfb
+    c2, c3 = 3 * (q0 - p0) - 2 * p1 - q1, 2 * (p0 - q0) + p1 + q1
+    s = fa / (fa - fb)  # secant start
+    for _ in range(8):
+        val = p0 + s * (p1 + s * (c2 + s * c3))
+        der = p1 + s * (2 * c2 + 3 * s * c3)
+        if der == 0.0:
+            return np.nan
+        s = min(max(s - val / der, 0.0), 1.0)
+    return a + s * d
+
+
+@njit
+def _at_row(Z, kt, kz, nk, tau, r, rM, c0, d_min):
+    """``(z(τ), f, df/dτ)`` of the row event ``f = r·z + c0`` at ``τ``, ``z`` composed
+    (:func:`compose`) from the latest known state at or before ``τ`` (``kt[:nk]``, ``kz``)."""
+    best = 0
+    for i in range(nk):
+        if kt[i] <= tau and kt[i] >= kt[best]:
+            best = i
+    rest = tau - kt[best]
+    k = int(rest / d_min * (1.0 + 1e-12)) if rest > 0.0 else 0
+    k = min(k, (1 << Z.shape[0]) - 1)
+    z = compose(Z, kz[best].copy(), k) if k else kz[best].copy()
+    return z, r @ z + c0, rM @ z
+
+
+@njit
+def first_zero_row(Z, z_lo, r, rM, c0, lo, hi, tol, d_min):
+    """First zero in ``(lo, hi]`` of the row event ``f(τ) = r·z(τ) + c0`` (``df/dτ =
+    rM·z``, ``rM = Mᵀ r``) on the flow composed of the levels ``Z`` (smallest ``d_min``)
+    from ``z(lo) = z_lo``, by the safeguarded Newton iteration of
+    :func:`~femrub.steppers.flows.first_zero` (cubic Hermite start, Newton from the closed
+    side, regula falsi, bisection; each evaluation from the latest state known on the open
+    side). Returns ``(found, τ, z(τ))`` with ``f(τ) <= 0`` within ``tol`` of the zero."""
+    kt = np.empty(128)
+    kz = np.empty((128, z_lo.size))
+    kt[0], kz[0], nk = lo, z_lo, 1
+    f_lo, df_lo = r @ z_lo + c0, rM @ z_lo
+    if f_lo <= 0.0:  # at the surface at lo: halve the bracket towards lo until f > 0
+        x, ok = hi, False
+        for _ in range(40):
+            x = lo + 0.5 * (x - lo)
+            zx, fx, dfx = _at_row(Z, kt, kz, nk, x, r, rM, c0, d_min)
+            if fx > 0.0:
+                kt[nk], kz[nk], nk, ok = x, zx, nk + 1, True
+                break
+        if not ok:
+            return False, hi, z_lo
+        a, f_a = x, fx
+    else:
+        a, f_a = lo, f_lo
+    x = hi
+    z, fx, dfx = _at_row(Z, kt, kz, nk, x, r, rM, c0, d_min)
+    if fx > 0.0 and nk < kt.size:
+        kt[nk], kz[nk], nk = x, z, nk + 1
+    bt, bz = x, z
+    bh, f_bh, df_bh = hi, fx, dfx
+    width, slow = bh - a, 0
+    for it in range(60):
+        if it == 0 and f_lo > 0.0:
+            x_new = hermite_root(lo, f_lo, df_lo, x, fx, dfx)
+        elif slow >= 3:  # the bracket stopped shrinking: bisection
+            x_new, slow = 0.5 * (a + bh), 0
+        else:
+            x_new = x - fx / dfx if dfx != 0.0 else np.nan
+            if not (a < x_new < bh) and df_bh != 0.0:  # Newton from the closed side
+                x_new = bh - f_bh / df_bh
+        if not (a < x_new < bh):  # outside the bracket: regula falsi, else bisection
+            x_new = a - f_a * (bh - a) / (f_bh - f_a) if f_bh != f_a else np.nan
+            if not (a < x_new < bh):
+                x_new = 0.5 * (a + bh)
+        if abs(x_new - x) <= tol:  # converged
+            if fx > 0.0 and bh - x > tol:  # from the open side: step just past the zero
+                x = min(x + 2.0 * tol, bh)
+                z, fx, dfx = _at_row(Z, kt, kz, nk, x, r, rM, c0, d_min)
+                if fx <= 0.0:
+                    bt, bz = x, z
+            break
+        x = x_new
+        z, fx, dfx = _at_row(Z, kt, kz, nk, x, r, rM, c0, d_min)
+        if fx > 0.0:
+            a, f_a = x, fx
+            if nk < kt.size:
+                kt[nk], kz[nk], nk = x, z, nk + 1
+        else:
+            bh, f_bh, df_bh, bt, bz = x, fx, dfx, x, z
+        if bh - a <= tol:
+            break
+        slow = slow + 1 if bh - a > 0.5 * width else 0
+        width = min(width, bh - a) if slow == 0 else width
+    return True, bt, bz
+
+
 def warm_up() -> None:
     """Compile (or load from the disk cache) the kernels for the argument types of a run,
     before any timed step (nothing is computed that is kept)."""
@@ -202,7 +331,9 @@ def warm_up() -> None:
     Z = square_levels(np.zeros((2, 2)), 2, 1e-150)
     compose(Z, np.zeros(2), 1)
     compose_integrals(np.zeros((2, 6, 2)), np.zeros(2), 1, 0, 1)
+    integrals_over(np.zeros((2, 6, 2)), 1, np.zeros((2, 2)), np.zeros((2, 2)), Z, np.zeros(2), 1, 1, 1.0, True)
     double_integrals(np.zeros((1, 2, 2)), np.zeros((2, 2)), Z, 1e-150)
     act, held, w = np.zeros(1, dtype=np.int64), np.zeros(1, dtype=np.bool_), np.zeros(8)
     off = np.zeros(0)
+    first_zero_row(Z, np.ones(2), np.ones(2), np.ones(2), -3.0, 0.0, 1.0, 1e-3, 0.5)
     flight(np.zeros((10, 2)), np.zeros(2), 6, 1, np.zeros((2, 1)), off, held, 2, act, True, w)

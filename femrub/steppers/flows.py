@@ -216,7 +216,13 @@ class FlowFamily:
         return self._levels[key]
 
     def generator_z(self, S: tuple) -> np.ndarray:
-        """``M`` of the augmented state ``z = [X; P_S; s, ṡ, …, s^(p)]``: ``ż = M z``."""
+        """``M`` of the augmented state ``z = [X; P_S; s, ṡ, …, s^(p)]``: ``ż = M z`` (cached)."""
+        key = ("M", S)
+        if key not in self._probe:
+            self._probe[key] = self._augmented(S)
+        return self._probe[key]
+
+    def _augmented(self, S: tuple) -> np.ndarray:
         K, E, _ = self.generator(S)
         nz, m, p = K.shape[0], E.shape[1], self.degree
         N = nz + (p + 1) * m

@@ -32,7 +32,7 @@ import numpy as np
 import scipy.linalg as sla
 import scipy.sparse as sp
 
-from .exponential_kernels import compose, compose_integrals, double_integrals, form_values
+from .exponential_kernels import double_integrals, form_values, integrals_over
 from .flows import _FLUSH, LEVEL_MIN
 
 __all__ = ["QUADRATIC", "LINEAR", "METER_ORDER", "NQ", "WorkIntegrals"]
@@ -139,8 +139,9 @@ class WorkIntegrals:
                 A.append(AM + AM.transpose(0, 2, 1))
                 B.append(B[-1] @ M)
             A, B = np.stack(A), np.stack(B)
-            size = np.array(
-                [max(np.max(np.abs(a), initial=0.0), np.max(np.abs(b))) for a, b in zip(A, B)]
+            size = np.maximum(
+                np.abs(A).reshape(_TERMS, -1).max(axis=1, initial=0.0),
+                np.abs(B).reshape(_TERMS, -1).max(axis=1),
             )
             tau = unit * 2.0 ** np.arange(LEVEL_MIN, LEVEL_MIN + len(Z))
             # the series' last term is round-off against its first up to level lo - 1
@@ -179,19 +180,24 @@ class WorkIntegrals:
         Y, lo, act, A, B = self.levels(S, unit)
         k = int(rest / unit * 2.0**-LEVEL_MIN * (1.0 + 1e-12)) if rest > 0.0 else 0
         k = min(k, (1 << (lo + len(Y))) - 1)
-        # per level from the top bit: [Γ_e z; C J_e z; Z_e z] in one product (compiled)
-        z = np.ascontiguousarray(z, dtype=float)
-        wq, wl, z, k = compose_integrals(Y, z, k, lo, act.size)
-        if k:
-            d = k * unit * 2.0**LEVEL_MIN
-            c = d ** np.arange(1, _TERMS + 1) / _FACTORIALS
-            wq = wq + c @ ((A @ z) @ z)
-            wl = wl + c @ (B @ z)
+        # per level from the top bit: [Γ_e z; C J_e z; Z_e z] in one product, the bits below
+        # lo by the series, the state with them (compiled)
+        N = A.shape[-1]
+        wq, wl, z = integrals_over(
+            Y,
+            lo,
+            A.reshape(-1, N),
+            B.reshape(-1, N),
+            self.flows.levels(S, unit),
+            np.ascontiguousarray(z, dtype=float),
+            k,
+            act.size,
+            unit * 2.0**LEVEL_MIN,
+            state,
+        )
         w = np.zeros(NQ + 2)
         w[act], w[NQ:] = wq, wl
-        if not state:
-            return w
-        return (compose(self.flows.levels(S, unit), z, k) if k else z), w
+        return (z, w) if state else w
 
     def step(self, S: tuple, z, q: int, unit: float) -> np.ndarray:
         """The integrals (NQ + 2,) over a whole step ``h = q unit`` from ``z`` (one form each)."""
