@@ -144,10 +144,12 @@ def double_integrals(g, j, Z, flush):
             for c in range(n):
                 if abs(Y[i, r, c]) < flush:
                     Y[i, r, c] = 0.0
-        if i + 1 < count:
+        if i + 1 < count:  # all forms in two products: U_f = Γ_f Z_i, then U_fᵀ Z_i
+            U = g.reshape(nf * n, n) @ Zi
+            V = np.empty((nf * n, n))
             for f in range(nf):
-                gz = np.ascontiguousarray((g[f] @ Zi).T)
-                g[f] = g[f] + gz @ Zi
+                V[f * n : (f + 1) * n] = U[f * n : (f + 1) * n].T
+            g = g + (V @ Zi).reshape(nf, n, n)
             j = j + j @ Zi
     return Y
 
@@ -331,7 +333,9 @@ def warm_up() -> None:
     Z = square_levels(np.zeros((2, 2)), 2, 1e-150)
     compose(Z, np.zeros(2), 1)
     compose_integrals(np.zeros((2, 6, 2)), np.zeros(2), 1, 0, 1)
-    integrals_over(np.zeros((2, 6, 2)), 1, np.zeros((2, 2)), np.zeros((2, 2)), Z, np.zeros(2), 1, 1, 1.0, True)
+    integrals_over(
+        np.zeros((2, 6, 2)), 1, np.zeros((2, 2)), np.zeros((2, 2)), Z, np.zeros(2), 1, 1, 1.0, True
+    )
     double_integrals(np.zeros((1, 2, 2)), np.zeros((2, 2)), Z, 1e-150)
     act, held, w = np.zeros(1, dtype=np.int64), np.zeros(1, dtype=np.bool_), np.zeros(8)
     off = np.zeros(0)

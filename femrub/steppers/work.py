@@ -133,9 +133,9 @@ class WorkIntegrals:
             Q = Q[act]
             # Γ(τ) = Σ τ^{k+1}/(k+1)! A_k, A_{k+1} = Mᵀ A_k + A_k M
             # C J(τ) = Σ τ^{k+1}/(k+1)! C M^k
-            A, B = [Q], [C]
-            for _ in range(_TERMS - 1):  # A_k symmetric: Mᵀ A_k = (A_k M)ᵀ
-                AM = A[-1] @ M
+            A, B, N = [Q], [C], M.shape[0]
+            for _ in range(_TERMS - 1):  # A_k symmetric: Mᵀ A_k = (A_k M)ᵀ (one product)
+                AM = (A[-1].reshape(-1, N) @ M).reshape(-1, N, N)
                 A.append(AM + AM.transpose(0, 2, 1))
                 B.append(B[-1] @ M)
             A, B = np.stack(A), np.stack(B)
@@ -147,7 +147,6 @@ class WorkIntegrals:
             # the series' last term is round-off against its first up to level lo - 1
             ok = tau ** (_TERMS - 1) / _FACTORIALS[-1] * size[-1] <= 1e-16 * size[0]
             lo = len(Z) if ok.all() else int(np.argmin(ok))
-            N = M.shape[0]
             Y = np.zeros((0, _level_rows(act.size, N), N))
             if lo < len(Z):  # the first level after the series' range, then doubling
                 g, j = self._van_loan(M, Q, C, tau[0]) if lo == 0 else _series(A, B, tau[lo])
