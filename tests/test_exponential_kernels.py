@@ -14,7 +14,6 @@ import scipy.linalg as sla
 from jit_child import child_json
 
 from femrub.contact.jit import compiled
-from femrub.steppers.flows import first_zero
 from femrub.steppers.exponential_kernels import (
     compose,
     compose_integrals,
@@ -26,6 +25,7 @@ from femrub.steppers.exponential_kernels import (
     quiet,
     square_levels,
 )
+from femrub.steppers.flows import first_zero
 
 ROOT = Path(__file__).resolve().parents[1]
 
