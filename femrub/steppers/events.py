@@ -17,8 +17,8 @@ import math
 
 import numpy as np
 
-from .exponential_kernels import first_zero_row, quiet
-from .flows import LEVEL_MIN, first_zero, shift
+from .exponential_kernels import first_zero_row, part_rows, quiet
+from .flows import LEVEL_MIN, first_zero
 
 __all__ = ["EventLocation"]
 
@@ -116,55 +116,34 @@ class EventLocation:
 
     def _part_grid(self, S, Xa, a, Xe, b):
         """The check grid of a part step ``(a, h]``: ``(grid, V, states)``, ``V`` the rows
-        ``[g; λ_S]`` at ``grid`` (probe rows from the first multiple of ``h / probes``,
-        reached with cached sub-step flows), ``states`` the states known on it."""
+        ``[g; λ_S; σ]`` at ``grid`` (``a``, the next multiples of ``h / probes`` (the first
+        reached with cached sub-step flows, the others by probe rows), ``h``; compiled,
+        :func:`~.exponential_kernels.part_rows`), ``states`` the states known on it."""
         c, h, t, flows, q = self.model.contact, self.h, self.t, self._flows, self.probes
-        n_s, d = len(S), h / self.probes
-
-        slides = flows.sliding(S)
-
-        def values(tau, X):
-            g = c.gap(t + tau, X)
-            if not S:
-                return g
-            lam = flows.multiplier(S, X, self._u(b, tau / h))
-            if not slides:
-                return np.concatenate([g, lam])
-            sig = flows.slip[0][list(slides)] @ X + flows.slip[1][list(slides)]
-            return np.concatenate([g, lam, sig])
-
-        # grid: a, the next multiples of d, h; rows of gaps and multipliers on it (blocks)
-        grid, rows, states = [[a]], [values(a, Xa)[None]], {0: (Xa, np.zeros(n_s))}
+        n, n_s, d = self.model.n_dofs, len(S), h / self.probes
         i1 = math.floor(a / d * (1.0 + 1e-12)) + 1  # first grid index after a
+        mid, k1, nj, start = False, 0, 0, 0.0
         if i1 < q:
-            g1 = i1 * d
-            if a > 0.0:  # part step: to the grid with cached sub-step flows
-                X1, P1 = flows.advance(S, Xa, a, g1, b, d)
-                grid.append([g1])
-                rows.append(values(g1, X1)[None])
-                states[1] = (X1, P1)
-            else:
-                X1 = Xa
-            start = g1 if a > 0.0 else 0.0  # the grid start the probe rows run from
+            mid, start = a > 0.0, (i1 * d if a > 0.0 else 0.0)
+            if mid:  # part step: to the grid with cached sub-step flows (as advance_z)
+                k1 = int((start - a) / d * 2.0**-LEVEL_MIN * (1.0 + 1e-12))
             if q - i1 > 1 or a == 0.0:
-                Rx, Rb = flows.probe(S, c.GT, q)
-                nj = q - 1 - (i1 if a > 0.0 else 0)  # probe points before h
-                r = Rx.shape[0] // (q - 1)
-                sig0 = start / h  # the load polynomial re-expanded at the grid start
-                b1 = b if sig0 == 0.0 else self._Dinv @ shift(b, sig0, 1.0)
-                V = Rx[: nj * r] @ X1
-                if Rb.shape[1]:
-                    V += Rb[: nj * r] @ b1.ravel()
-                V = V.reshape(nj, r)
-                taus = start + d * np.arange(1, nj + 1)
-                V[:, : c.n] += c.gap_at(t + taus) if callable(c.gap0) else c.gap0
-                if slides:
-                    V[:, c.n :] += flows.check_offsets(S)
-                grid.append(taus)
-                rows.append(V)
-        grid.append([h])
-        rows.append(values(h, Xe)[None])
-        return np.concatenate(grid), np.concatenate(rows), states
+                nj = q - 1 - (i1 if mid else 0)  # probe points before h
+        R, Rz = flows.check_rows(S, c.GT, q)
+        Z = flows.levels(S, d)
+        k1 = min(k1, (1 << len(Z)) - 1)
+        zero = np.zeros(n_s)
+        za = np.concatenate([Xa, zero, flows.chain(b, a / h)])
+        zh = np.concatenate([Xe, zero, flows.chain(b, 1.0)])
+        V, z1 = part_rows(Z, R, Rz, za, k1, mid, nj, zh)
+        grid = np.concatenate([[a], [start] if mid else [], start + d * np.arange(1, nj + 1), [h]])
+        V[:, : c.n] += c.gap_at(t + grid) if self._fixed_gap() is None else c.gap0
+        if flows.sliding(S):
+            V[:, c.n :] += flows.check_offsets(S)
+        states = {0: (Xa, zero)}
+        if mid:
+            states[1] = (z1[:n], z1[n : n + n_s])
+        return grid, V, states
 
     def _grid_rows(self, S, flow) -> np.ndarray:
         """``R`` (cached per held set): ``R u`` are the rows ``[Gᵀ X; λ_S]`` at

@@ -28,6 +28,7 @@ __all__ = [
     "hermite_root",
     "integrals_over",
     "open_end",
+    "part_rows",
     "quiet",
     "square_levels",
     "warm_up",
@@ -225,6 +226,27 @@ def flight(F, u, k, q, gap0, off, held, nz, act, measure, works):
 
 
 @njit
+def part_rows(Z, R, Rz, za, k1, mid, nj, zh):
+    """The check rows of a part step (:meth:`~.events.EventLocation._part_grid`) without the
+    casing's gaps and slip offsets: ``R z`` at its start ``za``, with ``mid`` at the first grid
+    point (``za`` advanced by ``k1`` smallest units, :func:`compose`), ``nj`` probe rows ``Rz``
+    from there, and ``R zh`` at the step end. Returns ``(V (rows, r), z at the grid point)``."""
+    r = R.shape[0]
+    V = np.empty((2 + (1 if mid else 0) + nj, r))
+    V[0] = R @ za
+    i, z1 = 1, za
+    if mid:
+        z1 = compose(Z, za.copy(), k1) if k1 else za.copy()
+        V[1] = R @ z1
+        i = 2
+    if nj > 0:
+        V[i : i + nj] = (Rz[: nj * r] @ z1).reshape(nj, r)
+        i += nj
+    V[i] = R @ zh
+    return V, z1
+
+
+@njit
 def hermite_root(a, fa, dfa, b, fb, dfb):
     """First guess of the zero in ``(a, b)``: Newton on the cubic Hermite interpolant of
     ``f`` from its values and slopes at the ends (``fa > 0 > fb``); NaN if it fails."""
@@ -339,5 +361,6 @@ def warm_up() -> None:
     double_integrals(np.zeros((1, 2, 2)), np.zeros((2, 2)), Z, 1e-150)
     act, held, w = np.zeros(1, dtype=np.int64), np.zeros(1, dtype=np.bool_), np.zeros(8)
     off = np.zeros(0)
+    part_rows(Z, np.ones((1, 2)), np.ones((2, 2)), np.ones(2), 1, True, 1, np.ones(2))
     first_zero_row(Z, np.ones(2), np.ones(2), np.ones(2), -3.0, 0.0, 1.0, 1e-3, 0.5)
     flight(np.zeros((10, 2)), np.zeros(2), 6, 1, np.zeros((2, 1)), off, held, 2, act, True, w)

@@ -293,6 +293,13 @@ class FlowFamily:
                 self._probe[key] = (Ex, Eu if Eu.shape[1] else None)
         return self._probe[key]
 
+    def check_rows(self, S: tuple, GT: np.ndarray, q: int) -> tuple[np.ndarray, np.ndarray]:
+        """``(R, Rz)``: the rows of :meth:`probe` on the augmented state ``z`` of
+        :meth:`levels` (loads as the chain's physical derivatives): ``R z`` are the gaps,
+        multipliers and slips at ``z``, ``Rz z`` those at ``j h / q`` later, j = 1 .. q − 1."""
+        self.probe(S, GT, q)
+        return self._probe[("z", S)]
+
     def probe(self, S: tuple, GT: np.ndarray, q: int) -> tuple[np.ndarray, np.ndarray]:
         """Gaps ``Gᵀ X``, held multipliers ``λ_S`` and slips at ``τ_j = j h / q``, j = 1 .. q − 1.
 
@@ -321,6 +328,7 @@ class FlowFamily:
                 Rz = np.vstack([Rz, Rz @ levels[-LEVEL_MIN + e]])
                 e += 1
             Rz = Rz[r : q * r]
+            self._probe[("z", S)] = (R, np.ascontiguousarray(Rz))
             self._probe[S] = (
                 np.ascontiguousarray(Rz[:, :n]),
                 np.ascontiguousarray(Rz[:, nz:] * scale),
