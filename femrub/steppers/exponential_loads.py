@@ -28,7 +28,6 @@ class LoadPolynomial:
         self._nodes = 0.5 * (1.0 - np.cos(np.pi * np.arange(p + 1) / max(p, 1)))  # Lobatto
         self._Vinv = np.linalg.inv(self._nodes[:, None] ** np.arange(p + 1))
         self._T01 = np.diag([float(math.factorial(i)) for i in range(p + 1)])
-        self._Dinv = np.linalg.inv(self._T01)
         self._sk = self._signal_values(self.t)
         # signals that take an array of times (checked once against one call per time)
         probe = self.t + self.h * self._nodes[1:]
