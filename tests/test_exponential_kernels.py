@@ -75,7 +75,7 @@ def test_doubled_integrals_compose_to_van_loan():
     Y = double_integrals(0.5 * (g0 + g0.T)[None].copy(), j0.copy(), Z, 1e-150)
     z = np.array([1.0, -0.5, 0.2, 0.3])
     k = 45
-    wq, wl, zk, rest = compose_integrals(Y, z.copy(), k, 0, 1)
+    wq, wl, zk, rest = compose_integrals(Y, Z, z.copy(), k, 0, 1)
     T = k * tau  # the reference over the whole duration (Van Loan)
     big[:n, :n], big[:n, n:], big[n:, n:] = -T * M.T, T * Q, T * M
     gT = sla.expm(T * M).T @ sla.expm(big)[:n, n:]
@@ -85,7 +85,7 @@ def test_doubled_integrals_compose_to_van_loan():
     assert wl == pytest.approx(Cr @ sla.expm(bj)[:n, n:] @ z, rel=1e-10)
     assert zk == pytest.approx(sla.expm(T * M) @ z, rel=1e-10)
     # bits below lo are left to the caller
-    *_, rest = compose_integrals(Y[2:], z.copy(), 7, 2, 1)
+    *_, rest = compose_integrals(Y[2:], Z, z.copy(), 7, 2, 1)
     assert rest == 3
 
 

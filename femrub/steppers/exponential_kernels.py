@@ -4,7 +4,7 @@ The exact flows of :mod:`~.flows` over ``unit 2^e`` are built once per held set 
 the increment ``D = Z − I`` of the smallest level (:func:`square_levels`), and a state is
 advanced over any duration ``k unit 2^LEVEL_MIN`` by composing the levels of the binary
 expansion of ``k`` from the top bit down (:func:`compose`); the work integrals of
-:mod:`~.work` compose their stacked level rows ``[Γ_e; C J_e; Z_e]`` the same way
+:mod:`~.work` compose their stacked level rows ``[Γ_e; C J_e]`` the same way
 (:func:`compose_integrals`). A whole step without event is one product of a matrix stacked
 once per held set, its integrals and event check read off it (:func:`flight`). These loops
 are the only implementation of that algebra:
@@ -70,10 +70,10 @@ def compose(Z, z, k):
 
 
 @njit
-def compose_integrals(Y, z, k, lo, n_forms):
+def compose_integrals(Y, Z, z, k, lo, n_forms):
     """The integrals over the levels ``e >= lo`` of the binary expansion of ``k`` (top bit
-    first), each level's stacked rows ``Y[e − lo] = [Γ_e (n_forms × N rows); C J_e (2 rows);
-    Z_e (N rows)]`` applied to the state at its start (one product per level)::
+    first), each level's stacked rows ``Y[e − lo] = [Γ_e (n_forms × N rows); C J_e (2 rows)]``
+    and its flow ``Z[e]`` applied to the state at its start::
 
         w_f += z_eᵀ Γ_{e,f} z_e,      w_lin += C J_e z_e,      z_{e+1} = Z_e z_e
 
@@ -90,7 +90,7 @@ def compose_integrals(Y, z, k, lo, n_forms):
             for f in range(n_forms):
                 wq[f] += y[f * n : (f + 1) * n] @ z
             wl += y[kn : kn + 2]
-            z = y[kn + 2 :].copy()
+            z = Z[e] @ z
             k -= 1 << e
         e -= 1
     return wq, wl, z, k
@@ -103,7 +103,7 @@ def integrals_over(Y, lo, A, B, Z, z, k, n_forms, d_min, state):
     ``Σ_t d^{t+1}/(t+1)! (zᵀ A_t z, B_t z)`` of their coefficients stacked as rows ``A``
     (terms × n_forms × N, N) and ``B`` (terms × 2, N). Returns ``(w_forms, w_lin, z)``, ``z``
     at the end of the duration with ``state`` (else at the end of the levels' part)."""
-    wq, wl, z, k = compose_integrals(Y, z, k, lo, n_forms)
+    wq, wl, z, k = compose_integrals(Y, Z, z, k, lo, n_forms)
     if k:
         n = z.size
         d = k * d_min
@@ -123,9 +123,9 @@ def integrals_over(Y, lo, A, B, Z, z, k, n_forms, d_min, state):
 
 @njit
 def double_integrals(g, j, Z, flush):
-    """The stacked rows ``Y[i] = [Γ_i (forms × N rows); C J_i (2 rows); Z_i (N rows)]`` of
-    successive dyadic levels from the integrals of the first, ``g`` (forms, N, N) and ``j``
-    (2, N), and the levels' flows ``Z`` (count, N, N): over ``[0, 2τ] = [0, τ] ∪ [τ, 2τ]``::
+    """The stacked rows ``Y[i] = [Γ_i (forms × N rows); C J_i (2 rows)]`` of successive dyadic
+    levels from the integrals of the first, ``g`` (forms, N, N) and ``j`` (2, N), and the
+    levels' flows ``Z`` (count, N, N): over ``[0, 2τ] = [0, τ] ∪ [τ, 2τ]``::
 
         Γ_{i+1} = Γ_i + Z_iᵀ Γ_i Z_i,        C J_{i+1} = C J_i + C J_i Z_i
 
@@ -134,14 +134,13 @@ def double_integrals(g, j, Z, flush):
     nf, n = g.shape[0], g.shape[1]
     count = Z.shape[0]
     kn = nf * n
-    Y = np.empty((count, kn + 2 + n, n))
+    Y = np.empty((count, kn + 2, n))
     for i in range(count):
         Zi = Z[i]
         for f in range(nf):
             Y[i, f * n : (f + 1) * n] = g[f]
         Y[i, kn : kn + 2] = j
-        Y[i, kn + 2 :] = Zi
-        for r in range(kn + 2 + n):
+        for r in range(kn + 2):
             for c in range(n):
                 if abs(Y[i, r, c]) < flush:
                     Y[i, r, c] = 0.0
@@ -354,9 +353,9 @@ def warm_up() -> None:
         return
     Z = square_levels(np.zeros((2, 2)), 2, 1e-150)
     compose(Z, np.zeros(2), 1)
-    compose_integrals(np.zeros((2, 6, 2)), np.zeros(2), 1, 0, 1)
+    compose_integrals(np.zeros((2, 4, 2)), Z, np.zeros(2), 1, 0, 1)
     integrals_over(
-        np.zeros((2, 6, 2)), 1, np.zeros((2, 2)), np.zeros((2, 2)), Z, np.zeros(2), 1, 1, 1.0, True
+        np.zeros((2, 4, 2)), 1, np.zeros((2, 2)), np.zeros((2, 2)), Z, np.zeros(2), 1, 1, 1.0, True
     )
     double_integrals(np.zeros((1, 2, 2)), np.zeros((2, 2)), Z, 1e-150)
     act, held, w = np.zeros(1, dtype=np.int64), np.zeros(1, dtype=np.bool_), np.zeros(8)

@@ -120,10 +120,10 @@ class WorkIntegrals:
 
     def levels(self, S: tuple, unit: float) -> tuple:
         """``(Y, lo, forms, A, B)`` of held set ``S`` (cached): per level ``e >= lo`` of
-        :meth:`~.flows.FlowFamily.levels` the stacked ``[Γ_e; C J_e; Z_e]`` (one product per
-        level in :meth:`over`; ``Γ`` of the non-zero ``forms`` only), and the Taylor
-        coefficients ``A_k, C M^k`` (k < :data:`_TERMS`) that give the integrals over any
-        duration below ``unit 2^lo`` to round-off."""
+        :meth:`~.flows.FlowFamily.levels` the stacked ``[Γ_e; C J_e]`` (one product per level
+        in :meth:`over`, with the level's flow; ``Γ`` of the non-zero ``forms`` only), and the
+        Taylor coefficients ``A_k, C M^k`` (k < :data:`_TERMS`) that give the integrals over
+        any duration below ``unit 2^lo`` to round-off."""
         key = (S, unit)
         if key not in self._levels:
             Z = self.flows.levels(S, unit)
@@ -133,12 +133,13 @@ class WorkIntegrals:
             Q = Q[act]
             # Γ(τ) = Σ τ^{k+1}/(k+1)! A_k, A_{k+1} = Mᵀ A_k + A_k M
             # C J(τ) = Σ τ^{k+1}/(k+1)! C M^k
-            A, B, N = [Q], [C], M.shape[0]
-            for _ in range(_TERMS - 1):  # A_k symmetric: Mᵀ A_k = (A_k M)ᵀ (one product)
-                AM = (A[-1].reshape(-1, N) @ M).reshape(-1, N, N)
-                A.append(AM + AM.transpose(0, 2, 1))
-                B.append(B[-1] @ M)
-            A, B = np.stack(A), np.stack(B)
+            N = M.shape[0]
+            A, B = np.empty((_TERMS, *Q.shape)), np.empty((_TERMS, *C.shape))
+            A[0], B[0] = Q, C
+            for k in range(_TERMS - 1):  # A_k symmetric: Mᵀ A_k = (A_k M)ᵀ (one product)
+                AM = (A[k].reshape(-1, N) @ M).reshape(-1, N, N)
+                np.add(AM, AM.transpose(0, 2, 1), out=A[k + 1])
+                np.matmul(B[k], M, out=B[k + 1])
             size = np.maximum(
                 np.abs(A).reshape(_TERMS, -1).max(axis=1, initial=0.0),
                 np.abs(B).reshape(_TERMS, -1).max(axis=1),
@@ -179,8 +180,8 @@ class WorkIntegrals:
         Y, lo, act, A, B = self.levels(S, unit)
         k = int(rest / unit * 2.0**-LEVEL_MIN * (1.0 + 1e-12)) if rest > 0.0 else 0
         k = min(k, (1 << (lo + len(Y))) - 1)
-        # per level from the top bit: [Γ_e z; C J_e z; Z_e z] in one product, the bits below
-        # lo by the series, the state with them (compiled)
+        # per level from the top bit: [Γ_e z; C J_e z] and Z_e z, the bits below lo by the
+        # series, the state with them (compiled)
         N = A.shape[-1]
         wq, wl, z = integrals_over(
             Y,
@@ -269,8 +270,8 @@ class WorkIntegrals:
 
 
 def _level_rows(n_forms: int, N: int) -> int:
-    """Rows of one level's stack ``[Γ_e (n_forms × N); C J_e (2); Z_e (N)]``."""
-    return n_forms * N + 2 + N
+    """Rows of one level's stack ``[Γ_e (n_forms × N); C J_e (2)]``."""
+    return n_forms * N + 2
 
 
 def _series(A, B, tau):
