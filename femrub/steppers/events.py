@@ -187,7 +187,9 @@ class EventLocation:
             return None
         if c.casing_heat is not None:
             return None
-        return np.broadcast_to(np.asarray(c.gap0, dtype=float), (c.n,))
+        if getattr(self, "_g0_fixed", None) is None:
+            self._g0_fixed = np.broadcast_to(np.asarray(c.gap0, dtype=float), (c.n,))
+        return self._g0_fixed
 
     def _z_row(self, S, x, u=None) -> np.ndarray:
         """A row ``r`` on the augmented state ``z = [X; P_S; s, …]`` of held set ``S``:
