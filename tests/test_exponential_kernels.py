@@ -126,6 +126,7 @@ def test_first_zero_row_finds_the_first_crossing_as_first_zero_does():
 
 def test_integrals_over_adds_the_series_below_the_levels():
     # ∫ x² dt and ∫ (x, v) dt of the oscillator over k units: levels from lo = 30, series below
+    # (on the Krylov vectors of the state; the A_k, C M^k here only start the levels)
     unit, lo, n_lev = 0.01, 30, 42
     M, Z = _oscillator_levels(unit, n_lev)
     Q, Cr = np.array([[[1.0, 0.0], [0.0, 0.0]]]), np.eye(2)
@@ -139,7 +140,7 @@ def test_integrals_over_adds_the_series_below_the_levels():
     Y = double_integrals(g0.copy(), j0.copy(), np.ascontiguousarray(Z[lo:]), 1e-150)
     z0, k = np.array([1.0, 0.0]), (5 << 36) + 123456789  # 5 units and a few small bits
     T = k * unit * 2.0**-36
-    args = (Y, lo, A.reshape(-1, 2), B.reshape(-1, 2), Z, z0.copy(), k, 1, unit * 2.0**-36)
+    args = (Y, lo, Q, Cr, M, Z, z0.copy(), k, 8, unit * 2.0**-36)
     wq, wl, z = integrals_over(*args, True)
     assert wq[0] == pytest.approx(T / 2 + np.sin(2 * T) / 4, rel=1e-12)
     assert wl == pytest.approx([np.sin(T), np.cos(T) - 1.0], rel=1e-11)

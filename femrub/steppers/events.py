@@ -5,10 +5,13 @@ held contacts sliding with friction (:mod:`~.exponential_friction`) are checked 
 a grid of ``probes`` points per step (probe rows: one product per step,
 :meth:`~femrub.steppers.flows.FlowFamily.probe`); at the first sign change of a gap below
 ``min(g(a), 0)`` (a closing), of a multiplier (a release) or of a slip (a stick) the time is
-found on the exact
-flow by :func:`~femrub.steppers.flows.first_zero` (cubic Hermite start, safeguarded Newton),
-each evaluation composed of cached sub-step flows from the latest state computed before it
-(:meth:`~femrub.steppers.flows.FlowFamily.advance_z`). Event times are exact to ``1e-10 h``.
+found on the exact flow by :func:`~femrub.steppers.flows.first_zero` (cubic Hermite start,
+safeguarded Newton), each evaluation composed of cached sub-step flows from the latest state
+computed before it (:meth:`~femrub.steppers.flows.FlowFamily.advance_z`); an event function
+linear on the augmented state (every one but a closing on a moving or worn casing) in one
+compiled call (:func:`~.exponential_kernels.first_zero_row`). Event times are exact to
+``1e-10 h``. A part step's check rows are one compiled call too
+(:func:`~.exponential_kernels.part_rows`).
 """
 
 from __future__ import annotations

@@ -97,25 +97,38 @@ def compose_integrals(Y, Z, z, k, lo, n_forms):
 
 
 @njit
-def integrals_over(Y, lo, A, B, Z, z, k, n_forms, d_min, state):
+def integrals_over(Y, lo, Q, C, M, Z, z, k, terms, d_min, state):
     """The integrals over ``k`` smallest units ``d_min`` from ``z``: the levels ``e >= lo``
     by :func:`compose_integrals`, the bits below ``lo`` (duration ``d``) by the Taylor series
-    ``Σ_t d^{t+1}/(t+1)! (zᵀ A_t z, B_t z)`` of their coefficients stacked as rows ``A``
-    (terms × n_forms × N, N) and ``B`` (terms × 2, N). Returns ``(w_forms, w_lin, z)``, ``z``
-    at the end of the duration with ``state`` (else at the end of the levels' part)."""
-    wq, wl, z, k = compose_integrals(Y, Z, z, k, lo, n_forms)
+    ``Σ_t d^{t+1}/(t+1)! (zᵀ A_t z, C M^t z)``, ``t < terms``, ``A_t = Σ_j C(t, j) (Mᵀ)^j Q
+    M^{t−j}`` read off the Krylov vectors ``v_j = M^j z`` (``zᵀ A_t z = Σ_j C(t, j) v_jᵀ Q
+    v_{t−j}``: products with the small ``M``, ``Q`` (n_forms, N, N), ``C`` (2, N) only).
+    Returns ``(w_forms, w_lin, z)``, ``z`` at the end of the duration with ``state``
+    (:func:`compose` of the bits below ``lo``), else at the end of the levels' part."""
+    nf = Q.shape[0]
+    wq, wl, z, k = compose_integrals(Y, Z, z, k, lo, nf)
     if k:
         n = z.size
         d = k * d_min
-        az = A @ z
-        bz = B @ z
+        v = np.empty((terms, n))
+        v[0] = z
+        for t in range(1, terms):
+            v[t] = M @ v[t - 1]
+        for f in range(nf):
+            u = v @ Q[f]  # rows u_j = Q v_j (Q symmetric)
+            c = 1.0
+            for t in range(terms):
+                c *= d / (t + 1)
+                acc, b = 0.0, 1.0  # Σ_j C(t, j) v_j · u_{t−j}
+                for j in range(t + 1):
+                    acc += b * (v[j] @ u[t - j])
+                    b = b * (t - j) / (j + 1)
+                wq[f] += c * acc
+        cv = v @ C.T
         c = 1.0
-        for t in range(B.shape[0] // 2):
+        for t in range(terms):
             c *= d / (t + 1)
-            for f in range(n_forms):
-                r = (t * n_forms + f) * n
-                wq[f] += c * (az[r : r + n] @ z)
-            wl += c * bz[2 * t : 2 * t + 2]
+            wl += c * cv[t]
         if state:
             z = compose(Z, z, k)
     return wq, wl, z
@@ -354,8 +367,9 @@ def warm_up() -> None:
     Z = square_levels(np.zeros((2, 2)), 2, 1e-150)
     compose(Z, np.zeros(2), 1)
     compose_integrals(np.zeros((2, 4, 2)), Z, np.zeros(2), 1, 0, 1)
+    q2 = np.zeros((1, 2, 2))
     integrals_over(
-        np.zeros((2, 4, 2)), 1, np.zeros((2, 2)), np.zeros((2, 2)), Z, np.zeros(2), 1, 1, 1.0, True
+        np.zeros((2, 4, 2)), 1, q2, np.zeros((2, 2)), Z[0], Z, np.ones(2), 1, 2, 1.0, True
     )
     double_integrals(np.zeros((1, 2, 2)), np.zeros((2, 2)), Z, 1e-150)
     act, held, w = np.zeros(1, dtype=np.int64), np.zeros(1, dtype=np.bool_), np.zeros(8)

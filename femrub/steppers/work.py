@@ -181,17 +181,17 @@ class WorkIntegrals:
         k = int(rest / unit * 2.0**-LEVEL_MIN * (1.0 + 1e-12)) if rest > 0.0 else 0
         k = min(k, (1 << (lo + len(Y))) - 1)
         # per level from the top bit: [Γ_e z; C J_e z] and Z_e z, the bits below lo by the
-        # series, the state with them (compiled)
-        N = A.shape[-1]
+        # series on the Krylov vectors of z, the state with them (compiled)
         wq, wl, z = integrals_over(
             Y,
             lo,
-            A.reshape(-1, N),
-            B.reshape(-1, N),
+            A[0],
+            B[0],
+            self.flows.generator_z(S),
             self.flows.levels(S, unit),
             np.ascontiguousarray(z, dtype=float),
             k,
-            act.size,
+            _TERMS,
             unit * 2.0**LEVEL_MIN,
             state,
         )
