@@ -87,10 +87,21 @@ class WorkIntegrals:
         self._levels: dict[tuple, tuple] = {}
         self._full: dict[tuple, tuple] = {}
         self._flight: dict[tuple, tuple] = {}
+        #: (S, unit) -> (forms, their base forms, factors): a form proportional to an earlier
+        #: one (the held friction heat and the tangential work of one sliding contact) is
+        #: integrated as that one, times its factor
+        self._alias: dict[tuple, tuple] = {}
 
     def caches(self) -> list[dict]:
-        """The caches keyed by held set (levels, whole-step forms, flight matrices)."""
-        return [self._levels, self._full, self._flight]
+        """The caches keyed by held set (levels, whole-step forms, flight matrices, aliases)."""
+        return [self._levels, self._full, self._flight, self._alias]
+
+    def expand(self, S: tuple, unit: float, w: np.ndarray) -> np.ndarray:
+        """``w`` (NQ + 2,) with the forms proportional to integrated ones filled in (place)."""
+        dst, src, coef = self._alias.get((S, unit), _NO_ALIAS)
+        if dst.size:
+            w[dst] = coef * w[src]
+        return w
 
     # -- forms on the augmented state -----------------------------------------------------------
     def forms(self, S: tuple, M: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -130,6 +141,7 @@ class WorkIntegrals:
             M = self.flows.generator_z(S)
             Q, C = self.forms(S, M)
             act = np.flatnonzero(np.any(Q, axis=(1, 2)))  # forms that are not zero
+            act, self._alias[key] = _proportional(Q, act)
             Q = Q[act]
             # Γ(τ) = Σ τ^{k+1}/(k+1)! A_k, A_{k+1} = Mᵀ A_k + A_k M
             # C J(τ) = Σ τ^{k+1}/(k+1)! C M^k
@@ -197,6 +209,7 @@ class WorkIntegrals:
         )
         w = np.zeros(NQ + 2)
         w[act], w[NQ:] = wq, wl
+        self.expand(S, unit, w)
         return (z, w) if state else w
 
     def step(self, S: tuple, z, q: int, unit: float) -> np.ndarray:
@@ -205,7 +218,7 @@ class WorkIntegrals:
         y, k_q = Y @ z, act.size
         w = np.zeros(NQ + 2)
         w[act], w[NQ:] = y[: k_q * z.size].reshape(k_q, z.size) @ z, y[k_q * z.size :]
-        return w
+        return self.expand(S, unit, w)
 
     def _step_forms(self, S: tuple, q: int, unit: float) -> tuple[np.ndarray, np.ndarray]:
         """``[Γ(h) (non-zero forms); C J(h)]`` stacked, and the forms' indices (cached)."""
@@ -266,7 +279,28 @@ class WorkIntegrals:
         _, act, _, nz = self._flight[(S, unit)]
         out = np.zeros(NQ + 2)
         form_values(y, u, nz, act, out)
-        return out
+        return self.expand(S, unit, out)
+
+
+_NO_ALIAS = (np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64), np.zeros(0))
+
+
+def _proportional(Q: np.ndarray, act: np.ndarray) -> tuple[np.ndarray, tuple]:
+    """The forms of ``act`` to integrate (``Q`` (NQ, N, N)) and ``(dst, src, coef)``: each
+    other form ``dst`` is ``coef`` times the integrated form ``src`` to round-off."""
+    base, dst, src, coef = [], [], [], []
+    for f in act:
+        for b in base:
+            c = float(np.vdot(Q[f], Q[b]) / np.vdot(Q[b], Q[b]))
+            if np.max(np.abs(Q[f] - c * Q[b])) <= 1e-14 * np.max(np.abs(Q[f])):
+                dst.append(f)
+                src.append(b)
+                coef.append(c)
+                break
+        else:
+            base.append(f)
+    alias = (np.array(dst, dtype=np.int64), np.array(src, dtype=np.int64), np.array(coef))
+    return np.array(base, dtype=np.int64), (alias if dst else _NO_ALIAS)
 
 
 def _level_rows(n_forms: int, N: int) -> int:
