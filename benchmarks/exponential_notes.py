@@ -49,13 +49,13 @@ earlier at load 1.4, before the proportional work forms below were integrated on
 the machine's noise of 3×); θ is 3.3× cheaper at 1 % tip temperature and 1.9× at 1 % `u_L2`;
 Carpenter does not reach 1 % at the steps tried (4 % in temperature at 0.2 × its stability
 limit, 6 s). The 3× target is met there at 1 % `u_L2_nodes` only, and only just; not at 1 %
-tip temperature or `u_L2`. This run's cost is mostly the rebuilds of each new slide direction (sub-step
-flows, work integrals, flight matrix: flop-bound dense products) and the Python around its
-events (closings on the moving casing still evaluate the casing's gap in Python in their
-root search). Cut here: the held friction heat of a sliding contact is −η times its
-tangential work, and such proportional forms are now integrated once (three level stacks
-instead of four); 0.041 → 0.036 s at h = 2e-4 s, partly the lower load (A/B under the lock,
-best of 10: 2–5 %).
+tip temperature or `u_L2`. This run's cost is mostly the rebuilds of each new slide
+direction (sub-step flows, work integrals, flight matrix: flop-bound dense products) and the
+Python around its events (closings on the moving casing still evaluate the casing's gap in
+Python in their root search). Cut here: the held friction heat of a sliding contact is −η
+times its tangential work, and such proportional forms are now integrated once (three level
+stacks instead of four); 0.041 → 0.036 s at h = 2e-4 s, partly the lower load (A/B under
+the lock, best of 10: 2–5 %).
 
 The 3× target is not met on the paper case, at any error, and the cost-floor table says why.
 The tip temperature: the exponential stepper reaches 1 % at its coarsest steps (its error does
