@@ -14,18 +14,22 @@ without it. A step without event is one compiled product of a matrix stacked onc
 set (the exact flight, its work integrals and the exact gaps and held multipliers on the
 event check grid, and the check itself: `exponential_kernels.flight`); the dyadic algebra
 (squaring the sub-step flows, composing a flow or its work integrals over any duration,
-doubling the integrals' levels) is compiled too. The event search (root finding, part-step
-grids), the impulses and the load signals stay in Python.
+doubling the integrals' levels) is compiled too, and so are the root search of every event
+function linear on the augmented state (a gap on a casing of constant gap, a held multiplier,
+a slip: `exponential_kernels.first_zero_row`), a part step's check rows (`part_rows`) and its
+work integrals (`integrals_over`); the load polynomials of 64 steps come from one vectorised
+call of the signals. The step's event bookkeeping, the impulses (the LCP), closings on a
+moving casing and the recorder stay in Python.
 
 θ runs each method's best implementation: on the paper case its compiled one-contact blocks
 (`steppers/theta_blocks.py`, a few µs per step); on the blade, whose two frictionless
 contacts on a moving casing have no compiled θ path, per step in Python, so the blade table
 also runs θ's compiled friction blocks on the same model with μ = 1e-9, the fair comparison
 there (slightly less accurate per step than the frictionless path: it needs h = 2.5e-7 s for
-1 % `u_L2`). The exponential stepper reaches 1 % `u_L2_nodes` at h = 1e-4 s, 5.8× cheaper
+1 % `u_L2`). The exponential stepper reaches 1 % `u_L2_nodes` at h = 1e-4 s, 4.4× cheaper
 than that θ, while θ in Python and Carpenter do not reach 1 % at the steps tried; 1 % `u_L2`
 (the interpolant of the output) is not reached at its finest step (1e-5 s: 1.2 %); the tip
-temperature target is not met (θ in Python reaches 1 % at h = 1e-4 s in 7 ms).
+temperature target is not met (θ in Python reaches 1 % at h = 1e-4 s in 6 ms).
 
 With its real Coulomb friction (μ = 0.02, "power" heat, every method on that model) every
 exponential run is now `ok`: held slides follow their slip, one direction per step fixed on
@@ -37,33 +41,56 @@ round-off. The price: each new direction (quantised to 5e-5 rad) rebuilds the he
 flows, probe rows and work integrals, about one per sliding step at coarse steps and about 50
 over the run at 5e-6 s (directions met are kept), and most sliding steps take two passes; the
 runs cost 1.7× (h = 1e-4 s) to 2.8× (5e-6 s) those of the fixed direction (0.03 s and
-0.076 s in the previous measurement). θ's compiled friction blocks have meanwhile become about
-ten times cheaper (1 % tip temperature at h = 5e-6 s in 0.011 s, 1 % displacement at
-2.5e-7 s in 0.12 s), so on this blade the exponential stepper is 2.8× cheaper than θ at 1 %
-`u_L2_nodes` (within 0.6 % at h = 2e-4 s) but θ is 3.8× cheaper at 1 % tip temperature and
-1.9× at 1 % `u_L2`; Carpenter does not reach 1 % at the steps tried (4 % in temperature at
-0.2 × its stability limit, 7 s). The 3× target is not met there.
+0.076 s in an earlier measurement). θ's compiled friction blocks reach 1 % tip temperature
+at h = 5e-6 s in 0.011 s and 1 % displacement at 2.5e-7 s in 0.11 s. The exponential stepper
+reaches 1 % `u_L2_nodes` at h = 2e-4 s (within 0.6 %) in 0.036 s: 3.1× cheaper than θ in this
+measurement, at the edge of the target (2.97× in a run of the same benchmark ten minutes
+earlier at load 1.4, before the proportional work forms below were integrated once: within
+the machine's noise of 3×); θ is 3.3× cheaper at 1 % tip temperature and 1.9× at 1 % `u_L2`;
+Carpenter does not reach 1 % at the steps tried (4 % in temperature at 0.2 × its stability
+limit, 6 s). The 3× target is met there at 1 % `u_L2_nodes` only, and only just; not at 1 %
+tip temperature or `u_L2`. This run's cost is mostly the rebuilds of each new slide
+direction (sub-step flows, work integrals, flight matrix: flop-bound dense products) and the
+Python around its events (closings on the moving casing still evaluate the casing's gap in
+Python in their root search). Cut here: the held friction heat of a sliding contact is −η
+times its tangential work, and such proportional forms are now integrated once (three level
+stacks instead of four); 0.041 → 0.036 s at h = 2e-4 s, partly the lower load (A/B under
+the lock, best of 10: 2–5 %).
 
 The 3× target is not met on the paper case, at any error, and the cost-floor table says why.
-The tip temperature: the exponential stepper reaches 1 % at its coarsest step (its error does
+The tip temperature: the exponential stepper reaches 1 % at its coarsest steps (its error does
 not depend on h: event location, not the step, sets it; without events it is off by 12 % at
-h = 1e-4 s and by 0.6–2× at coarser steps), but there its fixed cost alone (constructor; per
-held set the sub-step flows, probe rows and work integrals) is 4.9× the whole 3× target, and
-its 31 event steps 14×. The paper `u_L2` (h <= 2.5e-4 s, because the error is measured on the
-piecewise-linear interpolant of the output): steps without event (20 µs each), recorder and
-fixed cost already exceed the 3× target, and its 27 event steps cost more than the target by
-themselves. Profiled (cProfile, h = 2.5e-4 s): a step without event is Python around one
-compiled product (the load polynomial, packing the inputs, the step-end checks); an event
-step (about 0.6 ms) splits into the part-step work integrals (`WorkIntegrals.over`, about a
-third), the root search (about four exact-flow evaluations, each composing about 20 dyadic
-levels) and the part-step grids and impulses; the fixed cost is mostly the work integrals'
-levels. Cut here: the probe rows by doubling on the cached levels (3.5× cheaper: 8.8e-4 to
-2.5e-4 s at h = 5e-3 s), no impulse check at a quiet step's end when the grid shows every free
-gap clearly open (compiled), the load signals evaluated on the step's nodes at once; the runs
-moved within the machine's noise. Reaching 3× would need the whole step loop, event search
-included, compiled as θ's blocks are, and a fixed cost five times smaller; not done. A modal
-flow does not apply as such (the augmented generator's load chain is nilpotent, not
-diagonalisable); fewer dyadic levels would coarsen the event times (exact to 1e-10 h now).
+h = 1e-4 s and by 0.6–2× at coarser steps), 0.022 s against θ's 0.0044 s; at h = 5e-3 s its
+fixed cost alone (constructor; per held set the sub-step flows, probe rows and work
+integrals: 6.7 ms) is 4.6× the whole 3× target (1.46 ms) and its 31 event steps (13 ms, about
+0.4 ms per event) 8.8×. The paper `u_L2` (h <= 2.5e-4 s, because the error is measured on the
+piecewise-linear interpolant of the output): 0.029 s against θ's 0.039 s (1.37×; target
+0.0131 s); steps without event (16 µs each, 6.3 ms), recorder (5.9 ms) and fixed cost
+(5.4 ms) together already pass the target, and its 27 event steps (13 ms) cost about the
+target by themselves. At 1 % `u_L2_nodes` the exponential stepper is 1.8× cheaper than θ and
+at 0.1 % tip temperature as cheap (0.022 s both). This measurement's cuts (against the
+previous one at load 1.9–2.4; this one ran at load 1.0–1.4, so part of the difference is the
+load): the root search of every event function linear on the augmented state in one
+compiled call (each evaluation composed from the latest open-side state, as before), a part
+step's check rows and its work integrals in one compiled call each, the series of the work
+integrals below their levels on the Krylov vectors `M^j z` (a per-call pass over the stacked
+Taylor coefficients made the segment integrals memory-bound inside a run), 1.4 MB less fresh
+memory per held set's work integrals on this case (no copy of the level flows in their
+stacks: first-touch page faults of these caches were about half of their cost inside a run),
+the load polynomials of 64 steps at once. Run at h = 5e-3 s: 0.0315 → 0.0233 s (events
+0.020 → 0.013 s); at h = 2.5e-4 s: 0.0378 → 0.0302 s (a step without event 20 → 16 µs, events
+0.017 → 0.013 s); A/B against the previous code under the lock, interleaved at one load
+(1.7–2.6), best of 10: 25–27 ms against 31–33 ms and 33 ms against 37–38 ms. Left: the fixed cost is
+flop-bound dense products (squaring 45 sub-step levels, doubling 16 levels of the work
+integrals' forms, about 40 GFLOP/s on one core here), an event step is still about ten
+Python-level calls around these kernels, and the recorder's per-run `threadpool_limits` (BLAS
+library discovery, 2–3 ms of every method's run, θ's too) is outside this stepper. Reaching
+3× would need the whole step loop, event search and impulses included, compiled as θ's
+blocks are, with a fixed cost five times smaller; not done. A modal flow does not apply as
+such (the augmented generator's load chain is nilpotent, not diagonalisable); fewer dyadic
+levels with a Taylor remainder for the low bits of each duration would first need the
+augmented state balanced (`‖unit M‖₁` is 1e5–6e6 on these models while its spectral radius
+is about 1.6; the event times are exact to 1e-10 h now).
 Without event location (`events = false`) the same stepper is cheap but wrong: an end-of-step
 impulse only stops the tip mass while the rest of the bar flies through the casing for a
 whole step; event location and held contacts are therefore kept. On the free bar impact the

@@ -136,3 +136,23 @@ def test_bad_input():
         fr.ExponentialMoreau(m, 1e-4, load_degree=0)
     with pytest.raises(TypeError):
         fr.ExponentialMoreau("model", 1e-4)
+
+
+def test_load_polynomials_of_a_block_are_those_of_each_step():
+    # the paper bar's sine load takes arrays: BLOCK steps' polynomials come from one call
+    from femrub.steppers.exponential_loads import BLOCK
+
+    st = fr.ExponentialMoreau(fr.bar_model(alpha=3.0), 1e-4)
+    assert all(st._vector) and st._m0 == 1
+    for k in (0, 1, BLOCK - 1, BLOCK, BLOCK + 5):
+        t = st.t0 + k * st.h
+        st._sk = st._signal_values(t)
+        s0 = st._sk.copy()
+        b = st._load_poly(t).copy()
+        assert len(st._blocks) == BLOCK and np.array_equal(st._blocks[t][1], b)  # a block's
+        end = st._sk.copy()
+        st._sk = s0
+        assert b == pytest.approx(st._step_poly(t), rel=1e-14, abs=1e-14)
+        assert end == pytest.approx(st._sk, rel=1e-15, abs=0.0)
+        st._sk = s0  # the same step again (a slide's second pass): the same polynomial
+        assert np.array_equal(st._load_poly(t), b)

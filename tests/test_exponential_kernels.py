@@ -18,11 +18,14 @@ from femrub.steppers.exponential_kernels import (
     compose,
     compose_integrals,
     double_integrals,
+    first_zero_row,
     flight,
+    integrals_over,
     open_end,
     quiet,
     square_levels,
 )
+from femrub.steppers.flows import first_zero
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -72,7 +75,7 @@ def test_doubled_integrals_compose_to_van_loan():
     Y = double_integrals(0.5 * (g0 + g0.T)[None].copy(), j0.copy(), Z, 1e-150)
     z = np.array([1.0, -0.5, 0.2, 0.3])
     k = 45
-    wq, wl, zk, rest = compose_integrals(Y, z.copy(), k, 0, 1)
+    wq, wl, zk, rest = compose_integrals(Y, Z, z.copy(), k, 0, 1)
     T = k * tau  # the reference over the whole duration (Van Loan)
     big[:n, :n], big[:n, n:], big[n:, n:] = -T * M.T, T * Q, T * M
     gT = sla.expm(T * M).T @ sla.expm(big)[:n, n:]
@@ -82,8 +85,67 @@ def test_doubled_integrals_compose_to_van_loan():
     assert wl == pytest.approx(Cr @ sla.expm(bj)[:n, n:] @ z, rel=1e-10)
     assert zk == pytest.approx(sla.expm(T * M) @ z, rel=1e-10)
     # bits below lo are left to the caller
-    *_, rest = compose_integrals(Y[2:], z.copy(), 7, 2, 1)
+    *_, rest = compose_integrals(Y[2:], Z, z.copy(), 7, 2, 1)
     assert rest == 3
+
+
+def _oscillator_levels(unit, count, lo=-36):
+    """``z = [x, v]``, ``ẋ = v, v̇ = −x``: its flows over ``unit 2^e``, e = lo … lo + count − 1."""
+    M = np.array([[0.0, 1.0], [-1.0, 0.0]])
+    return M, square_levels(sla.expm(unit * 2.0**lo * M) - np.eye(2), count, 1e-150)
+
+
+def test_first_zero_row_finds_the_first_crossing_as_first_zero_does():
+    # x = cos t from (1, 0): the row event x − 1/2 first crosses zero at π/3, inside (0, 2]
+    unit, tol = 0.1, 1e-12
+    M, Z = _oscillator_levels(unit, 42)
+    r, c0 = np.array([1.0, 0.0]), -0.5
+    d_min = unit * 2.0**-36
+    found, tau, z = first_zero_row(Z, np.array([1.0, 0.0]), r, r @ M, c0, 0.0, 2.0, tol, d_min)
+    assert found and 0.0 <= tau - np.pi / 3 <= 3 * tol and r @ z + c0 <= 0.0
+    # the state at τ less the remainder below the smallest level (unit 2^-36)
+    assert z == pytest.approx([np.cos(tau), -np.sin(tau)], abs=2 * d_min)
+
+    def at(t):  # the same flow, composed from the start, for the Python iteration
+        zt = compose(Z, np.array([1.0, 0.0]), int(t / d_min * (1.0 + 1e-12)))
+        return zt, None, r @ zt + c0, r @ M @ zt
+
+    x, _, _ = first_zero(at, 0.5, 0.0, 2.0, tol, 0.0)
+    assert tau == pytest.approx(x, abs=2 * tol)
+    # at the surface at lo (f(lo) = 0, opening): the bracket is halved until f > 0 first
+    z0 = np.array([0.5, 0.1])  # x = 1/2 rising: the next crossing is on the way down
+    found, tau, _ = first_zero_row(Z, z0, r, r @ M, c0, 0.0, 2.0, tol, d_min)
+    t_ref = 2.0 * np.arctan2(0.1, 0.5)  # x(t) = 1/2 again: symmetric about the maximum
+    # (each evaluation composed from the latest open-side state drops its remainder below
+    # the smallest level: a few d_min)
+    assert found and tau == pytest.approx(t_ref, abs=3 * tol + 8 * d_min)
+    # no sign change: nothing found
+    found, *_ = first_zero_row(Z, np.array([1.0, 0.0]), r, r @ M, -3.0, 0.0, 2.0, tol, d_min)
+    assert not found
+
+
+def test_integrals_over_adds_the_series_below_the_levels():
+    # ∫ x² dt and ∫ (x, v) dt of the oscillator over k units: levels from lo = 30, series below
+    # (on the Krylov vectors of the state; the A_k, C M^k here only start the levels)
+    unit, lo, n_lev = 0.01, 30, 42
+    M, Z = _oscillator_levels(unit, n_lev)
+    Q, Cr = np.array([[[1.0, 0.0], [0.0, 0.0]]]), np.eye(2)
+    A, B = [Q], [Cr]  # Taylor coefficients A_{k+1} = Mᵀ A_k + A_k M, C M^k (8 terms)
+    for _ in range(7):
+        A.append(M.T @ A[-1] + A[-1] @ M)
+        B.append(B[-1] @ M)
+    A, B = np.stack(A), np.stack(B)
+    c = (unit * 2.0 ** (lo - 36)) ** np.arange(1, 9) / np.cumprod(np.arange(1.0, 9.0))
+    g0, j0 = np.tensordot(c, A, 1), np.tensordot(c, B, 1)
+    Y = double_integrals(g0.copy(), j0.copy(), np.ascontiguousarray(Z[lo:]), 1e-150)
+    z0, k = np.array([1.0, 0.0]), (5 << 36) + 123456789  # 5 units and a few small bits
+    T = k * unit * 2.0**-36
+    args = (Y, lo, Q, Cr, M, Z, z0.copy(), k, 8, unit * 2.0**-36)
+    wq, wl, z = integrals_over(*args, True)
+    assert wq[0] == pytest.approx(T / 2 + np.sin(2 * T) / 4, rel=1e-12)
+    assert wl == pytest.approx([np.sin(T), np.cos(T) - 1.0], rel=1e-11)
+    assert z == pytest.approx([np.cos(T), -np.sin(T)], rel=1e-11)
+    assert integrals_over(*args, False)[2] == pytest.approx(compose(Z, z0, k >> lo << lo))
 
 
 def test_quiet_flags_closings_and_releases_only():
@@ -130,6 +192,7 @@ def test_open_end_reads_the_last_grid_row_of_free_contacts():
 _CHILD = """
 import json, numpy as np, femrub as fr
 from femrub.contact.jit import compiled
+from femrub.steppers.flows import first_zero
 st = fr.ExponentialMoreau(fr.bar_model(alpha=3.0, restitution=0.0), 1e-3)
 r = st.run(0.02)
 print(json.dumps({"jit": compiled(), "status": r.status, "X": st.X.tolist(),

@@ -115,3 +115,20 @@ def test_whole_step_product_matches_the_matrix_exponential(S, measure, h):
         assert np.allclose(rest, W.step(S, z0, q, unit), rtol=1e-10, atol=1e-16)
     else:
         assert rest is None
+
+
+def test_proportional_forms_are_integrated_once():
+    # the held friction heat of one sliding contact is −η times its tangential work
+    from femrub.steppers.work import _proportional
+
+    rng = np.random.default_rng(1)
+    Q = np.zeros((6, 4, 4))
+    Q[1] = rng.standard_normal((4, 4))
+    Q[2] = Q[1] + np.eye(4)  # not proportional
+    Q[4] = rng.standard_normal((4, 4))
+    Q[5] = -0.7 * Q[4]
+    act, (dst, src, coef) = _proportional(Q, np.array([1, 2, 4, 5]))
+    assert act.tolist() == [1, 2, 4] and dst.tolist() == [5] and src.tolist() == [4]
+    assert coef == pytest.approx([-0.7], rel=1e-15)
+    act, (dst, _, _) = _proportional(Q, np.array([1, 2]))
+    assert act.tolist() == [1, 2] and dst.size == 0

@@ -5,10 +5,13 @@ held contacts sliding with friction (:mod:`~.exponential_friction`) are checked 
 a grid of ``probes`` points per step (probe rows: one product per step,
 :meth:`~femrub.steppers.flows.FlowFamily.probe`); at the first sign change of a gap below
 ``min(g(a), 0)`` (a closing), of a multiplier (a release) or of a slip (a stick) the time is
-found on the exact
-flow by :func:`~femrub.steppers.flows.first_zero` (cubic Hermite start, safeguarded Newton),
-each evaluation composed of cached sub-step flows from the latest state computed before it
-(:meth:`~femrub.steppers.flows.FlowFamily.advance_z`). Event times are exact to ``1e-10 h``.
+found on the exact flow by :func:`~femrub.steppers.flows.first_zero` (cubic Hermite start,
+safeguarded Newton), each evaluation composed of cached sub-step flows from the latest state
+computed before it (:meth:`~femrub.steppers.flows.FlowFamily.advance_z`); an event function
+linear on the augmented state (every one but a closing on a moving or worn casing) in one
+compiled call (:func:`~.exponential_kernels.first_zero_row`). Event times are exact to
+``1e-10 h``. A part step's check rows are one compiled call too
+(:func:`~.exponential_kernels.part_rows`).
 """
 
 from __future__ import annotations
@@ -17,8 +20,8 @@ import math
 
 import numpy as np
 
-from .exponential_kernels import quiet
-from .flows import first_zero, shift
+from .exponential_kernels import first_zero_row, part_rows, quiet
+from .flows import LEVEL_MIN, first_zero
 
 __all__ = ["EventLocation"]
 
@@ -54,17 +57,21 @@ class EventLocation:
             closing[list(S)] = False
         elif not closing.any():  # the common case: free flight, nothing closes
             return None
-        cand = []  # (bracket j, kind, contact, f(τ, X) -> (value, d/dτ))
+        # (bracket j, kind, contact, f(τ, X) -> (value, d/dτ), row): ``row = (r, c0)`` when
+        # f is linear on the augmented state, ``f = r·z + c0`` (a compiled root search)
+        cand = []
         lam, c_n = (flows.generator(S)[2], self.model.n_dofs) if S else (None, 0)
+        g0 = self._fixed_gap()
         for i in np.flatnonzero(closing):
             ref = min(gv[0, i], 0.0)
+            row = None if g0 is None else (self._z_row(S, x=c.GT[i]), g0[i] - ref)
 
             def f(tau, X, i=i, ref=ref):
                 rate = c.rate_at(t + tau)[i] if callable(c.gap_rate) else 0.0
                 dX = flows.rate(S, X, self._u(b, tau / h))
                 return c.gap(t + tau, X)[i] - ref, rate + c.GT[i] @ dX
 
-            cand.append((1 + int(np.argmax(f_cl[1:, i] < 0.0)), "closing", int(i), f))
+            cand.append((1 + int(np.argmax(f_cl[1:, i] < 0.0)), "closing", int(i), f, row))
         slides = flows.sliding(S)
         for k in np.flatnonzero(np.any(lv < 0.0, axis=0)):
             j = int(np.argmax(lv[:, k] < 0.0))
@@ -83,7 +90,11 @@ class EventLocation:
                 val = lx @ X + (lu @ u if lu.size else 0.0)
                 return val, lx @ flows.rate(S, X, u) + (lu @ du if lu.size else 0.0)
 
-            cand.append((j, kind, i, f))
+            if k >= n_s:
+                row = (self._z_row(S, x=flows.slip[0][i]), flows.slip[1][i])
+            else:
+                row = (self._z_row(S, x=lam[k, :c_n], u=lam[k, c_n:]), 0.0)
+            cand.append((j, kind, i, f, row))
         if not cand:
             return None
         j = min(x[0] for x in cand)
@@ -95,10 +106,10 @@ class EventLocation:
             states[j - 1] = (Xj, Pk + Pj)
         X0, P0 = states[j - 1]
         best = None
-        for jj, kind, i, f in cand:
+        for jj, kind, i, f, row in cand:
             if jj != j:
                 continue
-            found = self._root(S, f, lo, grid[j], X0, b)
+            found = self._root(S, f, lo, grid[j], X0, b, row)
             if found is not None and (best is None or found[0] < best[0]):
                 best = (*found, kind, i)
         if best is None:
@@ -108,55 +119,34 @@ class EventLocation:
 
     def _part_grid(self, S, Xa, a, Xe, b):
         """The check grid of a part step ``(a, h]``: ``(grid, V, states)``, ``V`` the rows
-        ``[g; λ_S]`` at ``grid`` (probe rows from the first multiple of ``h / probes``,
-        reached with cached sub-step flows), ``states`` the states known on it."""
+        ``[g; λ_S; σ]`` at ``grid`` (``a``, the next multiples of ``h / probes`` (the first
+        reached with cached sub-step flows, the others by probe rows), ``h``; compiled,
+        :func:`~.exponential_kernels.part_rows`), ``states`` the states known on it."""
         c, h, t, flows, q = self.model.contact, self.h, self.t, self._flows, self.probes
-        n_s, d = len(S), h / self.probes
-
-        slides = flows.sliding(S)
-
-        def values(tau, X):
-            g = c.gap(t + tau, X)
-            if not S:
-                return g
-            lam = flows.multiplier(S, X, self._u(b, tau / h))
-            if not slides:
-                return np.concatenate([g, lam])
-            sig = flows.slip[0][list(slides)] @ X + flows.slip[1][list(slides)]
-            return np.concatenate([g, lam, sig])
-
-        # grid: a, the next multiples of d, h; rows of gaps and multipliers on it (blocks)
-        grid, rows, states = [[a]], [values(a, Xa)[None]], {0: (Xa, np.zeros(n_s))}
+        n, n_s, d = self.model.n_dofs, len(S), h / self.probes
         i1 = math.floor(a / d * (1.0 + 1e-12)) + 1  # first grid index after a
+        mid, k1, nj, start = False, 0, 0, 0.0
         if i1 < q:
-            g1 = i1 * d
-            if a > 0.0:  # part step: to the grid with cached sub-step flows
-                X1, P1 = flows.advance(S, Xa, a, g1, b, d)
-                grid.append([g1])
-                rows.append(values(g1, X1)[None])
-                states[1] = (X1, P1)
-            else:
-                X1 = Xa
-            start = g1 if a > 0.0 else 0.0  # the grid start the probe rows run from
+            mid, start = a > 0.0, (i1 * d if a > 0.0 else 0.0)
+            if mid:  # part step: to the grid with cached sub-step flows (as advance_z)
+                k1 = int((start - a) / d * 2.0**-LEVEL_MIN * (1.0 + 1e-12))
             if q - i1 > 1 or a == 0.0:
-                Rx, Rb = flows.probe(S, c.GT, q)
-                nj = q - 1 - (i1 if a > 0.0 else 0)  # probe points before h
-                r = Rx.shape[0] // (q - 1)
-                sig0 = start / h  # the load polynomial re-expanded at the grid start
-                b1 = b if sig0 == 0.0 else self._Dinv @ shift(b, sig0, 1.0)
-                V = Rx[: nj * r] @ X1
-                if Rb.shape[1]:
-                    V += Rb[: nj * r] @ b1.ravel()
-                V = V.reshape(nj, r)
-                taus = start + d * np.arange(1, nj + 1)
-                V[:, : c.n] += c.gap_at(t + taus) if callable(c.gap0) else c.gap0
-                if slides:
-                    V[:, c.n :] += flows.check_offsets(S)
-                grid.append(taus)
-                rows.append(V)
-        grid.append([h])
-        rows.append(values(h, Xe)[None])
-        return np.concatenate(grid), np.concatenate(rows), states
+                nj = q - 1 - (i1 if mid else 0)  # probe points before h
+        R, Rz = flows.check_rows(S, c.GT, q)
+        Z = flows.levels(S, d)
+        k1 = min(k1, (1 << len(Z)) - 1)
+        zero = np.zeros(n_s)
+        za = np.concatenate([Xa, zero, flows.chain(b, a / h)])
+        zh = np.concatenate([Xe, zero, flows.chain(b, 1.0)])
+        V, z1 = part_rows(Z, R, Rz, za, k1, mid, nj, zh)
+        grid = np.concatenate([[a], [start] if mid else [], start + d * np.arange(1, nj + 1), [h]])
+        V[:, : c.n] += c.gap_at(t + grid) if self._fixed_gap() is None else c.gap0
+        if flows.sliding(S):
+            V[:, c.n :] += flows.check_offsets(S)
+        states = {0: (Xa, zero)}
+        if mid:
+            states[1] = (z1[:n], z1[n : n + n_s])
+        return grid, V, states
 
     def _grid_rows(self, S, flow) -> np.ndarray:
         """``R`` (cached per held set): ``R u`` are the rows ``[Gᵀ X; λ_S]`` at
@@ -192,14 +182,47 @@ class EventLocation:
         common case; compiled, :func:`~.exponential_kernels.quiet`)."""
         return quiet(V, self.model.contact.n, self._held(S))
 
-    def _root(self, S, f, lo, hi, X_lo, b):
+    def _fixed_gap(self):
+        """The casing's gaps ``g0`` (n_c,) when they are constant (fixed casing, no wear, no
+        casing heat: a closing is then a row event), else ``None``."""
+        c = self.model.contact
+        if callable(c.gap0) or c.gap_rate is not None or c.wear is not None:
+            return None
+        if c.casing_heat is not None:
+            return None
+        if getattr(self, "_g0_fixed", None) is None:
+            self._g0_fixed = np.broadcast_to(np.asarray(c.gap0, dtype=float), (c.n,))
+        return self._g0_fixed
+
+    def _z_row(self, S, x, u=None) -> np.ndarray:
+        """A row ``r`` on the augmented state ``z = [X; P_S; s, …]`` of held set ``S``:
+        ``r·z = x·X + u·s`` (``s``: the load signals, the chain's first block)."""
+        n, nz = self.model.n_dofs, self.model.n_dofs + len(S)
+        r = np.zeros(self._flows.generator_z(S).shape[0])
+        r[:n] = x
+        if u is not None and u.size:
+            r[nz : nz + u.size] = u
+        return r
+
+    def _root(self, S, f, lo, hi, X_lo, b, row=None):
         """First zero of ``f`` in ``(lo, hi]`` on the exact flow from ``(lo, X_lo)``
         (:func:`~femrub.steppers.flows.first_zero`): ``(τ, X(τ), P_S(lo..τ))`` or ``None``.
         Each evaluation starts from the latest state already computed before it (the open
-        side of the bracket), so Newton's shrinking corrections compose few sub-step flows."""
+        side of the bracket), so Newton's shrinking corrections compose few sub-step flows.
+        A row event ``f = r·z + c0`` (``row = (r, c0)``) is searched in one compiled call
+        (:func:`~.exponential_kernels.first_zero_row`, the same iteration)."""
         h, flows, d = self.h, self._flows, self.h / self.probes
         n, s = self.model.n_dofs, len(S)
-        known = [(lo, np.concatenate([X_lo, np.zeros(s), flows.chain(b, lo / h)]))]
+        z_lo = np.concatenate([X_lo, np.zeros(s), flows.chain(b, lo / h)])
+        if row is not None:
+            r, c0 = row
+            Z = flows.levels(S, d)
+            rM = r @ flows.generator_z(S)
+            found, tau, z = first_zero_row(
+                Z, z_lo, r, rM, float(c0), lo, hi, _XTOL * h, d * 2.0**LEVEL_MIN
+            )
+            return (tau, z[:n], z[n : n + s]) if found else None
+        known = [(lo, z_lo)]
 
         def at(tau):
             t0, z0 = max((k for k in known if k[0] <= tau), key=lambda k: k[0])

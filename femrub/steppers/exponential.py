@@ -310,7 +310,7 @@ class ExponentialMoreau(EventLocation, FrictionalContact, LoadPolynomial, Steppe
         y, V, calm, self._opened = flight(
             F, u, k, q, self._gap_grid(), off, self._held(S), nz, act, integ is not None, works
         )
-        rest = works if integ is not None else None
+        rest = integ.expand(S, self.h / q, works) if integ is not None else None
         return y[:n], y[n:nz], rest, (V if V.size else None), calm
 
     def _held(self, S) -> np.ndarray:

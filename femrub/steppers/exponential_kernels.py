@@ -4,7 +4,7 @@ The exact flows of :mod:`~.flows` over ``unit 2^e`` are built once per held set 
 the increment ``D = Z − I`` of the smallest level (:func:`square_levels`), and a state is
 advanced over any duration ``k unit 2^LEVEL_MIN`` by composing the levels of the binary
 expansion of ``k`` from the top bit down (:func:`compose`); the work integrals of
-:mod:`~.work` compose their stacked level rows ``[Γ_e; C J_e; Z_e]`` the same way
+:mod:`~.work` compose their stacked level rows ``[Γ_e; C J_e]`` the same way
 (:func:`compose_integrals`). A whole step without event is one product of a matrix stacked
 once per held set, its integrals and event check read off it (:func:`flight`). These loops
 are the only implementation of that algebra:
@@ -23,8 +23,12 @@ __all__ = [
     "compose_integrals",
     "double_integrals",
     "flight",
+    "first_zero_row",
     "form_values",
+    "hermite_root",
+    "integrals_over",
     "open_end",
+    "part_rows",
     "quiet",
     "square_levels",
     "warm_up",
@@ -66,10 +70,10 @@ def compose(Z, z, k):
 
 
 @njit
-def compose_integrals(Y, z, k, lo, n_forms):
+def compose_integrals(Y, Z, z, k, lo, n_forms):
     """The integrals over the levels ``e >= lo`` of the binary expansion of ``k`` (top bit
-    first), each level's stacked rows ``Y[e − lo] = [Γ_e (n_forms × N rows); C J_e (2 rows);
-    Z_e (N rows)]`` applied to the state at its start (one product per level)::
+    first), each level's stacked rows ``Y[e − lo] = [Γ_e (n_forms × N rows); C J_e (2 rows)]``
+    and its flow ``Z[e]`` applied to the state at its start::
 
         w_f += z_eᵀ Γ_{e,f} z_e,      w_lin += C J_e z_e,      z_{e+1} = Z_e z_e
 
@@ -86,17 +90,55 @@ def compose_integrals(Y, z, k, lo, n_forms):
             for f in range(n_forms):
                 wq[f] += y[f * n : (f + 1) * n] @ z
             wl += y[kn : kn + 2]
-            z = y[kn + 2 :].copy()
+            z = Z[e] @ z
             k -= 1 << e
         e -= 1
     return wq, wl, z, k
 
 
 @njit
+def integrals_over(Y, lo, Q, C, M, Z, z, k, terms, d_min, state):
+    """The integrals over ``k`` smallest units ``d_min`` from ``z``: the levels ``e >= lo``
+    by :func:`compose_integrals`, the bits below ``lo`` (duration ``d``) by the Taylor series
+    ``Σ_t d^{t+1}/(t+1)! (zᵀ A_t z, C M^t z)``, ``t < terms``, ``A_t = Σ_j C(t, j) (Mᵀ)^j Q
+    M^{t−j}`` read off the Krylov vectors ``v_j = M^j z`` (``zᵀ A_t z = Σ_j C(t, j) v_jᵀ Q
+    v_{t−j}``: products with the small ``M``, ``Q`` (n_forms, N, N), ``C`` (2, N) only).
+    Returns ``(w_forms, w_lin, z)``, ``z`` at the end of the duration with ``state``
+    (:func:`compose` of the bits below ``lo``), else at the end of the levels' part."""
+    nf = Q.shape[0]
+    wq, wl, z, k = compose_integrals(Y, Z, z, k, lo, nf)
+    if k:
+        n = z.size
+        d = k * d_min
+        v = np.empty((terms, n))
+        v[0] = z
+        for t in range(1, terms):
+            v[t] = M @ v[t - 1]
+        for f in range(nf):
+            u = v @ Q[f]  # rows u_j = Q v_j (Q symmetric)
+            c = 1.0
+            for t in range(terms):
+                c *= d / (t + 1)
+                acc, b = 0.0, 1.0  # Σ_j C(t, j) v_j · u_{t−j}
+                for j in range(t + 1):
+                    acc += b * (v[j] @ u[t - j])
+                    b = b * (t - j) / (j + 1)
+                wq[f] += c * acc
+        cv = v @ C.T
+        c = 1.0
+        for t in range(terms):
+            c *= d / (t + 1)
+            wl += c * cv[t]
+        if state:
+            z = compose(Z, z, k)
+    return wq, wl, z
+
+
+@njit
 def double_integrals(g, j, Z, flush):
-    """The stacked rows ``Y[i] = [Γ_i (forms × N rows); C J_i (2 rows); Z_i (N rows)]`` of
-    successive dyadic levels from the integrals of the first, ``g`` (forms, N, N) and ``j``
-    (2, N), and the levels' flows ``Z`` (count, N, N): over ``[0, 2τ] = [0, τ] ∪ [τ, 2τ]``::
+    """The stacked rows ``Y[i] = [Γ_i (forms × N rows); C J_i (2 rows)]`` of successive dyadic
+    levels from the integrals of the first, ``g`` (forms, N, N) and ``j`` (2, N), and the
+    levels' flows ``Z`` (count, N, N): over ``[0, 2τ] = [0, τ] ∪ [τ, 2τ]``::
 
         Γ_{i+1} = Γ_i + Z_iᵀ Γ_i Z_i,        C J_{i+1} = C J_i + C J_i Z_i
 
@@ -105,21 +147,22 @@ def double_integrals(g, j, Z, flush):
     nf, n = g.shape[0], g.shape[1]
     count = Z.shape[0]
     kn = nf * n
-    Y = np.empty((count, kn + 2 + n, n))
+    Y = np.empty((count, kn + 2, n))
     for i in range(count):
         Zi = Z[i]
         for f in range(nf):
             Y[i, f * n : (f + 1) * n] = g[f]
         Y[i, kn : kn + 2] = j
-        Y[i, kn + 2 :] = Zi
-        for r in range(kn + 2 + n):
+        for r in range(kn + 2):
             for c in range(n):
                 if abs(Y[i, r, c]) < flush:
                     Y[i, r, c] = 0.0
-        if i + 1 < count:
+        if i + 1 < count:  # all forms in two products: U_f = Γ_f Z_i, then U_fᵀ Z_i
+            U = g.reshape(nf * n, n) @ Zi
+            V = np.empty((nf * n, n))
             for f in range(nf):
-                gz = np.ascontiguousarray((g[f] @ Zi).T)
-                g[f] = g[f] + gz @ Zi
+                V[f * n : (f + 1) * n] = U[f * n : (f + 1) * n].T
+            g = g + (V @ Zi).reshape(nf, n, n)
             j = j + j @ Zi
     return Y
 
@@ -194,6 +237,128 @@ def flight(F, u, k, q, gap0, off, held, nz, act, measure, works):
     return y, V, calm, calm and open_end(V, n_c, held)
 
 
+@njit
+def part_rows(Z, R, Rz, za, k1, mid, nj, zh):
+    """The check rows of a part step (:meth:`~.events.EventLocation._part_grid`) without the
+    casing's gaps and slip offsets: ``R z`` at its start ``za``, with ``mid`` at the first grid
+    point (``za`` advanced by ``k1`` smallest units, :func:`compose`), ``nj`` probe rows ``Rz``
+    from there, and ``R zh`` at the step end. Returns ``(V (rows, r), z at the grid point)``."""
+    r = R.shape[0]
+    V = np.empty((2 + (1 if mid else 0) + nj, r))
+    V[0] = R @ za
+    i, z1 = 1, za
+    if mid:
+        z1 = compose(Z, za.copy(), k1) if k1 else za.copy()
+        V[1] = R @ z1
+        i = 2
+    if nj > 0:
+        V[i : i + nj] = (Rz[: nj * r] @ z1).reshape(nj, r)
+        i += nj
+    V[i] = R @ zh
+    return V, z1
+
+
+@njit
+def hermite_root(a, fa, dfa, b, fb, dfb):
+    """First guess of the zero in ``(a, b)``: Newton on the cubic Hermite interpolant of
+    ``f`` from its values and slopes at the ends (``fa > 0 > fb``); NaN if it fails."""
+    if fa == fb:
+        return np.nan
+    d = b - a
+    p0, p1, q0, q1 = fa, d * dfa, fb, d * dfb
+    c2, c3 = 3 * (q0 - p0) - 2 * p1 - q1, 2 * (p0 - q0) + p1 + q1
+    s = fa / (fa - fb)  # secant start
+    for _ in range(8):
+        val = p0 + s * (p1 + s * (c2 + s * c3))
+        der = p1 + s * (2 * c2 + 3 * s * c3)
+        if der == 0.0:
+            return np.nan
+        s = min(max(s - val / der, 0.0), 1.0)
+    return a + s * d
+
+
+@njit
+def _at_row(Z, kt, kz, nk, tau, r, rM, c0, d_min):
+    """``(z(τ), f, df/dτ)`` of the row event ``f = r·z + c0`` at ``τ``, ``z`` composed
+    (:func:`compose`) from the latest known state at or before ``τ`` (``kt[:nk]``, ``kz``)."""
+    best = 0
+    for i in range(nk):
+        if kt[i] <= tau and kt[i] >= kt[best]:
+            best = i
+    rest = tau - kt[best]
+    k = int(rest / d_min * (1.0 + 1e-12)) if rest > 0.0 else 0
+    k = min(k, (1 << Z.shape[0]) - 1)
+    z = compose(Z, kz[best].copy(), k) if k else kz[best].copy()
+    return z, r @ z + c0, rM @ z
+
+
+@njit
+def first_zero_row(Z, z_lo, r, rM, c0, lo, hi, tol, d_min):
+    """First zero in ``(lo, hi]`` of the row event ``f(τ) = r·z(τ) + c0`` (``df/dτ =
+    rM·z``, ``rM = Mᵀ r``) on the flow composed of the levels ``Z`` (smallest ``d_min``)
+    from ``z(lo) = z_lo``, by the safeguarded Newton iteration of
+    :func:`~femrub.steppers.flows.first_zero` (cubic Hermite start, Newton from the closed
+    side, regula falsi, bisection; each evaluation from the latest state known on the open
+    side). Returns ``(found, τ, z(τ))`` with ``f(τ) <= 0`` within ``tol`` of the zero."""
+    kt = np.empty(128)
+    kz = np.empty((128, z_lo.size))
+    kt[0], kz[0], nk = lo, z_lo, 1
+    f_lo, df_lo = r @ z_lo + c0, rM @ z_lo
+    if f_lo <= 0.0:  # at the surface at lo: halve the bracket towards lo until f > 0
+        x, ok = hi, False
+        for _ in range(40):
+            x = lo + 0.5 * (x - lo)
+            zx, fx, dfx = _at_row(Z, kt, kz, nk, x, r, rM, c0, d_min)
+            if fx > 0.0:
+                kt[nk], kz[nk], nk, ok = x, zx, nk + 1, True
+                break
+        if not ok:
+            return False, hi, z_lo
+        a, f_a = x, fx
+    else:
+        a, f_a = lo, f_lo
+    x = hi
+    z, fx, dfx = _at_row(Z, kt, kz, nk, x, r, rM, c0, d_min)
+    if fx > 0.0 and nk < kt.size:
+        kt[nk], kz[nk], nk = x, z, nk + 1
+    bt, bz = x, z
+    bh, f_bh, df_bh = hi, fx, dfx
+    width, slow = bh - a, 0
+    for it in range(60):
+        if it == 0 and f_lo > 0.0:
+            x_new = hermite_root(lo, f_lo, df_lo, x, fx, dfx)
+        elif slow >= 3:  # the bracket stopped shrinking: bisection
+            x_new, slow = 0.5 * (a + bh), 0
+        else:
+            x_new = x - fx / dfx if dfx != 0.0 else np.nan
+            if not (a < x_new < bh) and df_bh != 0.0:  # Newton from the closed side
+                x_new = bh - f_bh / df_bh
+        if not (a < x_new < bh):  # outside the bracket: regula falsi, else bisection
+            x_new = a - f_a * (bh - a) / (f_bh - f_a) if f_bh != f_a else np.nan
+            if not (a < x_new < bh):
+                x_new = 0.5 * (a + bh)
+        if abs(x_new - x) <= tol:  # converged
+            if fx > 0.0 and bh - x > tol:  # from the open side: step just past the zero
+                x = min(x + 2.0 * tol, bh)
+                z, fx, dfx = _at_row(Z, kt, kz, nk, x, r, rM, c0, d_min)
+                if fx <= 0.0:
+                    bt, bz = x, z
+            break
+        x = x_new
+        z, fx, dfx = _at_row(Z, kt, kz, nk, x, r, rM, c0, d_min)
+        if fx > 0.0:
+            a, f_a = x, fx
+            if nk < kt.size:
+                kt[nk], kz[nk], nk = x, z, nk + 1
+        else:
+            bh, f_bh, df_bh, bt, bz = x, fx, dfx, x, z
+        if bh - a <= tol:
+            break
+        slow = slow + 1 if bh - a > 0.5 * width else 0
+        width = min(width, bh - a) if slow == 0 else width
+    return True, bt, bz
+
+
 def warm_up() -> None:
     """Compile (or load from the disk cache) the kernels for the argument types of a run,
     before any timed step (nothing is computed that is kept)."""
@@ -201,8 +366,14 @@ def warm_up() -> None:
         return
     Z = square_levels(np.zeros((2, 2)), 2, 1e-150)
     compose(Z, np.zeros(2), 1)
-    compose_integrals(np.zeros((2, 6, 2)), np.zeros(2), 1, 0, 1)
+    compose_integrals(np.zeros((2, 4, 2)), Z, np.zeros(2), 1, 0, 1)
+    q2 = np.zeros((1, 2, 2))
+    integrals_over(
+        np.zeros((2, 4, 2)), 1, q2, np.zeros((2, 2)), Z[0], Z, np.ones(2), 1, 2, 1.0, True
+    )
     double_integrals(np.zeros((1, 2, 2)), np.zeros((2, 2)), Z, 1e-150)
     act, held, w = np.zeros(1, dtype=np.int64), np.zeros(1, dtype=np.bool_), np.zeros(8)
     off = np.zeros(0)
+    part_rows(Z, np.ones((1, 2)), np.ones((2, 2)), np.ones(2), 1, True, 1, np.ones(2))
+    first_zero_row(Z, np.ones(2), np.ones(2), np.ones(2), -3.0, 0.0, 1.0, 1e-3, 0.5)
     flight(np.zeros((10, 2)), np.zeros(2), 6, 1, np.zeros((2, 1)), off, held, 2, act, True, w)

@@ -13,7 +13,10 @@ import math
 
 import numpy as np
 
-__all__ = ["LoadPolynomial"]
+__all__ = ["LoadPolynomial", "BLOCK"]
+
+#: steps whose load polynomials are evaluated at once when every signal takes arrays
+BLOCK = 64
 
 
 class LoadPolynomial:
@@ -25,11 +28,11 @@ class LoadPolynomial:
         self._nodes = 0.5 * (1.0 - np.cos(np.pi * np.arange(p + 1) / max(p, 1)))  # Lobatto
         self._Vinv = np.linalg.inv(self._nodes[:, None] ** np.arange(p + 1))
         self._T01 = np.diag([float(math.factorial(i)) for i in range(p + 1)])
-        self._Dinv = np.linalg.inv(self._T01)
         self._sk = self._signal_values(self.t)
         # signals that take an array of times (checked once against one call per time)
         probe = self.t + self.h * self._nodes[1:]
         self._vector = [_vectorised(sig, probe) for sig in self._signals]
+        self._blocks: dict = {}  # step start time -> (s at it, b, s at its end)
 
     def _signal_values(self, t):
         """Load signals, then the casing's gap rates ``ġ0`` (moving casing, held contacts)."""
@@ -39,7 +42,39 @@ class LoadPolynomial:
         return np.array(s)
 
     def _load_poly(self, t):
-        """Monomial coefficients ``b`` (p+1, m) of the step's load, ``s = Σ b_i σ^i``."""
+        """Monomial coefficients ``b`` (p+1, m) of the step's load, ``s = Σ b_i σ^i``: from
+        the polynomials of :data:`BLOCK` steps evaluated at once (:meth:`_block_polys`) when
+        every signal takes arrays and the step starts where the previous one ended."""
+        if all(self._vector) and not self._n_a:
+            hit = self._blocks.get(t)
+            if hit is None:
+                hit = self._block_polys(t)
+            if hit is not None and np.array_equal(hit[0], self._sk):
+                self._sk = hit[2]
+                return hit[1]
+        return self._step_poly(t)
+
+    def _block_polys(self, t):
+        """The load polynomials of the :data:`BLOCK` steps from ``t`` (a step start
+        ``t0 + k h``, times computed as the stepper's), cached by start time; the entry of
+        ``t``, or ``None`` when ``t`` is not a step start."""
+        h, nodes = self.h, self._nodes
+        k = round((t - self.t0) / h)
+        if self.t0 + k * h != t:
+            return None
+        starts = self.t0 + (k + np.arange(BLOCK)) * h
+        times = starts[:, None] + nodes[1:] * h
+        S = np.empty((BLOCK, nodes.size, self._m0))
+        for j, sig in enumerate(self._signals):
+            S[:, 1:, j] = np.asarray(sig(times.ravel()), dtype=float).reshape(times.shape)
+        S[0, 0] = self._sk
+        S[1:, 0] = S[:-1, -1]
+        b = self._Vinv @ S
+        self._blocks = {float(tk): (S[i, 0], b[i], S[i, -1]) for i, tk in enumerate(starts)}
+        return self._blocks[t]
+
+    def _step_poly(self, t):
+        """:meth:`_load_poly` of one step, its signals evaluated here."""
         h, nodes = self.h, self._nodes
         S = np.empty((nodes.size, self._m0 + self._n_a))
         S[0] = self._sk

@@ -38,7 +38,7 @@ import math
 import numpy as np
 import scipy.linalg as sla
 
-from .exponential_kernels import compose, square_levels
+from .exponential_kernels import compose, hermite_root, square_levels
 
 __all__ = ["Flow", "FlowFamily", "LEVEL_MIN", "held_set", "first_zero", "shift"]
 
@@ -216,7 +216,13 @@ class FlowFamily:
         return self._levels[key]
 
     def generator_z(self, S: tuple) -> np.ndarray:
-        """``M`` of the augmented state ``z = [X; P_S; s, ṡ, …, s^(p)]``: ``ż = M z``."""
+        """``M`` of the augmented state ``z = [X; P_S; s, ṡ, …, s^(p)]``: ``ż = M z`` (cached)."""
+        key = ("M", S)
+        if key not in self._probe:
+            self._probe[key] = self._augmented(S)
+        return self._probe[key]
+
+    def _augmented(self, S: tuple) -> np.ndarray:
         K, E, _ = self.generator(S)
         nz, m, p = K.shape[0], E.shape[1], self.degree
         N = nz + (p + 1) * m
@@ -287,6 +293,13 @@ class FlowFamily:
                 self._probe[key] = (Ex, Eu if Eu.shape[1] else None)
         return self._probe[key]
 
+    def check_rows(self, S: tuple, GT: np.ndarray, q: int) -> tuple[np.ndarray, np.ndarray]:
+        """``(R, Rz)``: the rows of :meth:`probe` on the augmented state ``z`` of
+        :meth:`levels` (loads as the chain's physical derivatives): ``R z`` are the gaps,
+        multipliers and slips at ``z``, ``Rz z`` those at ``j h / q`` later, j = 1 .. q − 1."""
+        self.probe(S, GT, q)
+        return self._probe[("z", S)]
+
     def probe(self, S: tuple, GT: np.ndarray, q: int) -> tuple[np.ndarray, np.ndarray]:
         """Gaps ``Gᵀ X``, held multipliers ``λ_S`` and slips at ``τ_j = j h / q``, j = 1 .. q − 1.
 
@@ -315,27 +328,12 @@ class FlowFamily:
                 Rz = np.vstack([Rz, Rz @ levels[-LEVEL_MIN + e]])
                 e += 1
             Rz = Rz[r : q * r]
+            self._probe[("z", S)] = (R, np.ascontiguousarray(Rz))
             self._probe[S] = (
                 np.ascontiguousarray(Rz[:, :n]),
                 np.ascontiguousarray(Rz[:, nz:] * scale),
             )
         return self._probe[S]
-
-
-def _hermite_root(a, fa, dfa, b, fb, dfb) -> float:
-    """First guess of the zero in ``(a, b)``: Newton on the cubic Hermite interpolant of
-    ``f`` from its values and slopes at the ends (``fa > 0 > fb``); NaN if it fails."""
-    d = b - a
-    p0, p1, q0, q1 = fa, d * dfa, fb, d * dfb
-    c2, c3 = 3 * (q0 - p0) - 2 * p1 - q1, 2 * (p0 - q0) + p1 + q1
-    s = fa / (fa - fb)  # secant start
-    for _ in range(8):
-        val = p0 + s * (p1 + s * (c2 + s * c3))
-        der = p1 + s * (2 * c2 + 3 * s * c3)
-        if der == 0.0:
-            return math.nan
-        s = min(max(s - val / der, 0.0), 1.0)
-    return a + s * d
 
 
 def first_zero(at, f_lo: float, lo: float, hi: float, tol: float, df_lo=None):
@@ -366,7 +364,7 @@ def first_zero(at, f_lo: float, lo: float, hi: float, tol: float, df_lo=None):
     width, slow = bh - a, 0
     for it in range(60):
         if it == 0 and df_lo is not None and f_lo > 0.0:
-            x_new = _hermite_root(lo, f_lo, df_lo, x, fx, dfx)
+            x_new = hermite_root(lo, f_lo, df_lo, x, fx, dfx)
         elif slow >= 3:  # the bracket stopped shrinking: bisection
             x_new, slow = 0.5 * (a + bh), 0
         else:

@@ -32,7 +32,7 @@ import numpy as np
 import scipy.linalg as sla
 import scipy.sparse as sp
 
-from .exponential_kernels import compose, compose_integrals, double_integrals, form_values
+from .exponential_kernels import double_integrals, form_values, integrals_over
 from .flows import _FLUSH, LEVEL_MIN
 
 __all__ = ["QUADRATIC", "LINEAR", "METER_ORDER", "NQ", "WorkIntegrals"]
@@ -87,10 +87,21 @@ class WorkIntegrals:
         self._levels: dict[tuple, tuple] = {}
         self._full: dict[tuple, tuple] = {}
         self._flight: dict[tuple, tuple] = {}
+        #: (S, unit) -> (forms, their base forms, factors): a form proportional to an earlier
+        #: one (the held friction heat and the tangential work of one sliding contact) is
+        #: integrated as that one, times its factor
+        self._alias: dict[tuple, tuple] = {}
 
     def caches(self) -> list[dict]:
-        """The caches keyed by held set (levels, whole-step forms, flight matrices)."""
-        return [self._levels, self._full, self._flight]
+        """The caches keyed by held set (levels, whole-step forms, flight matrices, aliases)."""
+        return [self._levels, self._full, self._flight, self._alias]
+
+    def expand(self, S: tuple, unit: float, w: np.ndarray) -> np.ndarray:
+        """``w`` (NQ + 2,) with the forms proportional to integrated ones filled in (place)."""
+        dst, src, coef = self._alias.get((S, unit), _NO_ALIAS)
+        if dst.size:
+            w[dst] = coef * w[src]
+        return w
 
     # -- forms on the augmented state -----------------------------------------------------------
     def forms(self, S: tuple, M: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -120,33 +131,35 @@ class WorkIntegrals:
 
     def levels(self, S: tuple, unit: float) -> tuple:
         """``(Y, lo, forms, A, B)`` of held set ``S`` (cached): per level ``e >= lo`` of
-        :meth:`~.flows.FlowFamily.levels` the stacked ``[Γ_e; C J_e; Z_e]`` (one product per
-        level in :meth:`over`; ``Γ`` of the non-zero ``forms`` only), and the Taylor
-        coefficients ``A_k, C M^k`` (k < :data:`_TERMS`) that give the integrals over any
-        duration below ``unit 2^lo`` to round-off."""
+        :meth:`~.flows.FlowFamily.levels` the stacked ``[Γ_e; C J_e]`` (one product per level
+        in :meth:`over`, with the level's flow; ``Γ`` of the non-zero ``forms`` only), and the
+        Taylor coefficients ``A_k, C M^k`` (k < :data:`_TERMS`) that give the integrals over
+        any duration below ``unit 2^lo`` to round-off."""
         key = (S, unit)
         if key not in self._levels:
             Z = self.flows.levels(S, unit)
             M = self.flows.generator_z(S)
             Q, C = self.forms(S, M)
             act = np.flatnonzero(np.any(Q, axis=(1, 2)))  # forms that are not zero
+            act, self._alias[key] = _proportional(Q, act)
             Q = Q[act]
             # Γ(τ) = Σ τ^{k+1}/(k+1)! A_k, A_{k+1} = Mᵀ A_k + A_k M
             # C J(τ) = Σ τ^{k+1}/(k+1)! C M^k
-            A, B = [Q], [C]
-            for _ in range(_TERMS - 1):  # A_k symmetric: Mᵀ A_k = (A_k M)ᵀ
-                AM = A[-1] @ M
-                A.append(AM + AM.transpose(0, 2, 1))
-                B.append(B[-1] @ M)
-            A, B = np.stack(A), np.stack(B)
-            size = np.array(
-                [max(np.max(np.abs(a), initial=0.0), np.max(np.abs(b))) for a, b in zip(A, B)]
+            N = M.shape[0]
+            A, B = np.empty((_TERMS, *Q.shape)), np.empty((_TERMS, *C.shape))
+            A[0], B[0] = Q, C
+            for k in range(_TERMS - 1):  # A_k symmetric: Mᵀ A_k = (A_k M)ᵀ (one product)
+                AM = (A[k].reshape(-1, N) @ M).reshape(-1, N, N)
+                np.add(AM, AM.transpose(0, 2, 1), out=A[k + 1])
+                np.matmul(B[k], M, out=B[k + 1])
+            size = np.maximum(
+                np.abs(A).reshape(_TERMS, -1).max(axis=1, initial=0.0),
+                np.abs(B).reshape(_TERMS, -1).max(axis=1),
             )
             tau = unit * 2.0 ** np.arange(LEVEL_MIN, LEVEL_MIN + len(Z))
             # the series' last term is round-off against its first up to level lo - 1
             ok = tau ** (_TERMS - 1) / _FACTORIALS[-1] * size[-1] <= 1e-16 * size[0]
             lo = len(Z) if ok.all() else int(np.argmin(ok))
-            N = M.shape[0]
             Y = np.zeros((0, _level_rows(act.size, N), N))
             if lo < len(Z):  # the first level after the series' range, then doubling
                 g, j = self._van_loan(M, Q, C, tau[0]) if lo == 0 else _series(A, B, tau[lo])
@@ -179,19 +192,25 @@ class WorkIntegrals:
         Y, lo, act, A, B = self.levels(S, unit)
         k = int(rest / unit * 2.0**-LEVEL_MIN * (1.0 + 1e-12)) if rest > 0.0 else 0
         k = min(k, (1 << (lo + len(Y))) - 1)
-        # per level from the top bit: [Γ_e z; C J_e z; Z_e z] in one product (compiled)
-        z = np.ascontiguousarray(z, dtype=float)
-        wq, wl, z, k = compose_integrals(Y, z, k, lo, act.size)
-        if k:
-            d = k * unit * 2.0**LEVEL_MIN
-            c = d ** np.arange(1, _TERMS + 1) / _FACTORIALS
-            wq = wq + c @ ((A @ z) @ z)
-            wl = wl + c @ (B @ z)
+        # per level from the top bit: [Γ_e z; C J_e z] and Z_e z, the bits below lo by the
+        # series on the Krylov vectors of z, the state with them (compiled)
+        wq, wl, z = integrals_over(
+            Y,
+            lo,
+            A[0],
+            B[0],
+            self.flows.generator_z(S),
+            self.flows.levels(S, unit),
+            np.ascontiguousarray(z, dtype=float),
+            k,
+            _TERMS,
+            unit * 2.0**LEVEL_MIN,
+            state,
+        )
         w = np.zeros(NQ + 2)
         w[act], w[NQ:] = wq, wl
-        if not state:
-            return w
-        return (compose(self.flows.levels(S, unit), z, k) if k else z), w
+        self.expand(S, unit, w)
+        return (z, w) if state else w
 
     def step(self, S: tuple, z, q: int, unit: float) -> np.ndarray:
         """The integrals (NQ + 2,) over a whole step ``h = q unit`` from ``z`` (one form each)."""
@@ -199,7 +218,7 @@ class WorkIntegrals:
         y, k_q = Y @ z, act.size
         w = np.zeros(NQ + 2)
         w[act], w[NQ:] = y[: k_q * z.size].reshape(k_q, z.size) @ z, y[k_q * z.size :]
-        return w
+        return self.expand(S, unit, w)
 
     def _step_forms(self, S: tuple, q: int, unit: float) -> tuple[np.ndarray, np.ndarray]:
         """``[Γ(h) (non-zero forms); C J(h)]`` stacked, and the forms' indices (cached)."""
@@ -260,12 +279,33 @@ class WorkIntegrals:
         _, act, _, nz = self._flight[(S, unit)]
         out = np.zeros(NQ + 2)
         form_values(y, u, nz, act, out)
-        return out
+        return self.expand(S, unit, out)
+
+
+_NO_ALIAS = (np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64), np.zeros(0))
+
+
+def _proportional(Q: np.ndarray, act: np.ndarray) -> tuple[np.ndarray, tuple]:
+    """The forms of ``act`` to integrate (``Q`` (NQ, N, N)) and ``(dst, src, coef)``: each
+    other form ``dst`` is ``coef`` times the integrated form ``src`` to round-off."""
+    base, dst, src, coef = [], [], [], []
+    for f in act:
+        for b in base:
+            c = float(np.vdot(Q[f], Q[b]) / np.vdot(Q[b], Q[b]))
+            if np.max(np.abs(Q[f] - c * Q[b])) <= 1e-14 * np.max(np.abs(Q[f])):
+                dst.append(f)
+                src.append(b)
+                coef.append(c)
+                break
+        else:
+            base.append(f)
+    alias = (np.array(dst, dtype=np.int64), np.array(src, dtype=np.int64), np.array(coef))
+    return np.array(base, dtype=np.int64), (alias if dst else _NO_ALIAS)
 
 
 def _level_rows(n_forms: int, N: int) -> int:
-    """Rows of one level's stack ``[Γ_e (n_forms × N); C J_e (2); Z_e (N)]``."""
-    return n_forms * N + 2 + N
+    """Rows of one level's stack ``[Γ_e (n_forms × N); C J_e (2)]``."""
+    return n_forms * N + 2
 
 
 def _series(A, B, tau):
