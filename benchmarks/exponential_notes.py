@@ -26,10 +26,10 @@ moving casing and the recorder stay in Python.
 contacts on a moving casing have no compiled θ path, per step in Python, so the blade table
 also runs θ's compiled friction blocks on the same model with μ = 1e-9, the fair comparison
 there (slightly less accurate per step than the frictionless path: it needs h = 2.5e-7 s for
-1 % `u_L2`). The exponential stepper reaches 1 % `u_L2_nodes` at h = 1e-4 s, 4.4× cheaper
+1 % `u_L2`). The exponential stepper reaches 1 % `u_L2_nodes` at h = 2e-4 s, 6.6× cheaper
 than that θ, while θ in Python and Carpenter do not reach 1 % at the steps tried; 1 % `u_L2`
 (the interpolant of the output) is not reached at its finest step (1e-5 s: 1.2 %); the tip
-temperature target is not met (θ in Python reaches 1 % at h = 1e-4 s in 6 ms).
+temperature target is not met (θ in Python reaches 1 % at h = 1e-4 s in 4.5 ms).
 
 With its real Coulomb friction (μ = 0.02, "power" heat, every method on that model) every
 exponential run is now `ok`: held slides follow their slip, one direction per step fixed on
@@ -42,11 +42,11 @@ flows, probe rows and work integrals, about one per sliding step at coarse steps
 over the run at 5e-6 s (directions met are kept), and most sliding steps take two passes; the
 runs cost 1.7× (h = 1e-4 s) to 2.8× (5e-6 s) those of the fixed direction (0.03 s and
 0.076 s in an earlier measurement). θ's compiled friction blocks reach 1 % tip temperature
-at h = 5e-6 s in 0.011 s and 1 % displacement at 2.5e-7 s in 0.11 s. The exponential stepper
-reaches 1 % `u_L2_nodes` at h = 2e-4 s (within 0.6 %) in 0.036 s: 3.1× cheaper than θ in this
-measurement, at the edge of the target (2.97× in a run of the same benchmark ten minutes
-earlier at load 1.4, before the proportional work forms below were integrated once: within
-the machine's noise of 3×); θ is 3.3× cheaper at 1 % tip temperature and 1.9× at 1 % `u_L2`;
+at h = 5e-6 s in 0.0091 s and 1 % displacement at 2.5e-7 s in 0.115 s. The exponential
+stepper reaches 1 % `u_L2_nodes` at h = 2e-4 s (within 0.6 %) in 0.036 s: 3.2× cheaper than
+θ (best of 5 runs each; four single-timing runs of this benchmark gave 2.97–3.24×, the
+first before the proportional work forms below were integrated once); θ is 4.0× cheaper at
+1 % tip temperature and 1.8× at 1 % `u_L2`;
 Carpenter does not reach 1 % at the steps tried (4 % in temperature at 0.2 × its stability
 limit, 6 s). The 3× target is met there at 1 % `u_L2_nodes` only, and only just; not at 1 %
 tip temperature or `u_L2`. This run's cost is mostly the rebuilds of each new slide
@@ -58,39 +58,41 @@ stacks instead of four); 0.041 → 0.036 s at h = 2e-4 s, partly the lower load 
 the lock, best of 10: 2–5 %).
 
 The 3× target is not met on the paper case, at any error, and the cost-floor table says why.
-The tip temperature: the exponential stepper reaches 1 % at its coarsest steps (its error does
-not depend on h: event location, not the step, sets it; without events it is off by 12 % at
-h = 1e-4 s and by 0.6–2× at coarser steps), 0.022 s against θ's 0.0044 s; at h = 5e-3 s its
-fixed cost alone (constructor; per held set the sub-step flows, probe rows and work
-integrals: 6.7 ms) is 4.6× the whole 3× target (1.46 ms) and its 31 event steps (13 ms, about
-0.4 ms per event) 8.8×. The paper `u_L2` (h <= 2.5e-4 s, because the error is measured on the
-piecewise-linear interpolant of the output): 0.029 s against θ's 0.039 s (1.37×; target
-0.0131 s); steps without event (16 µs each, 6.3 ms), recorder (5.9 ms) and fixed cost
-(5.4 ms) together already pass the target, and its 27 event steps (13 ms) cost about the
-target by themselves. At 1 % `u_L2_nodes` the exponential stepper is 1.8× cheaper than θ and
-at 0.1 % tip temperature as cheap (0.022 s both). This measurement's cuts (against the
-previous one at load 1.9–2.4; this one ran at load 1.0–1.4, so part of the difference is the
-load): the root search of every event function linear on the augmented state in one
-compiled call (each evaluation composed from the latest open-side state, as before), a part
-step's check rows and its work integrals in one compiled call each, the series of the work
-integrals below their levels on the Krylov vectors `M^j z` (a per-call pass over the stacked
-Taylor coefficients made the segment integrals memory-bound inside a run), 1.4 MB less fresh
-memory per held set's work integrals on this case (no copy of the level flows in their
-stacks: first-touch page faults of these caches were about half of their cost inside a run),
-the load polynomials of 64 steps at once. Run at h = 5e-3 s: 0.0315 → 0.0233 s (events
-0.020 → 0.013 s); at h = 2.5e-4 s: 0.0378 → 0.0302 s (a step without event 20 → 16 µs, events
-0.017 → 0.013 s); A/B against the previous code under the lock, interleaved at one load
-(1.7–2.6), best of 10: 25–27 ms against 31–33 ms and 33 ms against 37–38 ms. Left: the fixed cost is
-flop-bound dense products (squaring 45 sub-step levels, doubling 16 levels of the work
-integrals' forms, about 40 GFLOP/s on one core here), an event step is still about ten
-Python-level calls around these kernels, and the recorder's per-run `threadpool_limits` (BLAS
-library discovery, 2–3 ms of every method's run, θ's too) is outside this stepper. Reaching
-3× would need the whole step loop, event search and impulses included, compiled as θ's
-blocks are, with a fixed cost five times smaller; not done. A modal flow does not apply as
-such (the augmented generator's load chain is nilpotent, not diagonalisable); fewer dyadic
-levels with a Taylor remainder for the low bits of each duration would first need the
-augmented state balanced (`‖unit M‖₁` is 1e5–6e6 on these models while its spectral radius
-is about 1.6; the event times are exact to 1e-10 h now).
+The tip temperature: the exponential stepper reaches 1 % at its coarsest steps (its error
+does not depend on h: event location, not the step, sets it; without events it is off by 12
+% at h = 1e-4 s and by 0.6–2× at coarser steps), 0.020 s against θ's 0.0017 s; at h = 5e-3 s
+its fixed cost alone (constructor; per held set the sub-step flows, probe rows and work
+integrals: 7.5 ms) is 13× the whole 3× target (0.56 ms) and its 31 event steps (14 ms, about
+0.45 ms per event) 25×. The paper `u_L2` (h <= 2.5e-4 s, because the error is measured on
+the piecewise-linear interpolant of the output): 0.028 s against θ's 0.037 s (1.33×; target
+0.0124 s); steps without event (17 µs each, 6.6 ms), recorder (4.1 ms) and fixed cost (5.7
+ms) together already pass the target, and its 27 event steps (14.5 ms) cost more than the
+target by themselves. At 1 % `u_L2_nodes` the exponential stepper is 1.9× cheaper than θ and
+at 0.1 % tip temperature as cheap (0.020 s both). The cuts of the previous measurement
+(single timings, against the one before at load 1.9–2.4; that one ran at load 1.0–1.4, so
+part of the difference is the load): the root search of every event function linear on the
+augmented state in one compiled call (each evaluation composed from the latest open-side
+state, as before), a part step's check rows and its work integrals in one compiled call
+each, the series of the work integrals below their levels on the Krylov vectors `M^j z` (a
+per-call pass over the stacked Taylor coefficients made the segment integrals memory-bound
+inside a run), 1.4 MB less fresh memory per held set's work integrals on this case (no copy
+of the level flows in their stacks: first-touch page faults of these caches were about half
+of their cost inside a run), the load polynomials of 64 steps at once. Run at h = 5e-3 s:
+0.0315 → 0.0233 s (events 0.020 → 0.013 s); at h = 2.5e-4 s: 0.0378 → 0.0302 s (a step
+without event 20 → 16 µs, events 0.017 → 0.013 s); A/B against the previous code under the
+lock, interleaved at one load (1.7–2.6), best of 10: 25–27 ms against 31–33 ms and 33 ms
+against 37–38 ms. Left: the fixed cost is flop-bound dense products (squaring 45 sub-step
+levels, doubling 16 levels of the work integrals' forms, about 40 GFLOP/s on one core here)
+and an event step is still about ten Python-level calls around these kernels. The recorder's
+BLAS library discovery (2–3 ms of every method's run) is gone since (one controller per
+process, `femrub/blas.py`): it made θ's cheapest paper runs about 2.4 ms cheaper and the
+paper targets further away. Reaching 3× would need the whole step loop, event search and
+impulses included, compiled as θ's blocks are, with a fixed cost five times smaller; not
+done. A modal flow does not apply as such (the augmented generator's load chain is
+nilpotent, not diagonalisable); fewer dyadic levels with a Taylor remainder for the low bits
+of each duration would first need the augmented state balanced (`‖unit M‖₁` is 1e5–6e6 on
+these models while its spectral radius is about 1.6; the event times are exact to 1e-10 h
+now).
 Without event location (`events = false`) the same stepper is cheap but wrong: an end-of-step
 impulse only stops the tip mass while the rest of the bar flies through the casing for a
 whole step; event location and held contacts are therefore kept. On the free bar impact the

@@ -227,7 +227,8 @@ def _level_rows(rows, keys, levels, others=("θ paper", "Carpenter")):
 def section(doc) -> str:
     """Section 6 of docs/performance.md (rendered by run_all.py from exponential_section.md)."""
     lines = [
-        f"Measured by `python benchmarks/exponential.py` (one BLAS thread for every method; "
+        "Measured by `python benchmarks/exponential.py` (one BLAS thread for every method; "
+        "a run under 0.5 s CPU: the best of 5; "
         f"load average {doc['machine']['load_average']} at the start, "
         f"{doc['machine'].get('load_average_end', '?')} at the end; every run: "
         "[performance/exponential.md](performance/exponential.md), data "
