@@ -402,3 +402,28 @@ def test_steppers_of_one_coated_model_each_start_on_a_fresh_coating(tmp_path):
     a.step()  # a's first step: the coating is started afresh for it
     with pytest.raises(RuntimeError, match="one after the other"):
         b.step()
+
+
+def test_contacts_reading_a_coating_at_points_are_warned_with_their_width(tmp_path):
+    """Several contacts with ``footprint = 0`` (point reads, whose later-revolution wear
+    keeps changing with the map): a warning names the width each contact stands for (their
+    span around the casing over their number less one); one contact, or a footprint, none."""
+    from test_rub_blocks import SCENE as BLADE
+
+    from femrub.app.casing import footprint_warning
+    from femrub.app.simulation import build
+
+    scene = load_scene("twisted-naca", BLADE)
+    with pytest.warns(UserWarning, match="contact.abradable.footprint = 0"):
+        sim = build(scene, stepper=False)
+    grid = sim.full.contact.wear.grid
+    phi = np.sort(np.mod(grid.angles, 2 * np.pi))
+    assert grid.angles.size > 1 and phi[-1] - phi[0] < np.pi  # one blade's tip: no wrap
+    width = (phi[-1] - phi[0]) / (np.unique(phi).size - 1) * grid.radius
+    (msg,) = [w for w in sim.report["warnings"] if "footprint" in w]
+    assert f"about {1e3 * width:.3g} mm" in msg
+    grid.footprint = width
+    assert footprint_warning(scene, grid) is None
+    path = tmp_path / "bar.toml"
+    path.write_text(SCENE.format(e=50e-6))  # one contact
+    assert "warnings" not in build(load_scene(str(path)), stepper=False).report

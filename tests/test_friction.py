@@ -215,16 +215,16 @@ def test_energy_and_heat_balance_close_on_a_full_blade_model(monkeypatch):
 
 
 def test_contacts_starting_inside_the_casing_warn_by_how_much():
-    from femrub.app.simulation import _initial_penetration
+    from femrub.app.build_warnings import initial_penetration, warn
 
     model = block_model()
     model.contact.gap0 = np.array([-3e-6])
     report = {}
     with pytest.warns(UserWarning, match=r"1 of 1 contacts start inside the casing.*3 um"):
-        _initial_penetration(model, report, None)
+        warn(initial_penetration(model), report)
     assert "3 um" in report["warnings"][0]
     model.contact.gap0 = np.array([1e-6])
-    _initial_penetration(model, report := {}, None)
+    warn(initial_penetration(model), report := {})
     assert "warnings" not in report
 
 

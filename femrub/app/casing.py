@@ -10,7 +10,7 @@ from ..contact.abradable import Abradable, CasingGrid
 from ..contact.casing_heat import CasingHeat
 from ..scene.spec import fail
 
-__all__ = ["abradable_of", "casing_grid", "casing_heat_of"]
+__all__ = ["abradable_of", "casing_grid", "casing_heat_of", "footprint_warning"]
 
 
 def casing_grid(scene, blade, points, omega, growth):
@@ -32,6 +32,25 @@ def abradable_of(scene, grid):
     if grid is None or a["thickness"] <= 0.0:
         return None
     return Abradable(a["thickness"], a["yield"], grid)
+
+
+def footprint_warning(scene, grid) -> str | None:
+    """A one-line warning when several contacts read a coating at points
+    (``contact.abradable.footprint = 0``), naming the width each stands for: their span
+    around the casing (the shortest arc holding them all) over their number less one."""
+    if grid is None or scene["contact"]["abradable"]["thickness"] <= 0.0 or grid.footprint:
+        return None
+    phi = np.unique(np.mod(grid.angles, 2 * np.pi))
+    if phi.size < 2:
+        return None
+    span = 2 * np.pi - np.diff(np.r_[phi, phi[0] + 2 * np.pi]).max()
+    width = span / (phi.size - 1) * grid.radius
+    return (
+        f"contact.abradable.footprint = 0: each of the {grid.angles.size} contacts reads the "
+        "coating at a point, so the wear of later revolutions keeps changing with "
+        "contact.abradable.n_angle (docs/abradable.md); set it to the tip width a contact "
+        f"stands for, about {1e3 * width:.3g} mm here"
+    )
 
 
 def casing_heat_of(scene, grid, eta, alpha, mu):

@@ -23,7 +23,6 @@ the model a second time. The paper's bar and a 3D blade go through the same path
 from __future__ import annotations
 
 import time
-import warnings
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -37,8 +36,9 @@ from ..model.rub import rub_model, tip_load
 from ..scene.spec import SceneError, fail
 from . import translate as tr
 from .blade import load_blade
+from .build_warnings import initial_penetration, warn
 from .cached import Stages
-from .casing import abradable_of, casing_grid, casing_heat_of
+from .casing import abradable_of, casing_grid, casing_heat_of, footprint_warning
 from .explain import explain
 from .scheme import bare_stepper, stepper_of
 from .step_check import check_step
@@ -243,7 +243,8 @@ def _build(scene, log, modes, stages, with_stepper=True) -> Simulation:
             damping=damping or None,
         )  # fmt: skip
         report["friction"] = {"mu": mu, "heat_law": law, "heat_partition": eta}
-        _initial_penetration(full, report, log)
+        warn(initial_penetration(full), report, log)
+        warn(footprint_warning(scene, grid), report, log)
     except ValueError as exc:  # a value the schema cannot see (e.g. a singular clamp)
         if isinstance(exc, SceneError):
             raise
@@ -355,26 +356,6 @@ def _select_signals(scene, model, report, size):
     report["limits"], report["ignored"] = kept_limits, ignored
     report["limits_default"] = sorted(defaults)
     return model.with_(observations=obs), kept_limits
-
-
-def _initial_penetration(model, report, log) -> None:
-    """Warn when contacts start inside the casing (negative gap at t = 0), and by how much."""
-    c = model.contact
-    if c is None:
-        return
-    g = np.asarray(c.gap_at(0.0), dtype=float)
-    inside = np.flatnonzero(g < 0.0)
-    if not inside.size:
-        return
-    msg = (
-        f"{inside.size} of {c.n} contacts start inside the casing at t = 0, by up to "
-        f"{-g.min() * 1e6:.3g} um ({', '.join(c.names[i] for i in inside[:4])}"
-        f"{', ...' if inside.size > 4 else ''}): the first steps push them out"
-    )
-    report.setdefault("warnings", []).append(msg)
-    warnings.warn(msg, stacklevel=3)
-    if log:
-        log(f"warning: {msg}")
 
 
 def _contacts_report(points, reach) -> dict:
