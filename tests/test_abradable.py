@@ -424,6 +424,10 @@ def test_contacts_reading_a_coating_at_points_are_warned_with_their_width(tmp_pa
     assert f"about {1e3 * width:.3g} mm" in msg
     grid.footprint = width
     assert footprint_warning(scene, grid) is None
+    with pytest.warns(UserWarning, match="footprint"):  # summary.json lists it first
+        run_scene(scene, tmp_path / "blade")
+    summary = json.loads((tmp_path / "blade" / "summary.json").read_text())
+    assert "contact.abradable.footprint = 0" in summary["warnings"][0]
     path = tmp_path / "bar.toml"
     path.write_text(SCENE.format(e=50e-6))  # one contact
     assert "warnings" not in build(load_scene(str(path)), stepper=False).report

@@ -267,7 +267,7 @@ def _finish(
         max_contact_temperature=_max_or_none(res.signals.get("contact_temperature")),
         energy_error=res.energy_error(),
         heat_error=res.heat_error(),
-        warnings=list(res.warnings),
+        warnings=[*doc["inputs"].get("build", {}).get("warnings", []), *res.warnings],
         units=res.units(),
         energy={k: float(v[-1]) for k, v in e.items()} if e else {},
         vtk=str(series.pvd_path.relative_to(out)) if series is not None else None,
