@@ -259,6 +259,28 @@ def part_rows(Z, R, Rz, za, k1, mid, nj, zh):
 
 
 @njit
+def next_iterate(hermite, lo, f_lo, df_lo, x, fx, dfx, a, f_a, bh, f_bh, df_bh, slow):
+    """The next iterate ``(x_new, slow)`` of the safeguarded Newton search for the first zero
+    of a gap-like function (``flows.first_zero``, :func:`first_zero_row`): the cubic Hermite
+    root between ``lo`` and ``x`` on the first iteration from an open start (``hermite``),
+    bisection once the bracket ``(a, bh)`` stopped shrinking (``slow >= 3``), else Newton at
+    ``x`` or from the closed side ``bh``; outside the bracket regula falsi, else bisection."""
+    if hermite and f_lo > 0.0:
+        x_new = hermite_root(lo, f_lo, df_lo, x, fx, dfx)
+    elif slow >= 3:  # the bracket stopped shrinking: bisection
+        x_new, slow = 0.5 * (a + bh), 0
+    else:
+        x_new = x - fx / dfx if dfx != 0.0 else np.nan
+        if not (a < x_new < bh) and df_bh != 0.0:  # Newton from the closed side
+            x_new = bh - f_bh / df_bh
+    if not (a < x_new < bh):  # outside the bracket: regula falsi, else bisection
+        x_new = a - f_a * (bh - a) / (f_bh - f_a) if f_bh != f_a else np.nan
+        if not (a < x_new < bh):
+            x_new = 0.5 * (a + bh)
+    return x_new, slow
+
+
+@njit
 def hermite_root(a, fa, dfa, b, fb, dfb):
     """First guess of the zero in ``(a, b)``: Newton on the cubic Hermite interpolant of
     ``f`` from its values and slopes at the ends (``fa > 0 > fb``); NaN if it fails."""
@@ -325,18 +347,8 @@ def first_zero_row(Z, z_lo, r, rM, c0, lo, hi, tol, d_min):
     bh, f_bh, df_bh = hi, fx, dfx
     width, slow = bh - a, 0
     for it in range(60):
-        if it == 0 and f_lo > 0.0:
-            x_new = hermite_root(lo, f_lo, df_lo, x, fx, dfx)
-        elif slow >= 3:  # the bracket stopped shrinking: bisection
-            x_new, slow = 0.5 * (a + bh), 0
-        else:
-            x_new = x - fx / dfx if dfx != 0.0 else np.nan
-            if not (a < x_new < bh) and df_bh != 0.0:  # Newton from the closed side
-                x_new = bh - f_bh / df_bh
-        if not (a < x_new < bh):  # outside the bracket: regula falsi, else bisection
-            x_new = a - f_a * (bh - a) / (f_bh - f_a) if f_bh != f_a else np.nan
-            if not (a < x_new < bh):
-                x_new = 0.5 * (a + bh)
+        x_new, slow = next_iterate(it == 0, lo, f_lo, df_lo, x, fx, dfx, a, f_a, bh, f_bh,
+                                   df_bh, slow)  # fmt: skip
         if abs(x_new - x) <= tol:  # converged
             if fx > 0.0 and bh - x > tol:  # from the open side: step just past the zero
                 x = min(x + 2.0 * tol, bh)
@@ -376,4 +388,5 @@ def warm_up() -> None:
     off = np.zeros(0)
     part_rows(Z, np.ones((1, 2)), np.ones((2, 2)), np.ones(2), 1, True, 1, np.ones(2))
     first_zero_row(Z, np.ones(2), np.ones(2), np.ones(2), -3.0, 0.0, 1.0, 1e-3, 0.5)
+    next_iterate(True, 0.0, 1.0, -1.0, 1.0, -1.0, -1.0, 0.0, 1.0, 1.0, -1.0, -1.0, 0)
     flight(np.zeros((10, 2)), np.zeros(2), 6, 1, np.zeros((2, 1)), off, held, 2, act, True, w)

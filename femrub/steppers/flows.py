@@ -38,7 +38,7 @@ import math
 import numpy as np
 import scipy.linalg as sla
 
-from .exponential_kernels import compose, hermite_root, square_levels
+from .exponential_kernels import compose, next_iterate, square_levels
 
 __all__ = ["Flow", "FlowFamily", "LEVEL_MIN", "held_set", "first_zero", "shift"]
 
@@ -362,19 +362,12 @@ def first_zero(at, f_lo: float, lo: float, hi: float, tol: float, df_lo=None):
     X, P, fx, dfx = at(x)
     best, bh, f_bh, df_bh = (x, X, P), hi, fx, dfx
     width, slow = bh - a, 0
+    hermite = df_lo is not None
     for it in range(60):
-        if it == 0 and df_lo is not None and f_lo > 0.0:
-            x_new = hermite_root(lo, f_lo, df_lo, x, fx, dfx)
-        elif slow >= 3:  # the bracket stopped shrinking: bisection
-            x_new, slow = 0.5 * (a + bh), 0
-        else:
-            x_new = x - fx / dfx if dfx != 0.0 else np.nan
-            if not (a < x_new < bh) and df_bh != 0.0:  # Newton from the closed side
-                x_new = bh - f_bh / df_bh
-        if not (a < x_new < bh):  # outside the bracket: regula falsi, else bisection
-            x_new = a - f_a * (bh - a) / (f_bh - f_a)
-            if not (a < x_new < bh):
-                x_new = 0.5 * (a + bh)
+        x_new, slow = next_iterate(it == 0 and hermite, float(lo), float(f_lo),
+                                   float(df_lo) if hermite else 0.0, float(x), float(fx),
+                                   float(dfx), float(a), float(f_a), float(bh), float(f_bh),
+                                   float(df_bh), slow)  # fmt: skip
         if abs(x_new - x) <= tol:  # converged
             if fx > 0.0 and bh - x > tol:  # from the open side: step just past the zero
                 x = min(x + 2.0 * tol, bh)
