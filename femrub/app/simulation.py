@@ -272,10 +272,12 @@ def _build(scene, log, modes, stages, with_stepper=True) -> Simulation:
         clock.exclude(ran[1])
     clock.done("reduction", f"{reduced.n_dofs} dofs")
     if scene["scheme"]["step_check"]:
-        given = chosen and chosen.pop()  # compared only, unless it is the run: kept whole
-        given = given and (given[0] if ran is not None else given[0].lean(), given[2])
+        given = None  # the estimate's run: compared only, unless it is the run (kept whole)
+        if chosen:
+            res, _, states = chosen.pop()
+            given = (res if ran is not None else res.lean(), states)
         report["time_step"], run_h, wall_h = check_step(
-            scene, reduced, full, lambda m, h: bare_stepper(scene, m, h), limits, run=given or None
+            scene, reduced, full, lambda m, h: bare_stepper(scene, m, h), limits, run=given
         )  # fmt: skip
         if ran is None and wall_h is not None and reusable_run(model):
             ran = (run_h[0], wall_h)  # the check stepped the run itself
