@@ -57,17 +57,12 @@ def coarsen(res, factor: int):
     rows = slice(0, n * factor + 1, factor)
     impulse = res.impulse[1 : n * factor + 1].reshape(n, factor, -1).sum(axis=1)
     return dataclasses.replace(
-        res,
+        res.lean(),
         h=res.h * factor,
         t=res.t[rows].copy(),
         impulse=np.vstack([res.impulse[:1], impulse]),
         gap=res.gap[rows].copy(),
         signals={k: v[rows].copy() for k, v in res.signals.items()},
-        energy={},
-        friction_force=None,
-        slip_velocity=None,
-        contact_state=None,
-        extra={},
     )
 
 
