@@ -22,8 +22,12 @@ Four studies, one command (``python benchmarks/exponential.py [--quick]``):
 Every method runs with one BLAS thread (``threadpoolctl``): on these small dense systems more
 threads only add spinning worker threads to the process's CPU time.
 
-Writes docs/performance/exponential.{md,json,png} and prints the tables. The floor study is
-in ``exponential_floor.py``, the tables and notes in ``exponential_report.py``.
+* ``floor`` (``exponential_floor.py``): where an exponential run's CPU goes;
+* ``bound`` (``exponential_bound.py``): the least cost of the exponential stepper against the
+  3× target at 1 % tip temperature (after the studies whose rows it reads).
+
+Writes docs/performance/exponential.{md,json,png} and prints the tables; the tables and notes
+are in ``exponential_report.py``.
 """
 
 from __future__ import annotations
@@ -41,10 +45,12 @@ import femrub as fr
 
 try:
     from . import _common as C
+    from .exponential_bound import bound
     from .exponential_floor import floor, frictionless
     from .exponential_report import THETA_BLOCKS, cheapest, markdown, plot, section
 except ImportError:  # run as a script
     import _common as C
+    from exponential_bound import bound
     from exponential_floor import floor, frictionless
     from exponential_report import THETA_BLOCKS, cheapest, markdown, plot, section
 
@@ -330,6 +336,15 @@ def _blade_rows(runs, T, t_ref, u_ref, T_ref, log) -> list[dict]:
     return rows
 
 
+def _nan(x):
+    """``x`` read back from JSON: its nulls are the NaNs :func:`_common.write_json` wrote."""
+    if isinstance(x, dict):
+        return {k: _nan(v) for k, v in x.items()}
+    if isinstance(x, list):
+        return [_nan(v) for v in x]
+    return math.nan if x is None else x
+
+
 def main(argv=None) -> dict:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--quick", action="store_true")
@@ -347,11 +362,12 @@ def main(argv=None) -> dict:
     }
     name = "exponential_quick" if args.quick and args.out is None else "exponential"
     out = (args.out or C.OUT) / name
+    old = {}
     if args.skip and out.with_suffix(".json").exists():  # keep the studies not rerun
         import json
 
         old = json.loads(out.with_suffix(".json").read_text())
-        doc = {**{k: v for k, v in old.items() if k in args.skip}, **doc}
+        doc = {**{k: _nan(v) for k, v in old.items() if k in args.skip}, **doc}
         # the 1-minute load (start, end) of the run each kept study was measured in
         kept = old.get("study_load", {})
         doc["study_load"] = {k: v for k, v in kept.items() if k in args.skip and k in doc}
@@ -365,6 +381,7 @@ def main(argv=None) -> dict:
         ("blade", blade),
         ("blade_friction", blade_friction),
         ("floor", floor),
+        ("bound", lambda cfg, log: bound(cfg, log, doc)),
     ):
         if name not in args.skip:
             load0 = C.machine()["load_average"]
@@ -372,6 +389,8 @@ def main(argv=None) -> dict:
                 doc[name] = fn(cfg, log)
             doc.setdefault("study_load", {})[name] = [load0, C.machine()["load_average"]]
     doc["machine"]["load_average_end"] = C.machine()["load_average"]
+    if old and set(doc.get("study_load", {})) <= set(args.skip):
+        doc["machine"] = old["machine"]  # nothing measured: the tables are re-rendered only
     out.parent.mkdir(parents=True, exist_ok=True)
     C.write_json(out.with_suffix(".json"), doc)
     out.with_suffix(".md").write_text(markdown(doc))

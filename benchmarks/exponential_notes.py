@@ -93,6 +93,22 @@ nilpotent, not diagonalisable); fewer dyadic levels with a Taylor remainder for 
 of each duration would first need the augmented state balanced (`‖unit M‖₁` is 1e5–6e6 on
 these models while its spectral radius is about 1.6; the event times are exact to 1e-10 h
 now).
+
+Why the paper target at 1 % tip temperature is out of reach (the least-cost table): θ's
+cheapest run there is 100 steps of its compiled blocks, 1.69 ms: 0.56 ms its constructor,
+0.35 ms its steps and 0.69 ms the rest of a run (recorder, energy meter, verdict), code every
+stepper runs. A third of θ's run (0.56 ms) is less than that shared rest alone, so as the code
+stands no stepper, however cheap its steps, is 3× cheaper than θ there (in the four runs of
+this study made on 2026-11-24 the shared rest was 0.69–1.09 ms, a third of θ's run
+0.56–1.0 ms). Making the shared rest cheaper makes θ's run cheaper as much; were it free for
+both, the exponential's whole run would have to cost at most (s + N k)/3 = 0.31 ms, and the
+two augmented exponentials of its held sets (free flight and held tip, 66 coordinates, at
+least 11 products each) take 0.26 ms of that at this machine's product speed (0.55 ms with
+SciPy), leaving 44 µs for its factorisation, 50 steps, 31 located events with their impulses
+and its exact energy integrals, which cost 22 ms today (500× that). On the blades the bound
+does not exclude the target (the exponentials take at most 15 % of the budget as the code
+stands); there the gap is the Python around events and, with friction, the rebuilds per
+slide direction.
 Without event location (`events = false`) the same stepper is cheap but wrong: an end-of-step
 impulse only stops the tip mass while the rest of the bar flies through the casing for a
 whole step; event location and held contacts are therefore kept. On the free bar impact the
