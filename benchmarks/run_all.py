@@ -22,8 +22,10 @@ from pathlib import Path
 
 try:
     from . import _common as C
+    from .performance_notes import COST_3D_NOTES, HARD_NOTES, MEASURES, SICONOS_HISTORY
 except ImportError:  # run as a script
     import _common as C
+    from performance_notes import COST_3D_NOTES, HARD_NOTES, MEASURES, SICONOS_HISTORY
 
 STUDIES = ("work_precision", "siconos_compare", "hard_cases", "cost_3d", "exponential")
 JSON = {
@@ -33,96 +35,6 @@ JSON = {
     "cost_3d": "cost_3d",
     "exponential": "exponential",
 }
-
-COST_3D_NOTES = """\
-Box blades (gmsh, vector P2 displacement + P1 temperature, 8 tip contacts, lobed casing,
-thermal coupling on), reduced to n_uv = n_θ = 20 (`benchmarks/cost_3d.py`; each size in a
-fresh process). The full model is stepped only while its sparse factorisation stays
-affordable; above a few 1e4 dofs the reduction is the way to run.
-
-**Bottlenecks found and removed** (measured on the NASA Rotor 37 blade, 96,255 P2
-displacement dofs, and on the 10,000-node bar):
-
-1. *Stiffness assembly* used the mass matrix's quadrature (order 4) for the P2 gradients:
-   51.5 s. The lowest exact rule (order 2 for P2 on straight tetrahedra, also exact for the
-   P1×P2 coupling) gives the same matrix in 14.5 s.
-2. *Sparse factorisation* of the 3D stiffness (damping eigen-solve, the reduction's static
-   shapes and shift-invert modes): SuperLU took 155 s (COLAMD) or 107 s (minimum degree on
-   AᵀA); MKL Pardiso (optional extra `femrub[fast]`) takes 14.5 s. Per-step solves stay on
-   SuperLU (Pardiso's per-call overhead: 3.7 ms against 0.26 ms on the bar).
-3. *Per-step overhead*: one BLAS thread always, chunked post-processing of observations and
-   energy (also with a VTK callback: 977 → 362 µs/step on the twisted-blade scene, the rest
-   being the VTK writing itself).
-
-What still dominates: the reduction's static shapes when the frictional heat is spread
-over many tip vertices (each is a thermal boundary dof: 134 on Rotor 37)."""
-
-MEASURES = """\
-Errors are measured on the tip of the bar against a reference (section 2):
-
-* **u L2**: time-L2 relative error of the tip displacement,
-  `sqrt(∫ (u − u_ref)² dt / ∫ u_ref² dt)`, the coarse solution interpolated linearly onto the
-  reference time grid; **u max**: `max |u − u_ref| / max |u_ref|`;
-* **T end**: relative error of the tip temperature rise at the end of the window;
-* **P phase**: largest error of the impulse of one contact phase (N s, summed over the steps
-  of a load period, `2π/Ω` = 30 ms: the paper case has one contact phase per period; the
-  impact case has one phase), divided by the largest reference phase impulse;
-* **t1**: absolute error (s) of the first-contact time, the end `t_k` of the first step
-  carrying an impulse above 1e-6 of the largest one (resolution: one step).
-
-CPU = `time.process_time()` of building the stepper and `run()` with the energy balance on
-(what a user runs); the offline cost of a reduction is listed apart."""
-
-
-HARD_NOTES = """\
-### Findings
-
-**Coarse steps (h = 5e-3 s: 6 steps per load period).** Table below: tip temperature at
-0.4 s over its value at h = 1e-6 s; 1/W, the effective mass of the impact law (inverse
-Delassus operator); the share of the impulse given in steps that end with the gap open by
-more than 1 µm. With the *paper* rule impulses and frictional heat are about 10× the
-fine-step values even without coupling, and the coupled run reaches the 1500 K stop (a
-numerical runaway); the *predicted* (Moreau–Jean) rule activates the contact in about one
-step out of 80 and under-predicts by orders of magnitude. Numerical damping (γ > 1/2)
-cures neither (paper rule 6–11×, predicted rule between 0 and 4×). Mechanism, read from
-the runs: the paper rule activates a contact when the *free* step would end inside the
-casing; the impulse then cancels the approach velocity at the end of the step
-(velocity-level law, e = 0), which at this step size freezes the tip where it was, up to
-tens of µm away from the casing. No consistent active set exists (closing leaves the gap
-open, opening closes it) and, by design (`ThetaMethod` docstring), the impulse is kept. At
-5e-3 s all of the paper rule's impulse is given at an open gap (none at the fine step), and
-each impulse is large: a step is quasi-static (ω₁h ≈ 15), so 1/W approaches (hγ)² EA/L:
-2.3 kg at γ = 1/2, 9.2 kg at γ = 1, for a bar of 0.1 kg. The frictional heat α P follows
-the impulses. The predicted rule tests `g_k + γ h ġ_k`, which at this step almost never
-sees the crossing: the tip sits a few µm inside the casing with almost no impulse. At
-h = 5e-4 s the paper rule is within +5 % on the temperature (10–12 % of its impulse already
-at an open gap), while its peak force shows the paper's "slight underestimation" (27 N
-against 46 N at 1e-6 s, where the force is a Dirac-like spike): the paper's "large steps
-underestimate" holds for the force, not for impulses and heat at 5e-3 s. Practical limit
-on this case: h ≤ 5e-4 s (60 steps per load period) with the paper rule; the predicted
-rule is already −44 % (uncoupled) to −71 % (coupled) there. A cure to investigate (not
-tried here): at a crossing step without a consistent active set, scale the impulse by the
-fraction of the step after the crossing instead of keeping all of it.
-
-**Stiff heat equation.** With grading 3 the tip elements are tiny (1.4 µm at 60 elements,
-38 nm at 200) and their thermal modes are stiff (Carpenter's explicit limit in the table:
-nanoseconds). With the physical coupling the θ-method is bounded and converged for both
-γ_θ = 1/2 and 1 (table: tip temperature within a few per cent between h = 1e-4 and
-2.5e-5 s). A first version of this case used the paper's coupling `K^uθ = β K^uu` and ran
-away to 1500 K with kN forces in 30 ms; the cause is the model, not the scheme: β K^uu
-expands each node by −β θ whatever its element size, so one hot micrometre-long tip element
-pushes the tip tens of µm into a 15 µm gap (and refining makes it worse). The energy
-balance closed, so the status could not flag it; femrub now refuses `coupling="paper"` on
-a graded bar. `gamma_thermal` (γ of the heat rows, e.g. 1 for backward Euler) is available
-for stiff heat equations.
-
-**Other cases** (table above). e = 1 without load: mechanical energy constant to about
-1e-10 over ~400 impacts; e = 0 and 0.5: no step increases the energy beyond round-off.
-α = 7 m/s: every scheme stops "diverged-physically" at 0.21 s with closed balances. Grazing
-and chattering: penetration 0.1–3 µm at h = 1e-4 s and ten times less at 1e-5 s; the
-contact work of a step is never positive beyond round-off. Twenty contacts:
-up to 16 active in one step (Lemke). Carpenter 2 % above its limit: blow-up detected after
-a few dozen steps, status "unstable", results kept."""
 
 
 def _load(out: Path, study: str):
@@ -235,6 +147,7 @@ def _siconos_section(sc) -> str:
             f"* `femrub paper` (all figures, {w['runs']} rows): **{w['wall']:.1f} s** wall, "
             f"{w['cpu']:.1f} s CPU, peak resident memory **{w['peak_rss_mib']:.0f} MiB**."
         )
+    parts.append("### Earlier runs\n\n" + SICONOS_HISTORY)
     return "\n\n".join(parts)
 
 
