@@ -38,9 +38,11 @@ import femrub as fr
 
 try:
     from . import _common as C
+    from .exponential_floor import _best
     from .exponential_report import OTHERS, THETA_BLOCKS, cheapest
 except ImportError:  # run as a script
     import _common as C
+    from exponential_floor import _best
     from exponential_report import OTHERS, THETA_BLOCKS, cheapest
 
 #: calls timed per measure (their least CPU is kept)
@@ -53,16 +55,6 @@ PADE = {
     9: (5, 2.097847961257068),
     13: (6, 5.371920351148152),
 }
-
-
-def _least(f, n=REPEATS) -> float:
-    """Least CPU time (s) of ``n`` calls of ``f``."""
-    out = math.inf
-    for _ in range(n):
-        c0 = time.process_time()
-        f()
-        out = min(out, time.process_time() - c0)
-    return out
 
 
 def _run_only(make, T, n=REPEATS) -> float:
@@ -96,11 +88,11 @@ def _exponentials(model, h, T) -> dict:
         hM = h * flows.generator_z(S)
         nz = hM.shape[0]
         a = np.random.default_rng(0).standard_normal((nz, nz))
-        product = _least(lambda a=a: a @ a, 10 * REPEATS)
+        product = _best(lambda a=a: a @ a, 10 * REPEATS)
         n_products.append(products(float(np.max(np.abs(np.linalg.eigvals(hM))))))
-        scipy_s += _least(lambda hM=hM: sl.expm(hM))
+        scipy_s += _best(lambda hM=hM: sl.expm(hM))
         ideal += n_products[-1] * product
-    return {"exp_run": _least(lambda: fr.ExponentialMoreau(model, h).run(T)),
+    return {"exp_run": _best(lambda: fr.ExponentialMoreau(model, h).run(T)),
             "held_sets": len(sets), "n_z": nz, "products": ", ".join(map(str, n_products)),
             "expm": scipy_s, "ideal": ideal}  # fmt: skip
 
@@ -116,8 +108,8 @@ def _case(name, model, rows, makers, T, log) -> dict | None:
     make = makers[other["method"]]
     h, hx = other["h"], best["exponential"]["h"]
     N = int(round(T / h))
-    c = _least(lambda: make(h).run(T))
-    s = _least(lambda: make(h))
+    c = _best(lambda: make(h).run(T))
+    s = _best(lambda: make(h))
     r1, rN = _run_only(lambda: make(h), h), _run_only(lambda: make(h), T)
     k = (rN - r1) / (N - 1)
     x = r1 - k

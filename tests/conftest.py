@@ -1,3 +1,4 @@
+import importlib.util
 import os
 import sys
 from pathlib import Path
@@ -37,3 +38,22 @@ def shared_data() -> Path:
     if not path.is_dir():
         pytest.skip(f"reference data not found at {path} (set FEMRUB_SHARED_DATA)")
     return path
+
+
+@pytest.fixture(scope="session")
+def load_benchmark():
+    """``name -> module``: ``benchmarks/<name>.py`` imported by path (its folder on
+    ``sys.path`` while it loads, for its sibling imports)."""
+    bench = ROOT / "benchmarks"
+
+    def load(name):
+        sys.path.insert(0, str(bench))
+        try:
+            spec = importlib.util.spec_from_file_location(name, bench / f"{name}.py")
+            mod = importlib.util.module_from_spec(spec)
+            spec.loader.exec_module(mod)
+        finally:
+            sys.path.remove(str(bench))
+        return mod
+
+    return load

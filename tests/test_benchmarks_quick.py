@@ -1,14 +1,9 @@
 """The work–precision study runs on tiny settings and writes a complete, finite table."""
 
-import importlib.util
 import json
 import math
-import sys
-from pathlib import Path
 
 import pytest
-
-BENCH = Path(__file__).resolve().parents[1] / "benchmarks"
 
 TINY = {
     "t_paper": 0.012,
@@ -28,15 +23,8 @@ TINY = {
 
 
 @pytest.fixture(scope="module")
-def wp():
-    sys.path.insert(0, str(BENCH))
-    try:
-        spec = importlib.util.spec_from_file_location("work_precision", BENCH / "work_precision.py")
-        mod = importlib.util.module_from_spec(spec)
-        spec.loader.exec_module(mod)
-    finally:
-        sys.path.remove(str(BENCH))
-    return mod
+def wp(load_benchmark):
+    return load_benchmark("work_precision")
 
 
 def test_quick_settings_cover_every_method(wp):

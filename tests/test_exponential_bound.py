@@ -1,26 +1,11 @@
 """The least-cost study of the exponential stepper (benchmarks/exponential_bound.py)."""
 
-import importlib.util
-import sys
-from pathlib import Path
-
 import pytest
-
-BENCH = Path(__file__).resolve().parents[1] / "benchmarks"
 
 
 @pytest.fixture(scope="module")
-def eb():
-    sys.path.insert(0, str(BENCH))
-    try:
-        spec = importlib.util.spec_from_file_location(
-            "exponential_bound", BENCH / "exponential_bound.py"
-        )
-        mod = importlib.util.module_from_spec(spec)
-        spec.loader.exec_module(mod)
-    finally:
-        sys.path.remove(str(BENCH))
-    return mod
+def eb(load_benchmark):
+    return load_benchmark("exponential_bound")
 
 
 @pytest.mark.parametrize(
