@@ -34,7 +34,7 @@ def test_bound_on_the_paper_bar(eb):
         {"method": "exponential", "h": 1e-3, "cpu": 2.0, "T_end": 0.02},  # not within 1 %
     ]
     makers = {"θ paper": lambda h: fr.ThetaMethod(model, h)}
-    row = eb._case("paper", model, rows, makers, 0.01, log=lambda s: None)
+    row = eb._case("paper", model, rows, makers, 0.01, lambda s: None, "cheapest within 1 %")
     assert row["other"] == "θ paper" and row["steps"] == 10 and row["exp_h"] == 2e-3
     assert row["budget_free"] == pytest.approx((row["constructor"] + row["stepping"]) / 3)
     assert row["budget_now"] == pytest.approx(row["run"] / 3 - row["shared"])
@@ -42,4 +42,17 @@ def test_bound_on_the_paper_bar(eb):
     assert 0 < row["ideal"] and 0 < row["expm"] and row["exp_run"] > 0
     assert row["verdict"] in ("infeasible", "infeasible as the code stands", "not excluded")
     # no exponential run within 1 %: no row
-    assert eb._case("paper", model, rows[::2], makers, 0.01, log=lambda s: None) is None
+    none = eb._case("paper", model, rows[::2], makers, 0.01, lambda s: None, "cheapest within 1 %")
+    assert none is None
+
+
+def test_steady_reading_skips_a_lucky_coarse_step(load_benchmark):
+    """θ within 1 % at 1e-3 s, above it at 2e-4 s, within it below: the steady run is 1e-4."""
+    report = load_benchmark("exponential_report")
+    rows = [
+        {"method": "θ paper", "h": h, "cpu": 1 / h, "T_end": e}
+        for h, e in ((1e-3, 0.009), (2e-4, 0.012), (1e-4, 0.006), (5e-5, 0.001))
+    ]
+    assert report.cheapest(rows, "T_end", 0.01)["θ paper"]["h"] == 1e-3
+    assert report.steadily(rows, "T_end", 0.01)["θ paper"]["h"] == 1e-4
+    assert report.steadily(rows[:2], "T_end", 0.01) == {}
