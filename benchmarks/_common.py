@@ -203,6 +203,19 @@ def md_table(rows: list[dict], cols: list[tuple[str, str]]) -> str:
     return "\n".join(out)
 
 
+def read_json(path: Path):
+    """A document :func:`write_json` wrote: its nulls back to the NaNs they were."""
+
+    def nan(x):
+        if isinstance(x, dict):
+            return {k: nan(v) for k, v in x.items()}
+        if isinstance(x, list):
+            return [nan(v) for v in x]
+        return math.nan if x is None else x
+
+    return nan(json.loads(Path(path).read_text()))
+
+
 def write_json(path: Path, doc) -> Path:
     """Write ``doc`` as indented JSON (NaN as null)."""
 

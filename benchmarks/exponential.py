@@ -23,11 +23,9 @@ Every method runs with one BLAS thread (``threadpoolctl``): on these small dense
 threads only add spinning worker threads to the process's CPU time.
 
 * ``floor`` (``exponential_floor.py``): where an exponential run's CPU goes;
-* ``bound`` (``exponential_bound.py``): the least cost of the exponential stepper against the
-  3× target at 1 % tip temperature (after the studies whose rows it reads).
+* ``bound`` (``exponential_bound.py``): the exponential stepper's least cost at 1 % tip temperature.
 
-Writes docs/performance/exponential.{md,json,png} and prints the tables; the tables and notes
-are in ``exponential_report.py``.
+Writes docs/performance/exponential.{md,json,png} (tables, notes: ``exponential_report.py``).
 """
 
 from __future__ import annotations
@@ -47,12 +45,14 @@ try:
     from . import _common as C
     from .exponential_bound import bound
     from .exponential_floor import floor, frictionless
-    from .exponential_report import THETA_BLOCKS, cheapest, markdown, plot, section
+    from .exponential_levels import THETA_BLOCKS, cheapest
+    from .exponential_report import markdown, plot, section
 except ImportError:  # run as a script
     import _common as C
     from exponential_bound import bound
     from exponential_floor import floor, frictionless
-    from exponential_report import THETA_BLOCKS, cheapest, markdown, plot, section
+    from exponential_levels import THETA_BLOCKS, cheapest
+    from exponential_report import markdown, plot, section
 
 FULL = {
     "t_acc": 0.4,
@@ -336,15 +336,6 @@ def _blade_rows(runs, T, t_ref, u_ref, T_ref, log) -> list[dict]:
     return rows
 
 
-def _nan(x):
-    """``x`` read back from JSON: its nulls are the NaNs :func:`_common.write_json` wrote."""
-    if isinstance(x, dict):
-        return {k: _nan(v) for k, v in x.items()}
-    if isinstance(x, list):
-        return [_nan(v) for v in x]
-    return math.nan if x is None else x
-
-
 def main(argv=None) -> dict:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--quick", action="store_true")
@@ -364,10 +355,8 @@ def main(argv=None) -> dict:
     out = (args.out or C.OUT) / name
     old = {}
     if args.skip and out.with_suffix(".json").exists():  # keep the studies not rerun
-        import json
-
-        old = json.loads(out.with_suffix(".json").read_text())
-        doc = {**{k: _nan(v) for k, v in old.items() if k in args.skip}, **doc}
+        old = C.read_json(out.with_suffix(".json"))
+        doc = {**{k: v for k, v in old.items() if k in args.skip}, **doc}
         # the 1-minute load (start, end) of the run each kept study was measured in
         kept = old.get("study_load", {})
         doc["study_load"] = {k: v for k, v in kept.items() if k in args.skip and k in doc}

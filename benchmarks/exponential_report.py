@@ -6,39 +6,14 @@ import math
 
 try:
     from . import _common as C
+    from .exponential_bound import BOUND_COLS, BOUND_TEXT
+    from .exponential_levels import OTHERS, TARGET, THETA_BLOCKS, cheapest
     from .exponential_notes import NOTES
 except ImportError:  # run as a script
     import _common as C
+    from exponential_bound import BOUND_COLS, BOUND_TEXT
+    from exponential_levels import OTHERS, TARGET, THETA_BLOCKS, cheapest
     from exponential_notes import NOTES
-
-
-TARGET = 3.0  # the issue's target: 3x cheaper than both θ and Carpenter at 1 %
-#: the blade's θ on its compiled friction blocks, μ = 1e-9 (benchmarks/exponential.py::blade)
-THETA_BLOCKS = "θ compiled (μ = 1e-9)"
-OTHERS = ("θ paper", THETA_BLOCKS, "Carpenter")
-
-
-def cheapest(rows, key, level):
-    """Per method: the cheapest run with ``key <= level``."""
-    out = {}
-    for r in rows:
-        if r[key] <= level and (r["method"] not in out or r["cpu"] < out[r["method"]]["cpu"]):
-            out[r["method"]] = r
-    return out
-
-
-def steadily(rows, key, level):
-    """Per method: its run at the coarsest step from which every finer step of the method
-    is within ``level`` (where the error does not fall monotonically with the step, the
-    cheapest run within ``level`` may be a lucky one; this one is not)."""
-    out = {}
-    for method in dict.fromkeys(r["method"] for r in rows):
-        runs = sorted((r for r in rows if r["method"] == method), key=lambda r: r["h"])
-        for r in runs:  # finest first: stop at the first step above the level
-            if not (r.get(key) is not None and r[key] <= level):
-                break
-            out[method] = r
-    return out
 
 
 def plot(wp, path):
@@ -161,33 +136,9 @@ def markdown(doc) -> str:
     if doc.get("bound"):
         out += [
             "\n## Least cost against the 3× target at 1 % tip temperature (CPU s)\n",
-            C.md_table(doc["bound"], _BOUND_COLS),
+            C.md_table(doc["bound"], BOUND_COLS),
         ]
     return "\n".join(out) + "\n"
-
-
-_BOUND_COLS = [
-    ("case", "case"),
-    ("reading", "run at 1 %"),
-    ("other", "best other"),
-    ("h", "its h (s)"),
-    ("steps", "steps"),
-    ("error", "its error"),
-    ("run", "its run c"),
-    ("constructor", "constructor s"),
-    ("stepping", "steps N k"),
-    ("shared", "rest of a run x"),
-    ("budget_now", "c/3 − x"),
-    ("budget_free", "(s + N k)/3"),
-    ("exp_h", "exponential h (s)"),
-    ("exp_run", "its run"),
-    ("held_sets", "held sets"),
-    ("n_z", "n_z"),
-    ("products", "least products"),
-    ("expm", "expm (SciPy)"),
-    ("ideal", "least products × product"),
-    ("verdict", "3× target"),
-]
 
 
 _FLOOR_COLS = [
@@ -373,22 +324,8 @@ def section(doc) -> str:
         ]
     if doc.get("bound"):
         lines += [
-            "**Least cost against the 3× target at 1 % tip temperature** "
-            "(`benchmarks/exponential_bound.py`; CPU s, least of 20 calls). The best other "
-            "method's run at 1 % (`c`; read two ways: its cheapest run within 1 %, and its run at"
-            " the coarsest step from which every finer step is within 1 %, since θ's error in tip"
-            " temperature does not fall monotonically with the step) is split into its "
-            "constructor `s`, its `N` steps (`k` from runs of 1 and `N` steps) and the rest of a "
-            "run `x` (recorder, energy meter, verdict: the same code for every stepper). The "
-            "target asks the exponential run to cost at most `c/3`; it pays `x` too and, at the "
-            "least, one exponential of the augmented generator `h M_S` per held set it meets: its"
-            " budget is `c/3 − x` as the code stands and at most `(s + N k)/3` were the shared "
-            "part free for both methods. Those exponentials measured by SciPy's `expm` and by the"
-            " least count of products any scaling-and-squaring Padé exponential needs on a "
-            "balanced matrix (Higham 2005) times one product's CPU. `infeasible`: even the least "
-            "products exceed `(s + N k)/3`; `infeasible as the code stands`: the budget `c/3 − x`"
-            " is below SciPy's exponentials (negative: below zero, for any stepper):",
-            C.md_table(doc["bound"], _BOUND_COLS),
+            BOUND_TEXT,
+            C.md_table(doc["bound"], BOUND_COLS),
         ]
     if "impact" in doc:
         lines += [

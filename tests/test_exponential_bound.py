@@ -48,7 +48,7 @@ def test_bound_on_the_paper_bar(eb):
 
 def test_steady_reading_skips_a_lucky_coarse_step(load_benchmark):
     """θ within 1 % at 1e-3 s, above it at 2e-4 s, within it below: the steady run is 1e-4."""
-    report = load_benchmark("exponential_report")
+    report = load_benchmark("exponential_levels")
     rows = [
         {"method": "θ paper", "h": h, "cpu": 1 / h, "T_end": e}
         for h, e in ((1e-3, 0.009), (2e-4, 0.012), (1e-4, 0.006), (5e-5, 0.001))
