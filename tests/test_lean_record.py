@@ -186,3 +186,31 @@ def test_the_step_check_and_the_estimate_are_those_of_whole_records(blade, monke
         _recorded_whole(mp, est)
         whole = estimate()
     assert estimate() == whole and whole["status_reference"] == "ok"
+
+
+@pytest.mark.parametrize("lean", [0, 1])
+def test_rows_a_step_leaves_unwritten_stay_zero_across_chunks(monkeypatch, lean):
+    """The per-step buffers are reused chunk after chunk: a step without friction rows
+    (or works) reads as zeros, not as the row a previous chunk left there."""
+    from femrub.output.recorder import Recorder
+
+    monkeypatch.setattr("femrub.output.recorder.CHUNK_STEPS", 4)
+    model = fr.bar_model(alpha=3.0)
+    n, k = 11, iter(range(1, 12))
+    st = fr.ThetaMethod(model, 1e-4)
+
+    def advance():  # friction rows on odd steps only
+        i = next(k)
+        info = {"heat": np.array([float(i)]), "state": np.array([1])} if i % 2 else None
+        return i * 1e-4, model.x0, np.zeros(1), info
+
+    rec = Recorder(model, 1e-4, n, scheme="test", stability_limit=np.inf, energy=False,
+                   lean=lean)  # fmt: skip
+    rows = []
+    rec.on_rows = lambda a: rows.append(a)
+    res = rec.record(st.state, advance)
+    assert res.steps == n and res.status == "ok"
+    if not lean:
+        np.testing.assert_array_equal(res.contact_state[:, 0], [0, 1] * 6)
+    streamed = np.concatenate([a["t"] for a in rows])
+    np.testing.assert_array_equal(streamed, np.arange(n + 1) * 1e-4)

@@ -16,9 +16,8 @@ file appended chunk by chunk, and the stored states); whatever stops a run (a ch
 Ctrl-C, SIGTERM, an exception), the rows recorded so far are returned and streamed.
 Per-step arrays of any trailing shape live in :meth:`Recorder.per_step` (one place: the
 streamed chunks and the final :class:`Results` are cut from it). The per-step buffers hold
-one chunk (row 0: the last row of the previous chunk); what is kept of the checked rows is
-:mod:`femrub.output.kept_rows`'s: every row, or a lean record of a run held only for a
-comparison (``lean = k``).
+one chunk (row 0: the previous chunk's last row); the checked rows are kept by
+:mod:`femrub.output.kept_rows` (every row, or a lean record of a run only compared).
 """
 
 from __future__ import annotations
@@ -75,10 +74,8 @@ class Recorder:
     on_state : callback ``f(State)`` fed each checked state (each ``on_state.stride``-th).
     on_rows : callback ``f(arrays)`` fed each checked block of rows as :meth:`per_step`
         gives them (row 0 with the first block).
-    lean : 0: keep every per-step array (:class:`~femrub.output.kept_rows.AllRows`); ``k >=
-        1``: keep only what a comparison of runs reads, every ``k``-th row with the impulses
-        summed over each ``k`` steps, and the verdict's measures of every row
-        (:class:`~femrub.output.kept_rows.LeanRows`).
+    lean : 0 keeps every per-step array; ``k >= 1`` only what a comparison of runs reads,
+        every ``k``-th row, impulses summed per ``k`` steps (:mod:`~femrub.output.kept_rows`).
     label : name of the run (progress bar and ``Results.info``).
     blowup_check : stop on energy created from nothing (a scheme may turn it off when the
         meter's quadratures, not the scheme, would open its balance).
@@ -213,8 +210,7 @@ class Recorder:
                         self._deliver(i0, i_end)
                         self._stream(i0, i_end)
                         bar.update(j)
-                        for a in (buf, *self.buffers().values(), *self.extra.values()):
-                            a[0] = a[j]  # the chunk's last row starts the next one
+                        self._next_chunk(j)
                         i0, j = i, 0
             except _Stop as stop:
                 i_end = self._stopped(stop, i0, j)
@@ -246,6 +242,14 @@ class Recorder:
         except Exception as exc:
             if self.status != "failed":
                 self.status, self.message = "failed", f"output: {type(exc).__name__}: {exc}"
+
+    def _next_chunk(self, j: int) -> None:
+        """Row ``j`` becomes the buffers' row 0; rows a step may not write are zeroed."""
+        for a in (self.buf, *self.buffers().values(), *self.extra.values()):
+            a[0] = a[j]
+        for a in (self.imp_t, self.heat, self.cstate, self._work, *self.extra.values()):
+            if a is not None:
+                a[1:] = 0
 
     def _work_rows(self, k: int) -> np.ndarray:
         """Per-step works and heats reported by the scheme (the first ``k`` of
@@ -292,13 +296,12 @@ class Recorder:
         return stop.row
 
     def _stream(self, i0: int, last: int) -> None:
-        """Feed ``on_rows`` the rows after the last streamed one, up to ``last`` (the
-        buffers' row 0 is row ``i0``)."""
+        """Feed ``on_rows`` the rows after the last streamed one, up to ``last`` (≥ ``i0``)."""
         if self.on_rows is None or last <= self._streamed:
             return
         rows = slice(self._streamed + 1 - i0, last + 1 - i0)
         self._streamed = last
-        self.on_rows(self.per_step(rows))
+        self.on_rows({k: v.copy() for k, v in self.per_step(rows).items()})  # buffers reused
 
     # -- one chunk ------------------------------------------------------------------------
     def _flush(self, i0: int, m: int) -> int:
@@ -328,8 +331,9 @@ class Recorder:
                 self.meter.update(0, X, self.imp[b], t[: m + 1], h, work, friction)
             bad = self.meter.blown_up(b) if self.blowup_check else None
             if bad is not None:
-                msg = f"energy created from nothing at t = {t[bad]:.6g} s"
-                raise _Stop("unstable", msg, i0 + bad)
+                raise _Stop(
+                    "unstable", f"energy created from nothing at t = {t[bad]:.6g} s", i0 + bad
+                )
         if not ok.all():
             raise _Stop("unstable", f"non-finite state at t = {t[last + 1 - i0]:.6g} s", last)
         hit = _limit_hit(self.limits, self._lim_idx, self.obs[b], self.imp[b] / h)
@@ -358,9 +362,11 @@ class Recorder:
         b = r - i0
         X = self.buf[b]
         gdot = np.zeros((X.shape[0], 0)) if c is None else c.gap_velocity(self.t[b], X)
-        for k, (ri, bi) in enumerate(zip(r, b)):
-            fi = self.imp_t[bi] if self.tangents else None
-            self.on_state(State(ri, self.t[bi], X[k], self.imp[bi], self.gap[bi], gdot[k], fi))
+        P, g = self.imp[b], self.gap[b]  # copies: a sink may hold states (buffers reused)
+        Pt = self.imp_t[b] if self.tangents else None
+        for k, ri in enumerate(r):
+            fi = None if Pt is None else Pt[k]
+            self.on_state(State(ri, self.t[b[k]], X[k], P[k], g[k], gdot[k], fi))
 
     # -- the collected results -------------------------------------------------------------
     def per_step(self, rows: slice) -> dict[str, np.ndarray]:
