@@ -214,3 +214,13 @@ def test_rows_a_step_leaves_unwritten_stay_zero_across_chunks(monkeypatch, lean)
         np.testing.assert_array_equal(res.contact_state[:, 0], [0, 1] * 6)
     streamed = np.concatenate([a["t"] for a in rows])
     np.testing.assert_array_equal(streamed, np.arange(n + 1) * 1e-4)
+
+
+def test_a_lean_record_saved_and_loaded_keeps_its_checks(tmp_path):
+    model = fr.bar_model(alpha=3.0)
+    lean = fr.ThetaMethod(model, 1e-4).run(0.05, lean=2)
+    back = fr.Results.load_npz(lean.save_npz(tmp_path / "lean.npz"))
+    assert back.checks == lean.checks and back.energy_error() == lean.energy_error() > 0
+    one = fr.ThetaMethod(model, 1e-4).run(0.0, lean=2)  # no step: no balance, NaN
+    back = fr.Results.load_npz(one.save_npz(tmp_path / "one.npz"))
+    assert np.isnan(one.energy_error()) and np.isnan(back.energy_error())

@@ -199,7 +199,7 @@ class Results:
     def energy_error(self) -> float:
         """Largest mechanical balance residual relative to the energy scale of the run."""
         if "energy_error" not in self.energy or self.t.size < 2:  # lean: measured, or NaN
-            return float(self.checks.get("energy_error", float("nan")))
+            return float(np.nan if (v := self.checks.get("energy_error")) is None else v)
         e = self.energy
         scale = max(
             np.max(np.abs(e["kinetic"] + e["elastic"])),
@@ -214,7 +214,7 @@ class Results:
         heat enters or leaves; NaN without a heat balance)."""
         e = self.energy
         if "heat_error" not in e or self.t.size < 2:
-            return float(self.checks.get("heat_error", float("nan")))
+            return float(np.nan if (v := self.checks.get("heat_error")) is None else v)
         scale = max(
             np.max(np.abs(e[k]))
             for k in ("heat_content", "friction_heat", "heat_load", "heat_outflow")
