@@ -3,9 +3,12 @@
 A run is trustworthy only if its step is fine enough. ``scheme.step_check = true`` measures
 it the way the reduction error is measured (:mod:`femrub.reduction.estimate`): by the
 difference with a richer run, here the run's own model at half the step, from the same
-initial state to the same end time and stop limits. The fine run is coarsened to the run's
-steps (:func:`coarsen`: its impulses summed over each pair of steps, its signals at the run's
-times; fields at the same checkpoints) and both are compared with the estimate's measures
+initial state to the same end time and stop limits. The fine run is recorded coarsened to
+the run's steps (``Stepper.run(lean=2)``, the rows :func:`coarsen` would keep: its impulses
+summed over each pair of steps, its signals at the run's times; fields at the same
+checkpoints; its per-step gaps, friction rows and energy balance never stored, its verdict
+measured on them as they pass: :mod:`femrub.output.kept_rows`) and both are compared with
+the estimate's measures
 (contact impulse per lobe passage, contact temperature history, displacement and
 temperature fields; a round-off twin of the fine run splits a sensitive response into a
 pointwise and a statistical part, as :func:`~femrub.reduction.estimate.estimate` does)::
@@ -48,7 +51,8 @@ def coarsen(res, factor: int):
     Times and signals every ``factor`` rows; the impulse of each coarse step is the sum of
     the fine impulses in it (so impulses per window and mean forces are preserved); the
     checkpoint states are kept (the fine run stores them at the same times). Every array is
-    a copy: none keeps the fine run's per-step arrays alive.
+    a copy: none keeps the fine run's per-step arrays alive. A run recorded with
+    ``Stepper.run(lean=factor)`` gives ``coarsen(res, factor).lean()`` without the fine rows.
     """
     factor = int(factor)
     if factor == 1:
@@ -76,9 +80,10 @@ def full_states(model, full):
     return lambda X: np.asarray(P.T @ (T @ np.asarray(X).T)).T
 
 
-def _simulate(stepper, t_end, every, limits, fields):
-    """Run ``stepper`` to ``t_end``, full states stored every ``every`` steps."""
-    res = stepper.run(t_end, store_every=every, limits=limits)
+def _simulate(stepper, t_end, every, limits, fields, lean=0):
+    """Run ``stepper`` to ``t_end``, full states stored every ``every`` steps (``lean``:
+    ``Stepper.run``'s)."""
+    res = stepper.run(t_end, store_every=every, limits=limits, lean=lean)
     return res, fields(res.states)
 
 
@@ -122,21 +127,20 @@ def check_step(scene, model, full, make_stepper, limits, run=None):
     if run is None:
         with phase(f"time-step check: run at h = {h:g} s"):
             w0 = time.perf_counter()
-            run = _simulate(make_stepper(model, h), t_end, every, limits, fields)
+            run = _simulate(make_stepper(model, h), t_end, every, limits, fields)  # may be the run
             wall = time.perf_counter() - w0
     with phase(f"time-step check: run at h/2 = {fine_h:g} s") as p:
-        res, states = _simulate(st, t_end, 2 * every, limits, fields)
-        fine, fine_status = (coarsen(res, 2), states), res.status
-        p["detail"] = f"{res.steps} steps"
-        del res  # only its coarsened rows are compared
+        fine = _simulate(st, t_end, 2 * every, limits, fields, lean=2)  # = coarsen(res, 2)
+        fine_status = fine[0].status
+        p["detail"] = f"{fine[0].steps} steps"
     window, label = lobe_passage(scene), ()
     err = estimate((label, *run), (label, *fine), full, window=window)
     if _richardson(err["estimate"]) > SAFETY * tol:  # how sensitive is the response?
         with phase(f"time-step check: twin at h/2 = {fine_h:g} s"):
-            tw, Xt = _simulate(make_stepper(_perturbed(model), fine_h), t_end, 2 * every,
-                               limits, fields)  # fmt: skip
-        err = estimate((label, *run), (label, *fine), full, window=window,
-                       twin=(coarsen(tw, 2), Xt), tolerance=tol)  # fmt: skip
+            twin = _simulate(make_stepper(_perturbed(model), fine_h), t_end, 2 * every,
+                             limits, fields, lean=2)  # fmt: skip
+        err = estimate((label, *run), (label, *fine), full, window=window, twin=twin,
+                       tolerance=tol)  # fmt: skip
     for key in ("sizes", "reference_sizes", "status_run", "status_reference"):
         err.pop(key, None)
     split = "predictability_horizon" in err

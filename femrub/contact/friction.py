@@ -39,7 +39,16 @@ import numpy as np
 from .coulomb import NON_POSITIVE, OPEN, SLIP, SOLVED, STICK, frictional_solve, newton_law
 from .impulses import solve_impulses
 
-__all__ = ["FrictionResult", "OPEN", "SLIP", "STICK", "coulomb_check", "solve_frictional_contact"]
+__all__ = [
+    "FrictionResult",
+    "OPEN",
+    "SLIP",
+    "STICK",
+    "coulomb_check",
+    "coulomb_check_rows",
+    "merge_coulomb_checks",
+    "solve_frictional_contact",
+]
 
 
 @dataclass(frozen=True)
@@ -167,10 +176,15 @@ def coulomb_check(normal_force, friction_force, slip_velocity, state, mu) -> dic
     time, so that a long run's check needs little memory beyond its arrays.
     """
     mu = np.asarray(mu, dtype=float)
-    parts = [
-        _check_rows(normal_force[r], friction_force[r], slip_velocity[r], state[r], mu)
+    return merge_coulomb_checks([
+        coulomb_check_rows(normal_force[r], friction_force[r], slip_velocity[r], state[r], mu)
         for r in (slice(k, k + CHECK_ROWS) for k in range(0, max(len(normal_force), 1), CHECK_ROWS))
-    ]  # fmt: skip
+    ])  # fmt: skip
+
+
+def merge_coulomb_checks(parts: list[dict]) -> dict:
+    """:func:`coulomb_check` of consecutive rows from the :func:`coulomb_check_rows` of each
+    block of them (maxima and sums: the same whatever the blocks)."""
     closed = [p for p in parts if p["closed"]]
     return {
         "cone": max(p["cone"] for p in closed) if closed else 0.0,
@@ -182,8 +196,9 @@ def coulomb_check(normal_force, friction_force, slip_velocity, state, mu) -> dic
     }
 
 
-def _check_rows(normal_force, friction_force, slip_velocity, state, mu) -> dict:
-    """:func:`coulomb_check` on some rows (``closed``: whether any contact is closed)."""
+def coulomb_check_rows(normal_force, friction_force, slip_velocity, state, mu) -> dict:
+    """:func:`coulomb_check` on some rows, to merge with :func:`merge_coulomb_checks`
+    (``closed``: whether any contact is closed)."""
     lam = np.asarray(normal_force, dtype=float)
     ft = np.linalg.norm(friction_force, axis=-1)
     bound = mu[None, :] * lam

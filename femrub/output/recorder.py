@@ -15,7 +15,9 @@ non-finite state or energy created from nothing ends the run with status
 file appended chunk by chunk, and the stored states); whatever stops a run (a check,
 Ctrl-C, SIGTERM, an exception), the rows recorded so far are returned and streamed.
 Per-step arrays of any trailing shape live in :meth:`Recorder.per_step` (one place: the
-streamed chunks and the final :class:`Results` are cut from it).
+streamed chunks and the final :class:`Results` are cut from it). The per-step buffers hold
+one chunk (row 0: the previous chunk's last row); the checked rows are kept by
+:mod:`femrub.output.kept_rows` (every row, or a lean record of a run only compared).
 """
 
 from __future__ import annotations
@@ -31,6 +33,7 @@ from ..blas import one_blas_thread
 from ..fem.linalg import compact
 from ..model.first_order import FirstOrderModel
 from .energy import SCHEME_INTEGRALS, EnergyMeter
+from .kept_rows import AllRows, LeanRows
 from .limits import limit_hit as _limit_hit
 from .limits import limit_index as _limit_index
 from .results import Results
@@ -71,6 +74,8 @@ class Recorder:
     on_state : callback ``f(State)`` fed each checked state (each ``on_state.stride``-th).
     on_rows : callback ``f(arrays)`` fed each checked block of rows as :meth:`per_step`
         gives them (row 0 with the first block).
+    lean : 0 keeps every per-step array; ``k >= 1`` only what a comparison of runs reads,
+        every ``k``-th row, impulses summed per ``k`` steps (:mod:`~femrub.output.kept_rows`).
     label : name of the run (progress bar and ``Results.info``).
     blowup_check : stop on energy created from nothing (a scheme may turn it off when the
         meter's quadratures, not the scheme, would open its balance).
@@ -81,16 +86,19 @@ class Recorder:
         stability_limit: float, energy: bool = True, limits: dict[str, float] | None = None,
         store_every: int = 0, on_state: Callable | None = None,
         on_rows: Callable | None = None, label: str | None = None, blowup_check: bool = True,
+        lean: int = 0,
     ):  # fmt: skip
         self.model, self.h, self.n, self.scheme = model, h, n_steps, scheme
         self.h_lim, self.label = stability_limit, label
         self.store_every, self.on_state, self.on_rows = store_every, on_state, on_rows
         self._streamed = -1
         self._delivered = 0
-        #: further per-step arrays ``(n + 1, ...)`` filled by a stepper (kept and streamed)
+        #: further per-step buffers ``(chunk + 1, ...)`` filled by a stepper (kept and streamed)
         self.extra: dict[str, np.ndarray] = {}
         self.blowup_check = blowup_check
-        N, nc, n = model.n_dofs, model.n_contacts, n_steps
+        N, nc = model.n_dofs, model.n_contacts
+        self.chunk = int(max(1, min(CHUNK_STEPS, CHUNK_VALUES // max(N, 1))))
+        n = self.chunk  # the buffers' rows: one chunk after its row 0
         self.names = list(model.observations)
         self.sizes = [model.observations[k].shape[0] for k in self.names]
         obs = [model.observations[k] for k in self.names]
@@ -109,6 +117,7 @@ class Recorder:
         self._lim_idx = _limit_index(self.limits, self.names, self.sizes)
         self._stored: list[np.ndarray] = []
         self._stored_rows: list[np.ndarray] = []
+        self._stored_t: list[np.ndarray] = []
         self.status, self.message = "ok", ""
         if h > stability_limit:
             self.status = "unstable"
@@ -116,8 +125,16 @@ class Recorder:
                 f"h = {h:.3g} s exceeds the stability limit {stability_limit:.3g} s of {scheme}"
             )
         self._work, self._n_work = None, 0
-        self.chunk = int(max(1, min(CHUNK_STEPS, CHUNK_VALUES // max(N, 1))))
         self.buf = np.empty((self.chunk + 1, N))
+        self.kept = AllRows(self) if not lean else LeanRows(self, lean)
+
+    def buffers(self) -> dict[str, np.ndarray]:
+        """The per-step buffers, by name (``energy_*``: the meter's), one chunk's rows."""
+        out = {"t": self.t, "obs": self.obs, "gap": self.gap, "imp": self.imp}
+        out.update(imp_t=self.imp_t, slip=self.slip, heat=self.heat, cstate=self.cstate)
+        if self.meter is not None:
+            out.update({f"energy_{k}": v for k, v in self.meter.data.items()})
+        return out
 
     # -- the run ---------------------------------------------------------------------------
     def record(
@@ -156,7 +173,7 @@ class Recorder:
                 while i < n:
                     if block is not None:  # a block of steps in one call, into the rows
                         m = min(self.chunk - j, n - i)
-                        r = slice(i + 1, i + 1 + m)
+                        r = slice(j + 1, j + 1 + m)
                         done, friction, err = block(
                             m, buf[j + 1 : j + 1 + m], t[r], imp[r], self.imp_t[r],
                             self.heat[r], self.cstate[r],
@@ -177,23 +194,23 @@ class Recorder:
                             i_end = self._flush(i0, j)
                             raise _Stop("failed", f"{self.scheme}: {exc}", i_end) from None
                         j += 1
-                        buf[j], t[i] = X, ti
+                        buf[j], t[j] = X, ti
                         if nc:
-                            imp[i] = P
+                            imp[j] = P
                         info = more[0] if more else None
                         if info:
                             if "works" in info:  # the scheme's own works and heats
-                                self._work_rows(len(SCHEME_INTEGRALS))[i] = info["works"]
+                                self._work_rows(len(SCHEME_INTEGRALS))[j] = info["works"]
                             elif "contact_work" in info:  # its own contact work
-                                self._work_rows(1)[i, 0] = info["contact_work"]
+                                self._work_rows(1)[j, 0] = info["contact_work"]
                             if "state" in info:
-                                self._friction_rows(i, info)
+                                self._friction_rows(j, info)
                     if j == self.chunk or i == n:
                         i_end = self._flush(i0, j)
                         self._deliver(i0, i_end)
-                        self._stream(i_end)
+                        self._stream(i0, i_end)
                         bar.update(j)
-                        buf[0] = buf[j]
+                        self._next_chunk(j)
                         i0, j = i, 0
             except _Stop as stop:
                 i_end = self._stopped(stop, i0, j)
@@ -208,10 +225,10 @@ class Recorder:
                     i_end = self._stopped(stop, i0, j - 1)
                 except KeyboardInterrupt:  # a second signal: keep the checked rows
                     i_end = i0
-                self._stream(i_end)
+                self._stream(i0, i_end)
             except Exception as exc:  # keep what was computed
                 self.status, self.message = "failed", f"{type(exc).__name__}: {exc}"
-                self._stream(i_end)
+                self._stream(i0, i_end)
             finally:
                 bar.close()
             self._flush_sink()
@@ -226,16 +243,24 @@ class Recorder:
             if self.status != "failed":
                 self.status, self.message = "failed", f"output: {type(exc).__name__}: {exc}"
 
+    def _next_chunk(self, j: int) -> None:
+        """Row ``j`` becomes the buffers' row 0; rows a step may not write are zeroed."""
+        for a in (self.buf, *self.buffers().values(), *self.extra.values()):
+            a[0] = a[j]
+        for a in (self.imp_t, self.heat, self.cstate, self._work, *self.extra.values()):
+            if a is not None:
+                a[1:] = 0
+
     def _work_rows(self, k: int) -> np.ndarray:
         """Per-step works and heats reported by the scheme (the first ``k`` of
-        :data:`~femrub.output.energy.SCHEME_INTEGRALS`; allocated on first use)."""
+        :data:`~femrub.output.energy.SCHEME_INTEGRALS`; a chunk's rows, on first use)."""
         if self._work is None:
-            self._work = np.zeros((self.n + 1, len(SCHEME_INTEGRALS)))
+            self._work = np.zeros((self.chunk + 1, len(SCHEME_INTEGRALS)))
         self._n_work = max(self._n_work, k)
         return self._work
 
     def _friction_rows(self, i: int, extra: dict) -> None:
-        """Friction quantities of step ``i`` (see :meth:`Stepper._step`)."""
+        """Friction quantities of the step in row ``i`` of the buffers (``Stepper._step``)."""
         self.has_friction = True
         if self.tangents:
             self.imp_t[i] = extra["friction_impulse"]
@@ -253,11 +278,13 @@ class Recorder:
             self.obs[0] = self._O @ s.X
         if self.meter is not None:
             self.meter.start(s.X)
+        self.kept.take(self, 0, 0)
         if self.on_state is not None:
             self.on_state(s)
         if self.store_every:
             self._stored.append(s.X[None, :].copy())
             self._stored_rows.append(np.array([0]))
+            self._stored_t.append(np.array([s.t]))
 
     def _stopped(self, stop: _Stop, i0: int, j: int) -> int:
         """Status and message of a check that ended the run; feed the sinks; last row kept."""
@@ -265,62 +292,66 @@ class Recorder:
         unstable = stop.status == "unstable"
         self.message = f"{self.scheme}: {stop.message}" if unstable else stop.message
         self._deliver(i0, min(stop.row, i0 + j))
-        self._stream(stop.row)
+        self._stream(i0, stop.row)
         return stop.row
 
-    def _stream(self, last: int) -> None:
-        """Feed ``on_rows`` the rows after the last streamed one, up to ``last``."""
+    def _stream(self, i0: int, last: int) -> None:
+        """Feed ``on_rows`` the rows after the last streamed one, up to ``last`` (≥ ``i0``)."""
         if self.on_rows is None or last <= self._streamed:
             return
-        rows = slice(self._streamed + 1, last + 1)
+        rows = slice(self._streamed + 1 - i0, last + 1 - i0)
         self._streamed = last
-        self.on_rows(self.per_step(rows))
+        self.on_rows({k: v.copy() for k, v in self.per_step(rows).items()})  # buffers reused
 
     # -- one chunk ------------------------------------------------------------------------
     def _flush(self, i0: int, m: int) -> int:
-        """Post-process and check rows ``i0 + 1 .. i0 + m`` of the buffer; last valid row."""
+        """Post-process and check rows ``i0 + 1 .. i0 + m`` (rows ``1 .. m`` of the buffers,
+        whose row 0 is row ``i0``); last valid row."""
         t, h, c = self.t, self.h, self.model.contact
-        rows = slice(i0 + 1, i0 + 1 + m)
         X = self.buf[: m + 1]
         ok = np.all(np.isfinite(X[1:]), axis=1)
         last = i0 + m if ok.all() else i0 + int(np.argmin(ok))
         if last < i0 + m:
-            m, rows, X = last - i0, slice(i0 + 1, last + 1), X[: last - i0 + 1]
+            m, X = last - i0, X[: last - i0 + 1]
+        b = slice(1, m + 1)  # the rows in the buffers
         O = self._O
         if O is not None:
-            self.obs[rows] = X[1:] @ O.T if isinstance(O, np.ndarray) else (O @ X[1:].T).T
+            self.obs[b] = X[1:] @ O.T if isinstance(O, np.ndarray) else (O @ X[1:].T).T
         if c is not None:
-            self.gap[rows] = c.gap(t[rows], X[1:])
+            self.gap[b] = c.gap(t[b], X[1:])
             if self.tangents:
-                self.slip[rows] = c.slip_velocity(X[1:])
+                self.slip[b] = c.slip_velocity(X[1:])
         if self.meter is not None and m:
-            friction = (self.imp_t[rows], self.heat[rows]) if self.has_friction else None
+            friction = (self.imp_t[b], self.heat[b]) if self.has_friction else None
             with np.errstate(all="ignore"):
                 work = None
                 if self._work is not None:
                     keys = SCHEME_INTEGRALS[: self._n_work]
-                    work = {k: self._work[rows, j] for j, k in enumerate(keys)}
-                self.meter.update(i0, X, self.imp[rows], t[i0 : rows.stop], h, work, friction)
-            bad = self.meter.blown_up(rows) if self.blowup_check else None
+                    work = {k: self._work[b, j] for j, k in enumerate(keys)}
+                self.meter.update(0, X, self.imp[b], t[: m + 1], h, work, friction)
+            bad = self.meter.blown_up(b) if self.blowup_check else None
             if bad is not None:
-                raise _Stop("unstable", f"energy created from nothing at t = {t[bad]:.6g} s", bad)
+                raise _Stop(
+                    "unstable", f"energy created from nothing at t = {t[bad]:.6g} s", i0 + bad
+                )
         if not ok.all():
-            raise _Stop("unstable", f"non-finite state at t = {t[last + 1]:.6g} s", last)
-        hit = _limit_hit(self.limits, self._lim_idx, self.obs[rows], self.imp[rows] / h)
+            raise _Stop("unstable", f"non-finite state at t = {t[last + 1 - i0]:.6g} s", last)
+        hit = _limit_hit(self.limits, self._lim_idx, self.obs[b], self.imp[b] / h)
         if hit is not None:
             k, what = hit
-            raise _Stop(
-                "diverged-physically", f"{what} at t = {t[rows.start + k]:.6g} s", rows.start + k
-            )
+            raise _Stop("diverged-physically", f"{what} at t = {t[1 + k]:.6g} s", i0 + 1 + k)
         if self.store_every:
-            r = np.arange(rows.start, rows.stop)
+            r = np.arange(i0 + 1, i0 + m + 1)
             r = r[r % self.store_every == 0]
             self._stored.append(self.buf[r - i0].copy())
             self._stored_rows.append(r)
-        return rows.stop - 1
+            self._stored_t.append(t[r - i0].copy())
+        return i0 + m
 
     def _deliver(self, i0: int, last: int) -> None:
-        """Feed ``on_state`` the checked rows ``i0 + 1 .. last`` of the buffer."""
+        """Hand the checked rows ``i0 + 1 .. last`` of the buffers to what keeps them, then
+        feed them to ``on_state``."""
+        self.kept.take(self, i0, last)
         first = max(i0, self._delivered)  # a sink interrupted once is not fed a row twice
         if self.on_state is None or last <= first:
             return
@@ -328,11 +359,14 @@ class Recorder:
         r = np.arange(first + 1, last + 1)
         stride = getattr(self.on_state, "stride", 1)  # a sink that keeps every stride-th
         r = r[r % stride == 0]
-        X = self.buf[r - i0]
-        gdot = np.zeros((X.shape[0], 0)) if c is None else c.gap_velocity(self.t[r], X)
+        b = r - i0
+        X = self.buf[b]
+        gdot = np.zeros((X.shape[0], 0)) if c is None else c.gap_velocity(self.t[b], X)
+        P, g = self.imp[b], self.gap[b]  # copies: a sink may hold states (buffers reused)
+        Pt = self.imp_t[b] if self.tangents else None
         for k, ri in enumerate(r):
-            fi = self.imp_t[ri] if self.tangents else None
-            self.on_state(State(ri, self.t[ri], X[k], self.imp[ri], self.gap[ri], gdot[k], fi))
+            fi = None if Pt is None else Pt[k]
+            self.on_state(State(ri, self.t[b[k]], X[k], P[k], g[k], gdot[k], fi))
 
     # -- the collected results -------------------------------------------------------------
     def per_step(self, rows: slice) -> dict[str, np.ndarray]:
@@ -353,47 +387,14 @@ class Recorder:
 
     def _results(self, i_end: int, cpu_seconds: float) -> Results:
         m = i_end + 1
-
-        def reached(a):  # the rows reached; no copy of a complete run's arrays (not reused)
-            return a[:m] if m == a.shape[0] else a[:m].copy()
-
-        signals, col = {}, 0
-        for name, size in zip(self.names, self.sizes):  # views of a complete run's rows
-            signals[name] = reached(self.obs[:, col : col + size])
-            col += size
         states = times = None
         if self._stored:
             rows = np.concatenate(self._stored_rows)
             keep = rows <= i_end
             if keep.any():
                 states = np.concatenate(self._stored)[keep]
-                times = self.t[rows[keep]]
-        c, nc = self.model.contact, self.model.n_contacts
-        if not self.has_friction:  # frictionless stepper: open or (frictionless) sliding
-            self.cstate[:m] = np.where(self.imp[:m] > 0.0, 2, 0)
-        ff = np.zeros((m, nc, 3))
-        sv = np.zeros((m, nc, 3))
-        if self.tangents and c.frames is not None:
-            ff = c.to_global(self.imp_t[:m] / self.h)
-            sv = c.to_global(self.slip[:m])
-        return Results(
-            scheme=self.scheme,
-            h=self.h,
-            t=reached(self.t),
-            signals=signals,
-            gap=reached(self.gap),
-            impulse=reached(self.imp),
-            energy=self.meter.arrays(m) if self.meter is not None else {},
-            status=self.status,
-            message=self.message,
-            steps=m - 1,
-            cpu_seconds=cpu_seconds,
-            states=states,
-            state_times=times,
-            friction_force=ff,
-            slip_velocity=sv,
-            contact_state=reached(self.cstate),
-            friction_limit=None if c is None else c.friction.copy(),
-            info={"label": self.label, "stability_limit": self.h_lim, "n_dofs": self.model.n_dofs},
-            extra={k: reached(v) for k, v in self.extra.items()},
-        )
+                times = np.concatenate(self._stored_t)[keep]
+        return self.kept.results(
+            self, m, status=self.status, message=self.message, cpu_seconds=cpu_seconds,
+            states=states, state_times=times,
+        )  # fmt: skip

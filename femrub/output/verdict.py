@@ -20,6 +20,10 @@ The recorder ends a run as ``unstable`` (blow-up), ``diverged-physically`` (a st
   while sliding, or not opposite to the slip velocity) beyond ``tolerances["coulomb"]``
   (relative, :func:`femrub.contact.friction.coulomb_check`) -> ``"inaccurate"``.
 
+A lean record (``Stepper.run(lean=k)``, :mod:`femrub.output.kept_rows`) keeps neither the
+energy balance nor the friction rows; the balance and Coulomb rules read the same measures
+taken on its rows as they were recorded (``Results.checks``).
+
 * ``resolution``: contact episodes (impulses less than ``merge_time`` apart form one
   episode) resolved by fewer than :data:`UNRESOLVED_STEPS` steps (median over the
   episodes) -> ``"inaccurate"`` (on the paper case, 2 steps per episode at h = 5e-3 s
@@ -135,6 +139,8 @@ def coulomb_message(check: dict | None, bound: float) -> str | None:
 
 def _coulomb(res, tol):
     ff, bound = getattr(res, "friction_force", None), tol.get("coulomb")
+    if ff is None and bound is not None:  # a lean record: checked as its rows passed
+        return coulomb_message(getattr(res, "checks", {}).get("coulomb"), bound)
     if ff is None or not ff.size or res.friction_limit is None or bound is None:
         return None
     from ..contact.friction import coulomb_check

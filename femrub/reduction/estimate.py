@@ -149,36 +149,40 @@ def compare(run, ref, fields_run, fields_ref, norms: dict, window: float) -> dic
     return out
 
 
-def simulate(reductor, sizes, make_stepper, t_end, checkpoints=5, limits=None, perturb=0.0):
+def simulate(reductor, sizes, make_stepper, t_end, checkpoints=5, limits=None, perturb=0.0,
+             lean=0):  # fmt: skip
     """Step ``reductor.reduce(*sizes)``; return the results and the full states stored.
 
     ``limits``: the run's stop limits (``Stepper.run``): the estimate compares the models
     over what the run itself can reach, not past a physical stop. ``perturb``: random
-    displacement (m) added to the initial state (:func:`twin`).
+    displacement (m) added to the initial state (:func:`twin`). ``lean = 1``: a run that is
+    only compared, recorded with what :func:`estimate` reads (``Stepper.run(lean=1)``:
+    ``Results.lean()``'s arrays, never the others).
     """
     what = "twin" if perturb else "run"
     with phase(f"reduction error estimate: {what} of sizes {list(sizes)} to {t_end:g} s") as p:
         m = reductor.reduce(*sizes)
         res, states = _simulate(m, reductor, sizes, make_stepper, t_end, checkpoints, limits,
-                                perturb)  # fmt: skip
+                                perturb, lean)  # fmt: skip
         p["detail"] = f"{res.steps} steps, {m.n_dofs} coordinates"
     return res, states
 
 
-def _simulate(m, reductor, sizes, make_stepper, t_end, checkpoints, limits, perturb):
+def _simulate(m, reductor, sizes, make_stepper, t_end, checkpoints, limits, perturb, lean):
     if perturb:
         x0 = np.array(m.x0, dtype=float)
         x0[m.layout.u] += perturb * np.random.default_rng(0).standard_normal(m.layout.n_u)
         m = m.with_(x0=x0)
     st = make_stepper(m)
     every = max(1, st.steps_to(t_end) // checkpoints)
-    res = st.run(t_end, store_every=every, limits=limits)
+    res = st.run(t_end, store_every=every, limits=limits, lean=lean)
     return res, reductor.reconstruct(res.states, *sizes)
 
 
-def twin(reductor, sizes, make_stepper, t_end, checkpoints=5, limits=None):
+def twin(reductor, sizes, make_stepper, t_end, checkpoints=5, limits=None, lean=0):
     """:func:`simulate` with the displacement perturbed by :data:`PERTURBATION` (m)."""
-    return simulate(reductor, sizes, make_stepper, t_end, checkpoints, limits, PERTURBATION)
+    return simulate(reductor, sizes, make_stepper, t_end, checkpoints, limits, PERTURBATION,
+                    lean)  # fmt: skip
 
 
 def _signal_pairs(a, b, k1: int):

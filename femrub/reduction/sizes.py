@@ -144,15 +144,6 @@ def _timed(*args, **kw):
     return (*simulate(*args, **kw), time.perf_counter() - t0)
 
 
-def _lean(sim):
-    """``(results, full states, wall)`` of a reference or twin run, with only what
-    :func:`~femrub.reduction.estimate.estimate` reads of the results
-    (:meth:`~femrub.output.results.Results.lean`), so that the runs the estimate holds
-    together (reference, run, twin) stay small. Never a run that may be the scene's run."""
-    res, *rest = sim
-    return (res.lean(), *rest)
-
-
 def _checked(red, model, want, make_stepper, scene, report, log, limits, on_run=None):
     """Sizes to run and their a-posteriori estimate (``report["error"]``).
 
@@ -168,22 +159,22 @@ def _checked(red, model, want, make_stepper, scene, report, log, limits, on_run=
     window = lobe_passage(scene)
     most = (red.n_uv, red.n_theta)
     # a run that carries state outside X (wear, casing heat) is stepped again as the
-    # scene's run (the estimate's later runs restart that state): every run here kept lean
+    # scene's run (the estimate's later runs restart that state): every run here recorded
+    # lean (Stepper.run(lean=1): only what estimate() reads, so that the runs it holds
+    # together stay small); otherwise those that are never the run
     whole = model.contact is None or not model.contact.carried_state
-    *ref, ref_wall = _timed(red, most, make_stepper, t_end, limits=limits)
     cands = [want] if want is not None else _ladder(most)
-    if not whole or (want is not None and want != most):  # never the run: keep it lean
-        ref = list(_lean(ref))
+    lean = int(not whole or (want is not None and want != most))  # the reference
+    *ref, ref_wall = _timed(red, most, make_stepper, t_end, limits=limits, lean=lean)
     chosen, err, tried, tw = None, None, [], None
     for c in cands:
         if c == most:
             break
-        *run, wall = _timed(red, c, make_stepper, t_end, limits=limits)
-        run = run if whole else list(_lean(run))
+        *run, wall = _timed(red, c, make_stepper, t_end, limits=limits, lean=int(not whole))
         kept = (run[0], wall, run[1])
         err = estimate((c, *run), (most, *ref), model, window=window)
         if err["estimate"] > SAFETY * tol:  # measure how sensitive the response is
-            tw = tw or _lean(twin(red, most, make_stepper, t_end, limits=limits))
+            tw = tw or twin(red, most, make_stepper, t_end, limits=limits, lean=1)
             err = estimate((c, *run), (most, *ref), model, window=window, twin=tw, tolerance=tol)
         tried.append({"sizes": list(c), "estimate": err["estimate"]})
         if want is not None or err["estimate"] <= SAFETY * tol:

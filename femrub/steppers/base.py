@@ -227,6 +227,7 @@ class Stepper:
         label: str | None = None,
         tolerances: dict | None = None,
         merge_time: float | None = None,
+        lean: int = 0,
     ) -> Results:
         """Integrate to ``t_end`` and collect :class:`~femrub.output.results.Results`.
 
@@ -246,6 +247,12 @@ class Stepper:
         tolerances, merge_time : see :func:`femrub.output.verdict.assess` (balance
             tolerances; contact impulses closer than ``merge_time`` s form one episode of
             the resolution check, ``None``: no check).
+        lean : 0: results with every per-step array. ``k >= 1``: a run held only to be
+            compared with another: only times, impulses, signals and the stored states, at
+            every ``k``-th step with the impulses summed over each ``k`` steps (``h`` of the
+            results ``k h``); gaps, friction rows and the energy balance are never stored,
+            the verdict reads its measures of them taken as the steps were recorded
+            (:mod:`femrub.output.kept_rows`, ``Results.checks``).
         """
         self._check_owner()
         recorder = Recorder(
@@ -261,6 +268,7 @@ class Stepper:
             on_rows=on_rows,
             label=label,
             blowup_check=self.blowup_check,
+            lean=lean,
         )
         res = recorder.record(
             self.state, self._advance, progress=progress, block=self._block_writer()

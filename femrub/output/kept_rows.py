@@ -1,0 +1,183 @@
+"""What a record keeps of its checked rows: every array (:class:`AllRows`) or, for a run held
+only to be compared with another, what the comparison reads (:class:`LeanRows`).
+
+A :class:`~femrub.output.recorder.Recorder` steps and checks a run chunk by chunk in buffers
+of one chunk's rows (their row 0 is the chunk's first row, the previous chunk's last); it
+hands each checked row once to its store, ``take(rec, i0, last)`` (rows up to ``last``,
+the buffers' row 0 being row ``i0``), and the store makes the
+:class:`~femrub.output.results.Results`:
+
+* :class:`AllRows`: every per-step array of every row (a run's history);
+* :class:`LeanRows`: what :meth:`~femrub.output.results.Results.lean` keeps (times, impulses,
+  signals; the checkpoint states are the recorder's) at rows ``0, k, 2k, …`` with the
+  impulses summed over each ``k`` steps, ``h`` becoming ``k h``: the run seen on the steps
+  of ``k h`` (:func:`femrub.app.step_check.coarsen`), rows of an incomplete last group
+  dropped. Gaps, friction rows and the energy balance are never stored; what the verdict
+  reads of them is measured as the rows pass, into ``Results.checks``: the largest balance
+  residuals and the scales :meth:`~femrub.output.results.Results.energy_error` and
+  :meth:`~femrub.output.results.Results.heat_error` divide them by, and the Coulomb check
+  (:func:`~femrub.contact.friction.coulomb_check`). Maxima and sums over rows do not depend
+  on how the rows are cut, so these are the values the whole arrays would give.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..contact.friction import coulomb_check_rows, merge_coulomb_checks
+from .results import Results
+
+__all__ = ["AllRows", "LeanRows"]
+
+#: the largest magnitudes a lean record keeps of the energy balance (its residuals, scales)
+_ENERGY_MAXIMA = ("energy_error", "mechanical", "external_work", "thermal_work", "heat_error",
+                  "heat_content", "friction_heat", "heat_load", "heat_outflow")  # fmt: skip
+
+
+def _signals(rec, obs) -> dict[str, np.ndarray]:
+    """The columns of ``obs`` (rows of the recorder's observations) by signal name (views)."""
+    out, col = {}, 0
+    for name, size in zip(rec.names, rec.sizes):
+        out[name] = obs[:, col : col + size]
+        col += size
+    return out
+
+
+def _info(rec) -> dict:
+    return {"label": rec.label, "stability_limit": rec.h_lim, "n_dofs": rec.model.n_dofs}
+
+
+class AllRows:
+    """Every per-step array of every row, ``n_steps + 1`` rows allocated at once."""
+
+    def __init__(self, rec):
+        n1, self.taken = rec.n + 1, -1
+        self.rows = {k: np.zeros((n1, *a.shape[1:]), a.dtype) for k, a in rec.buffers().items()}
+        self.extra: dict[str, np.ndarray] = {}
+
+    def take(self, rec, i0: int, last: int) -> None:
+        """Copy rows ``taken + 1 .. last`` from the recorder's buffers."""
+        first = self.taken + 1
+        if last < first:
+            return
+        a, b = slice(first, last + 1), slice(first - i0, last + 1 - i0)
+        for k, v in rec.buffers().items():
+            self.rows[k][a] = v[b]
+        for k, v in rec.extra.items():
+            self.extra.setdefault(k, np.zeros((rec.n + 1, *v.shape[1:]), v.dtype))[a] = v[b]
+        self.taken = last
+
+    def results(self, rec, m: int, **kw) -> Results:
+        """The first ``m`` rows as :class:`Results` (``kw``: status, states, …)."""
+        r = self.rows
+
+        def reached(a):  # the rows reached; no copy of a complete run's arrays (not reused)
+            return a[:m] if m == a.shape[0] else a[:m].copy()
+
+        c, nc, h = rec.model.contact, rec.model.n_contacts, rec.h
+        if not rec.has_friction:  # frictionless stepper: open or (frictionless) sliding
+            r["cstate"][:m] = np.where(r["imp"][:m] > 0.0, 2, 0)
+        ff, sv = np.zeros((m, nc, 3)), np.zeros((m, nc, 3))
+        if rec.tangents and c.frames is not None:
+            ff, sv = c.to_global(r["imp_t"][:m] / h), c.to_global(r["slip"][:m])
+        energy = {k[7:]: reached(v) for k, v in r.items() if k.startswith("energy_")}
+        return Results(
+            scheme=rec.scheme, h=h, t=reached(r["t"]), signals=_signals(rec, reached(r["obs"])),
+            gap=reached(r["gap"]), impulse=reached(r["imp"]), energy=energy, steps=m - 1,
+            friction_force=ff, slip_velocity=sv, contact_state=reached(r["cstate"]),
+            friction_limit=None if c is None else c.friction.copy(), info=_info(rec),
+            extra={k: reached(v) for k, v in self.extra.items()}, **kw,
+        )  # fmt: skip
+
+
+class LeanRows:
+    """Times and signals every ``every``-th row, impulses summed per ``every`` steps, and the
+    verdict's measures of every row (module docstring)."""
+
+    def __init__(self, rec, every: int):
+        self.k, self.taken, self.groups = int(every), -1, 0
+        if self.k < 1:
+            raise ValueError(f"a lean record keeps every k-th row, k >= 1; got {every!r}")
+        n1, nc = rec.n // self.k + 1, rec.model.n_contacts
+        self.t, self.obs = np.zeros(n1), np.zeros((n1, rec.obs.shape[1]))
+        self.imp, self._open = np.zeros((n1, nc)), np.zeros((0, nc))
+        self.maxima = dict.fromkeys(_ENERGY_MAXIMA, -np.inf) if rec.meter is not None else None
+        # Coulomb check parts with the recorded contact states and, while the stepper has
+        # written no friction rows, with a frictionless stepper's (AllRows.results)
+        c = rec.model.contact
+        self._coulomb = None if c is None or not nc else ([], [])
+
+    def take(self, rec, i0: int, last: int) -> None:
+        """Keep and measure rows ``taken + 1 .. last`` of the recorder's buffers."""
+        first = self.taken + 1
+        if last < first:
+            return
+        b, k = slice(first - i0, last + 1 - i0), self.k
+        rows = np.arange(first, last + 1)
+        at = rows % k == 0
+        self.t[rows[at] // k], self.obs[rows[at] // k] = rec.t[b][at], rec.obs[b][at]
+        P = rec.imp[b]
+        if first == 0:  # the initial impulse, as is
+            self.imp[0], P = P[0], P[1:]
+        P = np.concatenate([self._open, P])  # the group left open by the previous rows first
+        g, j = len(P) // k, self.groups
+        self.imp[j + 1 : j + 1 + g] = P[: g * k].reshape(g, k, P.shape[1]).sum(axis=1)
+        self.groups, self._open = j + g, P[g * k :].copy()
+        self._measure(rec, b)
+        self.taken = last
+
+    def _measure(self, rec, b: slice) -> None:
+        """Running maxima of the balance (``Results.energy_error``'s terms) and Coulomb
+        check parts of the buffers' rows ``b``."""
+        if self.maxima is not None:
+            d, mx = rec.meter.data, self.maxima
+            terms = {k: d[k][b] for k in _ENERGY_MAXIMA if k != "mechanical"}
+            terms["mechanical"] = d["kinetic"][b] + d["elastic"][b]
+            for key, v in terms.items():
+                mx[key] = np.maximum(mx[key], np.max(np.abs(v)))
+        if self._coulomb is None:
+            return
+        c, h, imp = rec.model.contact, rec.h, rec.imp[b]
+        ff = sv = np.zeros((imp.shape[0], imp.shape[1], 3))
+        if rec.tangents and c.frames is not None:
+            ff, sv = c.to_global(rec.imp_t[b] / h), c.to_global(rec.slip[b])
+        mu, recorded, frictionless = np.asarray(c.friction, dtype=float), *self._coulomb
+        recorded.append(coulomb_check_rows(imp / h, ff, sv, rec.cstate[b], mu))
+        if not rec.has_friction:
+            state = np.where(imp > 0.0, 2, 0)
+            frictionless.append(coulomb_check_rows(imp / h, ff, sv, state, mu))
+
+    def checks(self, rec, m: int) -> dict:
+        """``Results.checks``: the balance residuals relative to their scales (as
+        ``energy_error()`` and ``heat_error()`` of the whole arrays) and the Coulomb check."""
+        out = {}
+        mx = self.maxima
+        if mx is not None:
+            nan = m < 2
+            scale = max(mx["mechanical"], mx["external_work"], mx["thermal_work"], 1e-300)
+            out["energy_error"] = float("nan") if nan else float(mx["energy_error"] / scale)
+            heat = max(mx[k] for k in _ENERGY_MAXIMA[5:])  # heat content, friction heat, …
+            out["heat_error"] = (
+                float("nan") if nan else (float(mx["heat_error"] / heat) if heat > 0 else 0.0)
+            )
+        if self._coulomb is not None and m:
+            parts = self._coulomb[0 if rec.has_friction else 1]
+            out["coulomb"] = merge_coulomb_checks(parts)
+        return out
+
+    def results(self, rec, m: int, **kw) -> Results:
+        """The kept rows of the first ``m`` rows reached as :class:`Results` (``kw``: status,
+        states, …): ``h`` is ``k h``, ``steps`` the steps of ``h`` stepped."""
+        n = (m - 1) // self.k if m else -1  # complete groups of the rows reached
+
+        def kept(a):
+            return a[: n + 1] if n + 1 == a.shape[0] else a[: n + 1].copy()
+
+        c = rec.model.contact
+        return Results(
+            scheme=rec.scheme, h=rec.h * self.k, t=kept(self.t),
+            signals=_signals(rec, kept(self.obs)), gap=np.zeros((n + 1, 0)),
+            impulse=kept(self.imp), steps=max(m - 1, 0), info=_info(rec),
+            friction_limit=None if c is None else c.friction.copy(),
+            checks=self.checks(rec, m), **kw,
+        )  # fmt: skip

@@ -1,0 +1,226 @@
+"""Lean records (``Stepper.run(lean=k)``, femrub.output.kept_rows): runs held only to be
+compared keep what the comparison reads, coarsened on the fly, and never store the rest;
+their verdict is the one the whole arrays would give."""
+
+import inspect
+import tracemalloc
+
+import numpy as np
+import pytest
+from test_rub_blocks import SCENE  # a frictional coated blade, power heat, 300 steps
+
+import femrub as fr
+from femrub.app.step_check import coarsen
+from femrub.contact.friction import coulomb_check
+from femrub.steppers import make_stepper
+
+
+@pytest.fixture(scope="module")
+def blade():
+    from femrub.app import build
+    from femrub.app.scheme import scheme_options
+    from femrub.scene import load_scene
+
+    scene = load_scene("twisted-naca", SCENE)
+    sim = build(scene, log=lambda s: None)
+    return sim.model, scene["scheme"], scheme_options(scene)
+
+
+def _blade_run(blade, h, blocks=True, **kw):
+    model, scheme, opts = blade
+    st = make_stepper(scheme["name"], model, h, **opts)
+    st.block_steps = blocks
+    return st.run(scheme["t_end"], **kw)
+
+
+def _same_as_coarsened(lean, full, k):
+    """``lean`` holds exactly ``coarsen(full, k).lean()``'s arrays, bit for bit."""
+    ref = coarsen(full, k).lean()
+    assert (lean.h, lean.steps, lean.status, lean.message) == (ref.h, ref.steps, ref.status,
+                                                                ref.message)  # fmt: skip
+    for name in ("t", "gap", "impulse", "states", "state_times", "friction_limit"):
+        a, b = getattr(lean, name), getattr(ref, name)
+        if b is None:
+            assert a is None, name
+            continue
+        assert a.shape == b.shape and a.dtype == b.dtype, name
+        np.testing.assert_array_equal(a, b, err_msg=name)
+    assert lean.signals.keys() == ref.signals.keys()
+    for key in ref.signals:
+        np.testing.assert_array_equal(lean.signals[key], ref.signals[key], err_msg=key)
+    assert lean.energy == {} and lean.extra == {}
+    assert lean.friction_force is None and lean.contact_state is None
+
+
+@pytest.mark.parametrize("chunk", [512, 7])  # 7: groups of k steps across chunks
+@pytest.mark.parametrize("k", [1, 2, 3])
+def test_a_lean_frictional_coated_run_is_its_full_run_coarsened(blade, monkeypatch, k, chunk):
+    monkeypatch.setattr("femrub.output.recorder.CHUNK_STEPS", chunk)
+    h = blade[1]["h"] / 2
+    full = _blade_run(blade, h, store_every=2 * 50)
+    lean = _blade_run(blade, h, store_every=2 * 50, lean=k)
+    assert full.status == "ok" and int((full.contact_state == 2).sum()) > 50  # slides
+    _same_as_coarsened(lean, full, k)
+    # what the verdict reads of the rows it did not keep: the whole arrays' values
+    assert lean.energy_error() == full.energy_error() > 0
+    assert lean.heat_error() == full.heat_error() > 0
+    check = coulomb_check(full.force, full.friction_force, full.slip_velocity,
+                          full.contact_state, full.friction_limit)  # fmt: skip
+    assert lean.checks["coulomb"] == check and check["slip_steps"] > 0
+
+
+def test_a_lean_run_of_the_per_step_path(blade):
+    h = blade[1]["h"]
+    full = _blade_run(blade, h, blocks=False, store_every=40)
+    lean = _blade_run(blade, h, blocks=False, store_every=40, lean=2)
+    _same_as_coarsened(lean, full, 2)
+    assert lean.energy_error() == full.energy_error()
+
+
+@pytest.mark.parametrize("tolerances", [{"energy": 1e-14}, {"heat": 1e-16},
+                                        {"coulomb": -1.0}])  # fmt: skip
+def test_the_verdict_of_a_lean_run_is_the_full_runs(blade, tolerances):
+    """Balance and Coulomb rules fire on a lean record as on the whole arrays."""
+    h = blade[1]["h"]
+    full = _blade_run(blade, h, tolerances=tolerances)
+    lean = _blade_run(blade, h, tolerances=tolerances, lean=2)
+    assert full.status == "inaccurate"
+    assert (lean.status, lean.message) == (full.status, full.message)
+
+
+def test_a_frictionless_lean_run_and_a_stop(monkeypatch):
+    """The paper's bar (one frictionless contact, exponential and θ steppers), a run that a
+    stop limit ends: the rows up to the stop, coarsened; the same verdict."""
+    monkeypatch.setattr("femrub.output.recorder.CHUNK_STEPS", 64)
+    model = fr.bar_model(alpha=3.0)
+    for st in (lambda: fr.ThetaMethod(model, 1e-4), lambda: fr.ExponentialMoreau(model, 2e-4)):
+        full, lean = st().run(0.1, store_every=30), st().run(0.1, store_every=30, lean=3)
+        _same_as_coarsened(lean, full, 3)
+        assert lean.energy_error() == full.energy_error()
+        assert lean.heat_error() == full.heat_error()
+        assert lean.checks["coulomb"] == coulomb_check(
+            full.force, full.friction_force, full.slip_velocity, full.contact_state,
+            full.friction_limit,
+        )  # fmt: skip
+    limits = {"tip_temperature": 0.5}
+    full = fr.ThetaMethod(model, 1e-4).run(0.1, limits=limits)
+    lean = fr.ThetaMethod(model, 1e-4).run(0.1, limits=limits, lean=2)
+    assert full.status == "diverged-physically" and 10 < full.steps < 999
+    _same_as_coarsened(lean, full, 2)
+
+
+def test_a_lean_record_does_not_allocate_the_rows_it_drops():
+    """Traced peak of a lean run: its kept rows and one chunk's buffers, not the n rows of
+    every per-step array (nor the results' friction and energy arrays)."""
+    model = fr.bar_model(alpha=3.0)
+    n = 40_000
+
+    def peak(**kw):
+        tracemalloc.start()
+        res = fr.ThetaMethod(model, 1e-6).run(n * 1e-6, **kw)
+        out = tracemalloc.get_traced_memory()[1]
+        tracemalloc.stop()
+        return res, out
+
+    full, full_peak = peak()
+    lean, lean_peak = peak(lean=2)
+    per_row = 8 + sum(v.shape[1] * 8 for v in lean.signals.values()) + 8 * model.n_contacts
+    kept = (n // 2 + 1) * per_row  # t, signals and impulses every second step
+    every_row = sum(a.nbytes for a in full.per_step().values()) / (n + 1)
+    assert every_row > 8 * per_row / 2  # the full record: energy, gaps, friction rows, ...
+    assert lean_peak < kept + 2_000_000  # + one chunk's buffers (and the stepper's own)
+    assert full_peak > 5 * lean_peak
+
+
+def _recorded_whole(monkeypatch, module):
+    """``module._simulate`` recording every row and coarsening afterwards, as before lean
+    records (the step check: ``coarsen(res, 2)``; the estimate: ``res.lean()``)."""
+    original = module._simulate
+    signature = inspect.signature(original)
+
+    def whole(*args, **kw):
+        bound = signature.bind(*args, **kw)
+        bound.apply_defaults()
+        lean, bound.arguments["lean"] = bound.arguments["lean"], 0
+        res, states = original(*bound.args, **bound.kwargs)
+        return (coarsen(res, lean) if lean > 1 else res.lean() if lean else res), states
+
+    monkeypatch.setattr(module, "_simulate", whole)
+
+
+def test_the_step_check_and_the_estimate_are_those_of_whole_records(blade, monkeypatch):
+    """The time-step error (fine run and twin recorded lean at k = 2) and the reduction
+    estimate (its runs recorded lean) equal, bit for bit, what whole records coarsened
+    afterwards gave, with the same statuses."""
+    from femrub.app import build
+    from femrub.app import step_check as sc
+    from femrub.app.scheme import bare_stepper
+    from femrub.reduction import estimate as est
+    from femrub.reduction.sizes import _checked
+    from femrub.scene import load_scene
+
+    # a step tolerance low enough that the round-off twin is stepped too
+    changes = {**SCENE, "scheme.step_check": True, "scheme.step_tolerance": 1e-6}
+    scene = load_scene("twisted-naca", changes)
+    sim = build(scene, log=lambda s: None)
+    assert sim.ran is None  # the coating: the check's and the estimate's runs are compared only
+
+    def check():
+        err, _, _ = sc.check_step(scene, sim.model, sim.full,
+                                  lambda m, h: bare_stepper(scene, m, h), sim.limits)  # fmt: skip
+        return {k: v for k, v in err.items() if k != "seconds"}
+
+    def estimate():
+        report, red = {}, sim.reductor
+        want = (scene["reduction"]["n_uv"], scene["reduction"]["n_theta"])
+        _checked(red, red.fom, want, lambda m: bare_stepper(scene, m), scene, report, None,
+                 sim.limits)  # fmt: skip
+        return {k: v for k, v in report["error"].items() if k != "seconds"}
+
+    lean = check()
+    assert "sensitivity" in lean and lean["status_reference"] == "ok"
+    with monkeypatch.context() as mp:
+        _recorded_whole(mp, sc)
+        assert check() == lean
+    with monkeypatch.context() as mp:
+        _recorded_whole(mp, est)
+        whole = estimate()
+    assert estimate() == whole and whole["status_reference"] == "ok"
+
+
+@pytest.mark.parametrize("lean", [0, 1])
+def test_rows_a_step_leaves_unwritten_stay_zero_across_chunks(monkeypatch, lean):
+    """The per-step buffers are reused chunk after chunk: a step without friction rows
+    (or works) reads as zeros, not as the row a previous chunk left there."""
+    from femrub.output.recorder import Recorder
+
+    monkeypatch.setattr("femrub.output.recorder.CHUNK_STEPS", 4)
+    model = fr.bar_model(alpha=3.0)
+    n, k = 11, iter(range(1, 12))
+    st = fr.ThetaMethod(model, 1e-4)
+
+    def advance():  # friction rows on odd steps only
+        i = next(k)
+        info = {"heat": np.array([float(i)]), "state": np.array([1])} if i % 2 else None
+        return i * 1e-4, model.x0, np.zeros(1), info
+
+    rec = Recorder(model, 1e-4, n, scheme="test", stability_limit=np.inf, energy=False,
+                   lean=lean)  # fmt: skip
+    rows = []
+    rec.on_rows = lambda a: rows.append(a)
+    res = rec.record(st.state, advance)
+    assert res.steps == n and res.status == "ok"
+    if not lean:
+        np.testing.assert_array_equal(res.contact_state[:, 0], [0, 1] * 6)
+    streamed = np.concatenate([a["t"] for a in rows])
+    np.testing.assert_array_equal(streamed, np.arange(n + 1) * 1e-4)
+
+
+def test_a_lean_record_saved_and_loaded_keeps_its_checks(tmp_path):
+    model = fr.bar_model(alpha=3.0)
+    lean = fr.ThetaMethod(model, 1e-4).run(0.05, lean=2)
+    back = fr.Results.load_npz(lean.save_npz(tmp_path / "lean.npz"))
+    assert back.checks == lean.checks and back.energy_error() == lean.energy_error() > 0
+    one = fr.ThetaMethod(model, 1e-4).run(0.0, lean=2)  # no step: no balance, NaN
+    back = fr.Results.load_npz(one.save_npz(tmp_path / "one.npz"))
+    assert np.isnan(one.energy_error()) and np.isnan(back.energy_error())
