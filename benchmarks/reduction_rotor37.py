@@ -20,7 +20,6 @@ time-discretisation error of the largest model, for scale.
 
 from __future__ import annotations
 
-import dataclasses
 import os
 import resource
 import time
@@ -31,6 +30,7 @@ from femrub.app.cache import ModelCache
 from femrub.app.cli import _changes
 from femrub.app.scheme import bare_stepper, scheme_options
 from femrub.app.simulation import build
+from femrub.app.step_check import coarsen
 from femrub.reduction import ThermoelasticCraigBampton
 from femrub.reduction.estimate import PERTURBATION, compare, field_norms, twin
 from femrub.reduction.sizes import lobe_passage
@@ -41,15 +41,6 @@ from femrub.steppers import make_stepper
 STORED = 50
 #: size factors of the models compared (1 = the scene's sizes; ``--factors``)
 FACTORS = (1, 2, 4)
-
-
-def _coarsen(res, f: int):
-    """``res`` (step h/f) seen at every f-th step: signals sampled, impulses summed."""
-    n = (len(res.t) - 1) // f
-    imp = res.impulse
-    coarse = np.vstack([imp[:1], imp[1 : 1 + n * f].reshape(n, f, -1).sum(axis=1)])
-    sig = {k: v[: 1 + n * f : f] for k, v in res.signals.items()}
-    return dataclasses.replace(res, t=res.t[: 1 + n * f : f], impulse=coarse, signals=sig)
 
 
 def _peak_gib() -> float:
@@ -112,7 +103,7 @@ def measure(name: str, sets: list[str], factors=FACTORS, log=print) -> dict:
     st = make_stepper(s["name"], red.reduce(*sizes[-1]), s["h"] / 2, **scheme_options(scene))
     half = st.run(t_end, store_every=2 * max(1, st.steps_to(t_end) // (2 * STORED)))
     Xh = red.reconstruct(half.states, *sizes[-1])
-    half_diff = compare(runs[-1]["res"], _coarsen(half, 2), runs[-1]["X"], Xh, norms, window)
+    half_diff = compare(runs[-1]["res"], coarsen(half, 2), runs[-1]["X"], Xh, norms, window)
     log(f"{sizes[-1]} at h/2 stepped")
     for r in runs:
         r.pop("X")

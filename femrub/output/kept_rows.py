@@ -25,13 +25,10 @@ from __future__ import annotations
 import numpy as np
 
 from ..contact.friction import coulomb_check_rows, merge_coulomb_checks
+from .balance import BALANCE_TERMS, balance_maxima, energy_error_of, heat_error_of
 from .results import Results
 
 __all__ = ["AllRows", "LeanRows"]
-
-#: the largest magnitudes a lean record keeps of the energy balance (its residuals, scales)
-_ENERGY_MAXIMA = ("energy_error", "mechanical", "external_work", "thermal_work", "heat_error",
-                  "heat_content", "friction_heat", "heat_load", "heat_outflow")  # fmt: skip
 
 
 def _signals(rec, obs) -> dict[str, np.ndarray]:
@@ -101,7 +98,7 @@ class LeanRows:
         n1, nc = rec.n // self.k + 1, rec.model.n_contacts
         self.t, self.obs = np.zeros(n1), np.zeros((n1, rec.obs.shape[1]))
         self.imp, self._open = np.zeros((n1, nc)), np.zeros((0, nc))
-        self.maxima = dict.fromkeys(_ENERGY_MAXIMA, -np.inf) if rec.meter is not None else None
+        self.maxima = dict.fromkeys(BALANCE_TERMS, -np.inf) if rec.meter is not None else None
         # Coulomb check parts with the recorded contact states and, while the stepper has
         # written no friction rows, with a frictionless stepper's (AllRows.results)
         c = rec.model.contact
@@ -130,11 +127,8 @@ class LeanRows:
         """Running maxima of the balance (``Results.energy_error``'s terms) and Coulomb
         check parts of the buffers' rows ``b``."""
         if self.maxima is not None:
-            d, mx = rec.meter.data, self.maxima
-            terms = {k: d[k][b] for k in _ENERGY_MAXIMA if k != "mechanical"}
-            terms["mechanical"] = d["kinetic"][b] + d["elastic"][b]
-            for key, v in terms.items():
-                mx[key] = np.maximum(mx[key], np.max(np.abs(v)))
+            mx = balance_maxima(rec.meter.data, b)
+            self.maxima = {k: max(v, mx[k]) for k, v in self.maxima.items()}
         if self._coulomb is None:
             return
         c, h, imp = rec.model.contact, rec.h, rec.imp[b]
@@ -154,12 +148,8 @@ class LeanRows:
         mx = self.maxima
         if mx is not None:
             nan = m < 2
-            scale = max(mx["mechanical"], mx["external_work"], mx["thermal_work"], 1e-300)
-            out["energy_error"] = float("nan") if nan else float(mx["energy_error"] / scale)
-            heat = max(mx[k] for k in _ENERGY_MAXIMA[5:])  # heat content, friction heat, …
-            out["heat_error"] = (
-                float("nan") if nan else (float(mx["heat_error"] / heat) if heat > 0 else 0.0)
-            )
+            out["energy_error"] = float("nan") if nan else energy_error_of(mx)
+            out["heat_error"] = float("nan") if nan else heat_error_of(mx)
         if self._coulomb is not None and m:
             parts = self._coulomb[0 if rec.has_friction else 1]
             out["coulomb"] = merge_coulomb_checks(parts)

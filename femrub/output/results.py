@@ -31,6 +31,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .balance import ENERGY_TERMS, HEAT_TERMS, balance_maxima, energy_error_of, heat_error_of
 from .csv_rows import decimate_columns, write_csv_rows
 from .jsonfile import jsonable
 
@@ -200,14 +201,7 @@ class Results:
         """Largest mechanical balance residual relative to the energy scale of the run."""
         if "energy_error" not in self.energy or self.t.size < 2:  # lean: measured, or NaN
             return float(np.nan if (v := self.checks.get("energy_error")) is None else v)
-        e = self.energy
-        scale = max(
-            np.max(np.abs(e["kinetic"] + e["elastic"])),
-            np.max(np.abs(e["external_work"])),
-            np.max(np.abs(e["thermal_work"])),
-            1e-300,
-        )
-        return float(np.max(np.abs(e["energy_error"])) / scale)
+        return energy_error_of(balance_maxima(self.energy, terms=ENERGY_TERMS))
 
     def heat_error(self) -> float:
         """Largest heat-balance residual relative to the heat scale of the run (0 when no
@@ -215,11 +209,7 @@ class Results:
         e = self.energy
         if "heat_error" not in e or self.t.size < 2:
             return float(np.nan if (v := self.checks.get("heat_error")) is None else v)
-        scale = max(
-            np.max(np.abs(e[k]))
-            for k in ("heat_content", "friction_heat", "heat_load", "heat_outflow")
-        )
-        return float(np.max(np.abs(e["heat_error"])) / scale) if scale > 0 else 0.0
+        return heat_error_of(balance_maxima(e, terms=HEAT_TERMS))
 
     def per_step(self) -> dict[str, np.ndarray]:
         """Every per-step array by name (rows = times), before flattening."""
