@@ -38,8 +38,15 @@ def with_map(model, n_angle: int):
 
     c = model.contact
     w, g = c.wear, c.wear.grid
-    grid = CasingGrid(g.angles, g.axial, g.radius, g.omega, n_angle=n_angle, n_axial=g.n_axial,
-                      footprint=g.footprint)  # fmt: skip
+    grid = CasingGrid(
+        g.angles,
+        g.axial,
+        g.radius,
+        g.omega,
+        n_angle=n_angle,
+        n_axial=g.n_axial,
+        footprint=g.footprint,
+    )
     c.wear = Abradable(w.thickness, w.yield_force, grid)
     return model
 

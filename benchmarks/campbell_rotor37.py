@@ -15,8 +15,12 @@ import time
 from _common import DOCS, OUT, fmt, machine
 
 PUBLISHED_HZ = (312.12, 922.81, 1165.62)
-DECK = {"material.young": 210e9, "material.poisson": 0.3, "material.density": 9000.0,
-        "physics.lumping": "consistent"}  # fmt: skip
+DECK = {
+    "material.young": 210e9,
+    "material.poisson": 0.3,
+    "material.density": 9000.0,
+    "physics.lumping": "consistent",
+}
 
 
 def main(methods) -> None:

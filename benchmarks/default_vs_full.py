@@ -97,7 +97,7 @@ def measure(name: str, sets: list[str]) -> dict:
             build_full=t_build_full,
             run_full=wall_f,
             cpu_full=cpu_f,
-        ),  # fmt: skip
+        ),
         load=(load0, os.getloadavg()),
         stored=m,
     )
@@ -144,11 +144,15 @@ def table(r: dict) -> str:
             full = r["energy"][1] if i == 0 else r["heat"][1]
             lines.append(f"| {label} | {x:.1e} / {full:.1e} | ≤ 1 % | {ok(x, lim)} |")
             continue
-        lines.append(f"| {label} | {pct(x)}{extra} | {'≤ 5 %' if lim else ''} | "
-                     f"{ok(x, lim) if lim else ''} |")  # fmt: skip
+        lines.append(
+            f"| {label} | {pct(x)}{extra} | {'≤ 5 %' if lim else ''} | "
+            f"{ok(x, lim) if lim else ''} |"
+        )
     tr, tf = r["tmin"]
-    lines.append(f"| lowest temperature (reduced / full) | {tr:.2f} K / {tf:.2f} K | ≥ −0.5 K | "
-                 f"{ok(-tr, 0.5)} |")  # fmt: skip
+    lines.append(
+        f"| lowest temperature (reduced / full) | {tr:.2f} K / {tf:.2f} K | ≥ −0.5 K | "
+        f"{ok(-tr, 0.5)} |"
+    )
     d = r["estimate_detail"]
     lines += [
         "",

@@ -281,10 +281,13 @@ def blade_friction(cfg, log) -> dict:
     h_lim = fr.Carpenter(model, 1e-9).stability_limit()
     runs = (
         ("θ paper", cfg["fric_theta_h"], lambda h: fr.ThetaMethod(model, h)),
-        ("Carpenter", tuple(f * h_lim for f in cfg["blade_carpenter_f"]),
-         lambda h: fr.Carpenter(model, h)),
+        (
+            "Carpenter",
+            tuple(f * h_lim for f in cfg["blade_carpenter_f"]),
+            lambda h: fr.Carpenter(model, h),
+        ),
         ("exponential", cfg["fric_exp_h"], lambda h: fr.ExponentialMoreau(model, h)),
-    )  # fmt: skip
+    )
     return {
         "n_dofs": model.n_dofs,
         "t_end": T,
@@ -324,8 +327,13 @@ def _blade_rows(runs, T, t_ref, u_ref, T_ref, log) -> list[dict]:
                 "heat_error": float(res.heat_error()),
             }
             if res.friction_limit is not None and np.any(res.friction_limit > 0):
-                ch = coulomb_check(res.force, res.friction_force, res.slip_velocity,
-                                   res.contact_state, res.friction_limit)  # fmt: skip
+                ch = coulomb_check(
+                    res.force,
+                    res.friction_force,
+                    res.slip_velocity,
+                    res.contact_state,
+                    res.friction_limit,
+                )
                 row["coulomb_direction"] = ch["direction"]
                 row["coulomb_sliding"] = ch["slip_equality"]
             rows.append(row)
@@ -360,7 +368,7 @@ def main(argv=None) -> dict:
         # the 1-minute load (start, end) of the run each kept study was measured in
         kept = old.get("study_load", {})
         doc["study_load"] = {k: v for k, v in kept.items() if k in args.skip and k in doc}
-    from femrub.steppers.exponential_kernels import warm_up
+    from femrub.steppers.exponential.kernels import warm_up
 
     warm_up()  # compiled once per machine (numba's cache): never in a timed run
     for name, fn in (

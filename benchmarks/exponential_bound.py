@@ -11,7 +11,7 @@ thread::
 The 3× target asks the exponential stepper's whole run to cost at most ``c / 3``. Its run
 pays the same recorder and verdict (``x``) and, whatever else, one exponential of the
 augmented generator ``h M_S`` per held set ``S`` it meets (the exact flight over a step,
-:class:`~femrub.steppers.flows.FlowFamily`). Two budgets for these exponentials:
+:class:`~femrub.steppers.exponential.flows.FlowFamily`). Two budgets for these exponentials:
 
 * as the code stands: ``c / 3 − x``;
 * with the shared part of a run free for both methods: ``(s + N k) / 3`` (the most it can be
@@ -71,8 +71,9 @@ def _run_only(make, T, n=REPEATS) -> float:
 def products(rho_h: float) -> int:
     """Least ``n × n`` products of a scaling-and-squaring Padé exponential of a balanced
     matrix of spectral radius ``rho_h`` (approximant + squarings)."""
-    return min(p + max(0, math.ceil(math.log2(rho_h / th))) if rho_h > 0 else p
-               for p, th in PADE.values())  # fmt: skip
+    return min(
+        p + max(0, math.ceil(math.log2(rho_h / th))) if rho_h > 0 else p for p, th in PADE.values()
+    )
 
 
 def _exponentials(model, h, T) -> dict:
@@ -92,9 +93,14 @@ def _exponentials(model, h, T) -> dict:
         n_products.append(products(float(np.max(np.abs(np.linalg.eigvals(hM))))))
         scipy_s += _best(lambda hM=hM: sl.expm(hM))
         ideal += n_products[-1] * product
-    return {"exp_run": _best(lambda: fr.ExponentialMoreau(model, h).run(T)),
-            "held_sets": len(sets), "n_z": nz, "products": ", ".join(map(str, n_products)),
-            "expm": scipy_s, "ideal": ideal}  # fmt: skip
+    return {
+        "exp_run": _best(lambda: fr.ExponentialMoreau(model, h).run(T)),
+        "held_sets": len(sets),
+        "n_z": nz,
+        "products": ", ".join(map(str, n_products)),
+        "expm": scipy_s,
+        "ideal": ideal,
+    }
 
 
 #: how a method's run "at 1 %" is read off its work–precision rows
@@ -118,10 +124,22 @@ def _case(name, model, rows, makers, T, log, reading) -> dict | None:
     k = (rN - r1) / (N - 1)
     x = r1 - k
     e = _exponentials(model, hx, T)
-    row = {"case": name, "reading": reading, "other": other["method"], "h": h, "steps": N,
-           "error": other["T_end"], "run": c,
-           "constructor": s, "stepping": N * k, "shared": x, "budget_now": c / 3 - x,
-           "budget_free": (s + N * k) / 3, "exp_h": hx, **e}  # fmt: skip
+    row = {
+        "case": name,
+        "reading": reading,
+        "other": other["method"],
+        "h": h,
+        "steps": N,
+        "error": other["T_end"],
+        "run": c,
+        "constructor": s,
+        "stepping": N * k,
+        "shared": x,
+        "budget_now": c / 3 - x,
+        "budget_free": (s + N * k) / 3,
+        "exp_h": hx,
+        **e,
+    }
     row["verdict"] = (
         "infeasible"
         if row["ideal"] > row["budget_free"]
@@ -139,11 +157,16 @@ def bound(cfg, log, doc) -> list[dict]:
     out = []
     if doc.get("work_precision"):
         model = C.paper_model()
-        makers = {"θ paper": lambda h: fr.ThetaMethod(model, h),
-                  "Carpenter": lambda h: fr.Carpenter(model, h)}  # fmt: skip
+        makers = {
+            "θ paper": lambda h: fr.ThetaMethod(model, h),
+            "Carpenter": lambda h: fr.Carpenter(model, h),
+        }
         for reading in READINGS:
-            out.append(_case("paper", model, doc["work_precision"]["rows"], makers,
-                             cfg["t_wp"], log, reading))  # fmt: skip
+            out.append(
+                _case(
+                    "paper", model, doc["work_precision"]["rows"], makers, cfg["t_wp"], log, reading
+                )
+            )
     for key in ("blade", "blade_friction"):
         if not (cfg["blade_t"] and doc.get(key)):
             continue
@@ -164,9 +187,11 @@ def bound(cfg, log, doc) -> list[dict]:
         c = model.contact
         mu = np.maximum(np.broadcast_to(np.asarray(c.friction, float), (c.n,)), 1e-9)
         blocks = model.with_(contact=replace(c, friction=mu))
-        makers = {"θ paper": lambda h, m=model: fr.ThetaMethod(m, h),
-                  THETA_BLOCKS: lambda h, b=blocks: fr.ThetaMethod(b, h),
-                  "Carpenter": lambda h, m=model: fr.Carpenter(m, h)}  # fmt: skip
+        makers = {
+            "θ paper": lambda h, m=model: fr.ThetaMethod(m, h),
+            THETA_BLOCKS: lambda h, b=blocks: fr.ThetaMethod(b, h),
+            "Carpenter": lambda h, m=model: fr.Carpenter(m, h),
+        }
         for reading in READINGS:
             out.append(_case(key, model, doc[key]["rows"], makers, cfg["blade_t"], log, reading))
     return [r for r in out if r is not None]

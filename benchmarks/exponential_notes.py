@@ -5,9 +5,10 @@ NOTES = """\
 Reading. The exponential stepper is exact between contact events (docs/theory.md §4b): its
 error is the same at every step size (what remains on the paper case is its distance to the
 θ reference), so its cheapest run at a level is its coarsest step. The frictionless runs are
-`ok`: the stepper integrates every work and heat of the energy balance on its exact flights
-(`steppers/work.py`), so the balance closes to round-off at every step (with friction too:
-the tangential work and the "power" heat of held contacts are integrated exactly; those
+`ok`: the stepper integrates every work and heat of the energy balance on its exact
+flights (`steppers/exponential/work.py`), so the balance closes to round-off at every step
+(with friction too: the tangential work and the "power" heat of held contacts are
+integrated exactly; those
 runs' status is below). That integration is part of `run` with the balance kept, as for
 every method here; "exponential, energy off" (in performance/exponential.md) is the same run
 without it. A step without event is one compiled product of a matrix stacked once per held
@@ -33,7 +34,7 @@ temperature target is not met (θ in Python reaches 1 % at h = 1e-4 s in 4.5 ms)
 
 With its real Coulomb friction (μ = 0.02, "power" heat, every method on that model) every
 exponential run is now `ok`: held slides follow their slip, one direction per step fixed on
-the step's end slip (docs/theory.md §4b, `steppers/exponential_slide.py`), so Coulomb's
+the step's end slip (docs/theory.md §4b, `steppers/exponential/slide.py`), so Coulomb's
 direction check is 2e-10–4e-10 at h >= 5e-5 s and 5.4e-9 at finer steps (one step with an
 impact inside it, whose impulse is along the slip at the impact; the fixed casing direction
 gave 1.5e-7–8.5e-7, above the verdict's 1e-8), sliding equality <= 3.7e-9, balances at

@@ -33,9 +33,17 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 OUT = ROOT / "docs" / "performance" / "mutation_smoke.md"
 IGNORE = shutil.ignore_patterns(
-    ".git", "__pycache__", "*.egg-info", ".hypothesis", ".pytest_cache", ".ruff_cache", "out",
-    "results", "*.vtu", "*.pvd",
-)  # fmt: skip
+    ".git",
+    "__pycache__",
+    "*.egg-info",
+    ".hypothesis",
+    ".pytest_cache",
+    ".ruff_cache",
+    "out",
+    "results",
+    "*.vtu",
+    "*.pvd",
+)
 
 
 @dataclass(frozen=True)

@@ -85,17 +85,40 @@ def study(name, changes, sizes, thermal, every, projection="static-mass"):
         e = compare(res, ref, X, ref.states, norms, window)
         fin = compare(res, ref, X[-1:], ref.states[len(X) - 1 : len(X)], norms, window)
         tmin = float(X[:, full.layout.t].min()) if full.layout.n_t else 0.0
-        rows.append(dict(n_uv=n_uv, n_theta=n_t, n=model.n_dofs,
-                         n_bt=model.info["n_boundary_theta"], err=e,
-                         u_end=fin["displacement"], t_end=fin.get("temperature", 0.0),
-                         energy=res.energy_error(), heat=res.heat_error(), tmin=tmin,
-                         status=res.status, cpu=cpu, res=res, X=X))  # fmt: skip
+        rows.append(
+            dict(
+                n_uv=n_uv,
+                n_theta=n_t,
+                n=model.n_dofs,
+                n_bt=model.info["n_boundary_theta"],
+                err=e,
+                u_end=fin["displacement"],
+                t_end=fin.get("temperature", 0.0),
+                energy=res.energy_error(),
+                heat=res.heat_error(),
+                tmin=tmin,
+                status=res.status,
+                cpu=cpu,
+                res=res,
+                X=X,
+            )
+        )
     for r in rows:
         r["est"] = compare(r["res"], big[0], r["X"], big[1], norms, window)
-    return dict(scene=name, full=ref, cpu_full=cpu_full, cpu_reductor=cpu_red, rows=rows,
-                window=window, n_full=full.n_dofs, t_end=t_end, thermal=thermal,
-                projection=projection, full_energy=ref.energy_error(),
-                full_heat=ref.heat_error())  # fmt: skip
+    return dict(
+        scene=name,
+        full=ref,
+        cpu_full=cpu_full,
+        cpu_reductor=cpu_red,
+        rows=rows,
+        window=window,
+        n_full=full.n_dofs,
+        t_end=t_end,
+        thermal=thermal,
+        projection=projection,
+        full_energy=ref.energy_error(),
+        full_heat=ref.heat_error(),
+    )
 
 
 def _heading(st) -> str:
@@ -158,8 +181,12 @@ def plot(st, path):
     key = "contact_temperature" if "contact_temperature" in f.signals else "tip_temperature"
     ax[1].plot(f.t, f.signals[key].max(axis=1), "k", lw=2, label="full")
     for r in st["rows"]:
-        ax[1].plot(r["res"].t, r["res"].signals[key].max(axis=1), lw=0.8,
-                   label=f"({r['n_uv']}, {r['n_theta']})")  # fmt: skip
+        ax[1].plot(
+            r["res"].t,
+            r["res"].signals[key].max(axis=1),
+            lw=0.8,
+            label=f"({r['n_uv']}, {r['n_theta']})",
+        )
     ax[1].set(xlabel="t (s)", ylabel="hottest contact temperature rise (K)")
     ax[1].legend(fontsize=7)
     fig.tight_layout()

@@ -63,8 +63,12 @@ def measure(name: str, sets: list[str], factors=FACTORS, log=print) -> dict:
     load0 = os.getloadavg()
     t0 = time.perf_counter()
     bare = {k: v for k, v in changes.items() if not k.startswith("reduction.")}
-    fsim = build(load_scene(name, {**bare, "scheme.t_end": t_end, "reduction.method": "none"}),
-                 cache=ModelCache(), stepper=False, log=log)  # fmt: skip
+    fsim = build(
+        load_scene(name, {**bare, "scheme.t_end": t_end, "reduction.method": "none"}),
+        cache=ModelCache(),
+        stepper=False,
+        log=log,
+    )
     full = fsim.model
     t_full = time.perf_counter() - t0
     log(f"full model {full.n_dofs} state dofs built in {t_full:.0f} s; reductor at {sizes[-1]}")
@@ -86,9 +90,21 @@ def measure(name: str, sets: list[str], factors=FACTORS, log=print) -> dict:
         X = red.reconstruct(res.states, *s)
         tmin = float(X[:, full.layout.t].min()) if full.layout.n_t else 0.0
         impulse = float(np.abs(res.impulse).sum())
-        runs.append(dict(sizes=s, n=model.n_dofs, n_bt=model.info["n_boundary_theta"], res=res,
-                         X=X, cpu=cpu, tmin=tmin, energy=res.energy_error(),
-                         heat=res.heat_error(), status=res.status, impulse=impulse))  # fmt: skip
+        runs.append(
+            dict(
+                sizes=s,
+                n=model.n_dofs,
+                n_bt=model.info["n_boundary_theta"],
+                res=res,
+                X=X,
+                cpu=cpu,
+                tmin=tmin,
+                energy=res.energy_error(),
+                heat=res.heat_error(),
+                status=res.status,
+                impulse=impulse,
+            )
+        )
         log(f"{s}: {model.n_dofs} dofs stepped in {cpu:.1f} s CPU, status {res.status}")
     diff = lambda a, b: compare(a["res"], b["res"], a["X"], b["X"], norms, window)  # noqa: E731
     for i, r in enumerate(runs):
@@ -107,13 +123,24 @@ def measure(name: str, sets: list[str], factors=FACTORS, log=print) -> dict:
     log(f"{sizes[-1]} at h/2 stepped")
     for r in runs:
         r.pop("X")
-    return dict(scene=name, sets=sets, t_end=t_end, h=scene["scheme"]["h"], window=window,
-                n_full=full.n_dofs, n_contacts=full.n_contacts, runs=runs, twin=twin_diff,
-                half=half_diff,
-                projection=opts["projection"], thermal=opts["thermal"],
-                conduction=getattr(full.blocks, "info", {}).get("conduction", "?"),
-                times=dict(full=t_full, reductor=t_red, reductor_cpu=c_red),
-                peak=_peak_gib(), load=(load0, os.getloadavg()))  # fmt: skip
+    return dict(
+        scene=name,
+        sets=sets,
+        t_end=t_end,
+        h=scene["scheme"]["h"],
+        window=window,
+        n_full=full.n_dofs,
+        n_contacts=full.n_contacts,
+        runs=runs,
+        twin=twin_diff,
+        half=half_diff,
+        projection=opts["projection"],
+        thermal=opts["thermal"],
+        conduction=getattr(full.blocks, "info", {}).get("conduction", "?"),
+        times=dict(full=t_full, reductor=t_red, reductor_cpu=c_red),
+        peak=_peak_gib(),
+        load=(load0, os.getloadavg()),
+    )
 
 
 ROWS = (
@@ -134,8 +161,9 @@ def table(r: dict) -> str:
     pct = lambda x: "–" if x is None else f"{100 * x:.2f} %"  # noqa: E731
     runs = r["runs"]
     f = lambda s: f"({s[0]}, {s[1]})"  # noqa: E731
-    pairs = sorted(((i, j) for i in range(len(runs)) for j in runs[i]["vs"]),
-                   key=lambda p: (-p[1], p[0]))  # fmt: skip
+    pairs = sorted(
+        ((i, j) for i in range(len(runs)) for j in runs[i]["vs"]), key=lambda p: (-p[1], p[0])
+    )
     t, ld = r["times"], r["load"]
     big = runs[-1]
     others = ", ".join(f"{f(x['sizes'])} ({_name(x)})" for x in runs[1:])

@@ -34,10 +34,24 @@ def metrics(out: Path, window: float = 5.0) -> dict:
     first, last = rev <= rev[0] + window, rev >= rev[-1] - window
     row = {
         k: s.get(k)
-        for k in ("status", "message", "revolutions", "steps", "n_dofs", "n_full", "timings",
-                  "cpu_per_step_us", "energy_error", "max_contact_force", "max_friction_force",
-                  "friction_work", "heat_to_blade", "heat_to_casing", "coulomb_check")
-    }  # fmt: skip
+        for k in (
+            "status",
+            "message",
+            "revolutions",
+            "steps",
+            "n_dofs",
+            "n_full",
+            "timings",
+            "cpu_per_step_us",
+            "energy_error",
+            "max_contact_force",
+            "max_friction_force",
+            "friction_work",
+            "heat_to_blade",
+            "heat_to_casing",
+            "coulomb_check",
+        )
+    }
     row["rms_um_first"] = (1e6 * np.sqrt(np.mean(u[first] ** 2, axis=0))).tolist()
     row["rms_um_last"] = (1e6 * np.sqrt(np.mean(u[last] ** 2, axis=0))).tolist()
     row["max_um_first"] = (1e6 * np.abs(u[first]).max(axis=0)).tolist()

@@ -87,8 +87,9 @@ def prepare(folder: Path) -> dict:
     p = scene["physics"]
     blade = load_blade(scene)
     disc = discretise(blade, p["order"], clamped=scene["boundary"]["clamped"])
-    mats = assemble(disc, tr.material_of(scene), lumping=p["lumping"],
-                    coupling=tr.coupling_of(scene))  # fmt: skip
+    mats = assemble(
+        disc, tr.material_of(scene), lumping=p["lumping"], coupling=tr.coupling_of(scene)
+    )
     mb = np.unique(locate_contacts(disc).normal_rows(mats).indices)
     mi = np.setdiff1d(np.arange(mats.n_u), mb)
     K, M = mats.K.tocsr(), mats.M.tocsr()
@@ -128,8 +129,13 @@ def _factor(name: str, K):
         from cholespy import CholeskySolverD, MatrixType
 
         C = K.tocsc()
-        ch = CholeskySolverD(C.shape[0], C.indptr.astype(np.int32), C.indices.astype(np.int32),
-                             C.data, MatrixType.CSC)  # fmt: skip
+        ch = CholeskySolverD(
+            C.shape[0],
+            C.indptr.astype(np.int32),
+            C.indices.astype(np.int32),
+            C.data,
+            MatrixType.CSC,
+        )
 
         def solve(r):
             x = np.zeros_like(r)
@@ -169,10 +175,19 @@ def run_factor(name: str, folder: Path) -> dict:
     res = float(np.linalg.norm(K @ X - R) / np.linalg.norm(R))
     res1 = float(np.linalg.norm(K @ x - R[:, 0]) / np.linalg.norm(R[:, 0]))
     return dict(
-        factor_cpu=fc, factor_wall=fw, solves_cpu=sc, solves_wall=sw, one_cpu=oc, one_wall=ow,
-        residual=max(res, res1), base_mb=base, factor_mb=after - base, peak_mb=_rss_mb(),
-        load=[load0, _load()], note=note,
-    )  # fmt: skip
+        factor_cpu=fc,
+        factor_wall=fw,
+        solves_cpu=sc,
+        solves_wall=sw,
+        one_cpu=oc,
+        one_wall=ow,
+        residual=max(res, res1),
+        base_mb=base,
+        factor_mb=after - base,
+        peak_mb=_rss_mb(),
+        load=[load0, _load()],
+        note=note,
+    )
 
 
 def run_eigen(name: str, folder: Path) -> dict:
@@ -209,10 +224,15 @@ def run_eigen(name: str, folder: Path) -> dict:
     lam, V = np.asarray(lam)[order], V[:, order]
     r = np.linalg.norm(K @ V - (M @ V) * lam, axis=0) / np.linalg.norm(K @ V, axis=0)
     return dict(
-        cpu=cpu, wall=wall, f1_hz=float(np.sqrt(lam[0]) / (2 * np.pi)),
-        f12_hz=float(np.sqrt(lam[-1]) / (2 * np.pi)), residual=float(r.max()),
-        base_mb=base, peak_mb=_rss_mb(), load=[load0, _load()],
-    )  # fmt: skip
+        cpu=cpu,
+        wall=wall,
+        f1_hz=float(np.sqrt(lam[0]) / (2 * np.pi)),
+        f12_hz=float(np.sqrt(lam[-1]) / (2 * np.pi)),
+        residual=float(r.max()),
+        base_mb=base,
+        peak_mb=_rss_mb(),
+        load=[load0, _load()],
+    )
 
 
 def run_e2e(kind: str, cache_dir: str) -> dict:
@@ -230,9 +250,15 @@ def run_e2e(kind: str, cache_dir: str) -> dict:
     next(iter(sim.stepper.iterate(scene["scheme"]["t_end"])))  # the first step
     cpu, wall = time.process_time() - c0, time.perf_counter() - t0
     return dict(
-        cpu=cpu, wall=wall, peak_mb=_rss_mb(), timings=sim.timings, n_dofs=sim.model.n_dofs,
-        reduction_phases=sim.model.info.get("timings", {}), load=[load0, _load()], log=lines,
-    )  # fmt: skip
+        cpu=cpu,
+        wall=wall,
+        peak_mb=_rss_mb(),
+        timings=sim.timings,
+        n_dofs=sim.model.n_dofs,
+        reduction_phases=sim.model.info.get("timings", {}),
+        load=[load0, _load()],
+        log=lines,
+    )
 
 
 # -- driver ----------------------------------------------------------------------------------
@@ -283,8 +309,9 @@ def _tables(doc: dict) -> str:
     ]
     for name, r in doc["factor"].items():
         if "error" in r:
-            lines.append(f"| {FACTOR[name]} | not run: {r['error']} | | | | | | | | "
-                         f"{INSTALL[name]} |")  # fmt: skip
+            lines.append(
+                f"| {FACTOR[name]} | not run: {r['error']} | | | | | | | | {INSTALL[name]} |"
+            )
             continue
         lines.append(
             f"| {FACTOR[name]} | {_fmt(r['factor_cpu'])} | {_fmt(r['factor_wall'])} | "
@@ -300,8 +327,7 @@ def _tables(doc: dict) -> str:
     ]
     for name, r in doc["eigen"].items():
         if "error" in r:
-            lines.append(f"| {EIGEN[name]} | not run: {r['error']} | | | | | | | "
-                         f"{INSTALL[name]} |")  # fmt: skip
+            lines.append(f"| {EIGEN[name]} | not run: {r['error']} | | | | | | | {INSTALL[name]} |")
             continue
         lines.append(
             f"| {EIGEN[name]} | {_fmt(r['cpu'])} | {_fmt(r['wall'])} | {r['f1_hz']:.2f} | "
@@ -320,8 +346,9 @@ def _tables(doc: dict) -> str:
             if "error" in r:
                 lines.append(f"| {what[kind]} | not run: {r['error']} | | | | | | |")
                 continue
-            ph = ", ".join(f"{k.replace('_', ' ')} {v:.1f}" for k, v in
-                           r["reduction_phases"].items())  # fmt: skip
+            ph = ", ".join(
+                f"{k.replace('_', ' ')} {v:.1f}" for k, v in r["reduction_phases"].items()
+            )
             if kind == "hit":
                 ph = "loaded from the cache"
             lines.append(

@@ -44,10 +44,12 @@ HEADER = (
 
 
 def _commit() -> str:
-    p = subprocess.run(["git", "-C", str(ROOT), "rev-parse", "--short", "HEAD"],
-                       capture_output=True, text=True)  # fmt: skip
-    dirty = subprocess.run(["git", "-C", str(ROOT), "status", "--porcelain", "femrub"],
-                           capture_output=True, text=True).stdout.strip()  # fmt: skip
+    p = subprocess.run(
+        ["git", "-C", str(ROOT), "rev-parse", "--short", "HEAD"], capture_output=True, text=True
+    )
+    dirty = subprocess.run(
+        ["git", "-C", str(ROOT), "status", "--porcelain", "femrub"], capture_output=True, text=True
+    ).stdout.strip()
     return p.stdout.strip() + (" + changes" if dirty else "")
 
 
@@ -70,9 +72,21 @@ def _points(out: Path) -> list[dict]:
 
 def measure(speeds: str, workers: int, out: Path, cache: Path) -> dict:
     """Run the sweep in a child process; what it took."""
-    cmd = [sys.executable, "-m", "femrub", "sweep", "rotor37", "--param",
-           f"loads.rotation_speed={speeds}", "--workers", str(workers), "-o", str(out),
-           "--cache-dir", str(cache)]  # fmt: skip
+    cmd = [
+        sys.executable,
+        "-m",
+        "femrub",
+        "sweep",
+        "rotor37",
+        "--param",
+        f"loads.rotation_speed={speeds}",
+        "--workers",
+        str(workers),
+        "-o",
+        str(out),
+        "--cache-dir",
+        str(cache),
+    ]
     for s in SETS:
         cmd += ["--set", s]
     env = dict(os.environ, PYTHONPATH=str(ROOT) + os.pathsep + os.environ.get("PYTHONPATH", ""))

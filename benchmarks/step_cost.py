@@ -39,8 +39,9 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
 
-def _per_step(model, scheme: dict, opts: dict, t_end: float, energy: bool, blocks=True,
-              on_state=None) -> dict:  # fmt: skip
+def _per_step(
+    model, scheme: dict, opts: dict, t_end: float, energy: bool, blocks=True, on_state=None
+) -> dict:
     """CPU (all threads) and wall time per step of ``run()`` alone (``blocks``: the
     compiled blocks of steps, else step by step; ``on_state``: an output callback, e.g. a
     VTK series, whose frames are all on disk when ``run`` returns)."""
@@ -51,10 +52,15 @@ def _per_step(model, scheme: dict, opts: dict, t_end: float, energy: bool, block
     c0, w0 = time.process_time(), time.perf_counter()
     res = st.run(t_end, energy=energy, on_state=on_state)
     wall, cpu = time.perf_counter() - w0, time.process_time() - c0
-    return {"steps": res.steps, "us": 1e6 * cpu / res.steps, "wall_us": 1e6 * wall / res.steps,
-            "status": res.status,
-            "energy_error": float(np.max(np.abs(res.energy["energy_error"])))
-            if "energy_error" in res.energy else None}  # fmt: skip
+    return {
+        "steps": res.steps,
+        "us": 1e6 * cpu / res.steps,
+        "wall_us": 1e6 * wall / res.steps,
+        "status": res.status,
+        "energy_error": float(np.max(np.abs(res.energy["energy_error"])))
+        if "energy_error" in res.energy
+        else None,
+    }
 
 
 def _bare_blocks(model, scheme: dict, opts: dict, t_end: float) -> dict:
@@ -100,14 +106,18 @@ def _vtk(sim, scheme: dict, opts: dict, stride: int, t_end: float, repeats: int 
         for key, background in (("vtk", True), ("vtk_inline", False)):
             with tempfile.TemporaryDirectory() as d:
                 c0, w0 = time.process_time(), time.perf_counter()
-                series = VTKSeries(d, sim.model, sim.fields, h=scheme["h"], stride=stride,
-                                   background=background)  # fmt: skip
+                series = VTKSeries(
+                    d, sim.model, sim.fields, h=scheme["h"], stride=stride, background=background
+                )
                 setup = (time.process_time() - c0, time.perf_counter() - w0)
                 row = _per_step(sim.model, scheme, opts, t_end, False, on_state=series)
                 series.close()
                 files = list(Path(d).glob("*.vtu"))
-                row |= {"main_us": 1e6 * series.seconds / row["steps"], "setup": setup,
-                        "writer_us": 1e6 * series._writer_cpu / row["steps"]}  # fmt: skip
+                row |= {
+                    "main_us": 1e6 * series.seconds / row["steps"],
+                    "setup": setup,
+                    "writer_us": 1e6 * series._writer_cpu / row["steps"],
+                }
                 runs.setdefault(key, []).append(row)
                 out["vtk_frames"] = len(series.frames)
                 out["vtk_mb"] = sum(f.stat().st_size for f in files) / len(files) / 1e6
@@ -182,8 +192,9 @@ def _compile_cost() -> dict:
     with tempfile.TemporaryDirectory() as cache:
         env = {**os.environ, "NUMBA_CACHE_DIR": cache, "PYTHONPATH": str(ROOT)}
         for key in ("compile_s", "cached_s"):
-            run = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True,
-                                 text=True, check=True)  # fmt: skip
+            run = subprocess.run(
+                [sys.executable, "-c", code], env=env, capture_output=True, text=True, check=True
+            )
             out[key] = float(run.stdout.split()[-1])
     return out
 
@@ -204,13 +215,17 @@ def measure(scene_name: str, revolutions: float, vtk: bool = True) -> dict:
     opts = scheme_options(scene)
     m = sim.model
     row = {
-        "scene": scene_name, "n_dofs": m.n_dofs, "contacts": m.contact.n, "t_end": t_end,
-        "build_s": build_s, "no_energy": _per_step(m, scene["scheme"], opts, t_end, False),
+        "scene": scene_name,
+        "n_dofs": m.n_dofs,
+        "contacts": m.contact.n,
+        "t_end": t_end,
+        "build_s": build_s,
+        "no_energy": _per_step(m, scene["scheme"], opts, t_end, False),
         "energy": _per_step(m, scene["scheme"], opts, t_end, True),
         "steps_path": _per_step(m, scene["scheme"], opts, t_end, False, blocks=False),
         **_bare_blocks(m, scene["scheme"], opts, t_end),
         **_split(m, scene["scheme"], opts, t_end),
-    }  # fmt: skip
+    }
     if vtk:
         row.update(_vtk(sim, scene["scheme"], opts, 50, t_end))
     row["load"] = [load0, os.getloadavg()[0]]

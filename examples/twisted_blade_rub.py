@@ -30,23 +30,45 @@ OMEGA = 1500.0  # rad/s
 H, T_END = 2e-6, 6e-3  # s
 
 blade = naca_blade(
-    "0012", span=0.1, root_chord=0.05, tip_chord=0.035, twist=20.0, n_sections=3,
-    hub_radius=0.2, h=0.012, n_contact=5,
-)  # fmt: skip
+    "0012",
+    span=0.1,
+    root_chord=0.05,
+    tip_chord=0.035,
+    twist=20.0,
+    n_sections=3,
+    hub_radius=0.2,
+    h=0.012,
+    n_contact=5,
+)
 material = fr.Material(
-    young=110e9, rho=4500.0, poisson=0.3, rho_c=4500.0 * 585.0, conductivity=7.0,
+    young=110e9,
+    rho=4500.0,
+    poisson=0.3,
+    rho_c=4500.0 * 585.0,
+    conductivity=7.0,
     expansion=8.6e-6,
-)  # fmt: skip
+)
 casing = Lobed(clearance=20e-6, depth=40e-6, lobes=3)
 full, fields = solid_model(
-    blade, material, casing=casing, rotation_speed=OMEGA, friction=0.02,
-    coupling="physical", thermal=True,
-)  # fmt: skip
+    blade,
+    material,
+    casing=casing,
+    rotation_speed=OMEGA,
+    friction=0.02,
+    coupling="physical",
+    thermal=True,
+)
 model, reductor = craig_bampton_thermal(full, n_uv=24, n_theta=20)
 results = run_to_folder(
-    fr.ThetaMethod(model, h=H), T_END, OUT, fields=fields, vtk_stride=100, overwrite=True,
-    snapshot=False, inputs={"example": "twisted_blade_rub", "casing": casing.as_dict()},
-)  # fmt: skip
+    fr.ThetaMethod(model, h=H),
+    T_END,
+    OUT,
+    fields=fields,
+    vtk_stride=100,
+    overwrite=True,
+    snapshot=False,
+    inputs={"example": "twisted_blade_rub", "casing": casing.as_dict()},
+)
 
 n_tets = blade.n_tets
 full_dofs, reduced_dofs = full.n_dofs, model.n_dofs
@@ -57,7 +79,9 @@ pvd = OUT / "vtk" / "rub.pvd"
 
 if __name__ == "__main__":
     print(blade.summary())
-    print(f"model: {full_dofs} -> {reduced_dofs} dofs, status {results.status}, "
-          f"first contact {first_contact_time:.4g} s, max force {max_contact_force:.4g} N, "
-          f"max tip temperature rise {max_temperature:.4g} K")  # fmt: skip
+    print(
+        f"model: {full_dofs} -> {reduced_dofs} dofs, status {results.status}, "
+        f"first contact {first_contact_time:.4g} s, max force {max_contact_force:.4g} N, "
+        f"max tip temperature rise {max_temperature:.4g} K"
+    )
     print(f"open {pvd} in ParaView")

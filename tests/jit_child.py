@@ -18,6 +18,7 @@ def child_json(code: str, jit: bool) -> dict:
         env.pop("NUMBA_DISABLE_JIT", None)
     else:
         env["NUMBA_DISABLE_JIT"] = "1"
-    run = subprocess.run([sys.executable, "-c", code], env=env, cwd=ROOT, capture_output=True,
-                         text=True, check=True)  # fmt: skip
+    run = subprocess.run(
+        [sys.executable, "-c", code], env=env, cwd=ROOT, capture_output=True, text=True, check=True
+    )
     return json.loads(run.stdout.splitlines()[-1])

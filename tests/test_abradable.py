@@ -123,8 +123,19 @@ def test_every_activation_rule_honours_the_bound(rule):
         P = impulses(*args, upper=upper)
         assert np.all(P >= 0.0) and np.all(P <= upper)
         if n == 1:
-            one = impulse_one(rule, g_k[0], gd_k[0], g_p[0], gd_p[0], W[0, 0], 0.5 * h * W[0, 0],
-                              e[0], h, gamma, upper[0])  # fmt: skip
+            one = impulse_one(
+                rule,
+                g_k[0],
+                gd_k[0],
+                g_p[0],
+                gd_p[0],
+                W[0, 0],
+                0.5 * h * W[0, 0],
+                e[0],
+                h,
+                gamma,
+                upper[0],
+            )
             assert P[0] == pytest.approx(min(free[0], upper[0]), rel=1e-9, abs=1e-18)
             assert one == pytest.approx(P[0], rel=1e-9, abs=1e-18)
 
@@ -176,11 +187,17 @@ def test_frictional_blade_cuts_the_coating_at_the_yield_force(tmp_path):
     bound): the normal force never exceeds the coating's yield, Coulomb's law holds with the
     capped normal force, coating is removed, the balances close."""
     changes = {
-        "geometry.h": 0.03, "geometry.n_sections": 2, "contact.reach": "all",
-        "contact.friction": 0.15, "contact.abradable.thickness": "30 um",
-        "contact.abradable.yield": 5.0, "loads.centrifugal": "off",
-        "reduction.method": "none", "scheme.t_end": 1.5e-3, "outputs.vtk_stride": 0,
-    }  # fmt: skip
+        "geometry.h": 0.03,
+        "geometry.n_sections": 2,
+        "contact.reach": "all",
+        "contact.friction": 0.15,
+        "contact.abradable.thickness": "30 um",
+        "contact.abradable.yield": 5.0,
+        "loads.centrifugal": "off",
+        "reduction.method": "none",
+        "scheme.t_end": 1.5e-3,
+        "outputs.vtk_stride": 0,
+    }
     res, _ = run_scene(load_scene("twisted-naca", changes), tmp_path / "out")
     s = json.loads((tmp_path / "out" / "summary.json").read_text())
     assert s["status"] == "ok", s.get("message")
@@ -303,8 +320,9 @@ def test_the_bound_of_a_step_entering_the_coating_is_the_part_of_the_step_on_it(
     """``h F_y`` for a contact closed at ``t_k``; ``F_y`` times the part of the step after the
     free motion reaches the worn surface for one open at ``t_k``; ``inf`` worn through."""
     cell = 2 * math.pi / 16
-    grid = CasingGrid((np.arange(0, 16, 4) + 0.5) * cell, [0.0] * 4, 0.3, 100.0, n_angle=16,
-                      n_axial=1)  # fmt: skip
+    grid = CasingGrid(
+        (np.arange(0, 16, 4) + 0.5) * cell, [0.0] * 4, 0.3, 100.0, n_angle=16, n_axial=1
+    )
     wear = Abradable(1e-4, 10.0, grid)
     wear.reset(h=1e-6)
     wear.depth[11:14, 0] = 1e-4  # around the fourth contact (centre 12) at t = 0: worn through
@@ -328,8 +346,14 @@ def test_a_mass_entering_the_coating_is_held_only_after_it_reaches_it():
     m, v, F_y, d, h = 2.0, 0.5, 400.0, 1.3e-6, 1e-6  # stops in m v / F_y = 2.5 ms
     grid = CasingGrid([0.0], [0.0], 0.3, 0.0, n_angle=1, n_axial=1)
     wear = Abradable(1e-2, F_y, grid)
-    c = Contact(G=[[-1.0], [0.0]], Gv=[[0.0], [-1.0]], Hm=[[0.0], [-1.0]], Ht=[[0.0], [0.0]],
-                gap0=d, wear=wear)  # fmt: skip
+    c = Contact(
+        G=[[-1.0], [0.0]],
+        Gv=[[0.0], [-1.0]],
+        Hm=[[0.0], [-1.0]],
+        Ht=[[0.0], [0.0]],
+        gap0=d,
+        wear=wear,
+    )
     A = np.diag([1.0, m])
     B = np.array([[0.0, 1.0], [0.0, 0.0]])
     model = FirstOrderModel(A, B, Layout(n_u=1, n_v=1, n_t=0), contact=c, x0=np.array([0.0, v]))

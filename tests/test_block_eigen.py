@@ -58,8 +58,12 @@ def test_lowest_modes_block_path_equals_arpack_path(monkeypatch):
     np.testing.assert_allclose(lam_b, lam_a, rtol=1e-11)
     np.testing.assert_allclose(V_b, V_a, atol=1e-8)  # same normalisation: same shapes
     # a free structure (singular K) is shifted as on the ARPACK path
-    free = 1e4 * sp.diags([-np.ones(599), np.r_[1.0, 2.0 * np.ones(598), 1.0], -np.ones(599)],
-                          [-1, 0, 1]).tocsc()  # fmt: skip
+    free = (
+        1e4
+        * sp.diags(
+            [-np.ones(599), np.r_[1.0, 2.0 * np.ones(598), 1.0], -np.ones(599)], [-1, 0, 1]
+        ).tocsc()
+    )
     lam = eigen.lowest_modes(free, sp.identity(600), 3, vectors=False)
     exact = 1e4 * (2.0 - 2.0 * np.cos(np.arange(3) * np.pi / 600))
     np.testing.assert_allclose(lam, exact, atol=1e-9)

@@ -80,8 +80,19 @@ def test_campbell_cli_linear(tmp_path):
     basis's); CSV and PNG."""
     _scene(tmp_path, "linear")
     out = tmp_path / "cb"
-    code = main(["campbell", str(tmp_path / "box-linear.toml"), "--speeds", "0:1000:250",
-                 "--modes", "3", "-o", str(out), "-q"])  # fmt: skip
+    code = main(
+        [
+            "campbell",
+            str(tmp_path / "box-linear.toml"),
+            "--speeds",
+            "0:1000:250",
+            "--modes",
+            "3",
+            "-o",
+            str(out),
+            "-q",
+        ]
+    )
     assert code == 0
     doc = json.loads((out / "campbell.json").read_text())
     assert len(doc["sample_speeds"]) == 2 and doc["check_max_relative_error"] < 1e-3

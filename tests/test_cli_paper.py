@@ -9,10 +9,23 @@ from femrub.app.cli import main
 from femrub.output.results import Results
 
 REQUIRED = {
-    "figure", "label", "scheme", "h", "alpha", "coupled", "first_contact_time", "contact_phases",
-    "max_contact_force", "tip_temperature_end", "max_penetration", "energy_error", "steps",
-    "cpu_seconds", "status", "n_dofs",
-}  # fmt: skip
+    "figure",
+    "label",
+    "scheme",
+    "h",
+    "alpha",
+    "coupled",
+    "first_contact_time",
+    "contact_phases",
+    "max_contact_force",
+    "tip_temperature_end",
+    "max_penetration",
+    "energy_error",
+    "steps",
+    "cpu_seconds",
+    "status",
+    "n_dofs",
+}
 
 
 @pytest.fixture(scope="module")

@@ -41,8 +41,14 @@ def test_run_writes_the_results_folder(tiny, tmp_path, capsys):
     out = tmp_path / "out"
     assert main(["run", str(tiny), "-o", str(out), "--quiet"]) == 0
     assert capsys.readouterr().out == ""
-    for name in ("history.csv", "history.npz", "summary.json", "signals.png", "scene.toml",
-                 "explain.txt"):  # fmt: skip
+    for name in (
+        "history.csv",
+        "history.npz",
+        "summary.json",
+        "signals.png",
+        "scene.toml",
+        "explain.txt",
+    ):
         assert (out / name).is_file(), name
     s = json.loads((out / "summary.json").read_text())
     assert s["status"] == "ok" and s["steps"] == 500

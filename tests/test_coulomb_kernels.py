@@ -47,11 +47,33 @@ def solve_all() -> list:
     for code, g_k, gd_k, g_p, GZ3, W, q, mu, e, ub, U in problems():
         n = q.shape[0]
         act, P, u, state, res, it, status = frictional_fixed_point(
-            code, g_k, gd_k, g_p, GZ3, W, q, mu, e, ub, U, np.zeros((n, 3)), False,
-            1e-3, 0.5, 1e-12, 60,
-        )  # fmt: skip
-        out.append({"active": act.tolist(), "P": P.tolist(), "u": u.tolist(),
-                    "state": state.tolist(), "status": int(status)})  # fmt: skip
+            code,
+            g_k,
+            gd_k,
+            g_p,
+            GZ3,
+            W,
+            q,
+            mu,
+            e,
+            ub,
+            U,
+            np.zeros((n, 3)),
+            False,
+            1e-3,
+            0.5,
+            1e-12,
+            60,
+        )
+        out.append(
+            {
+                "active": act.tolist(),
+                "P": P.tolist(),
+                "u": u.tolist(),
+                "state": state.tolist(),
+                "status": int(status),
+            }
+        )
     return out
 
 
@@ -90,8 +112,15 @@ def test_fixed_point_solutions_satisfy_signorini_coulomb():
 def test_compiled_and_python_kernels_agree():
     code = "import json, tests.test_coulomb_kernels as t; print(json.dumps(t.solve_all()))"
     env = {**os.environ, "NUMBA_DISABLE_JIT": "1", "PYTHONPATH": str(ROOT)}
-    run = subprocess.run([sys.executable, "-c", code], env=env, cwd=ROOT, capture_output=True,
-                         text=True, check=True, timeout=600)  # fmt: skip
+    run = subprocess.run(
+        [sys.executable, "-c", code],
+        env=env,
+        cwd=ROOT,
+        capture_output=True,
+        text=True,
+        check=True,
+        timeout=600,
+    )
     python, jit = json.loads(run.stdout), solve_all()
     assert len(python) == len(jit)
     for a, b in zip(python, jit):
@@ -108,11 +137,19 @@ def test_theta_run_with_several_frictional_contacts_meets_coulomb():
 
     scene = load_scene(
         "twisted-naca",
-        {"physics.thermal": "off", "contact.friction": 0.3, "scheme.t_end": 0.0015,
-         "outputs.vtk_stride": 0, "contact.casing.depth": "200 um",
-         "contact.casing.clearance": "5 um", "reduction.method": "craig-bampton",
-         "reduction.n_uv": 12, "reduction.n_theta": 0, "contact.reach": "all"},
-    )  # fmt: skip
+        {
+            "physics.thermal": "off",
+            "contact.friction": 0.3,
+            "scheme.t_end": 0.0015,
+            "outputs.vtk_stride": 0,
+            "contact.casing.depth": "200 um",
+            "contact.casing.clearance": "5 um",
+            "reduction.method": "craig-bampton",
+            "reduction.n_uv": 12,
+            "reduction.n_theta": 0,
+            "contact.reach": "all",
+        },
+    )
     sim = build(scene, log=lambda s: None)
     res = sim.stepper.run(scene["scheme"]["t_end"])
     assert sim.model.contact.n >= 4

@@ -25,8 +25,9 @@ def _same(basis, lam=LAM, mu=MU, area=1.0):
 
 @pytest.mark.parametrize("element", [fem.ElementTetP1, fem.ElementTetP2])
 def test_tetrahedra(element):
-    mesh = fem.MeshTet.init_tensor(np.linspace(0, 0.1, 4), np.linspace(0, 0.03, 3),
-                                   np.linspace(0, 0.005, 3))  # fmt: skip
+    mesh = fem.MeshTet.init_tensor(
+        np.linspace(0, 0.1, 4), np.linspace(0, 0.03, 3), np.linspace(0, 0.005, 3)
+    )
     _same(fem.Basis(mesh, fem.ElementVector(element()), intorder=2))
 
 

@@ -26,9 +26,13 @@ def _run(phase_drift, force_scale=1.0):
     force = force_scale * 1e3 * np.c_[1 + np.sin(ph), 1 + np.cos(ph)]
     sig = 1e-4 * np.c_[np.sin(ph), np.cos(ph)]
     res = SimpleNamespace(
-        t=T, impulse=force * (T[1] - T[0]), force=force,
-        signals={"contact_displacement": sig}, state_times=T[::400], status="ok",
-    )  # fmt: skip
+        t=T,
+        impulse=force * (T[1] - T[0]),
+        force=force,
+        signals={"contact_displacement": sig},
+        state_times=T[::400],
+        status="ok",
+    )
     return (res, np.c_[sig[::400], np.zeros((6, 0))])
 
 

@@ -91,7 +91,8 @@ def test_several_contacts_lcp_and_heat():
 
 @pytest.mark.parametrize("h", [1e-3, 1e-4])
 def test_energy_balance_closes_with_heat_entering_inside_steps(h):
-    # the stepper integrates the works and heats on its exact flights (steppers/work.py):
+    # the stepper integrates the works and heats on its exact flights
+    # (steppers/exponential/work.py):
     # the balance closes to round-off at any step, however many events fall inside one
     res = fr.ExponentialMoreau(_two_contact_bar(), h).run(0.1)
     assert res.status == "ok"
@@ -140,7 +141,7 @@ def test_bad_input():
 
 def test_load_polynomials_of_a_block_are_those_of_each_step():
     # the paper bar's sine load takes arrays: BLOCK steps' polynomials come from one call
-    from femrub.steppers.exponential_loads import BLOCK
+    from femrub.steppers.exponential.loads import BLOCK
 
     st = fr.ExponentialMoreau(fr.bar_model(alpha=3.0), 1e-4)
     assert all(st._vector) and st._m0 == 1

@@ -11,8 +11,24 @@ from femrub.contact.friction import SLIP, coulomb_check
 from femrub.model.first_order import Contact, EnergyForms, FirstOrderModel, Layout, LoadTerm
 
 
-def belt_model(n=1, m=2.0, N=20.0, mu=0.3, v_belt=10.0, eta=0.6, gap=1e-3, k=0.0, kz=0.0,
-               couple=0.0, e=0.0, C=5.0, law="power", alpha=0.0, ky=0.0, vy=0.0):  # fmt: skip
+def belt_model(
+    n=1,
+    m=2.0,
+    N=20.0,
+    mu=0.3,
+    v_belt=10.0,
+    eta=0.6,
+    gap=1e-3,
+    k=0.0,
+    kz=0.0,
+    couple=0.0,
+    e=0.0,
+    C=5.0,
+    law="power",
+    alpha=0.0,
+    ky=0.0,
+    vy=0.0,
+):
     """``n`` point masses (x, y, z each) with a lumped temperature each, pressed by ``N``
     onto a belt (gap ``gap``) moving at ``v_belt`` along x: friction μ, heat law ``law``
     (η of the friction power, or α λ), springs ``k`` along x to a wall, ``ky`` along y and
@@ -39,23 +55,42 @@ def belt_model(n=1, m=2.0, N=20.0, mu=0.3, v_belt=10.0, eta=0.6, gap=1e-3, k=0.0
     tang = np.column_stack([I[:, nu + 3 * i + j] for i in range(n) for j in (0, 1)])
     frame = [[0, 0, -1.0], [1.0, 0, 0], [0, 1.0, 0]]
     contact = Contact(
-        G=I[:, [3 * i + 2 for i in range(n)]], Gv=I[:, vz], Hm=I[:, vz],
-        Ht=I[:, 2 * nu : 2 * nu + nt], gap0=gap, restitution=e, Gvt=tang, friction=mu,
-        casing_velocity=[[v_belt, 0.0]] * n, frames=np.array([frame] * n), heat_law=law,
-        heat_partition=eta, heat_coefficient=alpha,
-    )  # fmt: skip
+        G=I[:, [3 * i + 2 for i in range(n)]],
+        Gv=I[:, vz],
+        Hm=I[:, vz],
+        Ht=I[:, 2 * nu : 2 * nu + nt],
+        gap0=gap,
+        restitution=e,
+        Gvt=tang,
+        friction=mu,
+        casing_velocity=[[v_belt, 0.0]] * n,
+        frames=np.array([frame] * n),
+        heat_law=law,
+        heat_partition=eta,
+        heat_coefficient=alpha,
+    )
     heat = np.r_[np.zeros(2 * nu), C * np.ones(nt)]
     energy = EnergyForms(
         Qk=sp.csr_matrix(sp.block_diag([np.zeros((nu, nu)), M, np.zeros((nt, nt))])),
         Qe=sp.csr_matrix(sp.block_diag([K, np.zeros((nu + nt, nu + nt))])),
-        Pth=sp.csr_matrix((2 * nu + nt,) * 2), Pd=sp.csr_matrix((2 * nu + nt,) * 2),
-        heat_content=heat, heat_outflow=np.zeros(2 * nu + nt),
-    )  # fmt: skip
+        Pth=sp.csr_matrix((2 * nu + nt,) * 2),
+        Pd=sp.csr_matrix((2 * nu + nt,) * 2),
+        heat_content=heat,
+        heat_outflow=np.zeros(2 * nu + nt),
+    )
     obs = {"x": sp.csr_matrix(I[[0]]), "vx": sp.csr_matrix(I[[nu]]), "y": sp.csr_matrix(I[[1]])}
     x0 = np.zeros(2 * nu + nt)
     x0[[nu + 3 * i + 1 for i in range(n)]] = vy
-    return FirstOrderModel(A=A, B=B.copy(), layout=Layout(nu, nu, nt), loads=loads,
-                           contact=contact, energy=energy, observations=obs, x0=x0)  # fmt: skip
+    return FirstOrderModel(
+        A=A,
+        B=B.copy(),
+        layout=Layout(nu, nu, nt),
+        loads=loads,
+        contact=contact,
+        energy=energy,
+        observations=obs,
+        x0=x0,
+    )
 
 
 def test_impact_then_slide_on_a_fast_belt_matches_the_hand_solution():
@@ -96,8 +131,9 @@ def test_energy_balance_with_friction_closes_and_creates_nothing(e, law):
     sliding along x on a spring: every impact and held flight dissipates (impact and
     friction work >= 0), the balance closes to round-off, heat = η × friction work
     ("power") or α P_n ("alpha")."""
-    model = belt_model(m=1.0, N=5.0, mu=0.2, v_belt=3.0, gap=2e-3, k=50.0, kz=400.0, e=e,
-                       law=law, alpha=0.7)  # fmt: skip
+    model = belt_model(
+        m=1.0, N=5.0, mu=0.2, v_belt=3.0, gap=2e-3, k=50.0, kz=400.0, e=e, law=law, alpha=0.7
+    )
     res = fr.ExponentialMoreau(model, 2e-3).run(0.5)
     assert res.status == "ok"
     en = res.energy
@@ -136,8 +172,11 @@ def test_a_held_slide_that_sticks_is_refused_at_the_exact_time():
         s = t - ti
         return xs * (1 - np.cos(w * s)) + mu * vi / w * np.sin(w * s)
 
-    t1 = brentq(lambda t: xs * w * np.sin(w * (t - ti)) + mu * vi * np.cos(w * (t - ti)) - vb,
-                ti, ti + 0.5 * np.pi / w)  # fmt: skip
+    t1 = brentq(
+        lambda t: xs * w * np.sin(w * (t - ti)) + mu * vi * np.cos(w * (t - ti)) - vb,
+        ti,
+        ti + 0.5 * np.pi / w,
+    )
     res = fr.ExponentialMoreau(model, h).run(0.6)
     assert res.status == "failed" and "stops sliding" in res.message
     t_msg = float(res.message.split("t = ")[1].split(" s")[0])
@@ -166,8 +205,9 @@ def test_a_held_slide_follows_its_slip_across_the_belt():
     ex = fr.ExponentialMoreau(model, 5e-4).run(T)
     th = fr.ThetaMethod(model, 1e-5).run(T)
     assert ex.status == "ok" and th.status == "ok"
-    check = coulomb_check(ex.force, ex.friction_force, ex.slip_velocity, ex.contact_state,
-                          ex.friction_limit)  # fmt: skip
+    check = coulomb_check(
+        ex.force, ex.friction_force, ex.slip_velocity, ex.contact_state, ex.friction_limit
+    )
     assert check["slip_steps"] == 200
     assert check["direction"] < 1e-9 and check["slip_equality"] < 1e-9
     w = ex.slip_velocity[:, 0]
@@ -185,8 +225,17 @@ def test_several_contacts_agree_with_the_theta_method(n):
     """Masses coupled by springs along x, each dropped on the belt from its own height
     (impacts at different times inside the coarse steps), several held sliding contacts:
     the exponential stepper at h = 5e-3 s agrees with the θ-method at 1e-5 s."""
-    model = belt_model(n=n, m=1.0, N=10.0, mu=0.25, v_belt=5.0, k=80.0, couple=150.0,
-                       gap=np.linspace(1e-3, 3e-3, n), kz=300.0)  # fmt: skip
+    model = belt_model(
+        n=n,
+        m=1.0,
+        N=10.0,
+        mu=0.25,
+        v_belt=5.0,
+        k=80.0,
+        couple=150.0,
+        gap=np.linspace(1e-3, 3e-3, n),
+        kz=300.0,
+    )
     T = 0.1
     ex = fr.ExponentialMoreau(model, 5e-3).run(T)
     th = fr.ThetaMethod(model, 1e-5).run(T)

@@ -1,4 +1,4 @@
-"""Compiled dyadic kernels of the exponential stepper (:mod:`femrub.steppers.exponential_kernels`).
+"""Compiled dyadic kernels of the exponential stepper (:mod:`femrub.steppers.exponential.kernels`).
 
 They are the only implementation of the level squaring, the composed advance and the
 composed work integrals: checked here against plain matrix exponentials and quadrature-free
@@ -14,7 +14,8 @@ import scipy.linalg as sla
 from jit_child import child_json
 
 from femrub.contact.jit import compiled
-from femrub.steppers.exponential_kernels import (
+from femrub.steppers.exponential.flows import first_zero
+from femrub.steppers.exponential.kernels import (
     compose,
     compose_integrals,
     double_integrals,
@@ -25,7 +26,6 @@ from femrub.steppers.exponential_kernels import (
     quiet,
     square_levels,
 )
-from femrub.steppers.flows import first_zero
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -192,7 +192,7 @@ def test_open_end_reads_the_last_grid_row_of_free_contacts():
 _CHILD = """
 import json, numpy as np, femrub as fr
 from femrub.contact.jit import compiled
-from femrub.steppers.flows import first_zero
+from femrub.steppers.exponential.flows import first_zero
 st = fr.ExponentialMoreau(fr.bar_model(alpha=3.0, restitution=0.0), 1e-3)
 r = st.run(0.02)
 print(json.dumps({"jit": compiled(), "status": r.status, "X": st.X.tolist(),

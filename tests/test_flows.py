@@ -8,7 +8,7 @@ import scipy.linalg as sla
 
 import femrub as fr
 from femrub.contact.casing import casing_profile, swept_gap
-from femrub.steppers.flows import LEVEL_MIN, Flow, first_zero, shift
+from femrub.steppers.exponential.flows import LEVEL_MIN, Flow, first_zero, shift
 
 
 def _family(h=2e-3):

@@ -45,9 +45,14 @@ def block_model(m=1.0, k=100.0, N=10.0, mu=0.3, v_belt=0.0, pull=None):
     )
     obs = {"x": sp.csr_matrix(e[[0]]), "vx": sp.csr_matrix(e[[3]])}
     return FirstOrderModel(
-        A=A, B=B, layout=Layout(3, 3, 0), loads=loads, contact=contact, energy=energy,
+        A=A,
+        B=B,
+        layout=Layout(3, 3, 0),
+        loads=loads,
+        contact=contact,
+        energy=energy,
         observations=obs,
-    )  # fmt: skip
+    )
 
 
 def _switches(res):
@@ -138,8 +143,9 @@ def test_block_pressed_and_dragged():
     )
     exact = mu * N * c / (6 * m) * (0.4 - ts) ** 3
     np.testing.assert_allclose(e["friction_work"][-1], exact, rtol=5e-3)
-    check = coulomb_check(res.force, res.friction_force, res.slip_velocity,
-                          res.contact_state, res.friction_limit)  # fmt: skip
+    check = coulomb_check(
+        res.force, res.friction_force, res.slip_velocity, res.contact_state, res.friction_limit
+    )
     assert check["cone"] <= 1e-12 and check["slip_equality"] <= 1e-12
     assert check["direction"] <= 1e-12
 
@@ -191,9 +197,13 @@ def test_energy_and_heat_balance_close_on_a_full_blade_model(monkeypatch):
 
     scene = load_scene(
         "twisted-naca",
-        {"reduction.method": "none", "contact.friction": 0.15, "scheme.t_end": 8e-4,
-         "outputs.vtk_stride": 0},
-    )  # fmt: skip
+        {
+            "reduction.method": "none",
+            "contact.friction": 0.15,
+            "scheme.t_end": 8e-4,
+            "outputs.vtk_stride": 0,
+        },
+    )
     res = build(scene).stepper.run(scene["scheme"]["t_end"])
     assert res.status == "ok" and res.force.max() > 0
     e = res.energy
@@ -201,16 +211,18 @@ def test_energy_and_heat_balance_close_on_a_full_blade_model(monkeypatch):
     assert e["friction_work"][-1] > 0
     # η = 1: the blade takes the whole friction work
     np.testing.assert_allclose(e["friction_heat"][-1], e["friction_work"][-1], rtol=1e-9)
-    check = coulomb_check(res.force, res.friction_force, res.slip_velocity,
-                          res.contact_state, res.friction_limit)  # fmt: skip
+    check = coulomb_check(
+        res.force, res.friction_force, res.slip_velocity, res.contact_state, res.friction_limit
+    )
     assert check["cone"] <= 1e-8 and check["slip_equality"] <= 1e-8
     assert check["direction"] <= 1e-8  # the heat fixed point keeps the state on the law
     # checked a few rows at a time: the same verdict
     import femrub.contact.friction as friction
 
     monkeypatch.setattr(friction, "CHECK_ROWS", 7)
-    rows = coulomb_check(res.force, res.friction_force, res.slip_velocity,
-                         res.contact_state, res.friction_limit)  # fmt: skip
+    rows = coulomb_check(
+        res.force, res.friction_force, res.slip_velocity, res.contact_state, res.friction_limit
+    )
     assert rows == check and check["slip_steps"] > 0 and len(res.t) > 7
 
 

@@ -16,8 +16,12 @@ def _history(n: int, seed: int = 0) -> dict:
     rng = np.random.default_rng(seed)
     t = np.cumsum(np.r_[0.0, rng.uniform(0.5, 1.5, n - 1)]) * 1e-6
     imp = rng.random((n, 3)) * (rng.random((n, 3)) < 0.4)
-    return {"t": t, "tip_displacement": np.sin(t * 1e5), "contact_force": imp / 1e-6,
-            "contact_impulse": imp}  # fmt: skip
+    return {
+        "t": t,
+        "tip_displacement": np.sin(t * 1e5),
+        "contact_force": imp / 1e-6,
+        "contact_impulse": imp,
+    }
 
 
 def _read(path):

@@ -30,9 +30,14 @@ def test_csv_rows_are_the_csv_modules_bytes(monkeypatch):
 def test_npz_is_a_compressed_numpy_archive(tmp_path):
     t = np.linspace(0.0, 1.0, 101)
     res = R.Results(
-        scheme="theta", h=0.01, t=t, signals={"tip_displacement": np.sin(t)[:, None]},
-        gap=np.cos(t)[:, None], impulse=np.abs(np.sin(3 * t))[:, None], steps=100,
-    )  # fmt: skip
+        scheme="theta",
+        h=0.01,
+        t=t,
+        signals={"tip_displacement": np.sin(t)[:, None]},
+        gap=np.cos(t)[:, None],
+        impulse=np.abs(np.sin(3 * t))[:, None],
+        steps=100,
+    )
     path = res.save_npz(tmp_path / "history.npz")
     with np.load(path) as d:
         assert {"t", "gap", "impulse", "normal_force", "meta", "signal_tip_displacement"} <= set(

@@ -28,8 +28,9 @@ def test_cold_cache_compiled_by_a_child_then_warm(tmp_path):
     env = {**os.environ, "NUMBA_CACHE_DIR": str(tmp_path), "PYTHONPATH": str(ROOT)}
 
     def run():
-        p = subprocess.run([sys.executable, "-c", SCRIPT], env=env, capture_output=True,
-                           text=True, timeout=600)  # fmt: skip
+        p = subprocess.run(
+            [sys.executable, "-c", SCRIPT], env=env, capture_output=True, text=True, timeout=600
+        )
         assert p.returncode == 0, p.stderr[-2000:]
         return p.stdout.split()
 

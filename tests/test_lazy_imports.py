@@ -11,9 +11,13 @@ HEAVY = ("skfem", "matplotlib", "scipy.sparse", "gmsh", "pyvista", "dask")
 def _loaded(code: str) -> list[str]:
     probe = f"{code}; import sys; print(','.join(m for m in {HEAVY!r} if m in sys.modules))"
     out = subprocess.run(
-        [sys.executable, "-c", probe], cwd=ROOT, capture_output=True, text=True, check=True,
+        [sys.executable, "-c", probe],
+        cwd=ROOT,
+        capture_output=True,
+        text=True,
+        check=True,
         env={"PYTHONPATH": str(ROOT), "PATH": ""},
-    )  # fmt: skip
+    )
     return [m for m in out.stdout.strip().split(",") if m]
 
 

@@ -36,8 +36,12 @@ def _blade_run(blade, h, blocks=True, **kw):
 def _same_as_coarsened(lean, full, k):
     """``lean`` holds exactly ``coarsen(full, k).lean()``'s arrays, bit for bit."""
     ref = coarsen(full, k).lean()
-    assert (lean.h, lean.steps, lean.status, lean.message) == (ref.h, ref.steps, ref.status,
-                                                                ref.message)  # fmt: skip
+    assert (lean.h, lean.steps, lean.status, lean.message) == (
+        ref.h,
+        ref.steps,
+        ref.status,
+        ref.message,
+    )
     for name in ("t", "gap", "impulse", "states", "state_times", "friction_limit"):
         a, b = getattr(lean, name), getattr(ref, name)
         if b is None:
@@ -64,8 +68,9 @@ def test_a_lean_frictional_coated_run_is_its_full_run_coarsened(blade, monkeypat
     # what the verdict reads of the rows it did not keep: the whole arrays' values
     assert lean.energy_error() == full.energy_error() > 0
     assert lean.heat_error() == full.heat_error() > 0
-    check = coulomb_check(full.force, full.friction_force, full.slip_velocity,
-                          full.contact_state, full.friction_limit)  # fmt: skip
+    check = coulomb_check(
+        full.force, full.friction_force, full.slip_velocity, full.contact_state, full.friction_limit
+    )
     assert lean.checks["coulomb"] == check and check["slip_steps"] > 0
 
 
@@ -77,8 +82,7 @@ def test_a_lean_run_of_the_per_step_path(blade):
     assert lean.energy_error() == full.energy_error()
 
 
-@pytest.mark.parametrize("tolerances", [{"energy": 1e-14}, {"heat": 1e-16},
-                                        {"coulomb": -1.0}])  # fmt: skip
+@pytest.mark.parametrize("tolerances", [{"energy": 1e-14}, {"heat": 1e-16}, {"coulomb": -1.0}])
 def test_the_verdict_of_a_lean_run_is_the_full_runs(blade, tolerances):
     """Balance and Coulomb rules fire on a lean record as on the whole arrays."""
     h = blade[1]["h"]
@@ -99,9 +103,12 @@ def test_a_frictionless_lean_run_and_a_stop(monkeypatch):
         assert lean.energy_error() == full.energy_error()
         assert lean.heat_error() == full.heat_error()
         assert lean.checks["coulomb"] == coulomb_check(
-            full.force, full.friction_force, full.slip_velocity, full.contact_state,
+            full.force,
+            full.friction_force,
+            full.slip_velocity,
+            full.contact_state,
             full.friction_limit,
-        )  # fmt: skip
+        )
     limits = {"tip_temperature": 0.5}
     full = fr.ThetaMethod(model, 1e-4).run(0.1, limits=limits)
     lean = fr.ThetaMethod(model, 1e-4).run(0.1, limits=limits, lean=2)
@@ -166,15 +173,17 @@ def test_the_step_check_and_the_estimate_are_those_of_whole_records(blade, monke
     assert sim.ran is None  # the coating: the check's and the estimate's runs are compared only
 
     def check():
-        err, _, _ = sc.check_step(scene, sim.model, sim.full,
-                                  lambda m, h: bare_stepper(scene, m, h), sim.limits)  # fmt: skip
+        err, _, _ = sc.check_step(
+            scene, sim.model, sim.full, lambda m, h: bare_stepper(scene, m, h), sim.limits
+        )
         return {k: v for k, v in err.items() if k != "seconds"}
 
     def estimate():
         report, red = {}, sim.reductor
         want = (scene["reduction"]["n_uv"], scene["reduction"]["n_theta"])
-        _checked(red, red.fom, want, lambda m: bare_stepper(scene, m), scene, report, None,
-                 sim.limits)  # fmt: skip
+        _checked(
+            red, red.fom, want, lambda m: bare_stepper(scene, m), scene, report, None, sim.limits
+        )
         return {k: v for k, v in report["error"].items() if k != "seconds"}
 
     lean = check()
@@ -204,8 +213,7 @@ def test_rows_a_step_leaves_unwritten_stay_zero_across_chunks(monkeypatch, lean)
         info = {"heat": np.array([float(i)]), "state": np.array([1])} if i % 2 else None
         return i * 1e-4, model.x0, np.zeros(1), info
 
-    rec = Recorder(model, 1e-4, n, scheme="test", stability_limit=np.inf, energy=False,
-                   lean=lean)  # fmt: skip
+    rec = Recorder(model, 1e-4, n, scheme="test", stability_limit=np.inf, energy=False, lean=lean)
     rows = []
     rec.on_rows = lambda a: rows.append(a)
     res = rec.record(st.state, advance)

@@ -29,8 +29,11 @@ def test_sparse_lu_spd_indefinite_general_and_singular(pardiso):
     rng = np.random.default_rng(0)
     n = 200
     b = rng.standard_normal((n, 3))
-    for M, sym in ((_laplacian(n), True), (_laplacian(n, 2.9), True),
-                   (_laplacian(n) + sp.diags(np.ones(n - 1), 1), False)):  # fmt: skip
+    for M, sym in (
+        (_laplacian(n), True),
+        (_laplacian(n, 2.9), True),
+        (_laplacian(n) + sp.diags(np.ones(n - 1), 1), False),
+    ):
         x = linalg.sparse_lu(M, symmetric=sym).solve(b)
         np.testing.assert_allclose(M @ x, b, atol=1e-9 * np.abs(b).max())
         x1 = linalg.sparse_lu(M, symmetric=sym).solve(b[:, 0])

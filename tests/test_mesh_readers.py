@@ -55,10 +55,16 @@ def tiny_deck(tmp_path_factory) -> dict:
     """
     rng = np.random.default_rng(7)
     corners = {
-        "a0": (0, 0, 0), "b0": (10, 0, 0), "c0": (10, 10, 0), "d0": (0, 10, 0),
-        "a1": (0, 0, 10), "b1": (10, 0, 10), "c1": (10, 10, 10), "d1": (0, 10, 10),
+        "a0": (0, 0, 0),
+        "b0": (10, 0, 0),
+        "c0": (10, 10, 0),
+        "d0": (0, 10, 0),
+        "a1": (0, 0, 10),
+        "b1": (10, 0, 10),
+        "c1": (10, 10, 10),
+        "d1": (0, 10, 10),
         "apex": (10, 0, 20),
-    }  # fmt: skip
+    }
     wedges = [("a0", "b0", "c0", "a1", "b1", "c1"), ("a0", "c0", "d0", "a1", "c1", "d1")]
     tet = ("a1", "b1", "c1", "apex")
     edges = sorted(
@@ -93,17 +99,34 @@ def tiny_deck(tmp_path_factory) -> dict:
     )
     (folder / "mesh" / "tiny_mesh.inp").write_text("\n".join(lines) + "\n")
     main = [
-        "*HEADING", "tiny test deck", "** a comment", "*INCLUDE, INPUT=mesh/tiny_mesh.inp",
-        "*NSET, NSET=BOTTOM, GENERATE", "101, 109, 1",
-        "*ELSET, ELSET=FIRST_TWO, GENERATE", "1, 2",
+        "*HEADING",
+        "tiny test deck",
+        "** a comment",
+        "*INCLUDE, INPUT=mesh/tiny_mesh.inp",
+        "*NSET, NSET=BOTTOM, GENERATE",
+        "101, 109, 1",
+        "*ELSET, ELSET=FIRST_TWO, GENERATE",
+        "1, 2",
         f"*NSET, NSET=CAP\n{nid('a1')}, {nid('b1')}, {nid('c1')}, {nid('apex')}",
         f"*NSET, NSET=RIM\n{nid('apex', 'c1')}, {nid('apex')}",
-        "*MATERIAL, NAME=STEEL", "*ELASTIC", "210000., 0.3", "*DENSITY", "7.85e-9",
-        "*EXPANSION", "1.2e-5", "*CONDUCTIVITY", "50.", "*SPECIFIC HEAT", "4.6e8",
+        "*MATERIAL, NAME=STEEL",
+        "*ELASTIC",
+        "210000., 0.3",
+        "*DENSITY",
+        "7.85e-9",
+        "*EXPANSION",
+        "1.2e-5",
+        "*CONDUCTIVITY",
+        "50.",
+        "*SPECIFIC HEAT",
+        "4.6e8",
         "*SOLID SECTION, ELSET=WEDGES, MATERIAL=STEEL",
-        "*BOUNDARY", "BOTTOM, 1, 3",
-        "*STEP", "*STATIC", "*END STEP",
-    ]  # fmt: skip
+        "*BOUNDARY",
+        "BOTTOM, 1, 3",
+        "*STEP",
+        "*STATIC",
+        "*END STEP",
+    ]
     (folder / "tiny.inp").write_text("\n".join(main) + "\n")
     return {"path": folder / "tiny.inp", "ids": ids, "xyz": xyz, "nid": nid}
 
@@ -122,8 +145,14 @@ def test_tiny_deck_volume_and_units(tiny_deck):
 def test_tiny_deck_material_in_si(tiny_deck):
     # N-mm-t-s deck: MPa, t/mm^3, mJ/(t K), mW/(mm K) -> Pa, kg/m^3, J/(kg K), W/(m K)
     mat = read_abaqus(tiny_deck["path"], "mm", radial_axis="z", tip="CAP").info["material"]
-    expected = {"young": 210e9, "poisson": 0.3, "density": 7850.0, "expansion": 1.2e-5,
-                "conductivity": 50.0, "specific_heat": 460.0}  # fmt: skip
+    expected = {
+        "young": 210e9,
+        "poisson": 0.3,
+        "density": 7850.0,
+        "expansion": 1.2e-5,
+        "conductivity": 50.0,
+        "specific_heat": 460.0,
+    }
     assert mat == pytest.approx(expected, rel=1e-12)
     assert read_abaqus(tiny_deck["path"], "cm", radial_axis="z", tip="CAP").info["material"] == {}
 

@@ -106,10 +106,16 @@ def test_contact_boundary_is_the_model_boundary(blade):
 def test_damping_stage_is_cached(tmp_path):
     """The pipeline's damping: a second build takes ``(a, b)`` from the cache, same ``C``."""
     over = {
-        "physics.damping_ratio": 0.005, "scheme.t_end": 2e-5, "outputs.vtk_stride": 0,
-        "reduction.method": "craig-bampton", "reduction.n_uv": 8, "reduction.n_theta": 0,
-        "reduction.tolerance": 1.0, "loads.centrifugal": "off", "physics.thermal": "off",
-    }  # fmt: skip
+        "physics.damping_ratio": 0.005,
+        "scheme.t_end": 2e-5,
+        "outputs.vtk_stride": 0,
+        "reduction.method": "craig-bampton",
+        "reduction.n_uv": 8,
+        "reduction.n_theta": 0,
+        "reduction.tolerance": 1.0,
+        "loads.centrifugal": "off",
+        "physics.thermal": "off",
+    }
     scene = load_scene("twisted-naca", over)
     cache = ModelCache(tmp_path / "cache")
     lines = []

@@ -17,8 +17,9 @@ MAT = fr.Material(young=110e9, rho=4500.0, rho_c=4500.0 * 585.0, conductivity=7.
 
 
 def _blade(h, n_contact=3):
-    blade = box_blade(span=0.1, chord=0.02, thickness=0.01, h=h, hub_radius=0.3,
-                      n_contact=n_contact)  # fmt: skip
+    blade = box_blade(
+        span=0.1, chord=0.02, thickness=0.01, h=h, hub_radius=0.3, n_contact=n_contact
+    )
     disc = discretise(blade)
     return blade, disc, assemble(disc, MAT, coupling="none")
 
@@ -27,8 +28,9 @@ def _blade(h, n_contact=3):
 def box():
     blade, disc, mats = _blade(0.01)
     points = locate_contacts(disc)
-    model, _ = rub_model(disc, mats, points, MAT, casing=Concentric(1e-6), friction=0.2,
-                         rotation_speed=1000.0)  # fmt: skip
+    model, _ = rub_model(
+        disc, mats, points, MAT, casing=Concentric(1e-6), friction=0.2, rotation_speed=1000.0
+    )
     return blade, disc, mats, points, model
 
 

@@ -29,9 +29,13 @@ def readme_3d(tmp_path_factory):
     outs = []
     for args in _commands("A 3D rub in two commands"):
         p = subprocess.run(
-            [sys.executable, "-m", "femrub", *args], cwd=cwd, env=env,
-            capture_output=True, text=True, timeout=900,
-        )  # fmt: skip
+            [sys.executable, "-m", "femrub", *args],
+            cwd=cwd,
+            env=env,
+            capture_output=True,
+            text=True,
+            timeout=900,
+        )
         assert p.returncode == 0, p.stderr[-2000:]
         outs.append(p)
     return cwd, outs

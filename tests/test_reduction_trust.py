@@ -109,9 +109,14 @@ def test_auto_picks_sizes_from_the_estimate():
     def built(tol):
         scene = load_scene(
             "twisted-naca",
-            {"reduction.tolerance": tol, "reduction.max_n_uv": 16, "reduction.max_n_theta": 16,
-             "scheme.t_end": 0.002, "outputs.vtk_stride": 0},
-        )  # fmt: skip
+            {
+                "reduction.tolerance": tol,
+                "reduction.max_n_uv": 16,
+                "reduction.max_n_theta": 16,
+                "scheme.t_end": 0.002,
+                "outputs.vtk_stride": 0,
+            },
+        )
         return build(scene).report["reduction"]
 
     loose, tight = built(0.9), built(0.02)

@@ -194,8 +194,11 @@ def test_paper_honours_ctrl_c(tmp_path, capsys, monkeypatch):
 
 def _serial(scene, todo, scheduler, workers, progress, cache=None):
     for r in todo:
-        r.update(sweep_mod.run_point(scene.data, scene.source, str(scene.base_dir),
-                                     r["params"], r["folder"]))  # fmt: skip
+        r.update(
+            sweep_mod.run_point(
+                scene.data, scene.source, str(scene.base_dir), r["params"], r["folder"]
+            )
+        )
 
 
 def test_resumed_sweep_keys_points_by_the_resolved_scene(tiny, tmp_path, monkeypatch):

@@ -34,22 +34,29 @@ def _one_error(capsys, *words):
 
 @pytest.mark.parametrize("workers", ["0", "-3"])
 def test_sweep_needs_a_worker(tiny, tmp_path, capsys, workers):
-    argv = ["sweep", str(tiny), "-o", str(tmp_path / "s"), "--param", "scheme.h=1e-4",
-            "--workers", workers, "-q"]  # fmt: skip
+    argv = [
+        "sweep",
+        str(tiny),
+        "-o",
+        str(tmp_path / "s"),
+        "--param",
+        "scheme.h=1e-4",
+        "--workers",
+        workers,
+        "-q",
+    ]
     assert main(argv) == 2
     _one_error(capsys, "at least 1 worker")
     assert not (tmp_path / "s").exists()
 
 
 def test_element_count_is_bounded_before_meshing(capsys):
-    argv = ["check", "twisted-naca", "-q", "--set", "geometry.kind=box",
-            "--set", "geometry.h=2e-5"]  # fmt: skip
+    argv = ["check", "twisted-naca", "-q", "--set", "geometry.kind=box", "--set", "geometry.h=2e-5"]
     assert main(argv) == 2
     _one_error(capsys, "geometry.h", "tetrahedra", "raise geometry.h")
 
 
-def test_unwritable_output_folder_is_reported_before_the_build(tiny, tmp_path, capsys,
-                                                               monkeypatch):  # fmt: skip
+def test_unwritable_output_folder_is_reported_before_the_build(tiny, tmp_path, capsys, monkeypatch):
     def no_build(*a, **k):
         raise AssertionError("the model was built before the folder was checked")
 
@@ -67,10 +74,10 @@ def test_step_cap_on_every_entry_point(capsys):
         ThetaMethod(bar_model(), 1e-6).run(1e6)
 
 
-@pytest.mark.parametrize("name, folder", [("../../X", "X-out"), ("/abs/path", "abs_path-out"),
-                                          ("..", "scene-out")])  # fmt: skip
-def test_scene_name_cannot_write_outside_the_working_folder(tmp_path, monkeypatch, name,
-                                                            folder):  # fmt: skip
+@pytest.mark.parametrize(
+    "name, folder", [("../../X", "X-out"), ("/abs/path", "abs_path-out"), ("..", "scene-out")]
+)
+def test_scene_name_cannot_write_outside_the_working_folder(tmp_path, monkeypatch, name, folder):
     work = tmp_path / "a" / "b"
     work.mkdir(parents=True)
     monkeypatch.chdir(work)

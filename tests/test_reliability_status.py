@@ -49,8 +49,9 @@ def test_physical_limits_are_on_without_a_limits_table(tmp_path):
     assert built.limits == {"tip_temperature": 1500.0, "tip_displacement": pytest.approx(0.03)}
     assert built.report["limits_default"] == ["tip_displacement", "tip_temperature"]
     out = tmp_path / "out"
-    (tmp_path / "bar.toml").write_text(BAR.replace("heat_coefficient = 3.0",
-                                                   "heat_coefficient = 9.0"))  # fmt: skip
+    (tmp_path / "bar.toml").write_text(
+        BAR.replace("heat_coefficient = 3.0", "heat_coefficient = 9.0")
+    )
     assert main(["run", str(tmp_path / "bar.toml"), "-o", str(out), "-q"]) == 0
     s = json.loads((out / "summary.json").read_text())
     assert s["status"] == "diverged-physically" and "tip_temperature exceeded 1500" in s["message"]
@@ -128,8 +129,11 @@ def test_repeated_contact_nodes_and_duplicate_mesh_nodes_are_refused(tmp_path, c
     mesh = tmp_path / "blade.msh"
     blade.save(mesh)
     scene = tmp_path / "mesh.toml"
-    nodes = [int(n) for n in blade.vertex_ids[blade.node_sets["tip"][:2]]] if (
-        blade.vertex_ids is not None) else [1, 2]  # fmt: skip
+    nodes = (
+        [int(n) for n in blade.vertex_ids[blade.node_sets["tip"][:2]]]
+        if (blade.vertex_ids is not None)
+        else [1, 2]
+    )
     scene.write_text(
         f'[geometry]\nkind = "mesh"\npath = "{mesh}"\n'
         f"[contact]\nnodes = [{nodes[0]}, {nodes[1]}, {nodes[0]}]\n"
@@ -158,8 +162,10 @@ def test_assess_is_the_one_place_that_decides():
 
 def test_every_failed_check_is_named_in_the_message():
     res = ThetaMethod(bar_model(), 1e-4).run(0.01)
-    tol = {"reduction": {"estimate": 0.06, "tolerance": 0.05},
-           "time_step": {"estimate": 0.19, "tolerance": 0.05, "h": 1e-4}}  # fmt: skip
+    tol = {
+        "reduction": {"estimate": 0.06, "tolerance": 0.05},
+        "time_step": {"estimate": 0.19, "tolerance": 0.05, "h": 1e-4},
+    }
     assess(res, tolerances=tol)
     assert res.status == "inaccurate"
     first, second = res.message.split("; ")

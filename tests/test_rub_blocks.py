@@ -27,12 +27,24 @@ ROOT = Path(__file__).resolve().parents[1]
 
 #: a coarse twisted blade, thermoelastic, power heat, a coating it cuts but never wears
 #: through (cut depth ~190 µm of 400 µm), 300 steps
-SCENE = {"geometry.h": 0.03, "geometry.n_sections": 2, "physics.thermal": "on",
-         "contact.friction": 0.3, "scheme.t_end": 0.0006, "outputs.vtk_stride": 0,
-         "contact.casing.depth": "200 um", "contact.casing.clearance": "5 um",
-         "reduction.method": "craig-bampton", "reduction.n_uv": 12, "reduction.n_theta": 6,
-         "contact.reach": "all", "contact.heat_law": "power", "contact.heat_partition": 0.5,
-         "contact.abradable.thickness": "400 um", "contact.abradable.yield": 20.0}  # fmt: skip
+SCENE = {
+    "geometry.h": 0.03,
+    "geometry.n_sections": 2,
+    "physics.thermal": "on",
+    "contact.friction": 0.3,
+    "scheme.t_end": 0.0006,
+    "outputs.vtk_stride": 0,
+    "contact.casing.depth": "200 um",
+    "contact.casing.clearance": "5 um",
+    "reduction.method": "craig-bampton",
+    "reduction.n_uv": 12,
+    "reduction.n_theta": 6,
+    "contact.reach": "all",
+    "contact.heat_law": "power",
+    "contact.heat_partition": 0.5,
+    "contact.abradable.thickness": "400 um",
+    "contact.abradable.yield": 20.0,
+}
 
 
 def _close(a, b, rel):
@@ -61,9 +73,14 @@ def _run(model, scheme, opts, blocks):
     w = model.contact.wear
     coat = None
     if w is not None:
-        coat = {"depth": w.depth.copy(), "history": np.array(w.history), "max": w.max_depth,
-                "volume": w.worn_volume, "last_t": w._last[0],
-                "last_r": w._last[1].copy()}  # fmt: skip
+        coat = {
+            "depth": w.depth.copy(),
+            "history": np.array(w.history),
+            "max": w.max_depth,
+            "volume": w.worn_volume,
+            "last_t": w._last[0],
+            "last_r": w._last[1].copy(),
+        }
     return res, st, coat
 
 
@@ -126,8 +143,9 @@ def test_footprint_blocks_equal_the_steps(blade):
     w = model.contact.wear
     g = w.grid
     cell = 2 * math.pi * g.radius / g.n_angle
-    grid = CasingGrid(g.angles, g.axial, g.radius, g.omega, g.n_angle, g.n_axial,
-                      footprint=2.5 * cell)  # fmt: skip
+    grid = CasingGrid(
+        g.angles, g.axial, g.radius, g.omega, g.n_angle, g.n_axial, footprint=2.5 * cell
+    )
     c = replace(model.contact, wear=Abradable(w.thickness, w.yield_force, grid))
     a, sa, ca, cb = _compare(model.with_(contact=c), scheme, opts, "rub")
     assert sa._bgrid[4] == pytest.approx(2.5, rel=1e-12)
@@ -161,11 +179,14 @@ def test_casing_heat_and_alpha_of_time_keep_the_per_step_path(blade):
     model, scheme, opts = blade
     c = model.contact
     heat = CasingHeat(c.wear.grid, 2e-3, 100.0, 100.0, 0.5, 1e-4, 0.5, np.ones(c.n))
-    for changes in ({"casing_heat": heat},
-                    {"heat_law": "alpha", "heat_coefficient": lambda t: np.ones(c.n)},
-                    {"friction": np.r_[0.0, np.full(c.n - 1, 0.3)]}):  # fmt: skip
-        st = make_stepper(scheme["name"], model.with_(contact=replace(c, **changes)),
-                          scheme["h"], **opts)  # fmt: skip
+    for changes in (
+        {"casing_heat": heat},
+        {"heat_law": "alpha", "heat_coefficient": lambda t: np.ones(c.n)},
+        {"friction": np.r_[0.0, np.full(c.n - 1, 0.3)]},
+    ):
+        st = make_stepper(
+            scheme["name"], model.with_(contact=replace(c, **changes)), scheme["h"], **opts
+        )
         assert block_kind(st) is None and st._block_writer() is None
 
 
@@ -244,8 +265,14 @@ def test_wear_kernels_equal_the_grid_and_a_vectorised_cut():
 
     w.reset(h=1e-4)
     w.depth.ravel()[:] = got
-    c = Contact(G=np.ones((1, 9)), Gv=np.ones((1, 9)), Hm=np.ones((1, 9)), Ht=np.zeros((1, 9)),
-                gap0=np.full(9, 1e-4), wear=w)  # fmt: skip
+    c = Contact(
+        G=np.ones((1, 9)),
+        Gv=np.ones((1, 9)),
+        Hm=np.ones((1, 9)),
+        Ht=np.zeros((1, 9)),
+        gap0=np.full(9, 1e-4),
+        wear=w,
+    )
     t = 0.0123 + 1e-4 * np.arange(50)
     np.testing.assert_array_equal(c.gap_at(t), np.array([c.gap_at(ti) for ti in t]))
     np.testing.assert_array_equal(c.rate_at(t), np.array([c.rate_at(ti) for ti in t]))
@@ -279,8 +306,14 @@ def test_rub_blocks_run_as_python_without_jit(blade, tmp_path):
             env["NUMBA_DISABLE_JIT"] = "1"
         else:
             env.pop("NUMBA_DISABLE_JIT")
-        run = subprocess.run([sys.executable, "-c", _CHILD, str(path)], env=env, cwd=ROOT,
-                             capture_output=True, text=True, check=True)  # fmt: skip
+        run = subprocess.run(
+            [sys.executable, "-c", _CHILD, str(path)],
+            env=env,
+            cwd=ROOT,
+            capture_output=True,
+            text=True,
+            check=True,
+        )
         out[jit] = json.loads(run.stdout.splitlines()[-1])
     py, jt = out[False], out[True]
     assert not py["jit"] and jt["jit"] and py["kind"] == jt["kind"] == "rub"

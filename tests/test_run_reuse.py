@@ -27,10 +27,16 @@ def sim():
 def _write(sim, out, ran, csv_stride=1):
     s = sim.scene
     return run_to_folder(
-        bare_stepper(s, sim.model), s["scheme"]["t_end"], out, limits=sim.limits or None,
-        plots=False, reduction_error=sim.report["reduction"]["error"], ran=ran,
-        rotation_speed=s["loads"]["rotation_speed"], csv_stride=csv_stride,
-    )  # fmt: skip
+        bare_stepper(s, sim.model),
+        s["scheme"]["t_end"],
+        out,
+        limits=sim.limits or None,
+        plots=False,
+        reduction_error=sim.report["reduction"]["error"],
+        ran=ran,
+        rotation_speed=s["loads"]["rotation_speed"],
+        csv_stride=csv_stride,
+    )
 
 
 def test_the_estimate_run_is_the_run(sim, tmp_path):
@@ -125,8 +131,9 @@ def test_a_sweep_worker_keeps_the_assembly(tmp_path, monkeypatch):
     build(scene.with_changes({"loads.rotation_speed": 1400.0}), cache=cache, log=notes.append)
     assert any("assembly loaded" in n for n in notes)  # from the cache folder, then kept
     notes.clear()
-    again = build(scene.with_changes({"loads.rotation_speed": 1300.0}), cache=cache,
-                  log=notes.append)  # fmt: skip
+    again = build(
+        scene.with_changes({"loads.rotation_speed": 1300.0}), cache=cache, log=notes.append
+    )
     assert any("assembly kept by this process" in n for n in notes)
     assert not any("assembly loaded" in n or "assembly stored" in n for n in notes)
     np.testing.assert_array_equal(again.full.A.toarray(), first.full.A.toarray())

@@ -126,8 +126,18 @@ def mesh_dir(tmp_path):
 def test_carpenter_step_above_stability_limit():
     msg = _built_error({"scheme.name": "carpenter", "scheme.h": 3e-5, "geometry.n_elements": 20})
     assert "scheme.h = 3e-05" in msg and "stability limit 2.6" in msg and "theta" in msg
-    assert build(Scene(normalize(_merge(_merge(copy.deepcopy(BASE), "scheme.name",
-                 "carpenter"), "scheme.h", 1e-6)))).stepper.name == "carpenter"  # fmt: skip
+    assert (
+        build(
+            Scene(
+                normalize(
+                    _merge(
+                        _merge(copy.deepcopy(BASE), "scheme.name", "carpenter"), "scheme.h", 1e-6
+                    )
+                )
+            )
+        ).stepper.name
+        == "carpenter"
+    )
 
 
 @pytest.mark.parametrize(
@@ -146,8 +156,9 @@ def test_build_errors_name_the_key(mesh_dir, changes, words):
 
 
 def test_reduction_larger_than_the_model():
-    msg = _built_error({"reduction.method": "craig-bampton", "reduction.n_uv": 100,
-                        "reduction.n_theta": 0})  # fmt: skip
+    msg = _built_error(
+        {"reduction.method": "craig-bampton", "reduction.n_uv": 100, "reduction.n_theta": 0}
+    )
     assert msg.startswith("reduction.n_uv: n_uv must be an integer in [0, 8]"), msg
 
 
@@ -176,8 +187,11 @@ def test_3d_only_and_bar_only_keys():
     doc = {"geometry": {"kind": "naca", "code": "12"}, "scheme": {"h": 1e-6, "t_end": 1e-5}}
     with pytest.raises(SceneError, match="geometry.code = '12': NACA code must be four digits"):
         normalize(doc)
-    doc = {"geometry": {"kind": "box"}, "contact": {"heat_coefficient": 1.0},
-           "scheme": {"h": 1e-6, "t_end": 1e-5}}  # fmt: skip
+    doc = {
+        "geometry": {"kind": "box"},
+        "contact": {"heat_coefficient": 1.0},
+        "scheme": {"h": 1e-6, "t_end": 1e-5},
+    }
     with pytest.raises(SceneError, match="contact.heat_coefficient = 1.0: 3D contacts"):
         normalize(doc)
 
@@ -202,25 +216,38 @@ def valid_bar_docs(draw):
         reduction.update(max_n_uv=4, max_n_theta=3, modes=draw(st.integers(1, 2)))
     return {
         "name": "random",
-        "geometry": {"kind": "bar", "n_elements": draw(st.integers(5, 12)),
-                     "length": draw(st.floats(0.05, 1.0)),
-                     "total_mass": draw(st.sampled_from([0.1, "density"]))},
-        "material": {"young": draw(st.floats(5e10, 2e11)),
-                     "conductivity": draw(st.floats(0.1, 20.0))},
-        "contact": {"casing": {"kind": "concentric",
-                               "clearance": draw(st.floats(0.0, 1e-4))},
-                    "heat_coefficient": draw(st.floats(0.0, 5.0)),
-                    "restitution": draw(st.floats(0.0, 1.0)) if scheme == "theta" else 0.0,
-                    "reach": draw(st.sampled_from(["auto", "all", 1e-5]))},
-        "loads": {"rotation_speed": draw(st.floats(1.0, 3000.0)),
-                  "tip_force": {"law": draw(st.sampled_from(["sin", "constant", "ramp"])),
-                                "amplitude": draw(st.floats(0.0, 10.0)), "ramp_time": 0.01}},
-        "physics": {"thermal": draw(st.sampled_from(["auto", "on", "off", True, False])),
-                    "coupling": draw(st.sampled_from(["auto", "none", "paper", "physical"])),
-                    "strain_heating": draw(st.booleans())},
+        "geometry": {
+            "kind": "bar",
+            "n_elements": draw(st.integers(5, 12)),
+            "length": draw(st.floats(0.05, 1.0)),
+            "total_mass": draw(st.sampled_from([0.1, "density"])),
+        },
+        "material": {
+            "young": draw(st.floats(5e10, 2e11)),
+            "conductivity": draw(st.floats(0.1, 20.0)),
+        },
+        "contact": {
+            "casing": {"kind": "concentric", "clearance": draw(st.floats(0.0, 1e-4))},
+            "heat_coefficient": draw(st.floats(0.0, 5.0)),
+            "restitution": draw(st.floats(0.0, 1.0)) if scheme == "theta" else 0.0,
+            "reach": draw(st.sampled_from(["auto", "all", 1e-5])),
+        },
+        "loads": {
+            "rotation_speed": draw(st.floats(1.0, 3000.0)),
+            "tip_force": {
+                "law": draw(st.sampled_from(["sin", "constant", "ramp"])),
+                "amplitude": draw(st.floats(0.0, 10.0)),
+                "ramp_time": 0.01,
+            },
+        },
+        "physics": {
+            "thermal": draw(st.sampled_from(["auto", "on", "off", True, False])),
+            "coupling": draw(st.sampled_from(["auto", "none", "paper", "physical"])),
+            "strain_heating": draw(st.booleans()),
+        },
         "scheme": {"name": scheme, "h": h, "t_end": 10 * h},
         "reduction": reduction,
-    }  # fmt: skip
+    }
 
 
 def _clean(doc):
@@ -251,14 +278,40 @@ JUNK = st.one_of(
     st.dictionaries(st.text(max_size=4), st.integers(), max_size=2),
 )
 KEYS = st.sampled_from(
-    ["name", "geometry.kind", "geometry.n_elements", "geometry.length", "geometry.total_mass",
-     "material.young", "material.poisson", "material.conductivity", "contact.casing",
-     "contact.casing.kind", "contact.casing.clearance", "contact.reach", "contact.restitution",
-     "contact.heat_coefficient", "contact.group", "loads.rotation_speed", "loads.tip_force",
-     "loads.tip_force.law", "loads.tip_force.frequency", "physics.thermal", "physics.rayleigh",
-     "physics.coupling", "scheme.name", "scheme.h", "scheme.t_end", "reduction.method",
-     "outputs.signals", "limits.tip_temperature", "geometry", "unknown.key", "scheme.extra"]
-)  # fmt: skip
+    [
+        "name",
+        "geometry.kind",
+        "geometry.n_elements",
+        "geometry.length",
+        "geometry.total_mass",
+        "material.young",
+        "material.poisson",
+        "material.conductivity",
+        "contact.casing",
+        "contact.casing.kind",
+        "contact.casing.clearance",
+        "contact.reach",
+        "contact.restitution",
+        "contact.heat_coefficient",
+        "contact.group",
+        "loads.rotation_speed",
+        "loads.tip_force",
+        "loads.tip_force.law",
+        "loads.tip_force.frequency",
+        "physics.thermal",
+        "physics.rayleigh",
+        "physics.coupling",
+        "scheme.name",
+        "scheme.h",
+        "scheme.t_end",
+        "reduction.method",
+        "outputs.signals",
+        "limits.tip_temperature",
+        "geometry",
+        "unknown.key",
+        "scheme.extra",
+    ]
+)
 
 
 @settings(max_examples=150, deadline=None, suppress_health_check=[HealthCheck.too_slow])

@@ -48,8 +48,18 @@ def _kernel(Q, X, bounds, out_columns, columns):
         offsets.append(np.searchsorted(out_columns, s))
     out = np.zeros((Q.shape[0], out_columns.size))
     cat = lambda a: np.concatenate(a).astype(np.int64)  # noqa: E731
-    _csr_dense_runs(Q.indptr, Q.indices, Q.data, X, cat(lows), cat(highs), cat(starts),
-                    cat(stops), cat(offsets), out)  # fmt: skip
+    _csr_dense_runs(
+        Q.indptr,
+        Q.indices,
+        Q.data,
+        X,
+        cat(lows),
+        cat(highs),
+        cat(starts),
+        cat(stops),
+        cat(offsets),
+        out,
+    )
     return out
 
 

@@ -47,8 +47,13 @@ def test_the_estimate_is_twice_the_measured_difference_to_the_half_step_run():
     assert err["difference"] >= err["contact_temperature"]
     assert err["estimate"] == pytest.approx(err["difference"] * 2**ORDER / (2**ORDER - 1))
     assert (err["h"], err["reference_h"]) == (h, h / 2)
-    assert err["decided_by"] in ("contact_force", "contact_temperature", "displacement",
-                                 "displacement_end", "temperature_end")  # fmt: skip
+    assert err["decided_by"] in (
+        "contact_force",
+        "contact_temperature",
+        "displacement",
+        "displacement_end",
+        "temperature_end",
+    )
 
 
 @pytest.mark.parametrize("h", [1e-3, 1e-5])

@@ -49,8 +49,17 @@ def test_sweep_runs_and_resumes(tmp_path, capsys):
     scene = tmp_path / "tiny.toml"
     scene.write_text(TINY)
     out = tmp_path / "sweep"
-    args = ["sweep", str(scene), "--param", "rotation_speed=100:300:100", "-o", str(out),
-            "--workers", "2", "-q"]  # fmt: skip
+    args = [
+        "sweep",
+        str(scene),
+        "--param",
+        "rotation_speed=100:300:100",
+        "-o",
+        str(out),
+        "--workers",
+        "2",
+        "-q",
+    ]
     assert main(args) == 0
     rows = _csv(out / "interaction.csv")
     assert [r["loads.rotation_speed"] for r in rows] == ["100.0", "200.0", "300.0"]
@@ -75,8 +84,15 @@ def test_sweep_runs_and_resumes(tmp_path, capsys):
 def test_sweep_rejects_an_invalid_point_before_any_work(tmp_path, capsys):
     scene = tmp_path / "tiny.toml"
     scene.write_text(TINY)
-    args = ["sweep", str(scene), "--param", "contact.restitution=0,2", "-o",
-            str(tmp_path / "s"), "-q"]  # fmt: skip
+    args = [
+        "sweep",
+        str(scene),
+        "--param",
+        "contact.restitution=0,2",
+        "-o",
+        str(tmp_path / "s"),
+        "-q",
+    ]
     assert main(args) == 2
     assert "contact.restitution = 2: must be" in capsys.readouterr().err
     assert not (tmp_path / "s").exists()
@@ -91,8 +107,11 @@ def test_the_map_draws_temperature_and_wear_only_where_the_scene_models_them():
     rigid = load_scene("paper", {"physics.thermal": "off"})
     assert "max_temperature" not in names(cold, rigid)
     assert "max_wear_depth" not in names(cold, rigid)
-    assert names(cold, rigid)[:3] == ["max_tip_displacement", "rms_tip_displacement",
-                                      "max_contact_force"]  # fmt: skip
+    assert names(cold, rigid)[:3] == [
+        "max_tip_displacement",
+        "rms_tip_displacement",
+        "max_contact_force",
+    ]
     hot = [{"max_temperature": 0.0}, {"max_temperature": 3.5}]
     assert "max_temperature" in names(hot, rigid)  # a point that heated is shown
     thermal = load_scene("paper", {"physics.thermal": "on"})

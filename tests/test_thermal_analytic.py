@@ -113,9 +113,15 @@ STATIONS = np.array([0.25, 0.5, 1.0]) * L
 
 def _exact(t, area=AREA):
     return bar_heat_flux_temperature(
-        STATIONS, t, flux=Q, length=L, conductivity=K_TH, rho_c=RHO * C, area=area,
+        STATIONS,
+        t,
+        flux=Q,
+        length=L,
+        conductivity=K_TH,
+        rho_c=RHO * C,
+        area=area,
         ramp_time=0.02 * TAU,
-    )  # fmt: skip
+    )
 
 
 def test_bar_conduction_matches_fourier_series():
@@ -229,13 +235,22 @@ ZL, ZT0 = 0.1, 293.15
 ZW = np.pi / ZL * np.sqrt(110e9 / RHO)
 ZK = np.pi / ZL
 ZMAT = fr.Material(
-    young=110e9, rho=RHO, rho_c=RHO * C, conductivity=RHO * C * ZW / ZK**2, expansion=5e-5,
+    young=110e9,
+    rho=RHO,
+    rho_c=RHO * C,
+    conductivity=RHO * C * ZW / ZK**2,
+    expansion=5e-5,
     reference_temperature=ZT0,
-)  # fmt: skip
+)
 ZPAR = dict(
-    young=ZMAT.young, rho=RHO, rho_c=ZMAT.rho_c, conductivity=ZMAT.conductivity,
-    expansion=ZMAT.expansion, t0=ZT0, wavenumber=ZK,
-)  # fmt: skip
+    young=ZMAT.young,
+    rho=RHO,
+    rho_c=ZMAT.rho_c,
+    conductivity=ZMAT.conductivity,
+    expansion=ZMAT.expansion,
+    t0=ZT0,
+    wavenumber=ZK,
+)
 
 
 def _zener_run(n, steps_per_period, periods):

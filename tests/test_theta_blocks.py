@@ -20,10 +20,18 @@ from femrub.contact.jit import compiled
 
 ROOT = Path(__file__).resolve().parents[1]
 
-NACA = {"physics.thermal": "off", "contact.friction": 0.3, "scheme.t_end": 0.0006,
-        "outputs.vtk_stride": 0, "contact.casing.depth": "200 um",
-        "contact.casing.clearance": "5 um", "reduction.method": "craig-bampton",
-        "reduction.n_uv": 12, "reduction.n_theta": 0, "contact.reach": "all"}  # fmt: skip
+NACA = {
+    "physics.thermal": "off",
+    "contact.friction": 0.3,
+    "scheme.t_end": 0.0006,
+    "outputs.vtk_stride": 0,
+    "contact.casing.depth": "200 um",
+    "contact.casing.clearance": "5 um",
+    "reduction.method": "craig-bampton",
+    "reduction.n_uv": 12,
+    "reduction.n_theta": 0,
+    "contact.reach": "all",
+}
 
 
 def _close(a, b, rel):

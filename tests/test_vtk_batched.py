@@ -25,9 +25,12 @@ def rub():
     blade = box_blade(span=0.1, chord=0.03, thickness=0.003, h=0.006, hub_radius=0.3, n_contact=5)
     mat = fr.Material(young=110e9, rho=4500.0, rho_c=4500 * 585.0, conductivity=7.0)
     model, fields = solid_model(
-        blade, mat, casing=Lobed(clearance=2e-6, depth=3e-6, lobes=2), rotation_speed=1000.0,
+        blade,
+        mat,
+        casing=Lobed(clearance=2e-6, depth=3e-6, lobes=2),
+        rotation_speed=1000.0,
         friction=0.05,
-    )  # fmt: skip
+    )
     return model, fields
 
 
@@ -209,8 +212,9 @@ class _Interrupted(VTKSeries):
 def test_interrupted_run_keeps_every_frame_taken(rub, tmp_path, background, batch):
     """Also when the frames taken are fewer than the writer's ``min_batch`` (batch 32)."""
     model, fields = rub
-    series = _Interrupted(tmp_path, model, fields, h=H, stride=STRIDE, batch=batch,
-                          background=background)  # fmt: skip
+    series = _Interrupted(
+        tmp_path, model, fields, h=H, stride=STRIDE, batch=batch, background=background
+    )
     res = fr.ThetaMethod(model, H).run(0.003, on_state=series)
     assert res.status == "interrupted"
     frames = _frames(series)  # written by the recorder's flush, before close

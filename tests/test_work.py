@@ -1,4 +1,4 @@
-"""Exact works and heats of the exponential stepper's flights (steppers/work.py)."""
+"""Exact works and heats of the exponential stepper's flights (steppers/exponential/work.py)."""
 
 import math
 
@@ -7,8 +7,8 @@ import pytest
 import scipy.linalg as sla
 
 import femrub as fr
-from femrub.steppers.flows import LEVEL_MIN
-from femrub.steppers.work import LINEAR, QUADRATIC
+from femrub.steppers.exponential.flows import LEVEL_MIN
+from femrub.steppers.exponential.work import LINEAR, QUADRATIC
 
 
 def _setup(h=2e-3):
@@ -61,7 +61,7 @@ def test_integrals_match_quadrature_on_the_exact_flow(S):
 
 def test_integral_keys_are_the_meter_keys():
     from femrub.output.energy import SCHEME_INTEGRALS
-    from femrub.steppers.work import METER_ORDER
+    from femrub.steppers.exponential.work import METER_ORDER
 
     # the stepper hands them in this order
     assert tuple((QUADRATIC + LINEAR)[i] for i in METER_ORDER) == SCHEME_INTEGRALS
@@ -119,7 +119,7 @@ def test_whole_step_product_matches_the_matrix_exponential(S, measure, h):
 
 def test_proportional_forms_are_integrated_once():
     # the held friction heat of one sliding contact is −η times its tangential work
-    from femrub.steppers.work import _proportional
+    from femrub.steppers.exponential.work import _proportional
 
     rng = np.random.default_rng(1)
     Q = np.zeros((6, 4, 4))

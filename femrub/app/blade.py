@@ -94,8 +94,11 @@ def _check_contacts(scene, pts) -> None:
         size = float(np.ptp(pts, axis=1).max()) or 1.0
         keys = np.round(pts.T / (_SAME_POINT * max(size, 1e-3))).astype(np.int64)
         if len(np.unique(keys, axis=0)) < pts.shape[1]:
-            fail(key, nodes if nodes is not None else contact["group"],
-                 "two contact points coincide; give each contact point once")  # fmt: skip
+            fail(
+                key,
+                nodes if nodes is not None else contact["group"],
+                "two contact points coincide; give each contact point once",
+            )
 
 
 def _groups(blade) -> str:
@@ -115,16 +118,30 @@ def _build(scene):
         )
     if kind == "naca":
         return naca_blade(
-            g["code"], g["span"], g["root_chord"], g["tip_chord"], g["twist"], g["n_sections"],
-            hub_radius=g["hub_radius"], stacking=g["stacking"], n_points=g["n_points"],
-            **tips, **size,
-        )  # fmt: skip
+            g["code"],
+            g["span"],
+            g["root_chord"],
+            g["tip_chord"],
+            g["twist"],
+            g["n_sections"],
+            hub_radius=g["hub_radius"],
+            stacking=g["stacking"],
+            n_points=g["n_points"],
+            **tips,
+            **size,
+        )
     if kind == "sections":
         paths = [scene.path(f) for f in g["files"]] if g.get("files") else scene.path(g["path"])
         return sections_blade(
-            paths, length_unit=g["length_unit"], pattern=g["pattern"], radial_axis=g["axis"],
-            interpolate=g["interpolate"], ruled=g["ruled"], **tips, **size,
-        )  # fmt: skip
+            paths,
+            length_unit=g["length_unit"],
+            pattern=g["pattern"],
+            radial_axis=g["axis"],
+            interpolate=g["interpolate"],
+            ruled=g["ruled"],
+            **tips,
+            **size,
+        )
     return _read(scene)
 
 

@@ -123,9 +123,15 @@ class Stages:
             return discretise(blade, order, clamped=clamped)
         mesh = blade.mesh
         key = content_key(
-            "discretisation", type(mesh).__name__, mesh.p, mesh.t, blade.node_sets,
-            blade.info.get("edge_midpoints"), order, clamped,
-        )  # fmt: skip
+            "discretisation",
+            type(mesh).__name__,
+            mesh.p,
+            mesh.t,
+            blade.node_sets,
+            blade.info.get("edge_midpoints"),
+            order,
+            clamped,
+        )
         kept = _DISCRETISED.get(key)
         if kept is not None:
             self._say(f"discretisation kept by this process ({key[:12]})")
@@ -141,10 +147,18 @@ class Stages:
             return assemble(disc, material, **kw)
         mesh = disc.mesh
         key = content_key(
-            "assembly", type(mesh).__name__, mesh.p, mesh.t, disc.order,
-            type(disc.basis_u.elem).__name__, type(disc.basis_t.elem).__name__,
-            disc.fixed_u, disc.fixed_t, material, kw,
-        )  # fmt: skip
+            "assembly",
+            type(mesh).__name__,
+            mesh.p,
+            mesh.t,
+            disc.order,
+            type(disc.basis_u.elem).__name__,
+            type(disc.basis_t.elem).__name__,
+            disc.fixed_u,
+            disc.fixed_t,
+            material,
+            kw,
+        )
         self._mats_key = key
         mats = _ASSEMBLED.get(key) if _ASSEMBLED is not None else None
         if mats is not None:
@@ -198,9 +212,17 @@ class Stages:
             return centrifugal_prestress(disc, material, omega, method, log=self.log)
         mesh = disc.mesh
         key = content_key(
-            "prestress", type(mesh).__name__, mesh.p, mesh.t, disc.order,
-            type(disc.basis_u.elem).__name__, disc.fixed_u, material, float(omega), method,
-        )  # fmt: skip
+            "prestress",
+            type(mesh).__name__,
+            mesh.p,
+            mesh.t,
+            disc.order,
+            type(disc.basis_u.elem).__name__,
+            disc.fixed_u,
+            material,
+            float(omega),
+            method,
+        )
         hit = self._fetch("prestress", key)
         if hit is not None:
             return hit
@@ -211,10 +233,18 @@ class Stages:
     def _model_key(self, model) -> str:
         n = model.n_dofs
         return content_key(
-            self._mats_key, model.layout, model.boundary, model.x0, model.A, model.B,
-            _state_arrays(model.contact, n), [_state_arrays(t, n) for t in model.loads],
-            model.observations, model.energy, model.to_full,
-        )  # fmt: skip
+            self._mats_key,
+            model.layout,
+            model.boundary,
+            model.x0,
+            model.A,
+            model.B,
+            _state_arrays(model.contact, n),
+            [_state_arrays(t, n) for t in model.loads],
+            model.observations,
+            model.energy,
+            model.to_full,
+        )
 
     def reduce(self, model, scene, log=None, make_stepper=None, limits=None, on_run=None):
         """:func:`~femrub.reduction.sizes.reduce_model`: ``(reduced, reductor, report)``.
@@ -260,8 +290,12 @@ class Stages:
             _REDUCTORS.clear()
             _REDUCTORS[bases] = reductor.detached()  # not the model of this point
             if kept is None:
-                self._keep("bases", bases, _REDUCTORS[bases], f"{reductor.n_uv} + "
-                           f"{reductor.n_theta} shapes on {model.n_dofs} dofs")  # fmt: skip
+                self._keep(
+                    "bases",
+                    bases,
+                    _REDUCTORS[bases],
+                    f"{reductor.n_uv} + {reductor.n_theta} shapes on {model.n_dofs} dofs",
+                )
         _say_phases(self._say, reduced.info.get("timings", {}))
         entry, shared = _detach(reduced, report, reductor.R.shape[1])
         if shared is not None and _MAPS.get(map_key) is not shared:

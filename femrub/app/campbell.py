@@ -89,8 +89,9 @@ def _track(Q_prev, Q, n):
     return cols[np.argsort(rows)], mac[rows, cols].min()
 
 
-def campbell(scene, speeds, *, modes: int = 6, samples: int = 3, check: bool = True,
-             log=None) -> CampbellResult:  # fmt: skip
+def campbell(
+    scene, speeds, *, modes: int = 6, samples: int = 3, check: bool = True, log=None
+) -> CampbellResult:
     """Campbell diagram of ``scene`` at ``speeds`` (module docstring)."""
     speeds = np.asarray(speeds, dtype=float)
     if speeds.size == 0 or np.any(speeds < 0) or not np.all(np.isfinite(speeds)):
@@ -105,8 +106,10 @@ def campbell(scene, speeds, *, modes: int = 6, samples: int = 3, check: bool = T
     mode = scene["loads"]["centrifugal"]
     method = "nonlinear" if mode in ("auto", "off") else mode
     if mode == "off" and log:  # e.g. the Rotor 37 scenes: off for their runs only
-        log("notice: loads.centrifugal = 'off' applies to runs; the Campbell diagram uses the "
-            "nonlinear prestress (--set loads.centrifugal=linear for the linear one)")  # fmt: skip
+        log(
+            "notice: loads.centrifugal = 'off' applies to runs; the Campbell diagram uses the "
+            "nonlinear prestress (--set loads.centrifugal=linear for the linear one)"
+        )
     top = float(speeds.max())
     if top == 0.0:
         method, samples = "off", 1
@@ -142,7 +145,7 @@ def campbell(scene, speeds, *, modes: int = 6, samples: int = 3, check: bool = T
         "worst_tracking_mac": worst,
         "rest_frequencies_hz": (
             np.sqrt(lowest_modes(Kr0, np.eye(V.shape[1]), modes, vectors=False)) / (2 * np.pi)
-        ).tolist(),  # fmt: skip
+        ).tolist(),
         "seconds_prestress": t_pre - t0,
     }
     if method != "off":
@@ -187,9 +190,19 @@ def write_campbell(res: CampbellResult, out, *, engine_orders: int | None = None
     header = "speed_rad_s,speed_rpm," + ",".join(f"f{j + 1}_hz" for j in range(n))
     table = np.column_stack([res.speeds, res.speeds * 30 / np.pi, res.frequencies])
     np.savetxt(out / "campbell.csv", table, delimiter=",", header=header, comments="", fmt="%.8g")
-    doc = {"method": res.method, "speeds_rad_s": [res.speeds.min(), res.speeds.max()],
-           "n_speeds": int(res.speeds.size), "modes": n, **res.info}  # fmt: skip
+    doc = {
+        "method": res.method,
+        "speeds_rad_s": [res.speeds.min(), res.speeds.max()],
+        "n_speeds": int(res.speeds.size),
+        "modes": n,
+        **res.info,
+    }
     (out / "campbell.json").write_text(json.dumps(doc, indent=2, default=float))
-    plot_campbell(res.speeds, res.frequencies, out / "campbell.png", engine_orders=engine_orders,
-                  title=f"Campbell diagram ({res.method} prestress)")  # fmt: skip
+    plot_campbell(
+        res.speeds,
+        res.frequencies,
+        out / "campbell.png",
+        engine_orders=engine_orders,
+        title=f"Campbell diagram ({res.method} prestress)",
+    )
     return doc

@@ -22,8 +22,15 @@ def casing_grid(scene, blade, points, omega, growth):
     n = a if a["thickness"] > 0.0 else h
     axial = blade.axis @ points.points if blade.dim == 3 else np.zeros(points.n)
     foot = a["footprint"] if a["thickness"] > 0.0 else 0.0
-    return CasingGrid(points.angles, axial, float(np.max(points.radii + growth)), omega,
-                      n_angle=n["n_angle"], n_axial=n["n_axial"], footprint=foot)  # fmt: skip
+    return CasingGrid(
+        points.angles,
+        axial,
+        float(np.max(points.radii + growth)),
+        omega,
+        n_angle=n["n_angle"],
+        n_axial=n["n_axial"],
+        footprint=foot,
+    )
 
 
 def abradable_of(scene, grid):
@@ -66,5 +73,13 @@ def casing_heat_of(scene, grid, eta, alpha, mu):
             f"no frictional heat reaches the casing (heat_partition {eta:g}, no heat "
             "coefficient); set contact.friction / heat_coefficient and heat_partition < 1",
         )
-    return CasingHeat(grid, h["thickness"], h["density"], h["specific_heat"], h["conductivity"],
-                      h["expansion"], eta, alpha)  # fmt: skip
+    return CasingHeat(
+        grid,
+        h["thickness"],
+        h["density"],
+        h["specific_heat"],
+        h["conductivity"],
+        h["expansion"],
+        eta,
+        alpha,
+    )

@@ -36,9 +36,13 @@ def _paper(args) -> int:
         print(f"femrub paper: reproducing {', '.join(figures or FIGURES)} into {out}/")
     try:
         rows = reproduce(
-            out, figures=figures, t_end=args.t_end, progress=not args.quiet, log=log,
+            out,
+            figures=figures,
+            t_end=args.t_end,
+            progress=not args.quiet,
+            log=log,
             overwrite=args.overwrite,
-        )  # fmt: skip
+        )
     except KeyboardInterrupt:
         print(
             f"femrub: paper interrupted; the rows of the finished runs are kept in "
@@ -88,8 +92,10 @@ def _cache_command(args) -> int:
         return 0
     info = cache.info()
     print(f"cache folder  {info['root']}")
-    print(f"entries       {info['entries']} ({info['bytes'] / 1e6:.1f} MB of "
-          f"{info['limit'] / 1e6:.0f} MB)")  # fmt: skip
+    print(
+        f"entries       {info['entries']} ({info['bytes'] / 1e6:.1f} MB of "
+        f"{info['limit'] / 1e6:.0f} MB)"
+    )
     for stage, s in sorted(info["stages"].items()):
         print(f"  {stage:<12}{s['entries']} ({s['bytes'] / 1e6:.1f} MB)")
     print(f"code version  {info['code']}")
@@ -121,9 +127,14 @@ def _run(args) -> int:
 
     t0 = time.perf_counter()
     res, built = run_scene(
-        scene, out, overwrite=args.overwrite, progress=not args.quiet, log=_log(args),
-        on_built=on_built, cache=_cache(args, _log(args)),
-    )  # fmt: skip
+        scene,
+        out,
+        overwrite=args.overwrite,
+        progress=not args.quiet,
+        log=_log(args),
+        on_built=on_built,
+        cache=_cache(args, _log(args)),
+    )
     where = f"{out}/ (summary.json, history.csv, history.npz)"
     if res.status == "interrupted":
         print(
@@ -140,8 +151,9 @@ def _run(args) -> int:
         )
         return 1
     if not args.quiet:
-        peak = max((abs(res.signals[k]).max() for k in res.signals if "temperature" in k),
-                   default=0.0)  # fmt: skip
+        peak = max(
+            (abs(res.signals[k]).max() for k in res.signals if "temperature" in k), default=0.0
+        )
         force = res.force.max() if res.force.size else 0.0
         print(
             f"done in {time.perf_counter() - t0:.1f} s: status {res.status}, {res.steps} "
@@ -152,8 +164,11 @@ def _run(args) -> int:
             print(f"  note: {res.message}")
         for w in res.warnings:
             print(f"  warning: {w}")
-        vtk = " and vtk/rub.pvd (ParaView)" if built.fields is not None and scene[
-            "outputs.vtk_stride"] else ""  # fmt: skip
+        vtk = (
+            " and vtk/rub.pvd (ParaView)"
+            if built.fields is not None and scene["outputs.vtk_stride"]
+            else ""
+        )
         print(f"  results in {out}/: summary.json, history.csv, signals.png{vtk}")
     if args.explain:
         from .explain import format_timings
@@ -212,10 +227,16 @@ def _sweep(args) -> int:
     out = Path(args.out or f"{safe_name(scene.name)}-sweep")
     t0 = time.perf_counter()
     rows = run_sweep(
-        scene, params, out, scheduler=args.scheduler, workers=args.workers,
-        overwrite=args.overwrite, progress=not args.quiet, log=None if args.quiet else print,
+        scene,
+        params,
+        out,
+        scheduler=args.scheduler,
+        workers=args.workers,
+        overwrite=args.overwrite,
+        progress=not args.quiet,
+        log=None if args.quiet else print,
         cache=_cache(args),
-    )  # fmt: skip
+    )
     failed = [r for r in rows if r.get("status") not in FINISHED]
     for r in failed:
         print(
@@ -240,17 +261,25 @@ def _campbell(args) -> int:
     out = Path(args.out or f"{scene.name}-campbell")
     t0 = time.perf_counter()
     res = campbell(
-        scene, speeds, modes=args.modes, samples=args.samples, check=not args.no_check,
+        scene,
+        speeds,
+        modes=args.modes,
+        samples=args.samples,
+        check=not args.no_check,
         log=_log(args),
-    )  # fmt: skip
+    )
     doc = write_campbell(res, out)
     if not args.quiet:
         rest = ", ".join(f"{f:.5g}" for f in doc["rest_frequencies_hz"])
-        print(f"done in {time.perf_counter() - t0:.1f} s: {out / 'campbell.png'}, "
-              f"{out / 'campbell.csv'}; at rest {rest} Hz")  # fmt: skip
+        print(
+            f"done in {time.perf_counter() - t0:.1f} s: {out / 'campbell.png'}, "
+            f"{out / 'campbell.csv'}; at rest {rest} Hz"
+        )
         if "check_max_relative_error" in doc:
-            print(f"  interpolation checked at {doc['check_speed']:.5g} rad/s: largest "
-                  f"frequency error {100 * doc['check_max_relative_error']:.2g} %")  # fmt: skip
+            print(
+                f"  interpolation checked at {doc['check_speed']:.5g} rad/s: largest "
+                f"frequency error {100 * doc['check_max_relative_error']:.2g} %"
+            )
     return 0
 
 
@@ -271,9 +300,10 @@ def _scene_args(p: argparse.ArgumentParser, out: bool = True) -> None:
 
 def _cache_args(p: argparse.ArgumentParser, switch: bool = True) -> None:
     p.add_argument(
-        "--cache-dir", help="cache folder of built models (default $FEMRUB_CACHE_DIR, else "
+        "--cache-dir",
+        help="cache folder of built models (default $FEMRUB_CACHE_DIR, else "
         "the user's cache folder)",
-    )  # fmt: skip
+    )
     if switch:
         p.add_argument("--no-cache", action="store_true", help="build every model anew")
 

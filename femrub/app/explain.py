@@ -136,27 +136,34 @@ def explain(report: dict, reach_key=None) -> str:
     rows += [("prestress", x) for x in _centrifugal(report.get("centrifugal"))]
     a = report.get("abradable")
     if a:
-        rows.append((
-            "abradable",
-            f"coating {_um(a['thickness'])} thick, yields at {a['yield']:g} N per contact; "
-            f"wear map {a['n_angle']} angles × {a['n_axial']} axial cells",
-        ))  # fmt: skip
+        rows.append(
+            (
+                "abradable",
+                f"coating {_um(a['thickness'])} thick, yields at {a['yield']:g} N per contact; "
+                f"wear map {a['n_angle']} angles × {a['n_axial']} axial cells",
+            )
+        )
     ch = report.get("casing_heat")
     if ch:
-        rows.append((
-            "casing",
-            f"lumped wall {_um(ch['thickness'])} thick (τ = {ch['tau']:.3g} s) takes "
-            f"{100 * (1 - ch['partition']):.3g} % of the frictional power; its expansion "
-            "closes the gaps",
-        ))  # fmt: skip
+        rows.append(
+            (
+                "casing",
+                f"lumped wall {_um(ch['thickness'])} thick (τ = {ch['tau']:.3g} s) takes "
+                f"{100 * (1 - ch['partition']):.3g} % of the frictional power; its expansion "
+                "closes the gaps",
+            )
+        )
     reach_key = reach_key or report.get("reach_key", "auto")
     rows += [("contacts", x) for x in _contacts(report["contacts"], reach_key)]
     f = report.get("friction")
     if f and f["mu"] > 0:
         rows.append(
-            ("friction", f"Coulomb μ = {f['mu']:g} (stick/slip, casing frame); heat law "
-             f"{f['heat_law']}, heat_partition {f['heat_partition']:g}")
-        )  # fmt: skip
+            (
+                "friction",
+                f"Coulomb μ = {f['mu']:g} (stick/slip, casing frame); heat law "
+                f"{f['heat_law']}, heat_partition {f['heat_partition']:g}",
+            )
+        )
     for w in report.get("warnings", []):
         rows.append(("warning", w))
     rows += [("reduction", x) for x in _reduction(report["reduction"])]
@@ -172,12 +179,14 @@ def explain(report: dict, reach_key=None) -> str:
     ts = report.get("time_step")
     if ts:
         verdict = "within" if ts["estimate"] <= ts["tolerance"] else "EXCEEDS"
-        rows.append((
-            "time step",
-            f"estimated error {100 * ts['estimate']:.2g} % ({verdict} scheme.step_tolerance "
-            f"{100 * ts['tolerance']:.2g} %): twice the difference to the run at h/2 "
-            f"({ts['decided_by']} {100 * ts['difference']:.2g} %), {ts['seconds']:.1f} s",
-        ))  # fmt: skip
+        rows.append(
+            (
+                "time step",
+                f"estimated error {100 * ts['estimate']:.2g} % ({verdict} scheme.step_tolerance "
+                f"{100 * ts['tolerance']:.2g} %): twice the difference to the run at h/2 "
+                f"({ts['decided_by']} {100 * ts['difference']:.2g} %), {ts['seconds']:.1f} s",
+            )
+        )
     rows.append(("signals", ", ".join(report["signals"]) + " (+ gaps, contact forces, energy)"))
     if report["signals_not_observed"]:
         rows.append(("not kept", ", ".join(report["signals_not_observed"]) + " (outputs.signals)"))

@@ -89,9 +89,16 @@ def _resolved(scene: Scene) -> Scene:
 
 
 def run_scene(
-    scene: Scene, out, *, overwrite=False, progress=False, log=None, on_built=None, modes=0,
+    scene: Scene,
+    out,
+    *,
+    overwrite=False,
+    progress=False,
+    log=None,
+    on_built=None,
+    modes=0,
     cache=None,
-):  # fmt: skip
+):
     """Build and run ``scene`` into the folder ``out``; return ``(results, built)``.
 
     Parameters

@@ -192,15 +192,22 @@ def _build(scene, log, modes, stages, with_stepper=True) -> Simulation:
         log(f"notice: {note}")
     omega = scene["loads"]["rotation_speed"]
     try:
-        disc = stages.discretise(blade, p["order"] if blade.dim == 3 else 1,
-                                 clamped=scene["boundary"]["clamped"])  # fmt: skip
+        disc = stages.discretise(
+            blade, p["order"] if blade.dim == 3 else 1, clamped=scene["boundary"]["clamped"]
+        )
         prestress = _prestress(scene, disc, material, omega, log, stages)
         mats = stages.assemble(
-            disc, material, area=tr.area_of(scene), lumping=p["lumping"],
+            disc,
+            material,
+            area=tr.area_of(scene),
+            lumping=p["lumping"],
             conduction=p["conduction"],
-            coupling=tr.coupling_of(scene), beta=p["beta"], strain_heating=p["strain_heating"],
-            rayleigh=tuple(p["rayleigh"]), prestress=prestress,
-        )  # fmt: skip
+            coupling=tr.coupling_of(scene),
+            beta=p["beta"],
+            strain_heating=p["strain_heating"],
+            rayleigh=tuple(p["rayleigh"]),
+            prestress=prestress,
+        )
         # modal damping once the contacts' boundary is known: its frequencies come through
         # the interior factorisation the reduction reuses (femrub.reduction.modal_damping)
         damping = p["damping_ratio"] and stages.damping(
@@ -215,11 +222,21 @@ def _build(scene, log, modes, stages, with_stepper=True) -> Simulation:
             vector = amplitude * tr.force_direction(scene, candidates)
             loads = [tip_load(disc, mats, vector, signal)]
         reach = contact_reach(
-            candidates, casing, rotation_speed=omega, gap_reference=c["gap_reference"],
-            reach=c["reach"], margin=c["reach_margin"], growth=growth, clearance=c["clearance"],
-            deflection=normal_deflection(mats, candidates.normal_rows(mats),
-                                         loads[0].vector if loads else None, force and force[2]),
-        )  # fmt: skip
+            candidates,
+            casing,
+            rotation_speed=omega,
+            gap_reference=c["gap_reference"],
+            reach=c["reach"],
+            margin=c["reach_margin"],
+            growth=growth,
+            clearance=c["clearance"],
+            deflection=normal_deflection(
+                mats,
+                candidates.normal_rows(mats),
+                loads[0].vector if loads else None,
+                force and force[2],
+            ),
+        )
         points = candidates.restrict(reach.keep)
         law = tr.heat_law_of(scene)
         mu = c["friction"] if blade.dim == 3 else 0.0
@@ -228,20 +245,32 @@ def _build(scene, log, modes, stages, with_stepper=True) -> Simulation:
             alpha = np.zeros(points.n)
             heated = mu > 0.0 and eta > 0.0
         else:
-            alpha = heat_coefficients(points.radii, "alpha", alpha=c["heat_coefficient"],
-                                      heat_partition=eta)  # fmt: skip
+            alpha = heat_coefficients(
+                points.radii, "alpha", alpha=c["heat_coefficient"], heat_partition=eta
+            )
             heated = bool(np.any(alpha > 0))
         grid = casing_grid(scene, blade, points, omega, growth[reach.keep])
         keep_t, report["thermal"] = tr.thermal_choice(scene, heated, points.n > 0)
         full, fields = rub_model(
-            disc, mats, points, material, casing=casing, rotation_speed=omega, alpha=alpha,
-            restitution=c["restitution"], offset=reach.offset[reach.keep], loads=loads,
-            thermal=keep_t, observe_at=points if points.n else candidates,
-            friction=mu, heat_law="power" if law == "power" else "alpha",
-            heat_partition=eta, wear=abradable_of(scene, grid),
+            disc,
+            mats,
+            points,
+            material,
+            casing=casing,
+            rotation_speed=omega,
+            alpha=alpha,
+            restitution=c["restitution"],
+            offset=reach.offset[reach.keep],
+            loads=loads,
+            thermal=keep_t,
+            observe_at=points if points.n else candidates,
+            friction=mu,
+            heat_law="power" if law == "power" else "alpha",
+            heat_partition=eta,
+            wear=abradable_of(scene, grid),
             casing_heat=casing_heat_of(scene, grid, eta, alpha, mu if law == "power" else 0.0),
             damping=damping or None,
-        )  # fmt: skip
+        )
         report["friction"] = {"mu": mu, "heat_law": law, "heat_partition": eta}
         warn(initial_penetration(full), report, log)
         warn(footprint_warning(scene, grid), report, log)
@@ -257,8 +286,11 @@ def _build(scene, log, modes, stages, with_stepper=True) -> Simulation:
     wear = full.contact.wear if full.contact is not None else None
     report["abradable"] = wear.as_dict() if wear is not None else None
     ch = full.contact.casing_heat if full.contact is not None else None
-    report["casing_heat"] = None if ch is None else {
-        "thickness": ch.b, "tau": ch.tau, "partition": eta, "expansion": ch.expansion}  # fmt: skip
+    report["casing_heat"] = (
+        None
+        if ch is None
+        else {"thickness": ch.b, "tau": ch.tau, "partition": eta, "expansion": ch.expansion}
+    )
     model, limits = _select_signals(scene, full, report, size)
     if modes:
         report["natural_frequencies_hz"] = stages.frequencies(model, modes).tolist()
@@ -278,7 +310,7 @@ def _build(scene, log, modes, stages, with_stepper=True) -> Simulation:
             given = (res if ran is not None else res.lean(), states)
         report["time_step"], run_h, wall_h = check_step(
             scene, reduced, full, lambda m, h: bare_stepper(scene, m, h), limits, run=given
-        )  # fmt: skip
+        )
         if ran is None and wall_h is not None and reusable_run(model):
             ran = (run_h[0], wall_h)  # the check stepped the run itself
             clock.exclude(wall_h)
@@ -325,15 +357,18 @@ def _centrifugal_report(scene, prestress, growth, reach) -> dict:
         return {"method": "off", "why": why}
     g = np.asarray(growth, dtype=float)
     return {
-        "method": prestress.method, "rotation_speed": prestress.omega,
-        "newton_iterations": prestress.iterations, "load_increments": prestress.increments,
-        "residual": prestress.residual, "clearance": scene["contact"]["clearance"],
+        "method": prestress.method,
+        "rotation_speed": prestress.omega,
+        "newton_iterations": prestress.iterations,
+        "load_increments": prestress.increments,
+        "residual": prestress.residual,
+        "clearance": scene["contact"]["clearance"],
         "tip_growth_min": float(g.min()) if g.size else 0.0,
         "tip_growth_max": float(g.max()) if g.size else 0.0,
         "tip_growth_mean": float(g.mean()) if g.size else 0.0,
         "min_gap": float(reach.min_gap.min()) if g.size else 0.0,
         "max_min_gap": float(reach.min_gap.max()) if g.size else 0.0,
-    }  # fmt: skip
+    }
 
 
 def _select_signals(scene, model, report, size):
@@ -366,7 +401,8 @@ def _contacts_report(points, reach) -> dict:
         "candidates": points.n,
         "kept": [n for n, k in zip(points.names, keep) if k],
         "dropped": [
-            {"name": n, "min_gap": float(g)} for n, g, k in zip(points.names, reach.min_gap, keep)
+            {"name": n, "min_gap": float(g)}
+            for n, g, k in zip(points.names, reach.min_gap, keep)
             if not k
         ],
         "min_gap_kept": [float(g) for g, k in zip(reach.min_gap, keep) if k],
@@ -374,7 +410,7 @@ def _contacts_report(points, reach) -> dict:
         "deflection": reach.deflection,
         "intrusion": reach.intrusion,
         "max_offset": float(np.max(reach.offset)) if points.n else 0.0,
-    }  # fmt: skip
+    }
 
 
 def _layout(model) -> dict:

@@ -137,10 +137,10 @@ def check_step(scene, model, full, make_stepper, limits, run=None):
     err = estimate((label, *run), (label, *fine), full, window=window)
     if _richardson(err["estimate"]) > SAFETY * tol:  # how sensitive is the response?
         with phase(f"time-step check: twin at h/2 = {fine_h:g} s"):
-            twin = _simulate(make_stepper(_perturbed(model), fine_h), t_end, 2 * every,
-                             limits, fields, lean=2)  # fmt: skip
-        err = estimate((label, *run), (label, *fine), full, window=window, twin=twin,
-                       tolerance=tol)  # fmt: skip
+            twin = _simulate(
+                make_stepper(_perturbed(model), fine_h), t_end, 2 * every, limits, fields, lean=2
+            )
+        err = estimate((label, *run), (label, *fine), full, window=window, twin=twin, tolerance=tol)
     for key in ("sizes", "reference_sizes", "status_run", "status_reference"):
         err.pop(key, None)
     split = "predictability_horizon" in err

@@ -151,16 +151,27 @@ def _client(scheduler, workers):
     if scheduler:
         return Client(scheduler), None
     cluster = LocalCluster(
-        n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=None,
+        n_workers=workers,
+        threads_per_worker=1,
+        processes=True,
+        dashboard_address=None,
         env={"OMP_NUM_THREADS": "1", "OPENBLAS_NUM_THREADS": "1", "MKL_NUM_THREADS": "1"},
-    )  # fmt: skip
+    )
     return Client(cluster), cluster
 
 
 def run_sweep(
-    scene: Scene, params, out, *, scheduler=None, workers=2, overwrite=False, progress=False,
-    log=None, cache=None,
-) -> list[dict]:  # fmt: skip
+    scene: Scene,
+    params,
+    out,
+    *,
+    scheduler=None,
+    workers=2,
+    overwrite=False,
+    progress=False,
+    log=None,
+    cache=None,
+) -> list[dict]:
     """Run the sweep; return one row per point (params, metrics, folder, skipped).
 
     Parameters
@@ -177,19 +188,33 @@ def run_sweep(
         at once and builds its own.
     """
     out = Path(out)
-    if scheduler is None and (isinstance(workers, bool) or not isinstance(workers, int)
-                              or workers < 1):  # fmt: skip
+    if scheduler is None and (
+        isinstance(workers, bool) or not isinstance(workers, int) or workers < 1
+    ):
         raise FolderError(f"--workers {workers!r}: give at least 1 worker process")
     points = grid(params)
     keys = [k for k, _ in params]
     scenes = [scene.with_changes(p) for p in points]  # every point valid before any work
     with claim(out, "sweep", check_result=False):
-        return _sweep(scene, params, points, scenes, keys, out, scheduler, workers, overwrite,
-                      progress, log, cache)  # fmt: skip
+        return _sweep(
+            scene,
+            params,
+            points,
+            scenes,
+            keys,
+            out,
+            scheduler,
+            workers,
+            overwrite,
+            progress,
+            log,
+            cache,
+        )
 
 
-def _sweep(scene, params, points, scenes, keys, out, scheduler, workers, overwrite, progress,
-           log, cache):  # fmt: skip
+def _sweep(
+    scene, params, points, scenes, keys, out, scheduler, workers, overwrite, progress, log, cache
+):
     hashes = [scene_hash(s) for s in scenes]
     doc = {
         "scene": scene.data,
@@ -204,8 +229,15 @@ def _sweep(scene, params, points, scenes, keys, out, scheduler, workers, overwri
         folder = out / "runs" / _point_name(i, p, digest)
         done = folder_status(folder) in FINISHED and not overwrite
         done = done and _hash_of(folder) == digest
-        rows.append({"point": i, "params": p, "folder": str(folder), "skipped": done,
-                     "scene_sha256": digest})  # fmt: skip
+        rows.append(
+            {
+                "point": i,
+                "params": p,
+                "folder": str(folder),
+                "skipped": done,
+                "scene_sha256": digest,
+            }
+        )
     todo = [r for r in rows if not r["skipped"]]
     for r in rows:
         if r["skipped"]:
@@ -234,11 +266,18 @@ def _compute(scene, todo, scheduler, workers, progress, cache=None) -> None:
     def submit(rows):
         return {
             client.submit(
-                run_point, scene.data, scene.source, str(scene.base_dir), r["params"],
-                r["folder"], cache, pure=False, key=f"femrub-point-{r['point']}-{id(r)}",
+                run_point,
+                scene.data,
+                scene.source,
+                str(scene.base_dir),
+                r["params"],
+                r["folder"],
+                cache,
+                pure=False,
+                key=f"femrub-point-{r['point']}-{id(r)}",
             ): r
             for r in rows
-        }  # fmt: skip
+        }
 
     try:
         bar = tqdm(total=len(todo), disable=not progress, unit="point", desc="sweep")
@@ -284,18 +323,42 @@ def _x(scene, key) -> float:
 
 def _write_csv(rows, keys, path) -> None:
     n_f = max((len(r.get("natural_frequencies_hz") or []) for r in rows), default=0)
-    cols = ["point", *keys, "status", "max_tip_displacement_m", "max_contact_force_N",
-            "max_temperature_K", "first_contact_time_s", "t_reached_s",
-            *[f"f{j + 1}_hz" for j in range(n_f)], "skipped", "folder", "message",
-            "rms_tip_displacement_m", "max_wear_depth_m"]  # fmt: skip
+    cols = [
+        "point",
+        *keys,
+        "status",
+        "max_tip_displacement_m",
+        "max_contact_force_N",
+        "max_temperature_K",
+        "first_contact_time_s",
+        "t_reached_s",
+        *[f"f{j + 1}_hz" for j in range(n_f)],
+        "skipped",
+        "folder",
+        "message",
+        "rms_tip_displacement_m",
+        "max_wear_depth_m",
+    ]
     with open(path, "w", newline="") as fh:
         w = csv.writer(fh)
         w.writerow(cols)
         for r in rows:
             f = list(r.get("natural_frequencies_hz") or []) + [""] * n_f
-            w.writerow([r["point"], *[r["x"] if k == keys[0] else r["params"][k] for k in keys],
-                        r.get("status"), r.get("max_tip_displacement"),
-                        r.get("max_contact_force"), r.get("max_temperature"),
-                        r.get("first_contact_time"), r.get("t_reached"), *f[:n_f],
-                        r["skipped"], r["folder"], r.get("message", ""),
-                        r.get("rms_tip_displacement"), r.get("max_wear_depth")])  # fmt: skip
+            w.writerow(
+                [
+                    r["point"],
+                    *[r["x"] if k == keys[0] else r["params"][k] for k in keys],
+                    r.get("status"),
+                    r.get("max_tip_displacement"),
+                    r.get("max_contact_force"),
+                    r.get("max_temperature"),
+                    r.get("first_contact_time"),
+                    r.get("t_reached"),
+                    *f[:n_f],
+                    r["skipped"],
+                    r["folder"],
+                    r.get("message", ""),
+                    r.get("rms_tip_displacement"),
+                    r.get("max_wear_depth"),
+                ]
+            )

@@ -137,10 +137,14 @@ def material_of(scene, deck: dict | None = None, notes: list | None = None) -> M
     if is_bar(scene) and g["total_mass"] != "density":
         rho = g["total_mass"] / (g["area"] * g["length"])
     return Material(
-        young=m["young"], rho=rho, poisson=m["poisson"],
-        rho_c=m["density"] * m["specific_heat"], conductivity=m["conductivity"],
-        expansion=m["expansion"], reference_temperature=m["reference_temperature"],
-    )  # fmt: skip
+        young=m["young"],
+        rho=rho,
+        poisson=m["poisson"],
+        rho_c=m["density"] * m["specific_heat"],
+        conductivity=m["conductivity"],
+        expansion=m["expansion"],
+        reference_temperature=m["reference_temperature"],
+    )
 
 
 def casing_of(scene):

@@ -372,11 +372,20 @@ def _figures(out, names, t_end, progress, log, rows, started) -> None:
 
 #: SI units of the numeric fields of a summary row
 _ROW_UNITS = {
-    "h": "s", "alpha": "m/s", "t_end": "s", "first_contact_time": "s", "max_contact_force": "N",
-    "tip_temperature_end": "K", "max_penetration": "m", "impact_dissipation": "J",
-    "energy_error": "-", "cpu_seconds": "s", "wall_seconds": "s", "cpu_per_step_us": "us",
+    "h": "s",
+    "alpha": "m/s",
+    "t_end": "s",
+    "first_contact_time": "s",
+    "max_contact_force": "N",
+    "tip_temperature_end": "K",
+    "max_penetration": "m",
+    "impact_dissipation": "J",
+    "energy_error": "-",
+    "cpu_seconds": "s",
+    "wall_seconds": "s",
+    "cpu_per_step_us": "us",
     "stability_limit": "s (null: unconditionally stable)",
-}  # fmt: skip
+}
 
 
 def _write_summary(out: Path, rows, started, status: str = "running") -> None:

@@ -236,8 +236,18 @@ class Abradable:
         else:
             x0, r0 = g.position(last[0])[i], last[1][i]
         flat = self.depth.ravel()  # a view: cut in place
-        deepest = cut_sweeps(flat, g.axial_cell[i], x0, x1, r0, r1, self.thickness,
-                             self.n_angle, self.n_axial, g.beta)  # fmt: skip
+        deepest = cut_sweeps(
+            flat,
+            g.axial_cell[i],
+            x0,
+            x1,
+            r0,
+            r1,
+            self.thickness,
+            self.n_angle,
+            self.n_axial,
+            g.beta,
+        )
         self.history.append((float(t), max(self.history[-1][1], float(deepest))))
 
     # -- results ------------------------------------------------------------------------

@@ -89,9 +89,17 @@ def impulse_one(rule, g_k, gd_k, g_p, gd_p, w, gz, e, h, gamma, upper=np.inf) ->
     The arithmetic is :func:`femrub.contact.theta_block.impulse_one_code` (compiled).
     """
     P = impulse_one_code(
-        ONE_RULES[rule], float(g_k), float(gd_k), float(g_p), float(gd_p), float(w), float(gz),
-        float(e), float(h), float(gamma),
-    )  # fmt: skip
+        ONE_RULES[rule],
+        float(g_k),
+        float(gd_k),
+        float(g_p),
+        float(gd_p),
+        float(w),
+        float(gz),
+        float(e),
+        float(h),
+        float(gamma),
+    )
     return min(P, upper)
 
 
@@ -200,9 +208,24 @@ def compile_kernels() -> None:
     q = np.array([[-1.0, 0.0, 0.0]])
     for code in (FIXED_POINT, PREDICTED):
         frictional_fixed_point(
-            code, -one, -one, -one, np.ones((1, 3)), W, q, one * 0.1, z, z.copy(),
-            np.full(1, np.inf), np.zeros((1, 3)), False, 1.0, 0.5, 1e-12, 60,
-        )  # fmt: skip
+            code,
+            -one,
+            -one,
+            -one,
+            np.ones((1, 3)),
+            W,
+            q,
+            one * 0.1,
+            z,
+            z.copy(),
+            np.full(1, np.inf),
+            np.zeros((1, 3)),
+            False,
+            1.0,
+            0.5,
+            1e-12,
+            60,
+        )
     solve_frictional_contact(W, q, 0.1, np.ones(1, dtype=bool))
     compile_blocks()
 
@@ -222,17 +245,72 @@ def compile_blocks() -> None:
     wait_background()  # a build's child compiling them (jit.compile_in_background)
     N, E, one, z = 2, np.empty, np.ones(1), np.zeros(1)
     T, Y, sig = np.eye(N), np.zeros((N, 0)), np.zeros((1, 0))
-    one_contact_block(np.zeros(N), T, Y, Y, sig, 0, 1.0, np.ones(N), np.ones(N), np.ones(N),
-                      1.0, 1.0, 0.0, 1.0, 0.5, np.inf, E((0, N)), E((0, 1)))  # fmt: skip
+    one_contact_block(
+        np.zeros(N),
+        T,
+        Y,
+        Y,
+        sig,
+        0,
+        1.0,
+        np.ones(N),
+        np.ones(N),
+        np.ones(N),
+        1.0,
+        1.0,
+        0.0,
+        1.0,
+        0.5,
+        np.inf,
+        E((0, N)),
+        E((0, 1)),
+    )
     rows = (E((0, N)), E((0, 1)), E((0, 1, 2)), E((0, 1)), E((0, 1), dtype=np.int8))
-    head = (np.zeros(N), T, Y, Y, sig, np.zeros((4, N)), np.zeros((1, 4)), np.zeros((N, 3)),
-            np.eye(3), np.zeros((1, 3)), FIXED_POINT, one, one * 0.0, one * np.inf,
-            np.zeros((1, 3)), False, 1.0, 0.5, one * 0.0, 1e-12, 60)  # fmt: skip
+    head = (
+        np.zeros(N),
+        T,
+        Y,
+        Y,
+        sig,
+        np.zeros((4, N)),
+        np.zeros((1, 4)),
+        np.zeros((N, 3)),
+        np.eye(3),
+        np.zeros((1, 3)),
+        FIXED_POINT,
+        one,
+        one * 0.0,
+        one * np.inf,
+        np.zeros((1, 3)),
+        False,
+        1.0,
+        0.5,
+        one * 0.0,
+        1e-12,
+        60,
+    )
     friction_block(*head, *rows)
     ints = np.zeros(1, dtype=np.int64)
     rub_block(
-        *head, True, np.zeros((N, 1)), np.zeros((3, 1)), one * 0.5, 20, True, E(0), E(0),
-        np.zeros((0, 1)), np.zeros((1, N)), z.copy(), z.copy(), ints, np.ones(5),
-        np.ones(2, dtype=np.int64), z.copy(), np.zeros(3), *rows, E(0),
-    )  # fmt: skip
+        *head,
+        True,
+        np.zeros((N, 1)),
+        np.zeros((3, 1)),
+        one * 0.5,
+        20,
+        True,
+        E(0),
+        E(0),
+        np.zeros((0, 1)),
+        np.zeros((1, N)),
+        z.copy(),
+        z.copy(),
+        ints,
+        np.ones(5),
+        np.ones(2, dtype=np.int64),
+        z.copy(),
+        np.zeros(3),
+        *rows,
+        E(0),
+    )
     cut_sweeps(z.copy(), ints, z.copy(), one * 0.5, z.copy(), z.copy(), 1.0, 1, 1, 0.0)

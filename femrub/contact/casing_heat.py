@@ -58,8 +58,9 @@ class CasingHeat:
     alpha : (n_c,) blade heat coefficients ``α_i = η μ |Ω| r_i`` (m/s).
     """
 
-    def __init__(self, grid, thickness, density, specific_heat, conductivity, expansion,
-                 partition, alpha):  # fmt: skip
+    def __init__(
+        self, grid, thickness, density, specific_heat, conductivity, expansion, partition, alpha
+    ):
         self.grid = grid
         self.b = check_finite_positive("contact.casing_heat.thickness", thickness)
         rho_c = check_finite_positive("contact.casing_heat.density", density)

@@ -176,10 +176,14 @@ def coulomb_check(normal_force, friction_force, slip_velocity, state, mu) -> dic
     time, so that a long run's check needs little memory beyond its arrays.
     """
     mu = np.asarray(mu, dtype=float)
-    return merge_coulomb_checks([
-        coulomb_check_rows(normal_force[r], friction_force[r], slip_velocity[r], state[r], mu)
-        for r in (slice(k, k + CHECK_ROWS) for k in range(0, max(len(normal_force), 1), CHECK_ROWS))
-    ])  # fmt: skip
+    return merge_coulomb_checks(
+        [
+            coulomb_check_rows(normal_force[r], friction_force[r], slip_velocity[r], state[r], mu)
+            for r in (
+                slice(k, k + CHECK_ROWS) for k in range(0, max(len(normal_force), 1), CHECK_ROWS)
+            )
+        ]
+    )
 
 
 def merge_coulomb_checks(parts: list[dict]) -> dict:

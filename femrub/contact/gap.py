@@ -158,8 +158,9 @@ class Contact:
         (:meth:`Abradable.impulse_cap <femrub.contact.abradable.Abradable.impulse_cap>`)."""
         return None if self.wear is None else self.wear.impulse_cap(t, h, gap_k, gap_p)
 
-    def after_step(self, t: float, X: np.ndarray, impulse: np.ndarray, h: float,
-                   extra: dict | None = None) -> None:  # fmt: skip
+    def after_step(
+        self, t: float, X: np.ndarray, impulse: np.ndarray, h: float, extra: dict | None = None
+    ) -> None:
         """Remove the coating the blade penetrated where it yielded (impulse at its cap), and
         heat the casing with its share of the step's frictional heat.
 

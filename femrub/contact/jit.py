@@ -131,14 +131,17 @@ def compile_in_background() -> bool:
     if not _cold(friction_block):
         return False
     root = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-    env = dict(os.environ, PYTHONPATH=os.pathsep.join(filter(None, (root, os.environ.get(
-        "PYTHONPATH")))))  # fmt: skip
+    env = dict(
+        os.environ, PYTHONPATH=os.pathsep.join(filter(None, (root, os.environ.get("PYTHONPATH"))))
+    )
     code = "from femrub.contact.activation import compile_kernels; compile_kernels()"
     try:
         _CHILD["process"] = subprocess.Popen(
-            [sys.executable, "-c", code], env=env, stdout=subprocess.DEVNULL,
+            [sys.executable, "-c", code],
+            env=env,
+            stdout=subprocess.DEVNULL,
             stderr=subprocess.DEVNULL,
-        )  # fmt: skip
+        )
     except OSError:  # pragma: no cover - no process to spare: compiled on first use
         return False
     return True

@@ -112,10 +112,51 @@ def _wear_cut(depth, GT, X, P, t, g0, angles, axial_cell, grid, dims, last_r, ws
 
 @njit
 def rub_block(
-    X, T, Y1, Y0, sig, S, off, Z, W, GZ, code, mu, e3, U3, warm, use_warm, h, gamma, alpha,
-    tol, max_iter, power, Zt, W3t, eta, max_heat, wear, t1, ta, g0a, GT, depth, angles,
-    axial_cell, grid, dims, last_r, wstate, Xout, Pout, Ptout, heat_out, state_out, hist,
-):  # fmt: skip
+    X,
+    T,
+    Y1,
+    Y0,
+    sig,
+    S,
+    off,
+    Z,
+    W,
+    GZ,
+    code,
+    mu,
+    e3,
+    U3,
+    warm,
+    use_warm,
+    h,
+    gamma,
+    alpha,
+    tol,
+    max_iter,
+    power,
+    Zt,
+    W3t,
+    eta,
+    max_heat,
+    wear,
+    t1,
+    ta,
+    g0a,
+    GT,
+    depth,
+    angles,
+    axial_cell,
+    grid,
+    dims,
+    last_r,
+    wstate,
+    Xout,
+    Pout,
+    Ptout,
+    heat_out,
+    state_out,
+    hist,
+):
     """``Xout.shape[0]`` frictional steps with the ``"power"`` heat fixed point (``power``)
     and/or the wear map (``wear``) (module docstring).
 
@@ -135,18 +176,40 @@ def rub_block(
     for j in range(Xout.shape[0]):
         Xp = _predict(T, Y1, Y0, sig, j, Xk)
         if wear:
-            d1 = depth_under(depth, positions(t1[j], angles, omega, scale), axial_cell,
-                             dims[0], dims[1], grid[4])  # fmt: skip
-            d0 = depth_under(depth, positions(t1[j] - h, angles, omega, scale), axial_cell,
-                             dims[0], dims[1], grid[4])  # fmt: skip
+            d1 = depth_under(
+                depth, positions(t1[j], angles, omega, scale), axial_cell, dims[0], dims[1], grid[4]
+            )
+            d0 = depth_under(
+                depth,
+                positions(t1[j] - h, angles, omega, scale),
+                axial_cell,
+                dims[0],
+                dims[1],
+                grid[4],
+            )
             for i in range(n):
                 off[j + 1, i] += d1[i]
                 off[j + 1, n + 3 * i] += (d1[i] - d0[i]) / h
                 U[i] = math.inf if d1[i] >= thickness else cap
         yk, q, e, gdk, active, P, u, st, res, status = friction_step(
-            Xk, Xp, S, off[j], off[j + 1], GZ, W, code, mu, e3, U, warm, use_warm, h, gamma,
-            tol, max_iter,
-        )  # fmt: skip
+            Xk,
+            Xp,
+            S,
+            off[j],
+            off[j + 1],
+            GZ,
+            W,
+            code,
+            mu,
+            e3,
+            U,
+            warm,
+            use_warm,
+            h,
+            gamma,
+            tol,
+            max_iter,
+        )
         if status != 0:
             return j, status, res, warm
         heat = np.zeros(n)
@@ -173,6 +236,7 @@ def rub_block(
             state_out[j, i] = st[i]
         hist[j] = math.nan
         if wear:
-            hist[j] = _wear_cut(depth, GT, Xk, P, ta[j], g0a[j], angles, axial_cell, grid,
-                                dims, last_r, wstate, U)  # fmt: skip
+            hist[j] = _wear_cut(
+                depth, GT, Xk, P, ta[j], g0a[j], angles, axial_cell, grid, dims, last_r, wstate, U
+            )
     return Xout.shape[0], 0, 0.0, warm

@@ -79,8 +79,9 @@ def _predict(T, Y1, Y0, sig, j, X):
 
 
 @njit
-def one_contact_block(X, T, Y1, Y0, sig, code, g0, gr, gv, z, w, gz, e, h, gamma, upper, Xout,
-                      Pout):  # fmt: skip
+def one_contact_block(
+    X, T, Y1, Y0, sig, code, g0, gr, gv, z, w, gz, e, h, gamma, upper, Xout, Pout
+):
     """``Xout.shape[0]`` steps of one frictionless contact with constant gap ``g0``;
     ``sig`` (m + 1, n_s): the load signals at ``t_k`` and at each step's end."""
     Xk = X
@@ -88,19 +89,28 @@ def one_contact_block(X, T, Y1, Y0, sig, code, g0, gr, gv, z, w, gz, e, h, gamma
         Xp = _predict(T, Y1, Y0, sig, j, Xk)
         P = min(
             impulse_one_code(
-                code, g0 + np.dot(gr, Xk), np.dot(gv, Xk), g0 + np.dot(gr, Xp), np.dot(gv, Xp),
-                w, gz, e, h, gamma,
+                code,
+                g0 + np.dot(gr, Xk),
+                np.dot(gv, Xk),
+                g0 + np.dot(gr, Xp),
+                np.dot(gv, Xp),
+                w,
+                gz,
+                e,
+                h,
+                gamma,
             ),
             upper,
-        )  # fmt: skip
+        )
         Xk = Xp if P == 0.0 else Xp + P * z
         Xout[j] = Xk
         Pout[j, 0] = P
 
 
 @njit
-def friction_step(Xk, Xp, S, ok, o1, GZ, W, code, mu, e3, U, warm, use_warm, h, gamma, tol,
-                  max_iter):  # fmt: skip
+def friction_step(
+    Xk, Xp, S, ok, o1, GZ, W, code, mu, e3, U, warm, use_warm, h, gamma, tol, max_iter
+):
     """The frictional contact solve of one step from ``X_k`` with the prediction ``X_p``.
 
     Local rows ``y = S X + o`` (``[g, ġ, w_t]``, casing terms ``o_k``, ``o_{k+1}``), Newton's
@@ -122,17 +132,56 @@ def friction_step(Xk, Xp, S, ok, o1, GZ, W, code, mu, e3, U, warm, use_warm, h, 
     q = yp[n:].copy().reshape((n, 3))
     entry_bounds(U, yk[:n], yp[:n])  # a coating's bound: the part of the step on it
     active, P, u, st, res, it, status = frictional_fixed_point(
-        code, yk[:n].copy(), gdk.copy(), yp[:n].copy(), GZ, W, q, mu, e.copy(), gdk.copy(),
-        U, warm, use_warm, h, gamma, tol, max_iter,
-    )  # fmt: skip
+        code,
+        yk[:n].copy(),
+        gdk.copy(),
+        yp[:n].copy(),
+        GZ,
+        W,
+        q,
+        mu,
+        e.copy(),
+        gdk.copy(),
+        U,
+        warm,
+        use_warm,
+        h,
+        gamma,
+        tol,
+        max_iter,
+    )
     return yk, q, e, gdk, active, P, u, st, res, status
 
 
 @njit
 def friction_block(
-    X, T, Y1, Y0, sig, S, off, Z, W, GZ, code, mu, e3, U, warm, use_warm, h, gamma, alpha, tol,
-    max_iter, Xout, Pout, Ptout, heat_out, state_out,
-):  # fmt: skip
+    X,
+    T,
+    Y1,
+    Y0,
+    sig,
+    S,
+    off,
+    Z,
+    W,
+    GZ,
+    code,
+    mu,
+    e3,
+    U,
+    warm,
+    use_warm,
+    h,
+    gamma,
+    alpha,
+    tol,
+    max_iter,
+    Xout,
+    Pout,
+    Ptout,
+    heat_out,
+    state_out,
+):
     """``Xout.shape[0]`` frictional steps (``off`` (m + 1, 4 n_c): the casing terms at
     ``t_k`` and at each step's end). Returns ``(steps done, status, residual, warm)``: a
     step whose solve failed (status ≠ 0) is not written, and the block stops there."""
@@ -141,9 +190,24 @@ def friction_block(
     for j in range(Xout.shape[0]):
         Xp = _predict(T, Y1, Y0, sig, j, Xk)
         yk, q, e, gdk, active, P, u, st, res, status = friction_step(
-            Xk, Xp, S, off[j], off[j + 1], GZ, W, code, mu, e3, U, warm, use_warm, h, gamma,
-            tol, max_iter,
-        )  # fmt: skip
+            Xk,
+            Xp,
+            S,
+            off[j],
+            off[j + 1],
+            GZ,
+            W,
+            code,
+            mu,
+            e3,
+            U,
+            warm,
+            use_warm,
+            h,
+            gamma,
+            tol,
+            max_iter,
+        )
         if status != 0:
             return j, status, res, warm
         warm, use_warm = P, True

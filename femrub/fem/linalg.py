@@ -213,8 +213,9 @@ def project(left: np.ndarray, Q, right: np.ndarray, chunk: int = 8192, parts=Non
             touched = [np.flatnonzero(np.any(nonzero[np.unique(Qs.indices)], axis=0))]
         else:  # the blocks of right this chunk reads
             lo, hi = Qs.indices.min(), Qs.indices.max()
-            touched = [c if bounds[b] <= hi and lo < bounds[b + 1] else none
-                       for b, c in enumerate(columns)]  # fmt: skip
+            touched = [
+                c if bounds[b] <= hi and lo < bounds[b + 1] else none for b, c in enumerate(columns)
+            ]
         rc = np.unique(np.concatenate(touched))
         if lc.size and rc.size:
             QR = csr_dense(Qs, right, touched, bounds, rc)

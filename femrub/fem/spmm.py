@@ -47,8 +47,13 @@ def _compile(fn):
 
 
 #: Threads the rows are split between (the cores this process may use, at most 8).
-THREADS = max(1, min(8, len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity")
-                     else (os.cpu_count() or 1)))  # fmt: skip
+THREADS = max(
+    1,
+    min(
+        8,
+        len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else (os.cpu_count() or 1),
+    ),
+)
 #: Nonzeros of ``Q`` per thread below which fewer threads are used (small products).
 NNZ_PER_THREAD = 100_000
 _POOL: dict = {}

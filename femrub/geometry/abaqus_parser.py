@@ -14,10 +14,13 @@ __all__ = ["SOLID_TYPES", "AbaqusModel", "ElementBlock", "parse_abaqus"]
 
 #: Supported solid element families: node count -> (cell kind, corner count).
 SOLID_TYPES = {
-    4: ("tetra", 4), 10: ("tetra", 4),
-    6: ("wedge", 6), 15: ("wedge", 6),
-    8: ("hexahedron", 8), 20: ("hexahedron", 8),
-}  # fmt: skip
+    4: ("tetra", 4),
+    10: ("tetra", 4),
+    6: ("wedge", 6),
+    15: ("wedge", 6),
+    8: ("hexahedron", 8),
+    20: ("hexahedron", 8),
+}
 _TYPE_RE = re.compile(r"^C3D(\d+)[A-Z]*$")
 #: material keywords read, and the quantities of their first data line (Abaqus order)
 _MATERIAL_KEYS = {

@@ -23,19 +23,43 @@ __all__ = ["MATERIAL_SI", "MIDSIDE_EDGES", "deck_material", "edge_midpoints", "r
 #: its length unit: m -> N-m-kg-s, mm -> N-mm-t-s (MPa, t/mm^3, mJ/(t K) = 1e-6 J/(kg K),
 #: mW/(mm K) = W/(m K)). A cm deck has no standard consistent system: its material is not read.
 MATERIAL_SI = {
-    "m": {"young": 1.0, "poisson": 1.0, "density": 1.0, "expansion": 1.0,
-          "conductivity": 1.0, "specific_heat": 1.0},
-    "mm": {"young": 1e6, "poisson": 1.0, "density": 1e12, "expansion": 1.0,
-           "conductivity": 1.0, "specific_heat": 1e-6},
-}  # fmt: skip
+    "m": {
+        "young": 1.0,
+        "poisson": 1.0,
+        "density": 1.0,
+        "expansion": 1.0,
+        "conductivity": 1.0,
+        "specific_heat": 1.0,
+    },
+    "mm": {
+        "young": 1e6,
+        "poisson": 1.0,
+        "density": 1e12,
+        "expansion": 1.0,
+        "conductivity": 1.0,
+        "specific_heat": 1e-6,
+    },
+}
 
 #: Corner pair (0-based) of every mid-side node, per element node count (Abaqus order).
 MIDSIDE_EDGES = {
     10: [(0, 1), (1, 2), (2, 0), (0, 3), (1, 3), (2, 3)],
     15: [(0, 1), (1, 2), (2, 0), (3, 4), (4, 5), (5, 3), (0, 3), (1, 4), (2, 5)],
-    20: [(0, 1), (1, 2), (2, 3), (3, 0), (4, 5), (5, 6), (6, 7), (7, 4),
-         (0, 4), (1, 5), (2, 6), (3, 7)],
-}  # fmt: skip
+    20: [
+        (0, 1),
+        (1, 2),
+        (2, 3),
+        (3, 0),
+        (4, 5),
+        (5, 6),
+        (6, 7),
+        (7, 4),
+        (0, 4),
+        (1, 5),
+        (2, 6),
+        (3, 7),
+    ],
+}
 
 
 def _lookup(model: AbaqusModel) -> np.ndarray:

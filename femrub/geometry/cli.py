@@ -37,9 +37,11 @@ def _common(p: argparse.ArgumentParser, sizes: bool = True) -> None:
             "--n-contact", type=int, default=None, help="number of contact nodes on the tip"
         )
         p.add_argument(
-            "--contact-margin", type=float, default=None,
+            "--contact-margin",
+            type=float,
+            default=None,
             help="chord fraction kept free of contact nodes at each edge (default 0.05)",
-        )  # fmt: skip
+        )
 
 
 def _fill(parser: argparse.ArgumentParser) -> argparse.ArgumentParser:
@@ -65,13 +67,17 @@ def _fill(parser: argparse.ArgumentParser) -> argparse.ArgumentParser:
     naca.add_argument("--twist", type=float, default=20.0, help="tip twist [deg] (default 20)")
     naca.add_argument("--n-sections", type=int, default=5, help="lofted sections (default 5)")
     naca.add_argument(
-        "--hub-radius", type=float, default=0.0,
+        "--hub-radius",
+        type=float,
+        default=0.0,
         help="radius of the root section from the machine axis (x) [m] (default 0)",
-    )  # fmt: skip
+    )
     naca.add_argument(
-        "--stacking", type=float, default=0.25,
+        "--stacking",
+        type=float,
+        default=0.25,
         help="chord fraction of the twist axis (default 0.25)",
-    )  # fmt: skip
+    )
     naca.add_argument(
         "--n-points", type=int, default=40, help="points per section side (default 40)"
     )
@@ -164,21 +170,37 @@ def run_mesh(args: argparse.Namespace) -> int:
     try:
         if args.mesh_kind == "box":
             blade = box_blade(
-                args.span, args.chord, args.thickness, hub_radius=args.hub_radius,
-                verbose=args.verbose, **_sizes(args),
-            )  # fmt: skip
+                args.span,
+                args.chord,
+                args.thickness,
+                hub_radius=args.hub_radius,
+                verbose=args.verbose,
+                **_sizes(args),
+            )
         elif args.mesh_kind == "naca":
             blade = naca_blade(
-                args.code, args.span, args.root_chord, args.tip_chord, args.twist, args.n_sections,
-                hub_radius=args.hub_radius, stacking=args.stacking, n_points=args.n_points,
-                verbose=args.verbose, **_sizes(args),
-            )  # fmt: skip
+                args.code,
+                args.span,
+                args.root_chord,
+                args.tip_chord,
+                args.twist,
+                args.n_sections,
+                hub_radius=args.hub_radius,
+                stacking=args.stacking,
+                n_points=args.n_points,
+                verbose=args.verbose,
+                **_sizes(args),
+            )
         elif args.mesh_kind == "sections":
             paths = args.files[0] if len(args.files) == 1 else args.files
             blade = sections_blade(
-                paths, length_unit=args.unit, pattern=args.pattern, radial_axis=args.axis,
-                verbose=args.verbose, **_sizes(args),
-            )  # fmt: skip
+                paths,
+                length_unit=args.unit,
+                pattern=args.pattern,
+                radial_axis=args.axis,
+                verbose=args.verbose,
+                **_sizes(args),
+            )
         else:
             blade = read_mesh(args.path, args.unit, **_read_kwargs(args))
         print(f"{blade.summary()} [{time.perf_counter() - start:.2f} s]")

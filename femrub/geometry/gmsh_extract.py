@@ -19,10 +19,17 @@ __all__ = ["GmshMesh", "physical_groups", "read_current_model", "to_blade_mesh"]
 
 # gmsh element type -> (cell kind, number of corner nodes); corners come first.
 _VOLUME_TYPES = {
-    4: ("tetra", 4), 11: ("tetra", 4), 29: ("tetra", 4), 30: ("tetra", 4),
-    5: ("hexahedron", 8), 12: ("hexahedron", 8), 17: ("hexahedron", 8),
-    6: ("wedge", 6), 13: ("wedge", 6), 18: ("wedge", 6),
-}  # fmt: skip
+    4: ("tetra", 4),
+    11: ("tetra", 4),
+    29: ("tetra", 4),
+    30: ("tetra", 4),
+    5: ("hexahedron", 8),
+    12: ("hexahedron", 8),
+    17: ("hexahedron", 8),
+    6: ("wedge", 6),
+    13: ("wedge", 6),
+    18: ("wedge", 6),
+}
 
 
 class GmshMesh:

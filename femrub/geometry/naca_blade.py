@@ -124,9 +124,16 @@ def naca_blade(
     _, _, thick = naca4_parameters(code)
     size = MeshSize(thick * tip_chord if h is None else h, h_min)
     sections = naca_sections(
-        code, span, root_chord, tip_chord, twist, n_sections,
-        hub_radius=hub_radius, stacking=stacking, n_points=n_points,
-    )  # fmt: skip
+        code,
+        span,
+        root_chord,
+        tip_chord,
+        twist,
+        n_sections,
+        hub_radius=hub_radius,
+        stacking=stacking,
+        n_points=n_points,
+    )
     s = chord_fractions(n_contact, contact_margin)
     upper, lower = sections[-1]
     # the k-th points of the two sides straddle the camber line symmetrically
@@ -139,6 +146,12 @@ def naca_blade(
         f" twist={twist}, n_sections={n_sections}, h={size.h})"
     )
     return loft_blade(
-        sections, size, "x", contact_targets=targets, verbose=verbose, source=source,
-        twist_deg=twist, code=code,
-    )  # fmt: skip
+        sections,
+        size,
+        "x",
+        contact_targets=targets,
+        verbose=verbose,
+        source=source,
+        twist_deg=twist,
+        code=code,
+    )

@@ -83,6 +83,13 @@ def sections_blade(
     names = [f.name for f in files]
     source = f"sections_blade({', '.join(names)}, unit={length_unit}, h={size.h:.4g})"
     return loft_blade(
-        sections, size, radial_axis, n_contact=n_contact, contact_margin=contact_margin,
-        interpolate=interpolate, ruled=ruled, verbose=verbose, source=source,
-    )  # fmt: skip
+        sections,
+        size,
+        radial_axis,
+        n_contact=n_contact,
+        contact_margin=contact_margin,
+        interpolate=interpolate,
+        ruled=ruled,
+        verbose=verbose,
+        source=source,
+    )

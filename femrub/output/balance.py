@@ -14,12 +14,27 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["BALANCE_TERMS", "ENERGY_TERMS", "HEAT_TERMS", "balance_maxima", "energy_error_of",
-           "heat_error_of"]  # fmt: skip
+__all__ = [
+    "BALANCE_TERMS",
+    "ENERGY_TERMS",
+    "HEAT_TERMS",
+    "balance_maxima",
+    "energy_error_of",
+    "heat_error_of",
+]
 
 #: the terms whose largest magnitudes make the two errors ("mechanical": kinetic + elastic)
-BALANCE_TERMS = ("energy_error", "mechanical", "external_work", "thermal_work", "heat_error",
-                 "heat_content", "friction_heat", "heat_load", "heat_outflow")  # fmt: skip
+BALANCE_TERMS = (
+    "energy_error",
+    "mechanical",
+    "external_work",
+    "thermal_work",
+    "heat_error",
+    "heat_content",
+    "friction_heat",
+    "heat_load",
+    "heat_outflow",
+)
 #: the terms of :func:`energy_error_of` and of :func:`heat_error_of`
 ENERGY_TERMS, HEAT_TERMS = BALANCE_TERMS[:4], BALANCE_TERMS[4:]
 

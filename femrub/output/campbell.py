@@ -36,8 +36,9 @@ def draw_campbell(ax, speeds, frequencies, *, engine_orders=None, label_modes=Tr
         f = k * s / (2 * np.pi)
         ax.plot(s, f, color="0.6", lw=0.7, ls="--", zorder=0)
         end = min(top, 1.1 * fmax * 2 * np.pi / k)
-        ax.annotate(f"{k}EO", (end, k * end / (2 * np.pi)), fontsize=7, color="0.4",
-                    ha="right", va="bottom")  # fmt: skip
+        ax.annotate(
+            f"{k}EO", (end, k * end / (2 * np.pi)), fontsize=7, color="0.4", ha="right", va="bottom"
+        )
     ax.set_ylim(0.0, 1.1 * fmax)
     ax.set_xlim(float(speeds.min()), top if top > 0 else 1.0)
 

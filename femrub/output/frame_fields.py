@@ -102,8 +102,16 @@ class FrameFields:
         Q = deviator_root(self.pairs, float(fields.mu))
         n_e = self.n_cells
         # ‖Q ε_e‖ for every element: rows (i n_e + e) of the k n_e × n_u operator Q ⊗ G
-        QG = sp.vstack([sum(Q[i, c] * G[c * n_e : (c + 1) * n_e] for c in range(len(self.pairs))
-                            if Q[i, c] != 0.0) for i in range(Q.shape[0])]).tocsr()  # fmt: skip
+        QG = sp.vstack(
+            [
+                sum(
+                    Q[i, c] * G[c * n_e : (c + 1) * n_e]
+                    for c in range(len(self.pairs))
+                    if Q[i, c] != 0.0
+                )
+                for i in range(Q.shape[0])
+            ]
+        ).tocsr()
         self._k = Q.shape[0]
         # blocks (name, rows of to_full or None for the stress, columns of X they need)
         blocks = [("displacement", vd), ("velocity", nu + vd)]
@@ -124,12 +132,19 @@ class FrameFields:
             # displacement and stress share the displacement columns: one GEMM
             S = np.asarray(QG @ Tu[:, cu])
             U = np.concatenate([T[vd][:, cu], S], axis=0)
-            self._ops.append((("displacement", "von_mises"), (vd.size, S.shape[0]), cu,
-                              np.ascontiguousarray(U.T, dtype=dtype)))  # fmt: skip
+            self._ops.append(
+                (
+                    ("displacement", "von_mises"),
+                    (vd.size, S.shape[0]),
+                    cu,
+                    np.ascontiguousarray(U.T, dtype=dtype),
+                )
+            )
             for name, rows in blocks[1:]:
                 c = used(T[rows])
-                self._ops.append(((name,), (rows.size,), c,
-                                  np.ascontiguousarray(T[rows][:, c].T, dtype=dtype)))  # fmt: skip
+                self._ops.append(
+                    ((name,), (rows.size,), c, np.ascontiguousarray(T[rows][:, c].T, dtype=dtype))
+                )
         c = fields.contacts
         #: the vertices that carry a contact (sorted, unique); forces are zero elsewhere
         self.contact_vertices, which = np.unique(np.asarray(c.vertices), return_inverse=True)

@@ -79,12 +79,22 @@ class AllRows:
             ff, sv = c.to_global(r["imp_t"][:m] / h), c.to_global(r["slip"][:m])
         energy = {k[7:]: reached(v) for k, v in r.items() if k.startswith("energy_")}
         return Results(
-            scheme=rec.scheme, h=h, t=reached(r["t"]), signals=_signals(rec, reached(r["obs"])),
-            gap=reached(r["gap"]), impulse=reached(r["imp"]), energy=energy, steps=m - 1,
-            friction_force=ff, slip_velocity=sv, contact_state=reached(r["cstate"]),
-            friction_limit=None if c is None else c.friction.copy(), info=_info(rec),
-            extra={k: reached(v) for k, v in self.extra.items()}, **kw,
-        )  # fmt: skip
+            scheme=rec.scheme,
+            h=h,
+            t=reached(r["t"]),
+            signals=_signals(rec, reached(r["obs"])),
+            gap=reached(r["gap"]),
+            impulse=reached(r["imp"]),
+            energy=energy,
+            steps=m - 1,
+            friction_force=ff,
+            slip_velocity=sv,
+            contact_state=reached(r["cstate"]),
+            friction_limit=None if c is None else c.friction.copy(),
+            info=_info(rec),
+            extra={k: reached(v) for k, v in self.extra.items()},
+            **kw,
+        )
 
 
 class LeanRows:
@@ -165,9 +175,15 @@ class LeanRows:
 
         c = rec.model.contact
         return Results(
-            scheme=rec.scheme, h=rec.h * self.k, t=kept(self.t),
-            signals=_signals(rec, kept(self.obs)), gap=np.zeros((n + 1, 0)),
-            impulse=kept(self.imp), steps=max(m - 1, 0), info=_info(rec),
+            scheme=rec.scheme,
+            h=rec.h * self.k,
+            t=kept(self.t),
+            signals=_signals(rec, kept(self.obs)),
+            gap=np.zeros((n + 1, 0)),
+            impulse=kept(self.imp),
+            steps=max(m - 1, 0),
+            info=_info(rec),
             friction_limit=None if c is None else c.friction.copy(),
-            checks=self.checks(rec, m), **kw,
-        )  # fmt: skip
+            checks=self.checks(rec, m),
+            **kw,
+        )

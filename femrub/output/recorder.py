@@ -82,12 +82,22 @@ class Recorder:
     """
 
     def __init__(
-        self, model: FirstOrderModel, h: float, n_steps: int, *, scheme: str,
-        stability_limit: float, energy: bool = True, limits: dict[str, float] | None = None,
-        store_every: int = 0, on_state: Callable | None = None,
-        on_rows: Callable | None = None, label: str | None = None, blowup_check: bool = True,
+        self,
+        model: FirstOrderModel,
+        h: float,
+        n_steps: int,
+        *,
+        scheme: str,
+        stability_limit: float,
+        energy: bool = True,
+        limits: dict[str, float] | None = None,
+        store_every: int = 0,
+        on_state: Callable | None = None,
+        on_rows: Callable | None = None,
+        label: str | None = None,
+        blowup_check: bool = True,
         lean: int = 0,
-    ):  # fmt: skip
+    ):
         self.model, self.h, self.n, self.scheme = model, h, n_steps, scheme
         self.h_lim, self.label = stability_limit, label
         self.store_every, self.on_state, self.on_rows = store_every, on_state, on_rows
@@ -175,9 +185,14 @@ class Recorder:
                         m = min(self.chunk - j, n - i)
                         r = slice(j + 1, j + 1 + m)
                         done, friction, err = block(
-                            m, buf[j + 1 : j + 1 + m], t[r], imp[r], self.imp_t[r],
-                            self.heat[r], self.cstate[r],
-                        )  # fmt: skip
+                            m,
+                            buf[j + 1 : j + 1 + m],
+                            t[r],
+                            imp[r],
+                            self.imp_t[r],
+                            self.heat[r],
+                            self.cstate[r],
+                        )
                         self.has_friction |= friction
                         i, j = i + done, j + done
                         if err is not None:
@@ -395,6 +410,11 @@ class Recorder:
                 states = np.concatenate(self._stored)[keep]
                 times = np.concatenate(self._stored_t)[keep]
         return self.kept.results(
-            self, m, status=self.status, message=self.message, cpu_seconds=cpu_seconds,
-            states=states, state_times=times,
-        )  # fmt: skip
+            self,
+            m,
+            status=self.status,
+            message=self.message,
+            cpu_seconds=cpu_seconds,
+            states=states,
+            state_times=times,
+        )

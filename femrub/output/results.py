@@ -306,9 +306,14 @@ class Results:
         checkpoint states, status): gaps, friction rows, energy balance and extra rows
         dropped, so that runs held together for an error estimate stay small."""
         return replace(
-            self, gap=self.gap[:, :0], energy={}, friction_force=None, slip_velocity=None,
-            contact_state=None, extra={},
-        )  # fmt: skip
+            self,
+            gap=self.gap[:, :0],
+            energy={},
+            friction_force=None,
+            slip_velocity=None,
+            contact_state=None,
+            extra={},
+        )
 
     def save_npz(self, path) -> Path:
         """Every step, compressed (``numpy.savez_compressed``'s format, zlib level

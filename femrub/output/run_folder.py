@@ -125,10 +125,25 @@ def run_to_folder(
     out = Path(out)
     with nullcontext() if claimed else claim(out, "run", overwrite=overwrite):
         return _run(
-            stepper, t_end, out, fields, vtk_stride, inputs, limits, progress, snapshot, plots,
-            timings, n_full, rotation_speed, merge_time, reduction_error, ran, step_error,
+            stepper,
+            t_end,
+            out,
+            fields,
+            vtk_stride,
+            inputs,
+            limits,
+            progress,
+            snapshot,
+            plots,
+            timings,
+            n_full,
+            rotation_speed,
+            merge_time,
+            reduction_error,
+            ran,
+            step_error,
             csv_stride,
-        )  # fmt: skip
+        )
 
 
 def _judged(ran, tolerances, merge_time):
@@ -146,9 +161,25 @@ def _judged(ran, tolerances, merge_time):
 
 
 def _run(
-    stepper, t_end, out, fields, vtk_stride, inputs, limits, progress, snapshot, plots, timings,
-    n_full, rotation_speed, merge_time, reduction_error, ran, step_error=None, csv_stride=1,
-):  # fmt: skip
+    stepper,
+    t_end,
+    out,
+    fields,
+    vtk_stride,
+    inputs,
+    limits,
+    progress,
+    snapshot,
+    plots,
+    timings,
+    n_full,
+    rotation_speed,
+    merge_time,
+    reduction_error,
+    ran,
+    step_error=None,
+    csv_stride=1,
+):
     summary_path = out / "summary.json"
     model = stepper.model
     doc = {
@@ -187,9 +218,14 @@ def _run(
                 res, wall = _judged(ran, tolerances, merge_time)
             else:
                 res = stepper.run(
-                    t_end, progress=progress, limits=limits, on_state=series, on_rows=history,
-                    merge_time=merge_time, tolerances=tolerances,
-                )  # fmt: skip
+                    t_end,
+                    progress=progress,
+                    limits=limits,
+                    on_state=series,
+                    on_rows=history,
+                    merge_time=merge_time,
+                    tolerances=tolerances,
+                )
     except KeyboardInterrupt:  # before the recorder took over: say so, keep the folder
         _write_json(summary_path, {**doc, "status": "interrupted", "message": "interrupted"})
         raise
@@ -201,15 +237,37 @@ def _run(
         wall = time.perf_counter() - t0
     with deferred():
         return _finish(
-            stepper, res, out, doc, series, history, wall, snapshot, plots, timings,
-            rotation_speed, summary_path, csv_stride,
-        )  # fmt: skip
+            stepper,
+            res,
+            out,
+            doc,
+            series,
+            history,
+            wall,
+            snapshot,
+            plots,
+            timings,
+            rotation_speed,
+            summary_path,
+            csv_stride,
+        )
 
 
 def _finish(
-    stepper, res, out, doc, series, history, wall, snapshot, plots, timings, rotation_speed,
-    summary_path, csv_stride=1,
-):  # fmt: skip
+    stepper,
+    res,
+    out,
+    doc,
+    series,
+    history,
+    wall,
+    snapshot,
+    plots,
+    timings,
+    rotation_speed,
+    summary_path,
+    csv_stride=1,
+):
     vtk_wall, vtk_cpu = (series.seconds, series.cpu_seconds) if series is not None else (0.0, 0.0)
     t_out = time.perf_counter()
     if history.received != len(res.t):  # not streamed (a run stepped elsewhere)

@@ -83,17 +83,28 @@ class VTKSeries:
     """
 
     def __init__(
-        self, directory, model, fields: FieldMap, *, h: float, stride: int = 10, name="rub",
-        batch: int = 32, min_batch: int = 8, background: bool = True,
-        flush_seconds: float = 10.0, dtype=np.float32,
-    ):  # fmt: skip
+        self,
+        directory,
+        model,
+        fields: FieldMap,
+        *,
+        h: float,
+        stride: int = 10,
+        name="rub",
+        batch: int = 32,
+        min_batch: int = 8,
+        background: bool = True,
+        flush_seconds: float = 10.0,
+        dtype=np.float32,
+    ):
         if model.to_full is None:
             raise ValueError("this model has no map to the full mesh (model.to_full)")
         if int(stride) < 1:
             raise ValueError(f"VTK output stride must be >= 1, got {stride!r}")
         if min(int(batch), int(min_batch)) < 1:
-            raise ValueError(f"VTK output batch and min_batch must be >= 1, got {batch!r}, "
-                             f"{min_batch!r}")  # fmt: skip
+            raise ValueError(
+                f"VTK output batch and min_batch must be >= 1, got {batch!r}, {min_batch!r}"
+            )
         self.dir = Path(directory)
         self.dir.mkdir(parents=True, exist_ok=True)
         self.model, self.fields, self.stride, self.name = model, fields, int(stride), name
@@ -105,8 +116,9 @@ class VTKSeries:
         self._fields = FrameFields(model, fields, self.h, dtype)
         point = {"displacement": 3, "velocity": 3, "temperature": 1}
         point |= {"contact_force": 3, "friction_force": 3}
-        self._vtu = VTUWriter(fields.mesh.p.T, fields.mesh.t.T, VTK_TETRA, point,
-                              ["von_mises"], _UNITS_COMMENT, dtype)  # fmt: skip
+        self._vtu = VTUWriter(
+            fields.mesh.p.T, fields.mesh.t.T, VTK_TETRA, point, ["von_mises"], _UNITS_COMMENT, dtype
+        )
         self.batch, self.min_batch = int(batch), min(int(min_batch), int(batch))
         self.flush_seconds = float(flush_seconds)
         self._vtu_main: VTUWriter | None = None
@@ -146,10 +158,14 @@ class VTKSeries:
         try:
             self._raise_error()
             fi = getattr(state, "friction_impulse", None)
-            frame = (self._taken, float(state.t), np.array(state.X, dtype=float),
-                     np.array(state.impulse, dtype=float),
-                     None if fi is None or not np.size(fi) else np.array(fi, dtype=float),
-                     t0)  # fmt: skip
+            frame = (
+                self._taken,
+                float(state.t),
+                np.array(state.X, dtype=float),
+                np.array(state.impulse, dtype=float),
+                None if fi is None or not np.size(fi) else np.array(fi, dtype=float),
+                t0,
+            )
             self._taken += 1
             if self._thread is None:
                 self._waiting.append(frame)

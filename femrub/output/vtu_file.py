@@ -23,9 +23,12 @@ __all__ = ["VTUWriter", "VTK_TETRA"]
 #: VTK cell type of a linear tetrahedron
 VTK_TETRA = 10
 _VTK_TYPES = {
-    "float32": "Float32", "float64": "Float64", "int32": "Int32", "int64": "Int64",
+    "float32": "Float32",
+    "float64": "Float64",
+    "int32": "Int32",
+    "int64": "Int64",
     "uint8": "UInt8",
-}  # fmt: skip
+}
 
 
 def _block(a: np.ndarray) -> bytes:
@@ -63,9 +66,15 @@ class VTUWriter:
     """
 
     def __init__(
-        self, points, cells, cell_type: int, point_fields: dict[str, int],
-        cell_fields: list[str], comment: str = "", dtype=np.float32,
-    ):  # fmt: skip
+        self,
+        points,
+        cells,
+        cell_type: int,
+        point_fields: dict[str, int],
+        cell_fields: list[str],
+        comment: str = "",
+        dtype=np.float32,
+    ):
         pts = np.asarray(points, dtype=np.float64)
         if pts.shape[1] < 3:
             pts = np.hstack([pts, np.zeros((pts.shape[0], 3 - pts.shape[1]))])
@@ -107,25 +116,34 @@ class VTUWriter:
             'header_type="UInt64">',
             "<UnstructuredGrid>",
             f'<Piece NumberOfPoints="{self.n_points}" NumberOfCells="{self.n_cells}">',
-            "<PointData>", *tags["point"], "</PointData>",
-            "<CellData>", *tags["cell"], "</CellData>",
-            "<Points>", *geo_tags["Points"], "</Points>",
-            "<Cells>", *geo_tags["Cells"], "</Cells>",
+            "<PointData>",
+            *tags["point"],
+            "</PointData>",
+            "<CellData>",
+            *tags["cell"],
+            "</CellData>",
+            "<Points>",
+            *geo_tags["Points"],
+            "</Points>",
+            "<Cells>",
+            *geo_tags["Cells"],
+            "</Cells>",
             "</Piece>",
             "</UnstructuredGrid>",
             '<AppendedData encoding="raw">',
             "_",
-        ]  # fmt: skip
+        ]
         head = "\n".join(line for line in xml if line).encode()
         self._file = bytearray(b"".join([head, *blobs, b"\n</AppendedData>\n</VTKFile>\n"]))
         le = self.dtype.newbyteorder("<")
         self._offsets = {name: len(head) + slots[name] for name in shapes}
         #: the fields of the next frame: views into the file's bytes, by name
         self.data = {
-            name: np.frombuffer(self._file, le, int(np.prod(shape)), self._offsets[name])
-            .reshape(shape)
+            name: np.frombuffer(self._file, le, int(np.prod(shape)), self._offsets[name]).reshape(
+                shape
+            )
             for name, shape in shapes.items()
-        }  # fmt: skip
+        }
 
     def copy(self) -> VTUWriter:
         """A writer of the same files with a buffer of its own (for another thread)."""

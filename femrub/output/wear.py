@@ -29,11 +29,23 @@ def write_wear(wear, out) -> dict:
     ang = np.degrees(wear.angle_centres())
     z = wear.axial_centres()
     header = "angle_deg," + ",".join(f"z={v:.6g}" for v in z)
-    np.savetxt(out / "wear_map.csv", np.column_stack([ang, surface]), delimiter=",",
-               header=header, comments="", fmt="%.8g")  # fmt: skip
+    np.savetxt(
+        out / "wear_map.csv",
+        np.column_stack([ang, surface]),
+        delimiter=",",
+        header=header,
+        comments="",
+        fmt="%.8g",
+    )
     hist = np.array(wear.history, dtype=float)
-    np.savetxt(out / "wear_history.csv", hist, delimiter=",", header="t_s,max_wear_depth_m",
-               comments="", fmt="%.8g")  # fmt: skip
+    np.savetxt(
+        out / "wear_history.csv",
+        hist,
+        delimiter=",",
+        header="t_s,max_wear_depth_m",
+        comments="",
+        fmt="%.8g",
+    )
     fig, (ax, bx) = plt.subplots(1, 2, figsize=(11, 4), gridspec_kw={"width_ratios": [3, 2]})
     edges = np.degrees(np.linspace(0, 2 * np.pi, wear.n_angle + 1))
     im = ax.pcolormesh(edges, wear.z_edges * 1e3, surface.T * 1e6, shading="flat", cmap="magma_r")
@@ -62,8 +74,9 @@ def write_casing_heat(heat, t_end: float, out) -> dict:
     T = heat.map_at(t_end)
     header = "angle_deg," + ",".join(f"z={v:.6g}" for v in grid.axial_centres())
     table = np.column_stack([np.degrees(grid.angle_centres()), T])
-    np.savetxt(out / "casing_temperature.csv", table, delimiter=",", header=header,
-               comments="", fmt="%.8g")  # fmt: skip
+    np.savetxt(
+        out / "casing_temperature.csv", table, delimiter=",", header=header, comments="", fmt="%.8g"
+    )
     hist = np.array(heat.history, dtype=float)
     keys = {
         "max_casing_temperature": float(hist[:, 1].max()),

@@ -24,8 +24,9 @@ import numpy as np
 __all__ = ["assemble_basis", "left_static_shapes", "velocity_static_shapes"]
 
 
-def assemble_basis(index, interior, n_u: int, n_full: int, layout, psi, u_shapes, v_shapes,
-                   chi, chi_u) -> np.ndarray:  # fmt: skip
+def assemble_basis(
+    index, interior, n_u: int, n_full: int, layout, psi, u_shapes, v_shapes, chi, chi_u
+) -> np.ndarray:
     """The (n_full, layout.n) basis of the diagram above.
 
     Parameters

@@ -52,9 +52,13 @@ class BoundaryCoordinates:
         """The Eq. (2) blocks ``b`` (a ``ThermoelasticMatrices``) in the coordinates ``u'``."""
         T, Tt, congruent = self.T, sp.csr_matrix(self.T.T), self.congruent
         return replace(
-            b, K=congruent(b.K), M=congruent(b.M), C=congruent(b.C),
-            Kut=sp.csr_matrix(Tt @ b.Kut), Ctu=sp.csr_matrix(sp.csr_matrix(b.Ctu) @ T),
-        )  # fmt: skip
+            b,
+            K=congruent(b.K),
+            M=congruent(b.M),
+            C=congruent(b.C),
+            Kut=sp.csr_matrix(Tt @ b.Kut),
+            Ctu=sp.csr_matrix(sp.csr_matrix(b.Ctu) @ T),
+        )
 
     def congruent(self, X) -> sp.csr_matrix:
         """``Tᵀ X T`` of a u-block matrix (``K' = Tᵀ K T``)."""

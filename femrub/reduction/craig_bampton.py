@@ -205,9 +205,12 @@ class ThermoelasticCraigBampton:
         left = None  # (left) adjoint modes; boundary columns: adjoint static shapes or unit vectors
         if projection not in ("galerkin", "second-order"):
             psi_l = left_static_shapes(
-                psi, projection, n_i, mb.size,
+                psi,
+                projection,
+                n_i,
+                mb.size,
                 lambda: solver.solve_transposed(-sp.csr_matrix(B)[self._bnd][:, self._int].T),
-            )  # fmt: skip
+            )
             mphi = orient_columns(normalise_columns(solver.M @ phi[:, : self.n_qu]))
             left = (psi_l, mphi, phi, chi, solver.Ctu.T @ chi)
         if not keep_solver:  # no more solves: the factorisations' memory before the bases'

@@ -69,8 +69,13 @@ QUANTITIES = (
     "displacement_end",
     "temperature_end",
 )
-DECISIVE = ("contact_force", "contact_temperature", "displacement", "displacement_end",
-            "temperature_end")  # fmt: skip
+DECISIVE = (
+    "contact_force",
+    "contact_temperature",
+    "displacement",
+    "displacement_end",
+    "temperature_end",
+)
 #: displacement perturbation (m, random on the u-coordinates) of the sensitivity twin
 PERTURBATION = 1e-15
 #: the predictable horizon ends where the twin differs by this share of the tolerance
@@ -149,8 +154,7 @@ def compare(run, ref, fields_run, fields_ref, norms: dict, window: float) -> dic
     return out
 
 
-def simulate(reductor, sizes, make_stepper, t_end, checkpoints=5, limits=None, perturb=0.0,
-             lean=0):  # fmt: skip
+def simulate(reductor, sizes, make_stepper, t_end, checkpoints=5, limits=None, perturb=0.0, lean=0):
     """Step ``reductor.reduce(*sizes)``; return the results and the full states stored.
 
     ``limits``: the run's stop limits (``Stepper.run``): the estimate compares the models
@@ -162,8 +166,9 @@ def simulate(reductor, sizes, make_stepper, t_end, checkpoints=5, limits=None, p
     what = "twin" if perturb else "run"
     with phase(f"reduction error estimate: {what} of sizes {list(sizes)} to {t_end:g} s") as p:
         m = reductor.reduce(*sizes)
-        res, states = _simulate(m, reductor, sizes, make_stepper, t_end, checkpoints, limits,
-                                perturb, lean)  # fmt: skip
+        res, states = _simulate(
+            m, reductor, sizes, make_stepper, t_end, checkpoints, limits, perturb, lean
+        )
         p["detail"] = f"{res.steps} steps, {m.n_dofs} coordinates"
     return res, states
 
@@ -181,8 +186,7 @@ def _simulate(m, reductor, sizes, make_stepper, t_end, checkpoints, limits, pert
 
 def twin(reductor, sizes, make_stepper, t_end, checkpoints=5, limits=None, lean=0):
     """:func:`simulate` with the displacement perturbed by :data:`PERTURBATION` (m)."""
-    return simulate(reductor, sizes, make_stepper, t_end, checkpoints, limits, PERTURBATION,
-                    lean)  # fmt: skip
+    return simulate(reductor, sizes, make_stepper, t_end, checkpoints, limits, PERTURBATION, lean)
 
 
 def _signal_pairs(a, b, k1: int):

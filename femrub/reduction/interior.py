@@ -51,10 +51,14 @@ class InteriorStiffness:
         """Whether ``K_ii`` (CSC) is this stiffness, entry for entry."""
         A = self.K
         return (
-            A is not None and A.shape == K_ii.shape and A.nnz == K_ii.nnz
-            and all(np.array_equal(getattr(A, f), getattr(K_ii, f))
-                    for f in ("indptr", "indices", "data"))
-        )  # fmt: skip
+            A is not None
+            and A.shape == K_ii.shape
+            and A.nnz == K_ii.nnz
+            and all(
+                np.array_equal(getattr(A, f), getattr(K_ii, f))
+                for f in ("indptr", "indices", "data")
+            )
+        )
 
     def solve_K(self, rhs, trans: bool = False) -> np.ndarray:
         """``K_ii⁻¹ rhs`` (or ``K_ii⁻ᵀ rhs``)."""

@@ -183,8 +183,12 @@ def _checked(red, model, want, make_stepper, scene, report, log, limits, on_run=
     if chosen is None:  # the largest: judged against the next smaller candidate
         chosen, kept = most, (ref[0], ref_wall, ref[1])
         if tried:
-            err = dict(err, estimate=err["estimate"], judged="largest model: difference to "
-                       f"the next smaller one {tried[-1]['sizes']} (pessimistic)")  # fmt: skip
+            err = dict(
+                err,
+                estimate=err["estimate"],
+                judged="largest model: difference to "
+                f"the next smaller one {tried[-1]['sizes']} (pessimistic)",
+            )
         else:
             err = {"estimate": 0.0, "note": "the run's model is the reference (no estimate)"}
     err.update(tolerance=tol, tried=tried, seconds=time.perf_counter() - t0)
@@ -206,9 +210,15 @@ def lobe_passage(scene) -> float:
 
 
 def reduce_model(
-    model, scene, log=None, make_stepper=None, reductor=None, limits=None, on_run=None,
+    model,
+    scene,
+    log=None,
+    make_stepper=None,
+    reductor=None,
+    limits=None,
+    on_run=None,
     stiffness=None,
-):  # fmt: skip
+):
     """Reduce ``model`` as ``scene["reduction"]`` asks; return ``(model, reductor, report)``.
 
     ``reductor`` is the one reductor built (at the largest sizes for ``"auto"``, at
@@ -267,10 +277,14 @@ def reduce_model(
             report["bases"] = "reused (same matrices and reduction options)"
         else:
             red = ThermoelasticCraigBampton(
-                model, n_uv, n_theta, projection=opts["projection"], thermal=opts["thermal"],
+                model,
+                n_uv,
+                n_theta,
+                projection=opts["projection"],
+                thermal=opts["thermal"],
                 keep_solver=method == "auto",  # only "auto" solves again (_auto_sizes)
                 stiffness=stiffness,
-            )  # fmt: skip
+            )
             stiffness = None  # the reductor's now
     except ValueError as exc:
         text = str(exc)

@@ -15,9 +15,16 @@ from dataclasses import dataclass, field
 from .units import SI_LABEL, to_si
 
 __all__ = [
-    "NONNEG", "POS", "REQUIRED", "SceneError", "Spec", "Variant", "fail", "float_spec",
+    "NONNEG",
+    "POS",
+    "REQUIRED",
+    "SceneError",
+    "Spec",
+    "Variant",
+    "fail",
+    "float_spec",
     "unknown_key",
-]  # fmt: skip
+]
 
 REQUIRED = object()
 #: bounds of a positive and of a non-negative value (``Spec`` keywords)

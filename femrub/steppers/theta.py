@@ -294,9 +294,24 @@ class ThetaMethod(Stepper):
         use_warm = self._warm3 is not None
         warm = self._warm3 if use_warm else self._warm0
         active, P, u, state, res_, it, status = frictional_fixed_point(
-            self._rule3, gap_k, gdot_k, gap_p, GZ, W, q, self._mu3, e, gdot_k, U, warm,
-            use_warm, h, self.gamma, 1e-12, 60,
-        )  # fmt: skip
+            self._rule3,
+            gap_k,
+            gdot_k,
+            gap_p,
+            GZ,
+            W,
+            q,
+            self._mu3,
+            e,
+            gdot_k,
+            U,
+            warm,
+            use_warm,
+            h,
+            self.gamma,
+            1e-12,
+            60,
+        )
         check_status(status, res_)
         heat = alpha * P[:, 0]  # the α λ heat is already in Z's normal columns
         power = c.heat_law == "power" and self.model.layout.n_t > 0
@@ -312,9 +327,15 @@ class ThetaMethod(Stepper):
                     break
                 heat = new
                 res = solve_frictional_contact(
-                    W, q + (self._W3t @ heat).reshape(n, 3), c.friction, active,
-                    restitution=e, u_before=gdot_k, warm=P, upper=upper,
-                )  # fmt: skip
+                    W,
+                    q + (self._W3t @ heat).reshape(n, 3),
+                    c.friction,
+                    active,
+                    restitution=e,
+                    u_before=gdot_k,
+                    warm=P,
+                    upper=upper,
+                )
                 P, u, state = res.P, res.u, res.state
             heat = new
         self._warm3 = P

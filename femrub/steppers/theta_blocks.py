@@ -156,9 +156,25 @@ def advance_block(st, m: int, X, t, P, Pt, heat, state) -> tuple:
     sig = _signals(st, t1)
     if st._block_kind == "one":
         one_contact_block(
-            st.X, st._bT, st._bY1, st._bY0, sig, ONE_RULES[st.activation], st._g0, st._gr,
-            st._gv, st._z, st._w, st._gz, st._e, h, st.gamma, np.inf, X, P,
-        )  # fmt: skip
+            st.X,
+            st._bT,
+            st._bY1,
+            st._bY0,
+            sig,
+            ONE_RULES[st.activation],
+            st._g0,
+            st._gr,
+            st._gv,
+            st._z,
+            st._w,
+            st._gz,
+            st._e,
+            h,
+            st.gamma,
+            np.inf,
+            X,
+            P,
+        )
         done, friction = m, False
     else:
         rub = st._block_kind == "rub"
@@ -169,15 +185,41 @@ def advance_block(st, m: int, X, t, P, Pt, heat, state) -> tuple:
             done, status, res, warm = _rub(st, sig, t1, off, warm, use_warm, X, P, Pt, heat, state)
         else:
             done, status, res, warm = friction_block(
-                st.X, st._bT, st._bY1, st._bY0, sig, st._bS, off, st._bZ, st._bW, st._bGZ,
-                st._rule3, st._mu3, st._e3, st._U3, warm, use_warm, h, st.gamma, st._balpha,
-                1e-12, 60, X, P, Pt, heat, state,
-            )  # fmt: skip
+                st.X,
+                st._bT,
+                st._bY1,
+                st._bY0,
+                sig,
+                st._bS,
+                off,
+                st._bZ,
+                st._bW,
+                st._bGZ,
+                st._rule3,
+                st._mu3,
+                st._e3,
+                st._U3,
+                warm,
+                use_warm,
+                h,
+                st.gamma,
+                st._balpha,
+                1e-12,
+                60,
+                X,
+                P,
+                Pt,
+                heat,
+                state,
+            )
         if done:
             st._warm3 = warm  # the last step's impulse
             st._memo = (k0 + done, t1[done - 1], off[done].copy())
-            st.extra = {"friction_impulse": Pt[done - 1].copy(), "heat": heat[done - 1].copy(),
-                        "state": state[done - 1].copy()}  # fmt: skip
+            st.extra = {
+                "friction_impulse": Pt[done - 1].copy(),
+                "heat": heat[done - 1].copy(),
+                "state": state[done - 1].copy(),
+            }
         friction = True
     if done:
         st.k = k0 + done
@@ -209,15 +251,55 @@ def _rub(st, sig, t1, off, warm, use_warm, X, P, Pt, heat, state) -> tuple:
         g0a = np.ascontiguousarray(_profile_gap(c, ta))
         last = w._last
         last_r = np.zeros(c.n) if last is None else np.array(last[1], dtype=float)
-        wstate = np.array([last is not None, 0.0 if last is None else last[0], w.history[-1][1]],
-                          dtype=float)  # fmt: skip
+        wstate = np.array(
+            [last is not None, 0.0 if last is None else last[0], w.history[-1][1]], dtype=float
+        )
     done, status, res, warm = rub_block(
-        st.X, st._bT, st._bY1, st._bY0, sig, st._bS, off, st._bZ, st._bW, st._bGZ,
-        st._rule3, st._mu3, st._e3, st._U3, warm, use_warm, h, st.gamma, st._balpha, 1e-12,
-        60, st._bpower, st._bZt, st._bW3t, st._beta, MAX_HEAT_ITERATIONS, st._bwear, t1, ta,
-        g0a, st._bGT, depth, st._bangles, st._baxial, st._bgrid, st._bdims, last_r, wstate,
-        X, P, Pt, heat, state, hist,
-    )  # fmt: skip
+        st.X,
+        st._bT,
+        st._bY1,
+        st._bY0,
+        sig,
+        st._bS,
+        off,
+        st._bZ,
+        st._bW,
+        st._bGZ,
+        st._rule3,
+        st._mu3,
+        st._e3,
+        st._U3,
+        warm,
+        use_warm,
+        h,
+        st.gamma,
+        st._balpha,
+        1e-12,
+        60,
+        st._bpower,
+        st._bZt,
+        st._bW3t,
+        st._beta,
+        MAX_HEAT_ITERATIONS,
+        st._bwear,
+        t1,
+        ta,
+        g0a,
+        st._bGT,
+        depth,
+        st._bangles,
+        st._baxial,
+        st._bgrid,
+        st._bdims,
+        last_r,
+        wstate,
+        X,
+        P,
+        Pt,
+        heat,
+        state,
+        hist,
+    )
     if w is not None and done:
         cut = np.flatnonzero(~np.isnan(hist[:done]))
         w.history.extend(zip(ta[cut].tolist(), hist[cut].tolist(), strict=True))

@@ -3,7 +3,7 @@
 A held contact sliding with friction ``μ`` takes the force ``λ_t = −μ λ ŝ`` along a unit
 direction ``ŝ`` of its tangent plane that is constant over a flight, so that its force column
 ``H = Hm − μ Hmt ŝ + Ht α_h`` is constant and the held flow linear and exact
-(:mod:`~.exponential_friction`). Coulomb's law wants ``ŝ`` along the slip ``w_t = Gvtᵀ X − v_c``,
+(:mod:`~.friction`). Coulomb's law wants ``ŝ`` along the slip ``w_t = Gvtᵀ X − v_c``,
 which turns with the structure's own tangential velocity. The direction is therefore chosen per
 step by a fixed point: the step is flown with a direction, the slip ``w_t`` at the end of each
 held flight in it (after any impulse at the step end) gives the next direction, and the step is
@@ -55,7 +55,7 @@ def _nbytes(value) -> int:
 
 
 class SlideDirections:
-    """Directions of held slides (mixin of :class:`~.exponential_friction.FrictionalContact`;
+    """Directions of held slides (mixin of :class:`~.friction.FrictionalContact`;
     see module docstring): the per-step fixed point and the flows kept per direction."""
 
     _target = None  # during a step's pass: contact -> state at the end of its held flight

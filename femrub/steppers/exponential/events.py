@@ -1,17 +1,17 @@
 """Contact events inside a step of the exponential stepper, located on its exact flows.
 
 The exact gaps ``g = g0(t) + Gᵀ X``, the multipliers ``λ_S`` of held contacts and the slips of
-held contacts sliding with friction (:mod:`~.exponential_friction`) are checked on
+held contacts sliding with friction (:mod:`~.friction`) are checked on
 a grid of ``probes`` points per step (probe rows: one product per step,
-:meth:`~femrub.steppers.flows.FlowFamily.probe`); at the first sign change of a gap below
+:meth:`~.flows.FlowFamily.probe`); at the first sign change of a gap below
 ``min(g(a), 0)`` (a closing), of a multiplier (a release) or of a slip (a stick) the time is
-found on the exact flow by :func:`~femrub.steppers.flows.first_zero` (cubic Hermite start,
+found on the exact flow by :func:`~.flows.first_zero` (cubic Hermite start,
 safeguarded Newton), each evaluation composed of cached sub-step flows from the latest state
-computed before it (:meth:`~femrub.steppers.flows.FlowFamily.advance_z`); an event function
+computed before it (:meth:`~.flows.FlowFamily.advance_z`); an event function
 linear on the augmented state (every one but a closing on a moving or worn casing) in one
-compiled call (:func:`~.exponential_kernels.first_zero_row`). Event times are exact to
+compiled call (:func:`~.kernels.first_zero_row`). Event times are exact to
 ``1e-10 h``. A part step's check rows are one compiled call too
-(:func:`~.exponential_kernels.part_rows`).
+(:func:`~.kernels.part_rows`).
 """
 
 from __future__ import annotations
@@ -20,8 +20,8 @@ import math
 
 import numpy as np
 
-from .exponential_kernels import first_zero_row, part_rows, quiet
 from .flows import LEVEL_MIN, first_zero
+from .kernels import first_zero_row, part_rows, quiet
 
 __all__ = ["EventLocation"]
 
@@ -121,7 +121,7 @@ class EventLocation:
         """The check grid of a part step ``(a, h]``: ``(grid, V, states)``, ``V`` the rows
         ``[g; λ_S; σ]`` at ``grid`` (``a``, the next multiples of ``h / probes`` (the first
         reached with cached sub-step flows, the others by probe rows), ``h``; compiled,
-        :func:`~.exponential_kernels.part_rows`), ``states`` the states known on it."""
+        :func:`~.kernels.part_rows`), ``states`` the states known on it."""
         c, h, t, flows, q = self.model.contact, self.h, self.t, self._flows, self.probes
         n, n_s, d = self.model.n_dofs, len(S), h / self.probes
         i1 = math.floor(a / d * (1.0 + 1e-12)) + 1  # first grid index after a
@@ -179,7 +179,7 @@ class EventLocation:
     def _quiet(self, S, V) -> bool:
         """A whole step without event: on the grid ``V`` (rows ``[g; λ_S]`` at ``j h / q``)
         no free gap falls below ``min(g(0), 0)`` and no held multiplier is negative (the
-        common case; compiled, :func:`~.exponential_kernels.quiet`)."""
+        common case; compiled, :func:`~.kernels.quiet`)."""
         return quiet(V, self.model.contact.n, self._held(S))
 
     def _fixed_gap(self):
@@ -206,11 +206,11 @@ class EventLocation:
 
     def _root(self, S, f, lo, hi, X_lo, b, row=None):
         """First zero of ``f`` in ``(lo, hi]`` on the exact flow from ``(lo, X_lo)``
-        (:func:`~femrub.steppers.flows.first_zero`): ``(τ, X(τ), P_S(lo..τ))`` or ``None``.
+        (:func:`~.flows.first_zero`): ``(τ, X(τ), P_S(lo..τ))`` or ``None``.
         Each evaluation starts from the latest state already computed before it (the open
         side of the bracket), so Newton's shrinking corrections compose few sub-step flows.
         A row event ``f = r·z + c0`` (``row = (r, c0)``) is searched in one compiled call
-        (:func:`~.exponential_kernels.first_zero_row`, the same iteration)."""
+        (:func:`~.kernels.first_zero_row`, the same iteration)."""
         h, flows, d = self.h, self._flows, self.h / self.probes
         n, s = self.model.n_dofs, len(S)
         z_lo = np.concatenate([X_lo, np.zeros(s), flows.chain(b, lo / h)])

@@ -24,7 +24,7 @@ and its impulse ``P_S = ∫ λ_S dt`` is integrated exactly by appending ``P_S``
 moving casing the held contacts keep ``ġ = ġ0(t) + Gvᵀ X = 0`` and ``λ_S`` gets
 ``−W_S⁻¹ g̈0_S(t)``: the casing's accelerations are extra inputs (``n_acc``). A held contact
 sliding with Coulomb friction along a fixed direction has its tangential force in its column
-``H_S`` (:mod:`~.exponential_friction`); its slip along that direction, ``σ = R_σ X + σ0``,
+``H_S`` (:mod:`~.friction`); its slip along that direction, ``σ = R_σ X + σ0``,
 is checked with the multipliers (:attr:`FlowFamily.slip`: rows after ``λ_S``, must stay > 0).
 
 Event times are found on these flows by :func:`first_zero` (safeguarded Newton), the states
@@ -38,7 +38,7 @@ import math
 import numpy as np
 import scipy.linalg as sla
 
-from .exponential_kernels import compose, next_iterate, square_levels
+from .kernels import compose, next_iterate, square_levels
 
 __all__ = ["Flow", "FlowFamily", "LEVEL_MIN", "held_set", "first_zero", "shift"]
 
@@ -193,7 +193,7 @@ class FlowFamily:
         One augmented matrix ``M = [[K, E, 0, …], [0, 0, I, …], …]``; the smallest level from
         its Taylor series, the others by squaring its increment (``Z = I + D``,
         ``D_{e+1} = 2 D_e + D_e²``: no cancellation against the identity; compiled,
-        :func:`~.exponential_kernels.square_levels`). Returns the stack (levels, N, N)."""
+        :func:`~.kernels.square_levels`). Returns the stack (levels, N, N)."""
         key = (S, unit)
         if key not in self._levels:
             M = self.generator_z(S)
@@ -364,10 +364,21 @@ def first_zero(at, f_lo: float, lo: float, hi: float, tol: float, df_lo=None):
     width, slow = bh - a, 0
     hermite = df_lo is not None
     for it in range(60):
-        x_new, slow = next_iterate(it == 0 and hermite, float(lo), float(f_lo),
-                                   float(df_lo) if hermite else 0.0, float(x), float(fx),
-                                   float(dfx), float(a), float(f_a), float(bh), float(f_bh),
-                                   float(df_bh), slow)  # fmt: skip
+        x_new, slow = next_iterate(
+            it == 0 and hermite,
+            float(lo),
+            float(f_lo),
+            float(df_lo) if hermite else 0.0,
+            float(x),
+            float(fx),
+            float(dfx),
+            float(a),
+            float(f_a),
+            float(bh),
+            float(f_bh),
+            float(df_bh),
+            slow,
+        )
         if abs(x_new - x) <= tol:  # converged
             if fx > 0.0 and bh - x > tol:  # from the open side: step just past the zero
                 x = min(x + 2.0 * tol, bh)

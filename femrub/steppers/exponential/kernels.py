@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..contact.jit import compiled, njit
+from ...contact.jit import compiled, njit
 
 __all__ = [
     "compose",
@@ -319,7 +319,7 @@ def first_zero_row(Z, z_lo, r, rM, c0, lo, hi, tol, d_min):
     """First zero in ``(lo, hi]`` of the row event ``f(τ) = r·z(τ) + c0`` (``df/dτ =
     rM·z``, ``rM = Mᵀ r``) on the flow composed of the levels ``Z`` (smallest ``d_min``)
     from ``z(lo) = z_lo``, by the safeguarded Newton iteration of
-    :func:`~femrub.steppers.flows.first_zero` (cubic Hermite start, Newton from the closed
+    :func:`~.flows.first_zero` (cubic Hermite start, Newton from the closed
     side, regula falsi, bisection; each evaluation from the latest state known on the open
     side). Returns ``(found, τ, z(τ))`` with ``f(τ) <= 0`` within ``tol`` of the zero."""
     kt = np.empty(128)
@@ -347,8 +347,9 @@ def first_zero_row(Z, z_lo, r, rM, c0, lo, hi, tol, d_min):
     bh, f_bh, df_bh = hi, fx, dfx
     width, slow = bh - a, 0
     for it in range(60):
-        x_new, slow = next_iterate(it == 0, lo, f_lo, df_lo, x, fx, dfx, a, f_a, bh, f_bh,
-                                   df_bh, slow)  # fmt: skip
+        x_new, slow = next_iterate(
+            it == 0, lo, f_lo, df_lo, x, fx, dfx, a, f_a, bh, f_bh, df_bh, slow
+        )
         if abs(x_new - x) <= tol:  # converged
             if fx > 0.0 and bh - x > tol:  # from the open side: step just past the zero
                 x = min(x + 2.0 * tol, bh)

@@ -28,9 +28,9 @@ heat integrated exactly, until ``λ`` vanishes (located the same way). Without e
 after :data:`MAX_EVENTS` in a step, impulses are given at the step end on penetrating,
 approaching contacts (velocity-level Moreau) and releases happen at step ends.
 
-Coulomb friction (:mod:`~.exponential_friction`): the impulses solve Signorini–Coulomb with
+Coulomb friction (:mod:`~.friction`): the impulses solve Signorini–Coulomb with
 Newton's law (the θ-method's solve); held contacts slide along their end-of-step slip (a fixed
-point per step, :mod:`~.exponential_slide`), checked like a multiplier (a stick ends the hold).
+point per step, :mod:`~.slide`), checked like a multiplier (a stick ends the hold).
 
 Dense: at most :data:`MAX_COORDINATES` coordinates (reduce larger models first).
 """
@@ -42,14 +42,14 @@ from types import SimpleNamespace
 
 import numpy as np
 
-from ..contact.impulses import solve_impulses
-from ..fem.linalg import Factorised
-from .base import Stepper
+from ...contact.impulses import solve_impulses
+from ...fem.linalg import Factorised
+from ..base import Stepper
 from .events import EventLocation
-from .exponential_friction import FrictionalContact
-from .exponential_kernels import flight, warm_up
-from .exponential_loads import LoadPolynomial
 from .flows import FlowFamily
+from .friction import FrictionalContact
+from .kernels import flight, warm_up
+from .loads import LoadPolynomial
 from .work import METER_ORDER, NQ, WorkIntegrals
 
 __all__ = ["ExponentialMoreau", "MAX_COORDINATES"]
@@ -284,7 +284,7 @@ class ExponentialMoreau(EventLocation, FrictionalContact, LoadPolynomial, Steppe
     def _flight(self, S, X, b):
         """The exact flight of ``S`` over the whole step from ``X`` with the load polynomial
         ``b``, in one product of a matrix stacked once per held set (compiled,
-        :func:`~.exponential_kernels.flight`): ``(X(h), P_S, integrals, V, quiet)``, the
+        :func:`~.kernels.flight`): ``(X(h), P_S, integrals, V, quiet)``, the
         integrals (:meth:`~.work.WorkIntegrals.flight_matrix`) with ``run(energy=True)``
         (else ``None``), the event check grid ``V`` (:meth:`_grid_rows`, with the casing's
         gaps) when events are located and whether it shows no event (:meth:`_quiet`)."""
@@ -375,7 +375,7 @@ class ExponentialMoreau(EventLocation, FrictionalContact, LoadPolynomial, Steppe
 
     def _impact(self, te, X, S, P, forced=None, plastic=None):
         """Newton impulses at time ``te`` (shared LCP; with friction
-        :meth:`~.exponential_friction.FrictionalContact._impact_friction`); update ``P`` in
+        :meth:`~.friction.FrictionalContact._impact_friction`); update ``P`` in
         place; new held set."""
         if self._fric:
             return self._impact_friction(te, X, S, P, forced, plastic)

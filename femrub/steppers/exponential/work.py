@@ -32,8 +32,8 @@ import numpy as np
 import scipy.linalg as sla
 import scipy.sparse as sp
 
-from .exponential_kernels import double_integrals, form_values, integrals_over
 from .flows import _FLUSH, LEVEL_MIN
+from .kernels import double_integrals, form_values, integrals_over
 
 __all__ = ["QUADRATIC", "LINEAR", "METER_ORDER", "NQ", "WorkIntegrals"]
 

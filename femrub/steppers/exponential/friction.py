@@ -22,7 +22,7 @@ force is ``λ_t = −μ λ ŝ`` along a unit direction ``ŝ`` that is constant o
 held contact's force column ``H = Hm − μ Hmt ŝ + Ht α_h`` is constant and its flow stays linear
 and exact (:class:`~.flows.FlowFamily`). ``ŝ`` is the direction of the slip
 ``w_t = Gvtᵀ X − v_c`` at the end of the step's held flight, found by a fixed point over the
-step (:mod:`~.exponential_slide`: the step is repeated from its start until the direction it
+step (:mod:`~.slide`: the step is repeated from its start until the direction it
 was flown with is its end slip's, up to an angle quantum), so that the recorded friction
 impulse of the step is opposite to the end slip as Coulomb's law wants; the casing's direction
 ``−v_c / |v_c|`` is where the first hold starts. The slip along ``ŝ``,
@@ -50,9 +50,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..contact.friction import OPEN, SLIP, STICK, solve_frictional_contact
-from ..output.recorder import StepRefused
-from .exponential_slide import SlideDirections
+from ...contact.friction import OPEN, SLIP, STICK, solve_frictional_contact
+from ...output.recorder import StepRefused
+from .slide import SlideDirections
 
 __all__ = ["FrictionalContact", "MAX_HEAT_ITERATIONS"]
 
@@ -188,9 +188,14 @@ class FrictionalContact(SlideDirections):
                 if not np.any(self._W3t):
                     break
                 res = solve_frictional_contact(
-                    W, q + (self._W3t @ heat).reshape(c.n, 3), self._mu, active,
-                    restitution=e, u_before=gd, warm=res.P,
-                )  # fmt: skip
+                    W,
+                    q + (self._W3t @ heat).reshape(c.n, 3),
+                    self._mu,
+                    active,
+                    restitution=e,
+                    u_before=gd,
+                    warm=res.P,
+                )
             heat = new
         Pi = res.P
         Xn = X + self._Z3 @ Pi.reshape(-1) + self._Zt @ heat
