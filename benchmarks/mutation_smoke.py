@@ -59,7 +59,7 @@ class Mutation:
 
 T = "tests/"
 MUTATIONS = [
-    # -- the thermal side (issue 18's probes) ------------------------------------------------
+    # -- the thermal side --------------------------------------------------------------------
     Mutation(
         "conductivity x10 in the weak form",
         "femrub/fem/forms.py",
@@ -130,7 +130,7 @@ MUTATIONS = [
         "return 0.5 * eta * mu * abs(omega) * radii",
         (T + "test_rub_3d_reference.py",),
     ),
-    # -- earlier probes (coupling, scheme, contact, reduction, lumping) ---------------------
+    # -- coupling, scheme, contact, reduction, lumping --------------------------------------
     Mutation(
         "paper coupling sign (K^uθ = −β K^uu)",
         "femrub/fem/assembly.py",
@@ -147,9 +147,9 @@ MUTATIONS = [
     ),
     Mutation(
         "impact law: restitution sign (one contact, default rule)",
-        "femrub/contact/activation.py",
-        "p_cap = (_target(g_k, e) - g_p) / gz",
-        "p_cap = (_target(g_k, -e) - g_p) / gz",
+        "femrub/contact/theta_block.py",
+        "p_cap = (min(g_k, 0.0) + e * max(g_k, 0.0) - g_p) / gz",
+        "p_cap = (min(g_k, 0.0) - e * max(g_k, 0.0) - g_p) / gz",
         (T + "test_energy.py", T + "test_impact_exact.py", T + "test_activation.py"),
     ),
     Mutation(
@@ -161,6 +161,13 @@ MUTATIONS = [
     ),
     Mutation(
         "tip mass doubled (row-sum lumping)",
+        "femrub/fem/assembly.py",
+        "return sp.diags(rows).tocsr()",
+        "return sp.diags(rows * np.r_[np.ones(rows.size - 1), 2.0]).tocsr()",
+        (T + "test_assembly.py",),
+    ),
+    Mutation(
+        "tip heat capacity doubled (row-sum lumping)",
         "femrub/fem/lumping.py",
         "return sp.diags(np.asarray(matrix.sum(axis=1)).ravel()).tocsr()",
         "return sp.diags(np.asarray(matrix.sum(axis=1)).ravel()"
@@ -170,8 +177,8 @@ MUTATIONS = [
     Mutation(
         "static shapes sign (Craig-Bampton Eq. 11)",
         "femrub/reduction/craig_bampton.py",
-        "psi = solver.solve(-B_ib)",
-        "psi = solver.solve(B_ib)",
+        "psi = solver.solve(-sp.csc_matrix(B)[:, self._bnd][self._int])",
+        "psi = solver.solve(sp.csc_matrix(B)[:, self._bnd][self._int])",
         (T + "test_reduction.py",),
     ),
     Mutation(
@@ -184,7 +191,7 @@ MUTATIONS = [
     Mutation(
         "HRZ lumping without its mass scaling",
         "femrub/fem/lumping.py",
-        "out[c::n_components] = diag[c::n_components] * total / diag[c::n_components].sum()",
+        "out[c::n_components] = diag[c::n_components] * totals[c] / diag[c::n_components].sum()",
         "out[c::n_components] = diag[c::n_components]",
         (T + "test_assembly.py", T + "test_solid.py"),
     ),

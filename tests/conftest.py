@@ -51,6 +51,7 @@ def load_benchmark():
         try:
             spec = importlib.util.spec_from_file_location(name, bench / f"{name}.py")
             mod = importlib.util.module_from_spec(spec)
+            sys.modules[name] = mod  # dataclasses look their module up while it loads
             spec.loader.exec_module(mod)
         finally:
             sys.path.remove(str(bench))

@@ -22,6 +22,10 @@ def test_paper_bar_sizes_and_lumped_mass():
     m = mats.M.diagonal()
     assert np.allclose(m[:-1], 0.1 / 20) and np.isclose(m[tip], 0.1 / 40)
     assert np.isclose(mats.M.sum(), 0.1 - 0.1 / 40)  # the clamped root node holds m/2n
+    # the heat capacity lumped the same way: rho c A L / n per node, half at the tip
+    node = CASE.density * CASE.specific_heat * CASE.area * CASE.length / 20
+    c = mats.Ctt.diagonal()
+    assert np.allclose(c[:-1], node, rtol=1e-12) and np.isclose(c[tip], node / 2, rtol=1e-12)
     model = fr.bar_model(CASE)
     assert model.n_dofs == 60  # u, v, θ on 20 free nodes (paper: n^uv = 38 + 2, n^θ = 19 + 1)
 
