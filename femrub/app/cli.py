@@ -85,13 +85,14 @@ def _cache(args, log=None):
 
 
 def _cache_command(args) -> int:
-    cache = _cache(args)
+    cache = _cache(args, log=lambda text: print(f"femrub {text}"))
     if args.cache_command == "clear":
         n, freed = cache.clear()
         print(f"femrub cache: removed {n} entries ({freed / 1e6:.1f} MB) from {cache.root}")
         return 0
     info = cache.info()
-    print(f"cache folder  {info['root']}")
+    marked = "" if info["marked"] else " (no femrub entries: not a femrub cache folder)"
+    print(f"cache folder  {info['root']}{marked}")
     print(
         f"entries       {info['entries']} ({info['bytes'] / 1e6:.1f} MB of "
         f"{info['limit'] / 1e6:.0f} MB)"
