@@ -20,16 +20,24 @@ from pathlib import Path
 from ..output.folder import FINISHED, claim, folder_status
 from ..output.run_folder import run_to_folder
 from ..scene.scene import Scene
+from .cache import source_version
+from .inputs import inputs_digest
 from .simulation import build
 
 __all__ = ["FINISHED", "folder_status", "merge_time", "run_scene", "scene_hash", "versions"]
 
 
 def scene_hash(scene: Scene) -> str:
-    """SHA-256 of the resolved scene (SI values, defaults, absolute paths; name excluded)."""
+    """SHA-256 of what shapes a run's result: the resolved scene (SI values, defaults,
+    absolute paths; name excluded), the bytes of every file it names
+    (:func:`~femrub.app.inputs.inputs_digest`: mesh, includes, sections) and femrub's
+    source (:func:`~femrub.app.cache.source_version`)."""
     data = {k: v for k, v in _resolved(scene).data.items() if k not in ("name", "description")}
     text = json.dumps(data, sort_keys=True, default=str)
-    return hashlib.sha256(text.encode()).hexdigest()
+    h = hashlib.sha256(text.encode())
+    h.update(inputs_digest(scene).encode())
+    h.update(source_version().encode())
+    return h.hexdigest()
 
 
 def merge_time(scene: Scene) -> float | None:
