@@ -29,6 +29,7 @@ import numpy as np
 
 from ..output.folder import FINISHED, FolderError, claim, folder_status
 from ..output.jsonfile import write_json
+from ..output.safe_write import atomic_file, write_atomic
 from ..scene import SceneError, parse_value, resolve_key
 from ..scene.scene import Scene
 from .cached import keep_assemblies
@@ -223,7 +224,7 @@ def _sweep(
         "scene_sha256": hashes,
     }
     write_json(out / "sweep.json", doc)
-    (out / "scene.toml").write_text(scene.dumps())
+    write_atomic(out / "scene.toml", scene.dumps())
     rows = []
     for i, (p, digest) in enumerate(zip(points, hashes)):
         folder = out / "runs" / _point_name(i, p, digest)
@@ -339,7 +340,7 @@ def _write_csv(rows, keys, path) -> None:
         "rms_tip_displacement_m",
         "max_wear_depth_m",
     ]
-    with open(path, "w", newline="") as fh:
+    with atomic_file(path, "w") as fh:
         w = csv.writer(fh)
         w.writerow(cols)
         for r in rows:
