@@ -107,8 +107,11 @@ def _cache_command(args) -> int:
 
 def _load(args):
     from ..scene import load_scene
+    from ..scene.run_checks import check_run
 
-    return load_scene(args.scene, _changes(args))
+    scene = load_scene(args.scene, _changes(args))
+    check_run(scene)
+    return scene
 
 
 def _log(args):

@@ -21,6 +21,7 @@ from ..output.folder import FINISHED, FolderError, claim, folder_status
 from ..output.jsonfile import write_json
 from ..output.run_folder import run_to_folder
 from ..output.safe_write import describe_os_error, write_atomic
+from ..scene.run_checks import check_run
 from ..scene.scene import Scene
 from .cache import source_version
 from .inputs import inputs_digest
@@ -124,6 +125,7 @@ def run_scene(
     cache : a :class:`~femrub.app.cache.ModelCache` of assembled and reduced models.
     """
     out = Path(out)
+    check_run(scene)
     _check_not_the_scene(scene, out)
     with claim(out, "run", overwrite=overwrite):
         return _run_claimed(scene, out, progress, log, on_built, modes, cache)

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import re
+import stat
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -107,6 +108,30 @@ def _set_members(model: AbaqusModel, sets, lines, generate, where) -> list[int]:
     return out
 
 
+#: largest deck file read (bytes): a bigger one, or a device (``/dev/zero``), is refused
+MAX_DECK_BYTES = 4 * 2**30
+
+
+def _check_size(path: Path) -> None:
+    """Refuse a deck file that is not a regular file or exceeds :data:`MAX_DECK_BYTES`."""
+    try:
+        st = path.stat()
+    except OSError as exc:
+        raise GeometryError(
+            f"Cannot read Abaqus/CalculiX file {str(path)!r}: {exc.strerror}; check the path."
+        ) from None
+    if not stat.S_ISREG(st.st_mode):
+        raise GeometryError(
+            f"Abaqus/CalculiX file {str(path)!r} is not a regular file (a device or a folder); "
+            "give the path of a deck file."
+        )
+    if st.st_size > MAX_DECK_BYTES:
+        raise GeometryError(
+            f"Abaqus/CalculiX file {str(path)!r} holds {st.st_size / 2**30:.1f} GiB, more than "
+            f"the {MAX_DECK_BYTES / 2**30:.0f} GiB read; check the *INCLUDE or split the mesh."
+        )
+
+
 class _Parser:
     def __init__(self) -> None:
         self.model = AbaqusModel()
@@ -116,6 +141,7 @@ class _Parser:
     def parse(self, path: Path, depth: int = 0) -> None:
         if depth > 10:
             raise GeometryError(f"*INCLUDE nesting deeper than 10 levels at {str(path)!r}.")
+        _check_size(path)
         try:
             text = path.read_text(encoding="utf-8", errors="strict")
         except (OSError, UnicodeDecodeError) as exc:
@@ -152,26 +178,31 @@ class _Parser:
             self._nodes(params, data, where)
         elif keyword == "ELEMENT":
             self._elements(params, data, where)
-        elif keyword == "NSET":
-            name = params.get("NSET") or ""
-            members = _set_members(self.model, self.model.nsets, data, "GENERATE" in params, where)
-            self.model.nsets.setdefault(name, []).extend(members)
-        elif keyword == "ELSET":
-            name = params.get("ELSET") or ""
-            members = _set_members(self.model, self.model.elsets, data, "GENERATE" in params, where)
-            self.model.elsets.setdefault(name, []).extend(members)
+        elif keyword in ("NSET", "ELSET"):
+            self._set(keyword, params, data, where)
         elif keyword == "BOUNDARY":
-            for line in data:
-                first = line.split(",")[0].strip()
-                try:
-                    self.model.boundary.append(int(first))
-                except ValueError:
-                    members = self.model.find_set(self.model.nsets, first)
-                    if members is None:
-                        raise GeometryError(
-                            f"*BOUNDARY at {where} uses undefined node set {first!r}."
-                        ) from None
-                    self.model.boundary.extend(members)
+            self._boundary(data, where)
+
+    def _set(self, keyword, params, data, where) -> None:
+        """``*NSET`` or ``*ELSET``: members appended to the named set."""
+        sets = self.model.nsets if keyword == "NSET" else self.model.elsets
+        name = params.get(keyword) or ""
+        members = _set_members(self.model, sets, data, "GENERATE" in params, where)
+        sets.setdefault(name, []).extend(members)
+
+    def _boundary(self, data, where) -> None:
+        """``*BOUNDARY``: the clamped nodes (numbers or node-set names)."""
+        for line in data:
+            first = line.split(",")[0].strip()
+            try:
+                self.model.boundary.append(int(first))
+            except ValueError:
+                members = self.model.find_set(self.model.nsets, first)
+                if members is None:
+                    raise GeometryError(
+                        f"*BOUNDARY at {where} uses undefined node set {first!r}."
+                    ) from None
+                self.model.boundary.extend(members)
 
     def _material(self, keyword, params, data, where) -> None:
         if keyword == "MATERIAL":

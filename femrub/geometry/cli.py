@@ -156,6 +156,40 @@ def _read_kwargs(args) -> dict:
     return kw
 
 
+#: largest number of tetrahedra ``femrub mesh`` makes (as the scene path: MAX_ELEMENTS)
+MAX_TETS = 2_000_000
+# tetrahedra per h³ of volume in a gmsh mesh of size h (regular tetrahedra: 6 √2)
+_TETS_PER_H3 = 8.5
+
+
+def estimate_tets(args) -> float | None:
+    """Tetrahedra a box or NACA blade of size ``--h`` gets (``None``: cannot estimate)."""
+    h = getattr(args, "h", None)
+    if args.mesh_kind == "box":
+        h = h or args.thickness
+        t = min(args.thickness, h)  # at least one element through the thickness
+        return _TETS_PER_H3 * args.span * args.chord * args.thickness / (h * h * t)
+    if args.mesh_kind == "naca" and h:
+        ratio = int(str(args.code)[2:]) / 100.0
+        t = min(ratio * args.root_chord, h)
+        area = 0.685 * ratio * 0.5 * (args.root_chord**2 + args.tip_chord**2)
+        return _TETS_PER_H3 * args.span * area / (h * h * t)
+    return None
+
+
+def _check_size(args) -> None:
+    """Refuse, before meshing, a size ``--h`` that gives more than :data:`MAX_TETS`."""
+    h = getattr(args, "h", None)
+    if h is not None and not h > 0:
+        raise GeometryError(f"--h {h!r}: give a positive element size in metres")
+    n = estimate_tets(args)
+    if n is not None and n > MAX_TETS:
+        raise GeometryError(
+            f"--h {h}: gives about {n:.2g} tetrahedra (at most {MAX_TETS:.0e}, estimated "
+            "before meshing); raise --h"
+        )
+
+
 def run_mesh(args: argparse.Namespace) -> int:
     """Execute the ``mesh`` sub-command; print a summary; return an exit code.
 
@@ -168,6 +202,7 @@ def run_mesh(args: argparse.Namespace) -> int:
 
     start = time.perf_counter()
     try:
+        _check_size(args)
         if args.mesh_kind == "box":
             blade = box_blade(
                 args.span,
