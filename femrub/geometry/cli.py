@@ -166,14 +166,20 @@ def estimate_tets(args) -> float | None:
     """Tetrahedra a box or NACA blade of size ``--h`` gets (``None``: cannot estimate)."""
     h = getattr(args, "h", None)
     if args.mesh_kind == "box":
+        dims = (args.span, args.chord, args.thickness)
+        if min(dims) <= 0:
+            return None  # the builder names the length at fault
         h = h or args.thickness
         t = min(args.thickness, h)  # at least one element through the thickness
-        return _TETS_PER_H3 * args.span * args.chord * args.thickness / (h * h * t)
-    if args.mesh_kind == "naca" and h:
-        ratio = int(str(args.code)[2:]) / 100.0
+        return _TETS_PER_H3 * (args.span / h) * (args.chord / h) * (args.thickness / t)
+    code = str(args.code)
+    if args.mesh_kind == "naca" and h and len(code) == 4 and code.isdigit():
+        ratio = int(code[2:]) / 100.0
+        if min(ratio, args.span, args.root_chord, args.tip_chord) <= 0:
+            return None
         t = min(ratio * args.root_chord, h)
         area = 0.685 * ratio * 0.5 * (args.root_chord**2 + args.tip_chord**2)
-        return _TETS_PER_H3 * args.span * area / (h * h * t)
+        return _TETS_PER_H3 * (args.span / h) * (area / h) / t
     return None
 
 
@@ -184,9 +190,10 @@ def _check_size(args) -> None:
         raise GeometryError(f"--h {h!r}: give a positive element size in metres")
     n = estimate_tets(args)
     if n is not None and n > MAX_TETS:
+        what = f"--h {h}" if h else f"--thickness {args.thickness} (the default --h)"
         raise GeometryError(
-            f"--h {h}: gives about {n:.2g} tetrahedra (at most {MAX_TETS:.0e}, estimated "
-            "before meshing); raise --h"
+            f"{what}: gives about {min(n, 1e300):.2g} tetrahedra (at most {MAX_TETS:.0e}, "
+            "estimated before meshing); raise --h"
         )
 
 

@@ -21,6 +21,7 @@ import platform
 import sys
 import time
 from contextlib import nullcontext
+from functools import partial
 from pathlib import Path
 
 import numpy as np
@@ -236,47 +237,35 @@ def _run(
             series.close()  # every frame taken is on disk, the writer thread stopped
     if ran is None:
         wall = time.perf_counter() - t0
-    args = (stepper, res, out, doc, series, history, wall, snapshot, plots, timings)
-    return _close(*args, rotation_speed, summary_path, csv_stride)
+    finish = partial(
+        _finish,
+        stepper,
+        res,
+        out,
+        doc,
+        series,
+        history,
+        wall,
+        snapshot,
+        plots,
+        timings,
+        rotation_speed,
+        summary_path,
+        csv_stride,
+    )
+    return _close(finish, res, out, doc, history, summary_path)
 
 
-def _close(
-    stepper,
-    res,
-    out,
-    doc,
-    series,
-    history,
-    wall,
-    snapshot,
-    plots,
-    timings,
-    rotation_speed,
-    summary_path,
-    csv_stride,
-):
-    """The final files of a stepped run, signals held back; a write error (a full disk)
-    fails the run with a line naming the file (:func:`_write_failed`); a signal received
-    while a finished result was written leaves it finished (a notice says so)."""
+def _close(finish, res, out, doc, history, summary_path):
+    """``finish()`` (the final files of a stepped run) with signals held back; a write
+    error (a full disk) fails the run with a line naming the file (:func:`_write_failed`);
+    a signal received while a finished result was written leaves it finished (a notice
+    says so)."""
     if history.error is not None:  # a full disk: the run stopped, its rows are in memory
         res.status, res.message = "failed", describe_os_error(history.error, "write")
     with deferred(reraise=False) as held:
         try:
-            res = _finish(
-                stepper,
-                res,
-                out,
-                doc,
-                series,
-                history,
-                wall,
-                snapshot,
-                plots,
-                timings,
-                rotation_speed,
-                summary_path,
-                csv_stride,
-            )
+            res = finish()
         except OSError as exc:
             _write_failed(res, exc, out, doc, summary_path)
     if held and res.status == "interrupted":
