@@ -138,3 +138,23 @@ def test_femrub_mesh_estimates_elements_before_meshing(capsys, monkeypatch):
     assert "tetrahedra" in capsys.readouterr().err
     assert main(["mesh", "naca", "--h", "1e-5"]) == 2
     assert "raise --h" in capsys.readouterr().err
+
+
+def test_a_lofted_blade_estimates_elements_before_meshing(tmp_path, capsys, monkeypatch):
+    import numpy as np
+
+    from femrub.geometry import section_blade
+
+    angle = np.linspace(0.0, 2 * np.pi, 40, endpoint=False)
+    for i, z in enumerate((0.0, 5.0, 10.0)):  # cm: ellipses 3 cm x 0.3 cm, 5 cm apart
+        pts = np.column_stack([1.5 * np.cos(angle), 0.15 * np.sin(angle), np.full(40, z)])
+        np.savetxt(tmp_path / f"s{i}.csv", pts, delimiter=",")
+    monkeypatch.setattr(section_blade, "loft_blade", lambda *a, **k: pytest.fail("meshed"))
+    assert main(["mesh", "sections", str(tmp_path), "--axis", "z", "--h", "1e-5"]) == 2
+    err = capsys.readouterr().err
+    assert "tetrahedra between these sections" in err and "raise h" in err
+    volume = np.pi * 0.015 * 0.0015 * 0.1  # m³
+    n = section_blade.estimate_section_tets(
+        [np.loadtxt(tmp_path / f"s{i}.csv", delimiter=",").T * 0.01 for i in range(3)], 1e-3
+    )
+    assert n == pytest.approx(8.5 * volume / 1e-9, rel=0.05)

@@ -172,7 +172,7 @@ def estimate_tets(args) -> float | None:
         h = h or args.thickness
         t = min(args.thickness, h)  # at least one element through the thickness
         return _TETS_PER_H3 * (args.span / h) * (args.chord / h) * (args.thickness / t)
-    code = str(args.code)
+    code = str(getattr(args, "code", ""))
     if args.mesh_kind == "naca" and h and len(code) == 4 and code.isdigit():
         ratio = int(code[2:]) / 100.0
         if min(ratio, args.span, args.root_chord, args.tip_chord) <= 0:
