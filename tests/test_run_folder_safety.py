@@ -111,3 +111,12 @@ def test_json_and_figures_replace_a_link_made_after_the_claim(tmp_path):
     assert target.read_text() == "precious"
     assert json.loads((tmp_path / "summary.json").read_text()) == {"a": 1}
     assert not (tmp_path / "signals.png").is_symlink()
+
+
+def test_a_users_summary_json_is_not_taken_for_femrubs(tmp_path, box, capsys):
+    out = tmp_path / "mine"
+    out.mkdir()
+    (out / "summary.json").write_text("my notes, not JSON")
+    assert main(["run", str(box), "-o", str(out), "-q", "--overwrite"]) == 2
+    assert "summary.json was not written by femrub" in capsys.readouterr().err
+    assert (out / "summary.json").read_text() == "my notes, not JSON"

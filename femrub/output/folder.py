@@ -108,11 +108,13 @@ def folder_kind(out) -> str | None:
         pass
     if (out / "sweep.json").exists():
         return "sweep"
-    if (out / "summary.json").exists():
+    if (out / "summary.json").exists():  # an older femrub's folder: a summary with a status
         try:
-            return "paper" if "runs" in read_json(out / "summary.json") else "run"
+            doc = read_json(out / "summary.json")
         except ValueError:
-            return "run"
+            return None  # not femrub's to judge: a user's file
+        if "status" in doc:
+            return "paper" if "runs" in doc else "run"
     return None
 
 
