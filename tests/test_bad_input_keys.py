@@ -3,6 +3,8 @@ the fix."""
 
 from __future__ import annotations
 
+import re
+
 import pytest
 
 from femrub.app.cli import main
@@ -158,3 +160,25 @@ def test_a_lofted_blade_estimates_elements_before_meshing(tmp_path, capsys, monk
         [np.loadtxt(tmp_path / f"s{i}.csv", delimiter=",").T * 0.01 for i in range(3)], 1e-3
     )
     assert n == pytest.approx(8.5 * volume / 1e-9, rel=0.05)
+
+
+@pytest.mark.parametrize(
+    "text, words",
+    [
+        ("*NODE\n99999999999999999999999, 0, 0, 0\n", "Malformed *NODE line"),
+        ("*NODE\n1, 1e999, 0, 0\n", "non-finite coordinate"),
+        ("*NSET, NSET=A, GENERATE\n1, 1e30, 1\n", "gives 1e+30 members"),
+        ("*NSET, NSET=A, GENERATE\n1, 999999999999, 1\n", "at most 1e+08"),
+        ("*NSET, NSET=A, GENERATE\n1, 9, 0\n", "step >= 1"),
+        ("*NODE\n1,0,0,0\n*ELEMENT, TYPE=C3D4\n1, 1, 2, 3, 99999999999999999999999\n", "*ELEMENT"),
+    ],
+)
+def test_deck_numbers_out_of_range_are_named(tmp_path, text, words):
+    """Numbers too large for an index or non-finite: a GeometryError naming the line, never
+    an OverflowError or a MemoryError."""
+    from femrub.geometry import GeometryError
+    from femrub.geometry.abaqus_reader import read_abaqus
+
+    (tmp_path / "deck.inp").write_text(text)
+    with pytest.raises(GeometryError, match=re.escape(words)):
+        read_abaqus(tmp_path / "deck.inp", "mm")

@@ -78,20 +78,35 @@ def _params(line: str) -> tuple[str, dict[str, str]]:
     return parts[0].upper(), params
 
 
+#: most members one GENERATE line may give (a deck's node count is far below)
+MAX_GENERATED = 100_000_000
+
+
+def _generated(line: str, where: str) -> range:
+    """The members of a ``first, last[, step]`` line of a GENERATE set."""
+    try:
+        v = [int(float(tok)) for tok in line.split(",") if tok.strip()]
+    except (ValueError, OverflowError):
+        v = []
+    if len(v) not in (2, 3) or (len(v) == 3 and v[2] < 1):
+        raise GeometryError(
+            f"GENERATE set at {where} needs 'first, last[, step >= 1]' lines, got {line!r}."
+        )
+    first, last, step = (v + [1])[:3]
+    count = max((last - first) // step + 1, 0)  # Python integers: no overflow
+    if count > MAX_GENERATED:
+        raise GeometryError(
+            f"GENERATE set at {where} gives {count:.3g} members (at most "
+            f"{MAX_GENERATED:.0e}): check the line {line!r}."
+        )
+    return range(first, last + 1, step)
+
+
 def _set_members(model: AbaqusModel, sets, lines, generate, where) -> list[int]:
     out: list[int] = []
     if generate:
         for line in lines:
-            try:
-                v = [int(float(tok)) for tok in line.split(",") if tok.strip()]
-            except ValueError:
-                v = []
-            if len(v) not in (2, 3):
-                raise GeometryError(
-                    f"GENERATE set at {where} needs 'first, last[, step]' lines, got {line!r}."
-                )
-            first, last, step = (v + [1])[:3]
-            out.extend(range(first, last + 1, step))
+            out.extend(_generated(line, where))
         return out
     for tok in (tok.strip() for line in lines for tok in line.split(",")):
         if not tok:
@@ -232,8 +247,13 @@ class _Parser:
             xyz = np.zeros((3, len(rows)))
             for k, r in enumerate(rows):
                 xyz[: len(r) - 1, k] = r[1:4]
-        except (ValueError, IndexError) as exc:
+        except (ValueError, IndexError, OverflowError) as exc:
             raise GeometryError(f"Malformed *NODE line in block at {where}: {exc}.") from exc
+        if not np.isfinite(xyz).all():
+            k = int(np.flatnonzero(~np.isfinite(xyz).all(axis=0))[0])
+            raise GeometryError(
+                f"*NODE {ids[k]} in block at {where} has a non-finite coordinate; fix the deck."
+            )
         self._node_ids.append(ids)
         self._coords.append(xyz)
         if params.get("NSET"):
@@ -251,7 +271,7 @@ class _Parser:
             values = np.array(
                 [int(v) for line in data for v in line.split(",") if v.strip()], dtype=np.int64
             )
-        except ValueError as exc:
+        except (ValueError, OverflowError) as exc:
             raise GeometryError(f"Malformed *ELEMENT data in block at {where}: {exc}.") from exc
         if values.size % (n_nodes + 1):
             raise GeometryError(
