@@ -194,3 +194,24 @@ def test_every_kind_of_value_round_trips(cache):
 def test_code_is_not_stored(cache):
     assert not cache.store(content_key("f"), {"f": print}, stage="test")
     assert "not stored" in cache.notes[-1]
+
+
+def test_femrub_check_on_a_cache_of_crafted_entries_runs_no_code(tmp_path, capsys):
+    """Every entry of a real cache replaced by a crafted one with a matching checksum (an
+    object array that would run code when unpickled, a legacy pickle): `femrub check` runs
+    no code, rebuilds each entry and stores it again."""
+    folder = tmp_path / "shared-cache"
+    argv = ["check", "paper", "-q", "--cache-dir", str(folder)]
+    assert main(argv) == 0
+    keys = [p.stem for p in folder.glob("*.json")]
+    assert keys
+    sentinel = tmp_path / "executed"
+    crafted = ModelCache(folder)
+    for key in keys:
+        exploit = np.empty(1, dtype=object)
+        exploit[0] = _Exploit(sentinel)
+        _plant(crafted, key, {"$": "array", "ref": "a0"}, {"a0": exploit})
+        (folder / f"{key}.pkl").write_bytes(pickle.dumps(_Exploit(sentinel)))
+    assert main(argv) == 0
+    assert not sentinel.exists()
+    assert all(ModelCache(folder).load(k) is not None for k in keys)  # rebuilt and stored
