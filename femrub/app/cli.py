@@ -51,7 +51,9 @@ def _paper(args) -> int:
             f"{out / 'summary.json'} (status interrupted); rerun with --overwrite to start again",
             file=sys.stderr,
         )
-        return 130
+        from ..output.interrupts import exit_status
+
+        return exit_status()
     if not args.quiet:
         bad = [r for r in rows if r["status"] != "ok"]
         for r in bad:
