@@ -1,7 +1,7 @@
 """SIGTERM like Ctrl-C, and writes that a second signal cannot cut in half.
 
 :func:`interruptible` turns SIGTERM (``kill``, a batch system's time limit) and SIGHUP (a
-closed terminal or SSH session) into the ``KeyboardInterrupt`` that Ctrl-C raises, so a run
+closed terminal or SSH connection) into the ``KeyboardInterrupt`` that Ctrl-C raises, so a run
 stops the same way whichever signal ends it: the recorder keeps every checked step and the
 status becomes ``interrupted`` (exit status 129 after SIGHUP, 130 otherwise:
 :func:`exit_status`).
