@@ -151,7 +151,7 @@ def test_corrupt_entry_is_detected_and_rebuilt(first, tmp_path):
     _build(local)
     for e in local.entries():
         if e["stage"] == "reduction":
-            path = local.root / f"{e['key']}.pkl"
+            path = local.root / f"{e['key']}.npz"
             data = bytearray(path.read_bytes())
             data[len(data) // 2] ^= 0xFF
             path.write_bytes(bytes(data))
@@ -202,7 +202,7 @@ def test_corrupt_or_missing_map_rebuilds_the_reduction(first, tmp_path, monkeypa
     local = ModelCache(tmp_path / "c")
     _build(local)
     (entry,) = _stored(local, "map")
-    path = local.root / f"{entry['key']}.pkl"
+    path = local.root / f"{entry['key']}.npz"
     if damage == "corrupt":
         data = bytearray(path.read_bytes())
         data[len(data) // 2] ^= 0xFF
@@ -281,20 +281,21 @@ def test_keys_follow_content():
 
 def test_size_limit_evicts_least_recently_used(tmp_path):
     blob = np.zeros(100_000)  # 800 kB
+    a, b, c = (content_key(name) for name in "abc")
     cache = ModelCache(tmp_path, limit=2_000_000)
-    cache.store("a", blob, stage="t")
-    cache.store("b", blob, stage="t")
+    cache.store(a, blob, stage="t")
+    cache.store(b, blob, stage="t")
     now = time.time()
-    os.utime(tmp_path / "a.json", (now - 100, now - 100))
-    os.utime(tmp_path / "b.json", (now - 50, now - 50))
-    assert cache.load("a") is not None  # a becomes the most recently used
-    cache.store("c", blob, stage="t")
+    os.utime(tmp_path / f"{a}.json", (now - 100, now - 100))
+    os.utime(tmp_path / f"{b}.json", (now - 50, now - 50))
+    assert cache.load(a) is not None  # a becomes the most recently used
+    cache.store(c, blob, stage="t")
     keys = {e["key"] for e in cache.entries()}
-    assert keys == {"a", "c"}
+    assert keys == {a, c}
     assert cache.info()["bytes"] <= cache.limit
     notes = []
     small = ModelCache(tmp_path / "small", limit=1000, log=notes.append)
-    assert not small.store("big", blob, stage="t")
+    assert not small.store(content_key("big"), blob, stage="t")
     assert small.entries() == [] and "exceeds the cache size" in notes[0]
 
 
@@ -308,7 +309,7 @@ def test_parse_size():
 
 def test_cli_cache_info_and_clear(tmp_path, capsys):
     cache = ModelCache(tmp_path)
-    cache.store("k", np.ones(3), stage="assembly")
+    cache.store(content_key("k"), np.ones(3), stage="assembly")
     assert main(["cache", "info", "--cache-dir", str(tmp_path)]) == 0
     out = capsys.readouterr().out
     assert str(tmp_path) in out and "assembly" in out and "entries       1" in out

@@ -227,6 +227,7 @@ def test_vtk_frames_are_complete_and_stale_frames_removed(tmp_path):
     scene.write_text(BOX)
     out = tmp_path / "out"
     (out / "vtk").mkdir(parents=True)
+    (out / ".femrub").write_text('{"kind": "run"}\n')  # an earlier run of femrub's
     (out / "vtk" / "rub_000099.vtu").write_text("stale frame of an earlier run")
     (out / "vtk" / "rub_000007.vtu.tmp").write_text("half-written")
     assert main(["run", str(scene), "-o", str(out), "-q"]) == 0

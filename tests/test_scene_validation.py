@@ -124,8 +124,8 @@ def mesh_dir(tmp_path):
 
 
 def test_carpenter_step_above_stability_limit():
-    msg = _built_error({"scheme.name": "carpenter", "scheme.h": 3e-5, "geometry.n_elements": 20})
-    assert "scheme.h = 3e-05" in msg and "stability limit 2.6" in msg and "theta" in msg
+    msg = _built_error({"scheme.name": "carpenter", "scheme.h": 4e-5, "geometry.n_elements": 20})
+    assert "scheme.h = 4e-05" in msg and "stability limit 2.6" in msg and "theta" in msg
     assert (
         build(
             Scene(

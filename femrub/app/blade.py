@@ -101,6 +101,94 @@ def _check_contacts(scene, pts) -> None:
             )
 
 
+#: largest blade taken (m): a bigger one is a millimetre mesh read as metres
+MAX_BLADE_SIZE = 5.0
+#: largest offset of a mid-side node from its edge's middle, in edge lengths (beyond a
+#: quarter the quadratic element's Jacobian changes sign)
+MAX_MIDSIDE_OFFSET = 0.25
+
+
+def _check_scale(scene, blade) -> None:
+    """Refuse a blade larger than :data:`MAX_BLADE_SIZE` (a unit slip)."""
+    if scene["geometry"]["kind"] != "mesh":
+        return
+    size = float(np.ptp(blade.mesh.p, axis=1).max())
+    if size > MAX_BLADE_SIZE:
+        unit = scene["geometry"].get("length_unit") or "m"
+        fail(
+            "geometry.length_unit",
+            unit,
+            f"the blade spans {size:.4g} m (more than {MAX_BLADE_SIZE:g} m): a millimetre "
+            f"mesh declared in {unit}? give length_unit = 'mm' if its numbers are millimetres",
+        )
+
+
+def _check_midside(scene, blade) -> None:
+    """Refuse mid-side nodes more than :data:`MAX_MIDSIDE_OFFSET` edge lengths off their
+    edge's middle (a distorted quadratic element)."""
+    mid = blade.info.get("edge_midpoints")
+    if mid is None:
+        return
+    p, edges = blade.mesh.p, blade.mesh.edges
+    length = np.linalg.norm(p[:, edges[1]] - p[:, edges[0]], axis=0)
+    off = np.linalg.norm(mid - 0.5 * (p[:, edges[0]] + p[:, edges[1]]), axis=0)
+    ratio = off / np.where(length > 0, length, np.inf)
+    worst = int(np.argmax(ratio))
+    if ratio[worst] > MAX_MIDSIDE_OFFSET:
+        where = ", ".join(f"{x:.6g}" for x in mid[:, worst])
+        fail(
+            "geometry.path",
+            scene["geometry"]["path"],
+            f"{int((ratio > MAX_MIDSIDE_OFFSET).sum())} distorted mid-side node(s), e.g. at "
+            f"({where}) m, {ratio[worst]:.2f} edge lengths off the edge's middle (at most "
+            f"{MAX_MIDSIDE_OFFSET:g}); repair the mesh",
+        )
+
+
+def _check_material(scene, blade) -> None:
+    """Refuse a deck without a material when the scene gives none (no silent titanium)."""
+    g = scene["geometry"]
+    if g["kind"] != "mesh" or "material" not in blade.info or blade.info["material"]:
+        return
+    if any(k.startswith("material.") for k in scene.given):
+        return
+    fail(
+        "material",
+        None,
+        f"{g['path']} has no *MATERIAL for its elements and the scene gives no [material]; "
+        "give material.young, .poisson, .density, ... in the scene (or a *MATERIAL in the deck)",
+    )
+
+
+def _check_clamped_contacts(scene, blade, pts) -> None:
+    """Refuse a contact point on a clamped node (its force would always be 0)."""
+    root = blade.node_sets.get("root")
+    if root is None or root.size == 0 or pts.shape[1] == 0:
+        return
+    size = float(np.ptp(blade.mesh.p, axis=1).max()) or 1.0
+    scale = _SAME_POINT * size * 1e3
+    clamped = {tuple(k) for k in np.round(blade.mesh.p[:, root].T / scale).astype(np.int64)}
+    keys = np.round(pts.T / scale).astype(np.int64)
+    hit = [i for i, k in enumerate(keys) if tuple(k) in clamped]
+    if hit:
+        contact = scene["contact"]
+        key, value = (
+            ("contact.nodes", contact["nodes"])
+            if contact.get("nodes")
+            else (
+                "contact.group",
+                contact["group"],
+            )
+        )
+        where = ", ".join(f"{x:.6g}" for x in pts[:, hit[0]])
+        fail(
+            key,
+            value,
+            f"{len(hit)} contact point(s) on clamped nodes of boundary.root, e.g. at ({where}) m:"
+            " a clamped node never moves and its contact force stays 0; choose free nodes",
+        )
+
+
 def _groups(blade) -> str:
     return ", ".join(f"{k} ({v.size} nodes)" for k, v in sorted(blade.node_sets.items())) or "none"
 
@@ -239,6 +327,9 @@ def load_blade(scene, log=None):
     except GeometryError as exc:
         raise SceneError(f"geometry ({scene['geometry']['kind']}): {exc}") from None
     _check_mesh(scene, blade)
+    _check_scale(scene, blade)
+    _check_midside(scene, blade)
+    _check_material(scene, blade)
     root = scene["boundary"].get("root")
     if root is not None and scene["geometry"]["kind"] != "mesh" and root != "root":
         if root not in blade.node_sets:
@@ -246,4 +337,5 @@ def load_blade(scene, log=None):
         blade.node_sets["root"] = blade.node_sets[root]
     pts = _contact_points(scene, blade)
     _check_contacts(scene, pts)
+    _check_clamped_contacts(scene, blade, pts)
     return replace(blade, contact_points=pts, node_sets=dict(blade.node_sets))

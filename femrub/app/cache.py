@@ -1,14 +1,30 @@
 """A content-addressed, size-limited on-disk store of built models (``femrub cache``).
 
-An entry is one pickled object under a key that is the SHA-256 of everything that built it
-(:func:`content_key`: arrays by their bytes, shape and dtype, sparse matrices by their
-canonical CSR or CSC arrays in the format they come in (no conversion), other values by
-their ``repr``, plus :func:`code_version`, the hash of femrub's model-building source). Two
-files per entry in the cache folder: ``KEY.pkl`` (the object) and ``KEY.json`` (stage,
-size, SHA-256 of ``KEY.pkl``, creation time, femrub version, a description). Writes go to a
-temporary file renamed into place, the data before the metadata, so concurrent runs (sweep
-workers) never see half an entry; a reader checks the checksum and treats a mismatch or an
-unreadable entry as a miss, deletes it and says so (``log``): the caller rebuilds it.
+An entry is data, never code. Its key is the SHA-256 (64 hex digits) of everything that
+built it (:func:`content_key`: arrays by their bytes, shape and dtype, sparse matrices by
+their canonical CSR or CSC arrays in the format they come in (no conversion), other values
+by their ``repr``, plus :func:`code_version`, the hash of the source that shapes the
+models). A key is checked to be 64 hex digits before any path is formed from it. Two files
+per entry in the cache folder:
+
+* ``KEY.npz``: the object as a JSON tree and the arrays it names
+  (:mod:`femrub.app.cache_codec`), read with ``allow_pickle=False``; nothing in it is
+  executed, and it can only hold instances of femrub's model-building classes;
+* ``KEY.json``: its metadata (stage, size, SHA-256 of ``KEY.npz``, creation time, code
+  version, a description), checked against :data:`ENTRY_SCHEMA` on every read.
+
+The folder is femrub's when it holds the marker ``CACHEDIR.TAG`` (the cache directory tag
+standard, naming femrub), written when femrub creates the folder or finds it empty: femrub
+stores in, reads from, evicts from and clears only a marked folder, and only the files named
+after a key (``KEY.npz``, ``KEY.json``, an older femrub's ``KEY.pkl``, never read) and its
+own temporaries ``.KEY.*.tmp``; the metadata files are its manifest. A folder holding other
+files and no marker is left alone (the run goes on without the cache, with a notice).
+
+Writes go to a temporary file beside the target renamed into place, the data before the
+metadata, so concurrent runs (sweep workers) never see half an entry; files are opened
+without following symbolic links. A reader checks the metadata's schema and the checksum
+and treats a malformed, mismatched or unreadable entry as a miss: it removes it, says so
+(``log``) and the caller rebuilds it.
 
 The folder is bounded: after each store the least recently used entries (a hit touches its
 metadata) are removed until the total fits ``limit`` bytes. ``clear()`` empties it,
@@ -22,7 +38,6 @@ import dataclasses
 import hashlib
 import json
 import os
-import pickle
 import re
 import tempfile
 import time
@@ -31,21 +46,55 @@ from pathlib import Path
 import numpy as np
 import scipy.sparse as sp
 
+from .cache_codec import decode, encode
+
 __all__ = [
     "DEFAULT_LIMIT",
+    "ENTRY_SCHEMA",
+    "MARKER",
     "ModelCache",
+    "check_key",
     "code_version",
     "content_key",
     "default_dir",
     "parse_size",
+    "source_version",
 ]
 
 #: Default size limit of the cache folder (bytes): a reduced Rotor 37 entry is a few
 #: hundred MB (its map to the full mesh is dense).
 DEFAULT_LIMIT = 8 * 2**30
-#: Package folders whose source code shapes the assembled and reduced matrices.
-CODE_FOLDERS = ("fem", "model", "contact", "reduction")
+#: Package folders (searched recursively) and modules whose source shapes the assembled
+#: and reduced models and the format of their entries.
+CODE_FOLDERS = ("fem", "model", "contact", "reduction", "steppers")
+CODE_FILES = ("app/cached.py", "app/cache.py", "app/cache_codec.py")
+#: The marker file of a femrub cache folder (https://bford.info/cachedir/).
+MARKER = "CACHEDIR.TAG"
+_TAG = "Signature: 8a477f597d28d172789f06886806bc55"
+_MARKER_TEXT = (
+    f"{_TAG}\n# This file is a cache directory tag created by femrub (model cache).\n"
+    "# For information about cache directory tags see https://bford.info/cachedir/\n"
+)
+_FORMAT = "femrub-cache-entry"
+_VERSION = 2
+_HEX = re.compile(r"[0-9a-f]{64}")
+_ENTRY_FILE = re.compile(r"([0-9a-f]{64})\.(npz|json|pkl)")
+_TEMP_FILE = re.compile(r"\.([0-9a-f]{64})\..*\.tmp")
+_LEGACY_TEMP = re.compile(r"tmp[0-9a-z_]{8}\.tmp")
+#: The metadata of an entry: field -> (types, check).
+ENTRY_SCHEMA = {
+    "format": (str, lambda v: v == _FORMAT),
+    "version": (int, lambda v: v == _VERSION),
+    "key": (str, lambda v: _HEX.fullmatch(v) is not None),
+    "stage": (str, lambda v: 0 < len(v) <= 64),
+    "size": (int, lambda v: v >= 0),
+    "sha256": (str, lambda v: _HEX.fullmatch(v) is not None),
+    "created": ((int, float), lambda v: v >= 0),
+    "code": (str, lambda v: len(v) <= 200),
+    "describe": (str, lambda v: len(v) <= 1000),
+}
 _CHUNK = 2**22
+_NOFOLLOW = getattr(os, "O_NOFOLLOW", 0)
 
 
 def default_dir() -> Path:
@@ -65,26 +114,41 @@ def parse_size(text) -> int:
     scale.update({"KI": 2**10, "MI": 2**20, "GI": 2**30, "TI": 2**40})
     if unit not in scale:
         raise ValueError(f"cache size {text!r}: unknown unit")
-    return int(float(m.group(1)) * scale[unit])
+    try:
+        return int(float(m.group(1)) * scale[unit])
+    except (ValueError, OverflowError):
+        raise ValueError(f"cache size {text!r}: use a number of bytes or e.g. 500MB") from None
 
 
-_CODE: str | None = None
+_VERSIONS: dict = {}
+
+
+def _hash_sources(folders, files=()) -> str:
+    from .. import __version__
+
+    root = Path(__file__).resolve().parents[1]
+    h = hashlib.sha256(__version__.encode())
+    paths = [p for f in folders for p in sorted((root / f).rglob("*.py"))]
+    for path in paths + [root / f for f in files]:
+        h.update(str(path.relative_to(root)).encode())
+        h.update(path.read_bytes())
+    return f"{__version__}+{h.hexdigest()[:16]}"
 
 
 def code_version() -> str:
-    """femrub's version and the SHA-256 of the model-building source (:data:`CODE_FOLDERS`)."""
-    global _CODE
-    if _CODE is None:
-        from .. import __version__
+    """femrub's version and the SHA-256 of the model-building source (:data:`CODE_FOLDERS`,
+    :data:`CODE_FILES`)."""
+    if "models" not in _VERSIONS:
+        _VERSIONS["models"] = _hash_sources(CODE_FOLDERS, CODE_FILES)
+    return _VERSIONS["models"]
 
-        root = Path(__file__).resolve().parents[1]
-        h = hashlib.sha256(__version__.encode())
-        for folder in CODE_FOLDERS:
-            for path in sorted((root / folder).glob("*.py")):
-                h.update(path.name.encode())
-                h.update(path.read_bytes())
-        _CODE = f"{__version__}+{h.hexdigest()[:16]}"
-    return _CODE
+
+def source_version() -> str:
+    """femrub's version and the SHA-256 of all of its source (what shapes a run's result:
+    the key of a sweep's points)."""
+    if "all" not in _VERSIONS:
+        _VERSIONS["all"] = _hash_sources(("",))
+    return _VERSIONS["all"]
 
 
 def _feed(h, x) -> None:
@@ -128,36 +192,77 @@ def content_key(*parts) -> str:
     return h.hexdigest()
 
 
-class _HashingWriter:
-    """A file wrapper that hashes what it writes (one pass to store and checksum)."""
-
-    def __init__(self, f):
-        self.f, self.h, self.size = f, hashlib.sha256(), 0
-
-    def write(self, b) -> int:
-        self.h.update(b)
-        self.size += memoryview(b).nbytes
-        return self.f.write(b)
+def check_key(key) -> str:
+    """``key`` when it is 64 lowercase hex digits (a :func:`content_key`), else ValueError."""
+    if not isinstance(key, str) or _HEX.fullmatch(key) is None:
+        raise ValueError(f"cache key {key!r} is not a SHA-256 hex digest")
+    return key
 
 
-def _file_hash(path: Path) -> str:
+def validate_entry(info, key: str) -> dict:
+    """``info`` when it is the metadata of entry ``key`` (:data:`ENTRY_SCHEMA`), else
+    ValueError naming the first field that is not."""
+    if not isinstance(info, dict):
+        raise ValueError(f"metadata is a {type(info).__name__}, not a mapping")
+    for field, (types, ok) in ENTRY_SCHEMA.items():
+        value = info.get(field)
+        if isinstance(value, bool) or not isinstance(value, types) or not ok(value):
+            raise ValueError(f"metadata field {field!r} is {value!r}")
+    if info["key"] != key:
+        raise ValueError(f"metadata names key {info['key'][:12]}, not {key[:12]}")
+    return info
+
+
+def _open_read(path: Path):
+    """``path`` opened for reading without following a symbolic link."""
+    return os.fdopen(os.open(path, os.O_RDONLY | _NOFOLLOW), "rb")
+
+
+def _file_hash(f) -> str:
     h = hashlib.sha256()
-    with open(path, "rb") as f:
-        while chunk := f.read(_CHUNK):
-            h.update(chunk)
+    while chunk := f.read(_CHUNK):
+        h.update(chunk)
     return h.hexdigest()
+
+
+def _read_npz(path: Path, sha256: str) -> tuple[bytes, dict]:
+    """The tree and arrays of an entry's data file, after its checksum."""
+    with _open_read(path) as f:
+        if _file_hash(f) != sha256:
+            raise ValueError("checksum mismatch")
+        f.seek(0)
+        with np.load(f, allow_pickle=False) as z:
+            arrays = {name: z[name] for name in z.files}
+    tree = arrays.pop("__tree__", None)
+    if tree is None or tree.dtype != np.uint8:
+        raise ValueError("no tree in the data file")
+    return tree.tobytes(), arrays
+
+
+def _write_beside(target: Path, write) -> None:
+    """``write(file)`` into a temporary file beside ``target``, renamed onto it."""
+    fd, tmp = tempfile.mkstemp(dir=target.parent, prefix=f".{target.stem}.", suffix=".tmp")
+    try:
+        with os.fdopen(fd, "wb") as f:
+            write(f)
+        os.replace(tmp, target)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
 
 
 class ModelCache:
     """The cache folder ``root`` (default :func:`default_dir`), at most ``limit`` bytes.
 
-    ``log``: callable for notices (a corrupt entry rebuilt, an entry too large to keep).
+    ``log``: callable for notices (a corrupt entry rebuilt, an entry too large to keep, a
+    folder that is not femrub's).
     """
 
     def __init__(self, root=None, limit: int = DEFAULT_LIMIT, log=None):
         self.root = Path(root) if root is not None else default_dir()
         self.limit = int(limit)
         self.log = log
+        self._refused = False
 
     def __repr__(self) -> str:
         return f"ModelCache({str(self.root)!r}, limit={self.limit})"
@@ -166,101 +271,148 @@ class ModelCache:
         return (ModelCache, (str(self.root), self.limit))
 
     def _paths(self, key: str) -> tuple[Path, Path]:
-        return self.root / f"{key}.pkl", self.root / f"{key}.json"
+        check_key(key)
+        return self.root / f"{key}.npz", self.root / f"{key}.json"
 
     def _notice(self, text: str) -> None:
         if self.log:
             self.log(text)
 
+    # -- the folder ---------------------------------------------------------------------------
+    def is_marked(self) -> bool:
+        """Whether the folder holds femrub's marker (a regular file, not a link)."""
+        path = self.root / MARKER
+        try:
+            with _open_read(path) as f:
+                return f.read(len(_TAG)).decode("ascii", "replace") == _TAG
+        except OSError:
+            return False
+
+    def _claim(self) -> bool:
+        """Make the folder femrub's (created, or empty but for femrub's own files) or say
+        why not."""
+        if self.is_marked():
+            return True
+        self.root.mkdir(parents=True, exist_ok=True)
+        foreign = [
+            p.name
+            for p in self.root.iterdir()
+            if not (_ENTRY_FILE.fullmatch(p.name) or _LEGACY_TEMP.fullmatch(p.name))
+        ]
+        if foreign:
+            if not self._refused:
+                self._notice(
+                    f"cache: {self.root} holds files femrub did not write ({foreign[0]}, ...) "
+                    f"and no {MARKER}; models are not cached there (give --cache-dir an empty "
+                    "or new folder)"
+                )
+            self._refused = True
+            return False
+        _write_beside(self.root / MARKER, lambda f: f.write(_MARKER_TEXT.encode()))
+        return True
+
     # -- entries ----------------------------------------------------------------------------
-    def load(self, key: str):
-        """The object stored under ``key``, or ``None`` (a miss, or a corrupt entry removed)."""
-        data, meta = self._paths(key)
+    def _read_meta(self, key: str) -> dict | None:
+        meta = self._paths(key)[1]
         try:
-            info = json.loads(meta.read_text())
-        except (OSError, ValueError):
+            with _open_read(meta) as f:
+                text = f.read(1_000_000)
+        except FileNotFoundError:
             return None
+        return validate_entry(json.loads(text), key)
+
+    def load(self, key: str):
+        """The object stored under ``key``, or ``None`` (a miss, or a malformed or corrupt
+        entry, removed with a notice)."""
+        data, meta = self._paths(key)
+        if not self.is_marked():
+            return None
+        stage = "?"
         try:
-            if _file_hash(data) != info["sha256"]:
-                raise ValueError("checksum mismatch")
-            with open(data, "rb") as f:
-                obj = pickle.load(f)
-        except Exception as exc:  # noqa: BLE001 - any unreadable entry is rebuilt
-            what = exc if isinstance(exc, ValueError) else type(exc).__name__
+            info = self._read_meta(key)
+            if info is None:
+                return None
+            stage = info["stage"]
+            obj = decode(*_read_npz(data, info["sha256"]))
+        except (OSError, ValueError, EOFError) as exc:
             self._notice(
-                f"cache: entry {key[:12]} ({info.get('stage', '?')}) is corrupt ({what}); "
-                "removed, rebuilding it"
+                f"cache: entry {key[:12]} ({stage}) is corrupt or malformed ({exc}); "
+                "skipped and removed, rebuilding it"
             )
             self._remove(key)
             return None
         try:
-            os.utime(meta)  # least recently used order
+            os.utime(meta, follow_symlinks=False)  # least recently used order
         except OSError:
             pass
         return obj
 
     def store(self, key: str, obj, *, stage: str, describe: str = "") -> bool:
-        """Store ``obj`` under ``key``; ``False`` when it cannot be (unpicklable, too large,
-        or the folder not writable: the run goes on without the cache)."""
+        """Store ``obj`` under ``key``; ``False`` when it cannot be (not data, too large,
+        the folder not femrub's or not writable: the run goes on without the cache)."""
         data, meta = self._paths(key)
-        tmp = None
         try:
-            self.root.mkdir(parents=True, exist_ok=True)
-            fd, tmp = tempfile.mkstemp(dir=self.root, suffix=".tmp")
-            with os.fdopen(fd, "wb") as f:
-                w = _HashingWriter(f)
-                pickle.dump(obj, w, protocol=5)
-            if w.size > self.limit:
-                self._notice(
-                    f"cache: {stage} entry of {w.size / 1e6:.0f} MB exceeds the cache size "
-                    f"{self.limit / 1e6:.0f} MB; not kept"
-                )
-                os.unlink(tmp)
+            tree, arrays = encode(obj)
+        except TypeError as exc:
+            self._notice(f"cache: {stage} entry not stored ({exc})")
+            return False
+        size = len(tree) + sum(a.nbytes for a in arrays.values())
+        if size > self.limit:
+            self._notice(
+                f"cache: {stage} entry of {size / 1e6:.0f} MB exceeds the cache size "
+                f"{self.limit / 1e6:.0f} MB; not kept"
+            )
+            return False
+        arrays["__tree__"] = np.frombuffer(tree, dtype=np.uint8)
+        try:
+            if not self._claim():
                 return False
-            os.replace(tmp, data)
-            tmp = None
+            _write_beside(data, lambda f: np.savez(f, **arrays))
+            with _open_read(data) as f:
+                digest = _file_hash(f)
             info = {
+                "format": _FORMAT,
+                "version": _VERSION,
                 "key": key,
                 "stage": stage,
-                "size": w.size,
-                "sha256": w.h.hexdigest(),
+                "size": data.lstat().st_size,
+                "sha256": digest,
                 "created": time.time(),
                 "code": code_version(),
-                "describe": describe,
+                "describe": describe[:1000],
             }
-            fd, tmp = tempfile.mkstemp(dir=self.root, suffix=".tmp")
-            with os.fdopen(fd, "w") as f:
-                json.dump(info, f)
-            os.replace(tmp, meta)
-            tmp = None
-        except (OSError, pickle.PicklingError, TypeError, AttributeError) as exc:
+            _write_beside(meta, lambda f: f.write(json.dumps(info).encode()))
+        except OSError as exc:
             self._notice(f"cache: {stage} entry not stored ({type(exc).__name__}: {exc})")
             return False
-        finally:
-            if tmp is not None:
-                Path(tmp).unlink(missing_ok=True)
         self._evict(keep=key)
         return True
 
     def _remove(self, key: str) -> int:
         freed = 0
-        for p in self._paths(key):
+        for p in (*self._paths(key), self.root / f"{check_key(key)}.pkl"):
             try:
-                freed += p.stat().st_size
+                freed += p.lstat().st_size
                 p.unlink()
             except OSError:
                 pass
         return freed
 
     def entries(self) -> list[dict]:
-        """Metadata of every entry, least recently used first (``used``: last access time)."""
+        """Metadata of every valid entry, least recently used first (``used``: last access
+        time); a malformed metadata file is skipped."""
         out = []
-        if not self.root.is_dir():
+        if not self.root.is_dir() or not self.is_marked():
             return out
         for meta in self.root.glob("*.json"):
+            key = meta.stem
+            if _HEX.fullmatch(key) is None:
+                continue
             try:
-                info = json.loads(meta.read_text())
-                info["used"] = meta.stat().st_mtime
+                info = self._read_meta(key)
+                if info is None:
+                    continue
+                info["used"] = meta.lstat().st_mtime
             except (OSError, ValueError):
                 continue
             out.append(info)
@@ -268,39 +420,50 @@ class ModelCache:
 
     def _evict(self, keep: str | None = None) -> None:
         entries = self.entries()
-        total = sum(e.get("size", 0) for e in entries)
+        total = sum(e["size"] for e in entries)
         for e in entries:
             if total <= self.limit:
                 break
             if e["key"] != keep:
                 self._remove(e["key"])
-                total -= e.get("size", 0)
+                total -= e["size"]
 
     def clear(self) -> tuple[int, int]:
-        """Remove every entry (and stray temporary files); return ``(entries, bytes)``."""
-        n = freed = 0
-        for e in self.entries():
-            freed += self._remove(e["key"])
-            n += 1
-        if self.root.is_dir():
-            for p in list(self.root.glob("*.pkl")) + list(self.root.glob("*.tmp")):
-                freed += p.stat().st_size
-                p.unlink(missing_ok=True)
-        return n, freed
+        """Remove every entry femrub wrote and its temporaries; return ``(entries, bytes)``
+        actually removed. A folder without femrub's marker is left alone (``(0, 0)``)."""
+        if not self.root.is_dir() or not self.is_marked():
+            if self.root.exists():
+                self._notice(f"cache: {self.root} has no {MARKER}: not femrub's, nothing removed")
+            return 0, 0
+        keys, freed = set(), 0
+        for p in self.root.iterdir():
+            m = _ENTRY_FILE.fullmatch(p.name) or _TEMP_FILE.fullmatch(p.name)
+            if m is None:
+                continue
+            try:
+                size = p.lstat().st_size
+                p.unlink()
+            except OSError:
+                continue
+            freed += size
+            if not p.name.endswith(".tmp"):
+                keys.add(m.group(1))
+        return len(keys), freed
 
     def info(self) -> dict:
         """Folder, limit, number of entries and bytes, per stage."""
         entries = self.entries()
         stages: dict[str, dict] = {}
         for e in entries:
-            s = stages.setdefault(e.get("stage", "?"), {"entries": 0, "bytes": 0})
+            s = stages.setdefault(e["stage"], {"entries": 0, "bytes": 0})
             s["entries"] += 1
-            s["bytes"] += e.get("size", 0)
+            s["bytes"] += e["size"]
         return {
             "root": str(self.root),
+            "marked": self.is_marked(),
             "limit": self.limit,
             "entries": len(entries),
-            "bytes": sum(e.get("size", 0) for e in entries),
+            "bytes": sum(e["size"] for e in entries),
             "stages": stages,
             "code": code_version(),
         }

@@ -4,9 +4,9 @@
 cache it only calls them:
 
 * ``assemble``: the Eq. (2) blocks (:func:`femrub.fem.discretisation.assemble`) without
-  modal damping; key: the mesh itself (vertices, cells, element, clamped dofs: the content
-  of the mesh file as read) and every argument of the assembly (material, lumping,
-  coupling, Rayleigh coefficients, ...);
+  modal damping; key: the mesh itself (vertices, cells, curved mid-side node positions,
+  element, clamped dofs: the content of the mesh file as read) and every argument of the
+  assembly (material, lumping, coupling, Rayleigh coefficients, ...);
 * ``damping``: the modal Rayleigh damping (:func:`femrub.reduction.modal_damping.modal_rayleigh`),
   set once the contacts' boundary is known, its frequencies taken through the interior
   factorisation that the reduction then reuses (``reduce`` hands it on); key: the assembly
@@ -145,12 +145,9 @@ class Stages:
         """:func:`~femrub.fem.discretisation.assemble` of ``disc``, through the cache."""
         if self.cache is None:
             return assemble(disc, material, **kw)
-        mesh = disc.mesh
         key = content_key(
             "assembly",
-            type(mesh).__name__,
-            mesh.p,
-            mesh.t,
+            *_mesh_parts(disc),
             disc.order,
             type(disc.basis_u.elem).__name__,
             type(disc.basis_t.elem).__name__,
@@ -210,12 +207,9 @@ class Stages:
         """:func:`~femrub.fem.prestress.centrifugal_prestress` of ``disc``, through the cache."""
         if self.cache is None:
             return centrifugal_prestress(disc, material, omega, method, log=self.log)
-        mesh = disc.mesh
         key = content_key(
             "prestress",
-            type(mesh).__name__,
-            mesh.p,
-            mesh.t,
+            *_mesh_parts(disc),
             disc.order,
             type(disc.basis_u.elem).__name__,
             disc.fixed_u,
@@ -333,6 +327,15 @@ class Stages:
             f = natural_frequencies(model, k)
             self._keep("frequencies", key, np.asarray(f), f"{k} frequencies")
         return f
+
+
+def _mesh_parts(disc) -> tuple:
+    """What identifies a discretisation's mesh: its kind, vertices, cells and the curved
+    position of every edge's midpoint read from the file (mid-side nodes of quadratic
+    elements, ``blade.info["edge_midpoints"]``: they curve the P2 cells)."""
+    mesh = disc.mesh
+    midpoints = getattr(disc.blade, "info", {}).get("edge_midpoints")
+    return type(mesh).__name__, mesh.p, mesh.t, midpoints
 
 
 def _say_phases(say, timings: dict) -> None:

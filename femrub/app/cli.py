@@ -9,7 +9,9 @@ everything; ``femrub cache info`` and ``femrub cache clear`` inspect and empty i
 Errors in the input or the output folder are reported on one line (``femrub: error: ...``)
 with exit status 2, never as a traceback (set ``FEMRUB_DEBUG=1`` to see one); an
 interrupted run (Ctrl-C or SIGTERM, any command) keeps what it wrote, says where, and exits
-with status 130; a run that fails keeps its partial results and exits with status 1. The
+with status 130 (129 after SIGHUP); a run that fails, or a fault of the machine (a full
+disk, a read error), keeps its partial results and exits with status 1 and one line naming
+the file and the fix. The
 default output folder is made from the scene name with anything but letters, digits and
 ``_.-`` replaced (it is always inside the working folder).
 """
@@ -49,7 +51,9 @@ def _paper(args) -> int:
             f"{out / 'summary.json'} (status interrupted); rerun with --overwrite to start again",
             file=sys.stderr,
         )
-        return 130
+        from ..output.interrupts import exit_status
+
+        return exit_status()
     if not args.quiet:
         bad = [r for r in rows if r["status"] != "ok"]
         for r in bad:
@@ -85,13 +89,14 @@ def _cache(args, log=None):
 
 
 def _cache_command(args) -> int:
-    cache = _cache(args)
+    cache = _cache(args, log=lambda text: print(f"femrub {text}"))
     if args.cache_command == "clear":
         n, freed = cache.clear()
         print(f"femrub cache: removed {n} entries ({freed / 1e6:.1f} MB) from {cache.root}")
         return 0
     info = cache.info()
-    print(f"cache folder  {info['root']}")
+    marked = "" if info["marked"] else " (no femrub entries: not a femrub cache folder)"
+    print(f"cache folder  {info['root']}{marked}")
     print(
         f"entries       {info['entries']} ({info['bytes'] / 1e6:.1f} MB of "
         f"{info['limit'] / 1e6:.0f} MB)"
@@ -104,8 +109,11 @@ def _cache_command(args) -> int:
 
 def _load(args):
     from ..scene import load_scene
+    from ..scene.run_checks import check_run
 
-    return load_scene(args.scene, _changes(args))
+    scene = load_scene(args.scene, _changes(args))
+    check_run(scene)
+    return scene
 
 
 def _log(args):
@@ -114,6 +122,7 @@ def _log(args):
 
 def _run(args) -> int:
     from ..output.folder import safe_name
+    from ..output.interrupts import exit_status
     from .run import run_scene
 
     scene = _load(args)
@@ -142,7 +151,7 @@ def _run(args) -> int:
             f"results kept in {where}; rerun the same command to start again",
             file=sys.stderr,
         )
-        return 130
+        return exit_status()
     if res.status == "failed":
         print(
             f"femrub: run failed at t = {res.t[-1]:.6g} s: {res.message}; partial results "
@@ -395,22 +404,24 @@ def main(argv=None) -> int:
     if not getattr(args, "func", None):
         parser.print_help()
         return 2
-    from ..output.interrupts import interruptible
+    from ..output.interrupts import exit_status, interruptible
 
     try:
         with interruptible():
             return int(args.func(args) or 0)
     except KeyboardInterrupt:
         print("femrub: interrupted; files written so far are kept", file=sys.stderr)
-        return 130
+        return exit_status()
     except (ValueError, FileNotFoundError, FileExistsError, KeyError) as exc:
         print(f"femrub: error: {_one_line(exc)}", file=sys.stderr)
         return 2
-    except OSError as exc:  # e.g. a folder that became unwritable: one line, not a traceback
+    except OSError as exc:  # a full disk, a read error: one line naming the file, status 1
         if os.environ.get("FEMRUB_DEBUG"):
             raise
-        print(f"femrub: error: {type(exc).__name__}: {_one_line(exc)}", file=sys.stderr)
-        return 2
+        from ..output.safe_write import describe_os_error
+
+        print(f"femrub: error: {_one_line(describe_os_error(exc))}", file=sys.stderr)
+        return 1
     except Exception as exc:
         if os.environ.get("FEMRUB_DEBUG"):
             raise

@@ -17,19 +17,30 @@ import json
 import math
 from pathlib import Path
 
-from ..output.folder import FINISHED, claim, folder_status
+from ..output.folder import FINISHED, FolderError, claim, folder_status
+from ..output.jsonfile import write_json
 from ..output.run_folder import run_to_folder
+from ..output.safe_write import describe_os_error, write_atomic
+from ..scene.run_checks import check_run
 from ..scene.scene import Scene
+from .cache import source_version
+from .inputs import inputs_digest
 from .simulation import build
 
 __all__ = ["FINISHED", "folder_status", "merge_time", "run_scene", "scene_hash", "versions"]
 
 
 def scene_hash(scene: Scene) -> str:
-    """SHA-256 of the resolved scene (SI values, defaults, absolute paths; name excluded)."""
+    """SHA-256 of what shapes a run's result: the resolved scene (SI values, defaults,
+    absolute paths; name excluded), the bytes of every file it names
+    (:func:`~femrub.app.inputs.inputs_digest`: mesh, includes, sections) and femrub's
+    source (:func:`~femrub.app.cache.source_version`)."""
     data = {k: v for k, v in _resolved(scene).data.items() if k not in ("name", "description")}
     text = json.dumps(data, sort_keys=True, default=str)
-    return hashlib.sha256(text.encode()).hexdigest()
+    h = hashlib.sha256(text.encode())
+    h.update(inputs_digest(scene).encode())
+    h.update(source_version().encode())
+    return h.hexdigest()
 
 
 def merge_time(scene: Scene) -> float | None:
@@ -114,16 +125,33 @@ def run_scene(
     cache : a :class:`~femrub.app.cache.ModelCache` of assembled and reduced models.
     """
     out = Path(out)
+    check_run(scene)
+    _check_not_the_scene(scene, out)
     with claim(out, "run", overwrite=overwrite):
         return _run_claimed(scene, out, progress, log, on_built, modes, cache)
 
 
+def _check_not_the_scene(scene: Scene, out: Path) -> None:
+    """Refuse an output folder whose ``scene.toml`` is the scene file being run."""
+    source = Path(scene.source)
+    dump = out / "scene.toml"
+    if source.is_file() and dump.exists() and dump.resolve() == source.resolve():
+        raise FolderError(
+            f"{dump} is the scene being run; femrub would replace it with its own dump: "
+            "copy it elsewhere or use another -o"
+        )
+
+
 def _run_claimed(scene, out, progress, log, on_built, modes, cache):
-    built = build(scene, log=log, modes=modes, cache=cache)
+    try:
+        built = build(scene, log=log, modes=modes, cache=cache)
+    except OSError as exc:  # a read error: the folder says so too
+        write_json(out / "summary.json", {"status": "failed", "message": describe_os_error(exc)})
+        raise
     if on_built is not None:
         on_built(built)
-    (out / "scene.toml").write_text(_resolved(scene).dumps())
-    (out / "explain.txt").write_text(built.explain() + "\n")
+    write_atomic(out / "scene.toml", _resolved(scene).dumps())
+    write_atomic(out / "explain.txt", built.explain() + "\n")
     o = scene["outputs"]
     stride = o["vtk_stride"] if built.fields is not None else 0
     inputs = {

@@ -35,6 +35,15 @@ def bare_stepper(scene, model, h=None):
     try:
         return make_stepper(s["name"], model, s["h"] if h is None else h, **scheme_options(scene))
     except ValueError as exc:
+        if "Delassus" in str(exc):
+            c = scene["contact"]
+            where = c.get("nodes") if c.get("nodes") is not None else c["group"]
+            raise SceneError(
+                f"contact ({where!r}): the contact cannot take an impulse (its Delassus "
+                "operator is not positive): a contact point that does not move (clamped, or "
+                "on dofs the reduction removed); choose free contact nodes or "
+                "reduction.method = 'none'"
+            ) from None
         raise SceneError(f"scheme ({s['name']}): {exc}") from None
 
 

@@ -33,6 +33,7 @@ from ..contact.heat import heat_coefficients
 from ..contact.points import locate_contacts
 from ..contact.reach import contact_reach, normal_deflection
 from ..model.rub import rub_model, tip_load
+from ..scene.run_checks import check_run
 from ..scene.spec import SceneError, fail
 from . import translate as tr
 from .blade import load_blade
@@ -166,6 +167,7 @@ class _Clock:
 
 def _build(scene, log, modes, stages, with_stepper=True) -> Simulation:
     scene.check_files()
+    check_run(scene)
     if jit.compile_in_background() and log:  # the first run on this machine: overlapped
         log("compiling the contact kernels in a background process (first run here) ...")
     clock = _Clock(log)

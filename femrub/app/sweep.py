@@ -29,7 +29,9 @@ import numpy as np
 
 from ..output.folder import FINISHED, FolderError, claim, folder_status
 from ..output.jsonfile import write_json
+from ..output.safe_write import atomic_file, write_atomic
 from ..scene import SceneError, parse_value, resolve_key
+from ..scene.run_checks import check_run
 from ..scene.scene import Scene
 from .cached import keep_assemblies
 from .run import run_scene, scene_hash
@@ -63,7 +65,28 @@ def parse_param(text: str) -> tuple[str, list]:
         values = [float(f"{a + i * step:.12g}") for i in range(n)]
         unit = m.group(4)
         return key, [f"{v:g} {unit}" for v in values] if unit else values
-    return key, [parse_value(v.strip()) for v in spec.split(",") if v.strip()]
+    return key, [parse_value(v) for v in _with_unit([v.strip() for v in spec.split(",")], text)]
+
+
+_UNIT = re.compile(r"^([-+]?[0-9.]+(?:[eE][-+]?[0-9]+)?)\s*([A-Za-zµμ/^][A-Za-z0-9µμ/^]*)?$")
+
+
+def _with_unit(items: list[str], text: str) -> list[str]:
+    """``["1000", "2000rpm"]`` -> ``["1000 rpm", "2000 rpm"]``: a unit written once, after
+    the last value, applies to every bare number of the list (as in ``START:STOP:STEPunit``).
+    """
+    if any(not v for v in items):
+        raise SceneError(f"--param {text!r}: an empty value between commas")
+    parts = [_UNIT.match(v) for v in items]
+    unit = parts[-1].group(2) if parts[-1] else None
+    if unit is None:
+        if any(m and m.group(2) for m in parts):
+            raise SceneError(
+                f"--param {text!r}: a unit on some values and not on the last; write it after "
+                "the last value (applies to all) or after each value"
+            )
+        return items
+    return [f"{m.group(1)} {unit}" if m and m.group(2) is None else v for m, v in zip(parts, items)]
 
 
 def grid(params: list[tuple[str, list]]) -> list[dict]:
@@ -192,9 +215,17 @@ def run_sweep(
         isinstance(workers, bool) or not isinstance(workers, int) or workers < 1
     ):
         raise FolderError(f"--workers {workers!r}: give at least 1 worker process")
-    points = grid(params)
     keys = [k for k, _ in params]
+    twice = sorted({k for k in keys if keys.count(k) > 1})
+    if twice:
+        raise SceneError(
+            f"--param {twice[0]} is given twice; give each key once with all its values "
+            f"(--param {twice[0].rsplit('.', 1)[-1]}=A,B,C)"
+        )
+    points = grid(params)
     scenes = [scene.with_changes(p) for p in points]  # every point valid before any work
+    for s in scenes:
+        check_run(s)
     with claim(out, "sweep", check_result=False):
         return _sweep(
             scene,
@@ -223,7 +254,7 @@ def _sweep(
         "scene_sha256": hashes,
     }
     write_json(out / "sweep.json", doc)
-    (out / "scene.toml").write_text(scene.dumps())
+    write_atomic(out / "scene.toml", scene.dumps())
     rows = []
     for i, (p, digest) in enumerate(zip(points, hashes)):
         folder = out / "runs" / _point_name(i, p, digest)
@@ -339,7 +370,7 @@ def _write_csv(rows, keys, path) -> None:
         "rms_tip_displacement_m",
         "max_wear_depth_m",
     ]
-    with open(path, "w", newline="") as fh:
+    with atomic_file(path, "w") as fh:
         w = csv.writer(fh)
         w.writerow(cols)
         for r in rows:

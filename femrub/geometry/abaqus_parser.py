@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import re
+import stat
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -77,20 +78,35 @@ def _params(line: str) -> tuple[str, dict[str, str]]:
     return parts[0].upper(), params
 
 
+#: most members one GENERATE line may give (a deck's node count is far below)
+MAX_GENERATED = 100_000_000
+
+
+def _generated(line: str, where: str) -> range:
+    """The members of a ``first, last[, step]`` line of a GENERATE set."""
+    try:
+        v = [int(float(tok)) for tok in line.split(",") if tok.strip()]
+    except (ValueError, OverflowError):
+        v = []
+    if len(v) not in (2, 3) or (len(v) == 3 and v[2] < 1):
+        raise GeometryError(
+            f"GENERATE set at {where} needs 'first, last[, step >= 1]' lines, got {line!r}."
+        )
+    first, last, step = (v + [1])[:3]
+    count = max((last - first) // step + 1, 0)  # Python integers: no overflow
+    if count > MAX_GENERATED:
+        raise GeometryError(
+            f"GENERATE set at {where} gives {count:.3g} members (at most "
+            f"{MAX_GENERATED:.0e}): check the line {line!r}."
+        )
+    return range(first, last + 1, step)
+
+
 def _set_members(model: AbaqusModel, sets, lines, generate, where) -> list[int]:
     out: list[int] = []
     if generate:
         for line in lines:
-            try:
-                v = [int(float(tok)) for tok in line.split(",") if tok.strip()]
-            except ValueError:
-                v = []
-            if len(v) not in (2, 3):
-                raise GeometryError(
-                    f"GENERATE set at {where} needs 'first, last[, step]' lines, got {line!r}."
-                )
-            first, last, step = (v + [1])[:3]
-            out.extend(range(first, last + 1, step))
+            out.extend(_generated(line, where))
         return out
     for tok in (tok.strip() for line in lines for tok in line.split(",")):
         if not tok:
@@ -107,6 +123,30 @@ def _set_members(model: AbaqusModel, sets, lines, generate, where) -> list[int]:
     return out
 
 
+#: largest deck file read (bytes): a bigger one, or a device (``/dev/zero``), is refused
+MAX_DECK_BYTES = 4 * 2**30
+
+
+def _check_size(path: Path) -> None:
+    """Refuse a deck file that is not a regular file or exceeds :data:`MAX_DECK_BYTES`."""
+    try:
+        st = path.stat()
+    except OSError as exc:
+        raise GeometryError(
+            f"Cannot read Abaqus/CalculiX file {str(path)!r}: {exc.strerror}; check the path."
+        ) from None
+    if not stat.S_ISREG(st.st_mode):
+        raise GeometryError(
+            f"Abaqus/CalculiX file {str(path)!r} is not a regular file (a device or a folder); "
+            "give the path of a deck file."
+        )
+    if st.st_size > MAX_DECK_BYTES:
+        raise GeometryError(
+            f"Abaqus/CalculiX file {str(path)!r} holds {st.st_size / 2**30:.1f} GiB, more than "
+            f"the {MAX_DECK_BYTES / 2**30:.0f} GiB read; check the *INCLUDE or split the mesh."
+        )
+
+
 class _Parser:
     def __init__(self) -> None:
         self.model = AbaqusModel()
@@ -116,6 +156,7 @@ class _Parser:
     def parse(self, path: Path, depth: int = 0) -> None:
         if depth > 10:
             raise GeometryError(f"*INCLUDE nesting deeper than 10 levels at {str(path)!r}.")
+        _check_size(path)
         try:
             text = path.read_text(encoding="utf-8", errors="strict")
         except (OSError, UnicodeDecodeError) as exc:
@@ -152,26 +193,31 @@ class _Parser:
             self._nodes(params, data, where)
         elif keyword == "ELEMENT":
             self._elements(params, data, where)
-        elif keyword == "NSET":
-            name = params.get("NSET") or ""
-            members = _set_members(self.model, self.model.nsets, data, "GENERATE" in params, where)
-            self.model.nsets.setdefault(name, []).extend(members)
-        elif keyword == "ELSET":
-            name = params.get("ELSET") or ""
-            members = _set_members(self.model, self.model.elsets, data, "GENERATE" in params, where)
-            self.model.elsets.setdefault(name, []).extend(members)
+        elif keyword in ("NSET", "ELSET"):
+            self._set(keyword, params, data, where)
         elif keyword == "BOUNDARY":
-            for line in data:
-                first = line.split(",")[0].strip()
-                try:
-                    self.model.boundary.append(int(first))
-                except ValueError:
-                    members = self.model.find_set(self.model.nsets, first)
-                    if members is None:
-                        raise GeometryError(
-                            f"*BOUNDARY at {where} uses undefined node set {first!r}."
-                        ) from None
-                    self.model.boundary.extend(members)
+            self._boundary(data, where)
+
+    def _set(self, keyword, params, data, where) -> None:
+        """``*NSET`` or ``*ELSET``: members appended to the named set."""
+        sets = self.model.nsets if keyword == "NSET" else self.model.elsets
+        name = params.get(keyword) or ""
+        members = _set_members(self.model, sets, data, "GENERATE" in params, where)
+        sets.setdefault(name, []).extend(members)
+
+    def _boundary(self, data, where) -> None:
+        """``*BOUNDARY``: the clamped nodes (numbers or node-set names)."""
+        for line in data:
+            first = line.split(",")[0].strip()
+            try:
+                self.model.boundary.append(int(first))
+            except ValueError:
+                members = self.model.find_set(self.model.nsets, first)
+                if members is None:
+                    raise GeometryError(
+                        f"*BOUNDARY at {where} uses undefined node set {first!r}."
+                    ) from None
+                self.model.boundary.extend(members)
 
     def _material(self, keyword, params, data, where) -> None:
         if keyword == "MATERIAL":
@@ -201,8 +247,13 @@ class _Parser:
             xyz = np.zeros((3, len(rows)))
             for k, r in enumerate(rows):
                 xyz[: len(r) - 1, k] = r[1:4]
-        except (ValueError, IndexError) as exc:
+        except (ValueError, IndexError, OverflowError) as exc:
             raise GeometryError(f"Malformed *NODE line in block at {where}: {exc}.") from exc
+        if not np.isfinite(xyz).all():
+            k = int(np.flatnonzero(~np.isfinite(xyz).all(axis=0))[0])
+            raise GeometryError(
+                f"*NODE {ids[k]} in block at {where} has a non-finite coordinate; fix the deck."
+            )
         self._node_ids.append(ids)
         self._coords.append(xyz)
         if params.get("NSET"):
@@ -220,7 +271,7 @@ class _Parser:
             values = np.array(
                 [int(v) for line in data for v in line.split(",") if v.strip()], dtype=np.int64
             )
-        except ValueError as exc:
+        except (ValueError, OverflowError) as exc:
             raise GeometryError(f"Malformed *ELEMENT data in block at {where}: {exc}.") from exc
         if values.size % (n_nodes + 1):
             raise GeometryError(

@@ -143,6 +143,35 @@ def deck_material(model: AbaqusModel, length_unit: str, elset: str | None = None
     return {k: v * factors[k] for k, v in mat.items()}
 
 
+def _elset_members(model: AbaqusModel, elset: str | None):
+    """Element numbers of ``elset`` (``None``: every element)."""
+    if elset is None:
+        return None
+    members = model.find_set(model.elsets, elset)
+    if members is None:
+        available = ", ".join(model.elsets) or "none"
+        raise GeometryError(
+            f"Element set {elset!r} not found (available ELSETs: {available}); fix elset=."
+        )
+    return np.asarray(members, dtype=np.int64)
+
+
+def _tetrahedra(model: AbaqusModel, table, keep) -> tuple[np.ndarray, dict]:
+    """The (4, n) tetrahedra (columns of the node table) of the deck's solid elements
+    (those of ``keep`` only, when given) and the element count per type."""
+    tets, counts = [], {}
+    for block in model.blocks:
+        nodes = block.nodes if keep is None else block.nodes[:, np.isin(block.ids, keep)]
+        kind, n_corner = SOLID_TYPES[block.nodes.shape[0]]
+        corner_ids = nodes[:n_corner]
+        cols = _columns(table, corner_ids.ravel(), f"*ELEMENT, TYPE={block.etype}").reshape(
+            corner_ids.shape
+        )
+        tets.append(split_into_tets(kind, cols, global_ids=corner_ids))
+        counts[block.etype] = counts.get(block.etype, 0) + nodes.shape[1]
+    return np.hstack(tets), counts
+
+
 def read_abaqus(
     path: str | Path,
     length_unit: str,
@@ -199,26 +228,8 @@ def read_abaqus(
     model = parse_abaqus(path)
     table = _lookup(model)
     points = model.coords * scale
-    keep = None
-    if elset is not None:
-        members = model.find_set(model.elsets, elset)
-        if members is None:
-            available = ", ".join(model.elsets) or "none"
-            raise GeometryError(
-                f"Element set {elset!r} not found (available ELSETs: {available}); fix elset=."
-            )
-        keep = np.asarray(members, dtype=np.int64)
-    tets, counts = [], {}
-    for block in model.blocks:
-        nodes = block.nodes if keep is None else block.nodes[:, np.isin(block.ids, keep)]
-        kind, n_corner = SOLID_TYPES[block.nodes.shape[0]]
-        corner_ids = nodes[:n_corner]
-        cols = _columns(table, corner_ids.ravel(), f"*ELEMENT, TYPE={block.etype}").reshape(
-            corner_ids.shape
-        )
-        tets.append(split_into_tets(kind, cols, global_ids=corner_ids))
-        counts[block.etype] = counts.get(block.etype, 0) + nodes.shape[1]
-    p, t, old_to_new = compact_vertices(points, np.hstack(tets))
+    tets, counts = _tetrahedra(model, table, _elset_members(model, elset))
+    p, t, old_to_new = compact_vertices(points, tets)
     t = orient_positive(p, t)
 
     root_ids = model.boundary if root is None else _named_set(model, root, "root")

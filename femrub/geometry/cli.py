@@ -156,6 +156,47 @@ def _read_kwargs(args) -> dict:
     return kw
 
 
+#: largest number of tetrahedra ``femrub mesh`` makes (as the scene path: MAX_ELEMENTS)
+MAX_TETS = 2_000_000
+# tetrahedra per h³ of volume in a gmsh mesh of size h (regular tetrahedra: 6 √2)
+_TETS_PER_H3 = 8.5
+
+
+def estimate_tets(args) -> float | None:
+    """Tetrahedra a box or NACA blade of size ``--h`` gets (``None``: cannot estimate)."""
+    h = getattr(args, "h", None)
+    if args.mesh_kind == "box":
+        dims = (args.span, args.chord, args.thickness)
+        if min(dims) <= 0:
+            return None  # the builder names the length at fault
+        h = h or args.thickness
+        t = min(args.thickness, h)  # at least one element through the thickness
+        return _TETS_PER_H3 * (args.span / h) * (args.chord / h) * (args.thickness / t)
+    code = str(getattr(args, "code", ""))
+    if args.mesh_kind == "naca" and h and len(code) == 4 and code.isdigit():
+        ratio = int(code[2:]) / 100.0
+        if min(ratio, args.span, args.root_chord, args.tip_chord) <= 0:
+            return None
+        t = min(ratio * args.root_chord, h)
+        area = 0.685 * ratio * 0.5 * (args.root_chord**2 + args.tip_chord**2)
+        return _TETS_PER_H3 * (args.span / h) * (area / h) / t
+    return None
+
+
+def _check_size(args) -> None:
+    """Refuse, before meshing, a size ``--h`` that gives more than :data:`MAX_TETS`."""
+    h = getattr(args, "h", None)
+    if h is not None and not h > 0:
+        raise GeometryError(f"--h {h!r}: give a positive element size in metres")
+    n = estimate_tets(args)
+    if n is not None and n > MAX_TETS:
+        what = f"--h {h}" if h else f"--thickness {args.thickness} (the default --h)"
+        raise GeometryError(
+            f"{what}: gives about {min(n, 1e300):.2g} tetrahedra (at most {MAX_TETS:.0e}, "
+            "estimated before meshing); raise --h"
+        )
+
+
 def run_mesh(args: argparse.Namespace) -> int:
     """Execute the ``mesh`` sub-command; print a summary; return an exit code.
 
@@ -168,6 +209,7 @@ def run_mesh(args: argparse.Namespace) -> int:
 
     start = time.perf_counter()
     try:
+        _check_size(args)
         if args.mesh_kind == "box":
             blade = box_blade(
                 args.span,

@@ -16,6 +16,30 @@ from .sections import read_section, section_files, split_section
 __all__ = ["sections_blade"]
 
 
+#: largest number of tetrahedra a lofted blade may get (as a box or NACA blade)
+MAX_TETS = 2_000_000
+# tetrahedra per h³ of volume in a gmsh mesh of size h (regular tetrahedra: 6 √2)
+_TETS_PER_H3 = 8.5
+
+
+def estimate_section_tets(sections: list[np.ndarray], h: float) -> float:
+    """Tetrahedra of a blade lofted through the closed ``sections`` ((3, m) points, m) at
+    element size ``h`` (m): its volume (section areas times the distances between their
+    centroids) over ``h² min(t, h)``, ``t`` the thinnest section's area over its chord."""
+    areas, centres, thin = [], [], np.inf
+    for pts in sections:
+        nxt = np.roll(pts, -1, axis=1)
+        area = 0.5 * float(np.linalg.norm(np.cross(pts.T, nxt.T).sum(axis=0)))
+        chord = float(np.linalg.norm(np.ptp(pts, axis=1))) or 1.0
+        areas.append(area)
+        centres.append(pts.mean(axis=1))
+        thin = min(thin, area / chord)
+    gaps = np.linalg.norm(np.diff(np.array(centres), axis=0), axis=1)
+    volume = float(np.sum(0.5 * (np.array(areas[1:]) + np.array(areas[:-1])) * gaps))
+    t = min(thin, h) if thin > 0 else h
+    return _TETS_PER_H3 * (volume / h) / h / t
+
+
 def sections_blade(
     paths: Sequence[str | Path] | str | Path,
     *,
@@ -69,17 +93,24 @@ def sections_blade(
     BladeMesh
         Mesh in metres with node sets ``root``, ``tip``, ``contact``.
     """
-    sections = []
+    sections, raw = [], []
     files = section_files(paths, pattern)
     for path in files:
         try:
-            sections.append(split_section(read_section(path, length_unit)))
+            raw.append(read_section(path, length_unit))
+            sections.append(split_section(raw[-1]))
         except GeometryError as exc:
             raise GeometryError(
                 f"Section file {str(path)!r}: {exc} Pass pattern=... or only airfoil section files."
             ) from exc
     tip_chord = float(np.linalg.norm(sections[-1][0][:, -1] - sections[-1][0][:, 0]))
     size = MeshSize(tip_chord / 12 if h is None else h, h_min)
+    n = estimate_section_tets(raw, size.h)
+    if n > MAX_TETS:
+        raise GeometryError(
+            f"h = {size.h:.4g} m gives about {min(n, 1e300):.2g} tetrahedra between these "
+            f"sections (at most {MAX_TETS:.0e}, estimated before meshing); raise h"
+        )
     names = [f.name for f in files]
     source = f"sections_blade({', '.join(names)}, unit={length_unit}, h={size.h:.4g})"
     return loft_blade(

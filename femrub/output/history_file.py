@@ -24,6 +24,7 @@ import numpy as np
 
 from .csv_rows import write_csv_rows
 from .results import UNITS, csv_header, flatten_columns
+from .safe_write import naming, open_nofollow
 
 __all__ = ["HistoryCSV"]
 
@@ -50,13 +51,43 @@ class HistoryCSV:
         self._tail = None  # the last row received, unless written
         self._t_written = 0.0  # time of the last row written
         self._carry = None  # impulses since the last row written, through the last received
+        self.error: OSError | None = None  # the write error that stopped the file
+        self._good = 0  # bytes of the file up to its last complete block
 
     def __call__(self, arrays: dict[str, np.ndarray]) -> None:
+        """Append a block; the first write error (a full disk) is raised once, with the
+        file's name, and kept in :attr:`error` (later blocks are dropped: the run stops)."""
+        if self.error is not None:
+            return
+        try:
+            with naming(self.path):
+                self._append(arrays)
+        except OSError as exc:
+            self.error = exc
+            self._cut()
+            raise
+
+    def _cut(self) -> None:
+        """Cut the file back to its last complete block (a write that failed half-way)."""
+        if self._fh is None:
+            return
+        try:
+            self._fh.flush()
+        except OSError:
+            pass
+        try:
+            os.truncate(self._fh.fileno(), self._good)
+        except OSError:
+            pass
+
+    def _append(self, arrays: dict[str, np.ndarray]) -> None:
         cols = flatten_columns(arrays)
         if self._fh is None:
-            self._fh = self.path.open("w", newline="")
+            self._fh = open_nofollow(self.path, "w", newline="")
             self._columns = list(cols)
             csv.writer(self._fh).writerow(csv_header(self._columns, UNITS))
+            self._fh.flush()
+            self._good = self._fh.tell()
             self._imp = [j for j, k in enumerate(cols) if k.startswith(_IMPULSE)]
             names = {k: j for j, k in enumerate(cols)}
             self._frc = [
@@ -111,16 +142,25 @@ class HistoryCSV:
         self.rows += block.shape[0]
         self._fh.flush()
         os.fsync(self._fh.fileno())
+        self._good = self._fh.tell()
 
     def close(self) -> None:
         """Write the last row received when one row in ``every`` left it out, and close."""
         if self._fh is None:
             return
-        if self._tail is not None:
+        if self._tail is not None and self.error is None:
             row = self._tail[None, :].copy()
             if self._imp:
                 self._set_impulses(row, self._carry[None, :], np.zeros(1, dtype=bool))
-            self._write(row)
+            try:
+                with naming(self.path):
+                    self._write(row)
+            except OSError as exc:
+                self.error = exc
+                self._cut()
             self._tail = None
-        self._fh.close()
+        try:
+            self._fh.close()
+        except OSError as exc:
+            self.error = self.error or exc
         self._fh = None

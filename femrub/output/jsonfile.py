@@ -9,10 +9,11 @@ from __future__ import annotations
 
 import json
 import math
-import os
 from pathlib import Path
 
 import numpy as np
+
+from .safe_write import write_atomic
 
 __all__ = ["jsonable", "read_json", "write_json"]
 
@@ -35,14 +36,10 @@ def jsonable(x):
 
 
 def write_json(path, doc: dict) -> None:
-    """Write ``doc`` to ``path`` atomically (temporary file, flushed, then renamed)."""
-    path = Path(path)
-    tmp = path.with_name(path.name + ".tmp")
-    with open(tmp, "w") as fh:
-        fh.write(json.dumps(jsonable(doc), indent=2, allow_nan=False))
-        fh.flush()
-        os.fsync(fh.fileno())
-    os.replace(tmp, path)
+    """Write ``doc`` to ``path`` atomically (a temporary file beside it, flushed, then
+    renamed: never through a symbolic link, :func:`~femrub.output.safe_write.atomic_file`)."""
+    text = json.dumps(jsonable(doc), indent=2, allow_nan=False)
+    write_atomic(path, text)
 
 
 def read_json(path) -> dict:

@@ -193,7 +193,14 @@ def energy_panel(res, *, title: str = ""):
 
 
 def savefig(fig, path) -> Path:
+    """Save ``fig`` to ``path`` (format from the suffix) through a temporary file beside it
+    (:func:`~femrub.output.safe_write.atomic_file`: never through a symbolic link)."""
+    from .safe_write import atomic_file, naming
+
     path = Path(path)
-    fig.savefig(path, dpi=130)
-    plt.close(fig)
+    try:
+        with naming(path), atomic_file(path) as fh:
+            fig.savefig(fh, dpi=130, format=path.suffix.lstrip(".") or "png")
+    finally:
+        plt.close(fig)
     return path

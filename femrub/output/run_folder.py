@@ -21,16 +21,18 @@ import platform
 import sys
 import time
 from contextlib import nullcontext
+from functools import partial
 from pathlib import Path
 
 import numpy as np
 
 from .. import __version__
-from .folder import ResultExists, claim
+from .folder import OUTPUTS, ResultExists, claim
 from .history_file import HistoryCSV
 from .interrupts import deferred, interruptible
 from .jsonfile import write_json as _write_json
 from .plots import savefig, tip_panels
+from .safe_write import describe_os_error, naming
 from .verdict import assess
 
 __all__ = ["STAGES", "run_to_folder", "ResultExists"]
@@ -235,22 +237,66 @@ def _run(
             series.close()  # every frame taken is on disk, the writer thread stopped
     if ran is None:
         wall = time.perf_counter() - t0
-    with deferred():
-        return _finish(
-            stepper,
-            res,
-            out,
-            doc,
-            series,
-            history,
-            wall,
-            snapshot,
-            plots,
-            timings,
-            rotation_speed,
-            summary_path,
-            csv_stride,
+    finish = partial(
+        _finish,
+        stepper,
+        res,
+        out,
+        doc,
+        series,
+        history,
+        wall,
+        snapshot,
+        plots,
+        timings,
+        rotation_speed,
+        summary_path,
+        csv_stride,
+    )
+    return _close(finish, res, out, doc, history, summary_path)
+
+
+def _close(finish, res, out, doc, history, summary_path):
+    """``finish()`` (the final files of a stepped run) with signals held back; a write
+    error (a full disk) fails the run with a line naming the file (:func:`_write_failed`);
+    a signal received while a finished result was written leaves it finished (a notice
+    says so)."""
+    if history.error is not None:  # a full disk: the run stopped, its rows are in memory
+        res.status, res.message = "failed", describe_os_error(history.error, "write")
+    with deferred(reraise=False) as held:
+        try:
+            res = finish()
+        except OSError as exc:
+            _write_failed(res, exc, out, doc, summary_path)
+    if held and res.status == "interrupted":
+        raise KeyboardInterrupt("signal received while writing results")
+    if held:  # the result was finished: its files are complete, the status stands
+        print(
+            f"femrub: signal received while the results were written; they are complete "
+            f"(status {res.status}) in {out}/",
+            file=sys.stderr,
         )
+    return res
+
+
+def _write_failed(res, exc: OSError, out: Path, doc: dict, summary_path: Path) -> None:
+    """After a write error (a full disk) in the final files: status ``failed`` with a line
+    naming the file and the fix, femrub's temporaries removed, the summary written if the
+    disk takes it (the rows streamed to ``history.csv`` stay)."""
+    res.status, res.message = "failed", describe_os_error(exc, "write")
+    for name in OUTPUTS["run"]:
+        for tmp in (*out.glob(f"{name}.tmp*"), *out.glob(f".{name}.*.tmp")):
+            tmp.unlink(missing_ok=True)
+    doc.update(
+        status=res.status,
+        message=res.message,
+        steps=res.steps,
+        t_reached=float(res.t[-1]) if len(res.t) else 0.0,
+    )
+    try:
+        _write_json(summary_path, doc)
+    except OSError:
+        print(f"femrub: {summary_path} not written either: {res.message}", file=sys.stderr)
 
 
 def _finish(
@@ -270,9 +316,11 @@ def _finish(
 ):
     vtk_wall, vtk_cpu = (series.seconds, series.cpu_seconds) if series is not None else (0.0, 0.0)
     t_out = time.perf_counter()
-    if history.received != len(res.t):  # not streamed (a run stepped elsewhere)
-        res.save_csv(out / "history.csv", every=csv_stride)
-    res.save_npz(out / "history.npz")
+    if history.received != len(res.t) and history.error is None:  # not streamed
+        with naming(out / "history.csv"):
+            res.save_csv(out / "history.csv", every=csv_stride)
+    with naming(out / "history.npz"):
+        res.save_npz(out / "history.npz")
     panels = [k for k in ("tip_displacement", "tip_temperature") if k in res.signals]
     if plots:
         savefig(
@@ -334,5 +382,6 @@ def _finish(
     doc.update(_friction_summary(res))
     for name, arr in res.signals.items():
         doc.setdefault("signals_max_abs", {})[name] = float(np.abs(arr).max()) if arr.size else 0.0
-    _write_json(summary_path, doc)
+    with naming(summary_path):
+        _write_json(summary_path, doc)
     return res

@@ -1,0 +1,60 @@
+"""Checks of a whole scene that the runs need, made before any expensive work.
+
+* :func:`check_steps`: ``scheme.t_end`` is a whole number of steps ``scheme.h`` (a stepper
+  takes ``round(t_end / h)`` steps: otherwise the run would end short of ``t_end``, or
+  past it, and still say ``ok``); the message gives both fixes;
+* :func:`check_friction`: the Coulomb coefficient μ (``contact.friction``) is at most
+  :data:`MAX_FRICTION` (a percentage or a typing slip, not a material pair).
+
+:func:`check_run` applies both; ``femrub run``, ``check`` and ``sweep`` call it on every
+scene (every point of a sweep) before building anything.
+"""
+
+from __future__ import annotations
+
+from .spec import fail
+
+__all__ = ["MAX_FRICTION", "check_friction", "check_run", "check_steps"]
+
+#: the largest Coulomb coefficient taken (metals on abradable coatings: about 0.1 to 1)
+MAX_FRICTION = 2.0
+_STEP_TOL = 1e-6
+
+
+def check_steps(scene) -> None:
+    """Refuse a ``scheme.t_end`` that is not a whole number of steps ``scheme.h``."""
+    h, t_end = scene.get("scheme.h"), scene.get("scheme.t_end")
+    if not all(isinstance(x, int | float) and not isinstance(x, bool) for x in (h, t_end)):
+        return
+    if h <= 0 or t_end <= 0:
+        return
+    n = t_end / h
+    whole = max(round(n), 1)
+    if abs(n - whole) <= _STEP_TOL * max(n, 1.0):
+        return
+    up = int(-(-n // 1))
+    fail(
+        "scheme.t_end",
+        t_end,
+        f"{n:.6g} steps of scheme.h = {h:g} s, not a whole number (the run would end at "
+        f"{whole * h:.6g} s); use scheme.t_end = {up * h:.6g} s ({up} steps) or "
+        f"scheme.h = {t_end / up:.6g} s",
+    )
+
+
+def check_friction(scene) -> None:
+    """Refuse a Coulomb coefficient above :data:`MAX_FRICTION`."""
+    mu = scene.get("contact.friction")
+    if isinstance(mu, int | float) and not isinstance(mu, bool) and mu > MAX_FRICTION:
+        fail(
+            "contact.friction",
+            mu,
+            f"a Coulomb coefficient above {MAX_FRICTION:g} is not a material pair (metal on "
+            "an abradable coating: 0.1 to 1); give μ itself, not a percentage",
+        )
+
+
+def check_run(scene) -> None:
+    """Every check of this module."""
+    check_steps(scene)
+    check_friction(scene)
