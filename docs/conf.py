@@ -43,6 +43,7 @@ root_doc = "index"
 exclude_patterns = [
     "_build",
     "**/campbell-rotor37-*",
+    # study sections that benchmarks/run_all.py renders into the pages
     "performance/exponential_section.md",
     "performance/cost_3d.md",
     "gallery/README.rst",
