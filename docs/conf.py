@@ -19,6 +19,8 @@ ROOT = HERE.parent
 sys.path.insert(0, str(ROOT))
 sys.path.insert(0, str(HERE / "_ext"))
 
+import paper_numbers  # noqa: E402
+
 import femrub  # noqa: E402
 
 project = "femrub"
@@ -52,7 +54,9 @@ exclude_patterns = [
     "auto_examples/*.zip",
 ]
 suppress_warnings = []
-myst_enable_extensions = ["dollarmath", "colon_fence"]
+myst_enable_extensions = ["dollarmath", "colon_fence", "substitution"]
+# the numbers of paper-reproduction.md: femrub paper's summary.json (_ext/paper_numbers.py)
+myst_substitutions = paper_numbers.substitutions(HERE / "paper" / "summary.json")
 myst_heading_anchors = 3
 
 # API reference
