@@ -38,12 +38,8 @@ def default_text(spec, required) -> str:
 
 
 def bounds_text(spec) -> str:
-    """Allowed values of a key: its interval and its words."""
-    parts = []
-    if spec.lo is not None:
-        parts.append(f"{'>' if spec.lo_open else '≥'} {spec.lo:g}")
-    if spec.hi is not None:
-        parts.append(f"{'<' if spec.hi_open else '≤'} {spec.hi:g}")
+    """Allowed values of a key: its interval (as the validator's messages word it) and words."""
+    parts = [spec._range().strip()] if spec.lo is not None or spec.hi is not None else []
     if spec.choices:
         words = ", ".join(_literal(c) for c in spec.choices)
         parts.append(("one of " if spec.kind == "choice" else "or ") + words)
