@@ -1,8 +1,8 @@
-"""Shared helpers of the speed and accuracy benchmarks (SI units throughout).
+"""Shared code of the speed and accuracy benchmarks (SI units throughout).
 
 * the two test problems: the paper's bar (``paper_model``) and a free elastic bar impacting
   a rigid obstacle (``impact_model``, exact d'Alembert solution ``impact_exact``);
-* the error measures of ``docs/performance.md`` (``Measures``, ``compare``);
+* the error measures of ``docs/performance/speed-and-accuracy.md`` (``Measures``, ``compare``);
 * CPU timing, peak memory, Markdown tables and JSON output.
 """
 
@@ -101,7 +101,7 @@ def first_contact(t, impulse, rel: float = 1e-6) -> float:
 
 
 def compare(m: Measures, ref: Measures) -> dict[str, float]:
-    """Error measures of ``m`` against ``ref`` (definitions in docs/performance.md).
+    """Error measures of ``m`` against ``ref`` (docs/performance/speed-and-accuracy.md).
 
     ``u_L2``: time-L2 relative error of the tip displacement (piecewise-linear interpolant
     of ``m`` on the reference grid); ``u_max``: largest error / largest reference value;
@@ -164,11 +164,29 @@ def peak_rss_mib() -> float:
     return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
 
 
+def _commit() -> str | None:
+    """The project's git commit (``None`` outside a git checkout)."""
+    import subprocess
+
+    try:
+        done = subprocess.run(
+            ["git", "-C", str(ROOT), "rev-parse", "--short", "HEAD"],
+            capture_output=True,
+            text=True,
+            timeout=10,
+        )
+    except (OSError, subprocess.SubprocessError):
+        return None
+    return done.stdout.strip() or None
+
+
 def machine() -> dict:
-    """Where the numbers come from: platform, Python, cores, load average."""
+    """Where the numbers come from: date, commit, platform, Python, cores, load average."""
     import os
 
     return {
+        "date": time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime()),
+        "commit": _commit(),
         "python": platform.python_version(),
         "platform": platform.platform(),
         "cores": os.cpu_count(),

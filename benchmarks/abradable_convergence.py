@@ -1,4 +1,4 @@
-"""Time-step convergence of a rub against an abradable coating (issue 17).
+"""Time-step convergence of a rub against an abradable coating.
 
 One scene is built once (model, reduction, coating); its θ-method is then stepped over the
 same interval at ``h / f`` for every factor ``f``, a fresh coating each time. Per factor:

@@ -1,4 +1,4 @@
-"""A scene reduced with its default settings against the same scene unreduced (issue 11).
+"""A scene reduced with its default settings against the same scene unreduced.
 
 ``python benchmarks/reduction_convergence_3d.py --default [--scene NAME] [--set K=V]``
 builds the scene exactly as ``femrub run`` does (its reduction, with ``auto`` sizes, the

@@ -1,4 +1,4 @@
-"""Exponential Moreau stepper against the θ-method and Carpenter (issue 16).
+"""Exponential Moreau stepper against the θ-method and Carpenter.
 
 Four studies, one command (``python benchmarks/exponential.py [--quick]``):
 
@@ -6,8 +6,9 @@ Four studies, one command (``python benchmarks/exponential.py [--quick]``):
   first-contact time of the exponential stepper at h = 5e-4 and 5e-3 s against a converged
   θ-method reference (two fine steps, their difference reported);
 * ``work-precision``: paper case over 0.1 s, error against CPU for θ (paper rule), Carpenter
-  and the exponential stepper, reference θ at ``h_ref``; errors as in docs/performance.md
-  (``u_L2`` on the reference grid, piecewise-linear interpolant of the run) plus ``u_L2 nodes``
+  and the exponential stepper, reference θ at ``h_ref``; errors as in
+  docs/performance/speed-and-accuracy.md (``u_L2`` on the reference grid, piecewise-linear
+  interpolant of the run) plus ``u_L2 nodes``
   (the run's own output times: the error of the computed states);
 * ``events``: the same with event location off (impulses at step ends only);
 * ``impact``: free bar hitting a rigid obstacle on a fixed mesh, several Courant numbers,

@@ -220,7 +220,7 @@ BOUND_COLS = [
     ("verdict", "3× target"),
 ]
 
-#: the least-cost table's header in docs/performance.md §6
+#: the least-cost table's header in docs/performance/exponential-stepper.md
 BOUND_TEXT = (
     "**Least cost against the 3× target at 1 % tip temperature** "
     "(`benchmarks/exponential_bound.py`; CPU s, least of 20 calls). The best other method's "

@@ -1,5 +1,6 @@
-"""The reading of ``benchmarks/exponential.py``'s tables (docs/performance.md §6): what they
-show and what is not met, with the numbers of the measurement they were written for."""
+"""The reading of ``benchmarks/exponential.py``'s tables
+(docs/performance/exponential-stepper.md): what they show and what is not met, with the
+numbers of the measurement they were written for."""
 
 NOTES = """\
 Reading. The exponential stepper is exact between contact events (docs/theory.md §4b): its

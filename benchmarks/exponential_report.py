@@ -219,7 +219,7 @@ def _level_rows(rows, keys, levels, others=("θ paper", "Carpenter")):
 
 
 def section(doc) -> str:
-    """Section 6 of docs/performance.md (rendered by run_all.py from exponential_section.md)."""
+    """docs/performance/exponential-stepper.md (rendered by run_all.py from this section)."""
     lines = [
         "Measured by `python benchmarks/exponential.py` (one BLAS thread for every method; "
         "a run under 0.5 s CPU: the best of 5; "

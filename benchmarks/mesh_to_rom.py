@@ -1,12 +1,12 @@
-"""Rotor 37 mesh file -> reduced thermo-mechanical model (issue 13, target 1), one command.
+"""Rotor 37 mesh file -> reduced thermo-mechanical model (target: ≤ 60 s, ≤ 3 GB), one command.
 
 Builds a scene (default ``rotor37``) in a fresh process without the model cache, up to its
 first step, and records wall and CPU time, peak resident memory (``VmHWM``), every logged
 phase with its time and the 1-minute load; the reduction error estimate is timed on its own
 (its value and verdict too), so the path is reported with and without it, and so is the
 estimate's run of the chosen sizes, which is the scene's run (``Simulation.ran``: it is not
-stepped again), so the path is also reported without it. Writes the table
-between the ``mesh_to_rom`` markers of ``docs/performance.md`` (``--no-write``: print it).
+stepped again), so the path is also reported without it. Writes the table between the
+``mesh_to_rom`` markers of ``docs/performance/rotor37-costs.md`` (``--no-write``: print it).
 
 The contact kernels are compiled once per machine (numba's on-disk cache); the table says
 whether this run found them compiled (``kernels``: ``cached``) or compiled them (``compiled
@@ -30,7 +30,7 @@ import time
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
-DOC = ROOT / "docs" / "performance.md"
+DOC = ROOT / "docs" / "performance" / "rotor37-costs.md"
 BEGIN, END = "<!-- mesh_to_rom:begin -->", "<!-- mesh_to_rom:end -->"
 
 

@@ -1,7 +1,6 @@
-"""Hand-written text of docs/performance.md §1–5 (``benchmarks/run_all.py`` renders it with
-the tables of the JSON files, so that ``--render-only`` keeps it): the error measures, notes
-on the 3D costs and the hard cases, and the record of earlier Siconos runs (the JSON holds
-the latest run only). Edit here, not in docs/performance.md."""
+"""Hand-written text of the performance pages that ``benchmarks/run_all.py`` renders with the
+tables of the JSON files (so that ``--render-only`` keeps it): the error measures and the
+readings of the 3D costs and of the hard cases. Edit here, not in the rendered pages."""
 
 # ruff: noqa: E501  (Markdown table rows)
 
@@ -11,21 +10,20 @@ thermal coupling on), reduced to n_uv = n_θ = 20 (`benchmarks/cost_3d.py`; each
 fresh process). The full model is stepped only while its sparse factorisation stays
 affordable; above a few 1e4 dofs the reduction is the way to run.
 
-**Bottlenecks found and removed** (measured on the NASA Rotor 37 blade, 96,255 P2
-displacement dofs, and on the 10,000-node bar):
+What the costs depend on (measured by hand on the NASA Rotor 37 blade, 96,255 P2
+displacement dofs, and on the 10,000-node bar; not regenerated):
 
-1. *Stiffness assembly* used the mass matrix's quadrature (order 4) for the P2 gradients:
-   51.5 s. The lowest exact rule (order 2 for P2 on straight tetrahedra, also exact for the
-   P1×P2 coupling) gives the same matrix in 14.5 s.
+1. *Stiffness assembly*: the P2 gradients are integrated with the lowest exact rule (order
+   2 on straight tetrahedra, also exact for the P1×P2 coupling): 14.5 s on Rotor 37, where
+   the mass matrix's order-4 rule took 51.5 s for the same matrix.
 2. *Sparse factorisation* of the 3D stiffness (damping eigen-solve, the reduction's static
-   shapes and shift-invert modes): SuperLU took 155 s (COLAMD) or 107 s (minimum degree on
-   AᵀA); MKL Pardiso (optional extra `femrub[fast]`) takes 14.5 s. Per-step solves stay on
-   SuperLU (Pardiso's per-call overhead: 3.7 ms against 0.26 ms on the bar).
+   shapes and shift-invert modes): MKL Pardiso takes 14.5 s, SuperLU 107 s (minimum degree
+   on AᵀA) to 155 s (COLAMD). Per-step solves stay on SuperLU (Pardiso's per-call overhead:
+   3.7 ms against 0.26 ms on the bar).
 3. *Per-step overhead*: one BLAS thread always, chunked post-processing of observations and
-   energy (also with a VTK callback: 977 → 362 µs/step on the twisted-blade scene, the rest
-   being the VTK writing itself).
+   energy.
 
-What still dominates: the reduction's static shapes when the frictional heat is spread
+What dominates: the reduction's static shapes when the frictional heat is spread
 over many tip vertices (each is a thermal boundary dof: 134 on Rotor 37)."""
 
 MEASURES = """\
@@ -94,60 +92,3 @@ and chattering: penetration 0.1–3 µm at h = 1e-4 s and ten times less at 1e-5
 contact work of a step is never positive beyond round-off. Twenty contacts:
 up to 16 active in one step (Lemke). Carpenter 2 % above its limit: blow-up detected after
 a few dozen steps, status "unstable", results kept."""
-
-SICONOS_HISTORY = """\
-Session 11 run (`python benchmarks/siconos_compare.py`, one run, Debian `python3-siconos`
-4.4.0, load 1.16 at the start and 1.01 at the end, another session's jobs on the machine):
-**20 dofs: 20.2× (≥ 2×: met; 9.8× with the energy balance); 1000 dofs: 129× (≥ 100×: met;
-71× with the energy balance)**; 10,000 dofs 1,730×. Against the issue-13d run below, the
-small bars are 3–4× cheaper per step. Part of it is this session's set-up on one BLAS
-thread (§8, session 11): an A/B of the 20-node bar (best of 5, load 1.2) gives 0.9 µs per
-step on the previous main and 0.4 µs after it, an OpenBLAS worker woken by the set-up
-having spun through most of the 20,000-step run. `femrub paper` in the same run: 8.5 s
-wall, 455 MiB peak.
-
-Issue-13d run (`python benchmarks/siconos_compare.py`, one run, Debian `python3-siconos`
-4.4.0 under `/usr/bin/python3.11`), 1-minute load 4.5 at the start and 4.9 at the end (two
-other sessions' Rotor 37 jobs on the same 2 cores): femrub's 20- and 100-node bars (40 and
-200 state values, dense) run in compiled blocks of steps (`femrub.steppers.theta_blocks`,
-§8 session 5); the 1000- and 10,000-node bars are sparse and step by step as before.
-Issue-13 targets: **≥ 2× Siconos at 20 dofs: met (7.0×**; 4.2× with the energy balance;
-the previous run had 0.40×: 23.7 against 9.5 µs); **≥ 100× at 1000 dofs: met (152×**;
-85× with the energy balance). A `--quick` run at load 2.5–2.9 gave 0.85 µs (10.5×) at
-20 nodes and 108 µs (127×) at 1000 nodes.
-
-Issue 13, first pass (the table, its targets, energy bookkeeping and paper-case costs):
-
-| nodes | femrub variant | femrub µs/step | best Siconos µs/step | Siconos / femrub | femrub µs / 1000 nnz(D) |
-|---|---|---|---|---|---|
-| 20 | femrub | 12.7 | 13.4 | 1.05 | 108 |
-| 20 | femrub, energy on | 15 | 13.4 | 0.89 | 128 |
-| 100 | femrub | 32.2 | 178 | 5.52 | 53.8 |
-| 100 | femrub, energy on | 44.3 | 178 | 4.01 | 74 |
-| 1000 | femrub | 145 | 1.85e+04 | 127 | 24.2 |
-| 1000 | femrub, energy on | 301 | 1.85e+04 | 61.6 | 50.1 |
-| 10000 | femrub | 2.42e+03 | 1.59e+06 | 656 | 40.4 |
-| 10000 | femrub, energy on | 4.15e+03 | 1.59e+06 | 383 | 69.2 |
-
-1. *No slower than Siconos at 20 dofs*: **met** (Siconos / femrub = 1.05: 12.7 against 13.4 µs per
-   step; 0.89 with the energy balance on).
-2. *At least 10× faster at 1000 dofs*: **met** (127×, 61.6× with the energy balance; 10,000 dofs:
-   656×).
-3. *Per-step cost linear in the nonzeros*: from 1000 to 10,000 nodes the cost grows as nnz^1.22 (145
-   → 2.42e+03 µs), **met**. Siconos grows as n² (dense or sparse storage: its step is not
-   sparse-aware in this configuration), hence the widening gap.
-
-Energy bookkeeping still costs 301 against 145 µs per step at 1000 nodes (quadratic forms on each
-chunk; a single transposed copy per chunk would save part of it).
-
-* Paper case, θ-method h = 1e-4 s over 0.4 s (4000 steps, energy balance on), fresh process: **0.13
-  s** wall for the run (0.23 s CPU), 1.59 s including imports and assembly; peak resident memory
-  **167 MiB**.
-* `femrub paper` (all figures, 19 rows): **41.5 s** wall, 42.4 s CPU, peak resident memory **671
-  MiB**.
-* Issue-13d (compiled blocks of steps, §8 session 5): paper case 0.02 s CPU for the 4000
-  steps (fresh process; 1.54 s wall with imports and assembly); `femrub paper` (21 rows)
-  **9.5 s wall**, 8.1 s CPU, peak 442 MiB, in `siconos_compare.py`'s subprocess at load
-  4.5–4.9; `/usr/bin/time femrub paper -o DIR -q` at load 2.9–3.3: **14.9 s wall**, 7.9 s
-  user, 443 MiB (main at the same load: 17.8 s wall, 11.7 s user); CSVs and figures
-  byte-identical to main's. Target 5 (≤ 20 s wall): **met**."""

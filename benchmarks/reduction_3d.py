@@ -195,7 +195,7 @@ def main(argv=None) -> None:
         )
     args.out.parent.mkdir(parents=True, exist_ok=True)
     old = args.out.read_text(encoding="utf-8") if args.out.exists() else ""
-    keep = old[old.index(CONVERGENCE) :] if CONVERGENCE in old else ""  # issue 11 studies
+    keep = old[old.index(CONVERGENCE) :] if CONVERGENCE in old else ""  # the convergence studies
     args.out.write_text("# 3D reduction cost\n\n" + _table(results) + keep, encoding="utf-8")
     args.out.with_suffix(".json").write_text(json.dumps(results, indent=1), encoding="utf-8")
     print(f"wrote {args.out}")

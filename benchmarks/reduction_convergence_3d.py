@@ -1,4 +1,4 @@
-"""Convergence of the reduced 3D rub models against the full model (issue 11).
+"""Convergence of the reduced 3D rub models against the full model.
 
 For the built-in ``twisted-naca`` scene the full model is stepped once (states stored at
 checkpoints), then one reductor is built at the largest sizes and its sub-basis models of
@@ -15,7 +15,7 @@ subsection per scene) and a plot ``docs/reduction_3d_<scene>.png``.
 
 ``--default`` instead runs the scene as ``femrub run`` does (default reduction: ``auto``
 sizes, its estimate and verdict) and the same scene with ``reduction.method = "none"``,
-and writes the issue-11 acceptance numbers (final temperature and displacement fields,
+and writes the acceptance numbers (final temperature and displacement fields,
 contact temperature history, balances, lowest temperature) into the subsection
 "default reduction vs full" (:mod:`default_vs_full`). ``--scene NAME`` and ``--set
 KEY=VALUE`` choose the scene (default ``twisted-naca``; ``rotor37-thermal`` with
@@ -46,8 +46,8 @@ from femrub.scene.scene import load_scene
 DOCS = Path(__file__).resolve().parents[1] / "docs"
 HEADING = "\n## Reduced vs full model in 3D"
 INTRO = (
-    "`python benchmarks/reduction_convergence_3d.py [--rotor37] [--projection P]` (issue "
-    "11): one full run, one reductor at the largest sizes, its sub-basis models stepped with "
+    "`python benchmarks/reduction_convergence_3d.py [--rotor37] [--projection P]`: "
+    "one full run, one reductor at the largest sizes, its sub-basis models stepped with "
     "the same scheme and step (`--default`: the scene reduced as `femrub run` does, against "
     "the same scene unreduced). Errors relative to the full model: contact impulse per "
     "lobe passage, "

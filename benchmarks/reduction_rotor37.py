@@ -1,4 +1,4 @@
-"""Rotor 37 reduced model against 2x and 4x larger reduced models (issue 11).
+"""Rotor 37 reduced model against 2x and 4x larger reduced models.
 
 ``python benchmarks/reduction_convergence_3d.py --rotor37 [--scene NAME] [--set K=V]``
 (run it under ``flock /tmp/femrub-heavy.lock``). The full Rotor 37 model (194,276 state

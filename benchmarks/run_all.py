@@ -1,13 +1,14 @@
-"""Run every speed/accuracy benchmark and regenerate ``docs/performance.md``.
+"""Run every speed/accuracy benchmark and regenerate the performance pages of the docs.
 
 ``python benchmarks/run_all.py`` runs ``work_precision.py``, ``siconos_compare.py``,
 ``hard_cases.py``, ``cost_3d.py`` and ``exponential.py`` (each in a fresh process, so timings
-and peak memory do not mix), writes
-their tables, JSON and plots into ``docs/performance/`` and rebuilds ``docs/performance.md``
-from the JSON files (about 20 min on the 2-core reference machine). ``--quick`` is a fast
-pass (about 2 min) that writes into ``build/performance-quick/`` unless ``--out`` is given,
-so the measured documentation is never overwritten by quick numbers. ``--render-only``
-rebuilds the Markdown from existing JSON; ``--skip NAME`` leaves one study out.
+and peak memory do not mix), writes their tables, JSON and plots into ``docs/performance/``
+and renders from the JSON files the overview ``docs/performance.md`` and one page per study
+(``PAGES``, in ``docs/performance/``; about 20 min on the 2-core reference machine).
+``--quick`` is a fast pass (about 2 min) that writes into ``build/performance-quick/``
+unless ``--out`` is given, so the measured documentation is never overwritten by quick
+numbers. ``--render-only`` rebuilds the Markdown from existing JSON; ``--skip NAME`` leaves
+one study out.
 """
 
 from __future__ import annotations
@@ -15,6 +16,7 @@ from __future__ import annotations
 import argparse
 import json
 import math
+import re
 import subprocess
 import sys
 import time
@@ -22,10 +24,10 @@ from pathlib import Path
 
 try:
     from . import _common as C
-    from .performance_notes import COST_3D_NOTES, HARD_NOTES, MEASURES, SICONOS_HISTORY
+    from .performance_notes import COST_3D_NOTES, HARD_NOTES, MEASURES
 except ImportError:  # run as a script
     import _common as C
-    from performance_notes import COST_3D_NOTES, HARD_NOTES, MEASURES, SICONOS_HISTORY
+    from performance_notes import COST_3D_NOTES, HARD_NOTES, MEASURES
 
 STUDIES = ("work_precision", "siconos_compare", "hard_cases", "cost_3d", "exponential")
 JSON = {
@@ -147,7 +149,6 @@ def _siconos_section(sc) -> str:
             f"* `femrub paper` (all figures, {w['runs']} rows): **{w['wall']:.1f} s** wall, "
             f"{w['cpu']:.1f} s CPU, peak resident memory **{w['peak_rss_mib']:.0f} MiB**."
         )
-    parts.append("### Earlier runs\n\n" + SICONOS_HISTORY)
     return "\n\n".join(parts)
 
 
@@ -192,24 +193,10 @@ def _targets(sc) -> str:
             f"3. *Per-step cost linear in the nonzeros*: from 1000 to 10,000 nodes the cost "
             f"grows as nnz^{f(g)} ({f(s1k.get('femrub_us'))} → {f(s10k.get('femrub_us'))} "
             f"µs), {ok(1.25 - g, 0)}. Siconos grows as n² (dense or sparse storage: its step "
-            "is not sparse-aware in this configuration), hence the widening gap.",
-            "### What was changed to meet them\n\n"
-            "A first run missed targets 1 and 3 (32.6 µs against 12.7 µs at 20 dofs; cost "
-            "growing as nnz^2.24 from 1000 to 10,000 nodes). Three changes fixed it:\n\n"
-            "1. **One BLAS thread for every size** (`Stepper.run`): a step is a few small "
-            "products and a sparse solve; with two OpenBLAS threads on a busy 2-core machine "
-            "a (1, 20000)·(20000,) product took 0.4–17 ms instead of 5 µs.\n"
-            "2. **Single-contact fast path in `ThetaMethod`** (dense model, one contact, "
-            "constant gap and α: the paper case): scalar gap, velocity, Delassus operator "
-            "and impulse instead of ~25 small numpy calls; for one contact the paper rule's "
-            "fixed point is `g_k <= 0 or g_p <= 0`. Same results to round-off.\n"
-            "3. **SuperLU, not Pardiso, for per-step solves**: Pardiso (optional, "
-            "`femrub[fast]`) is kept for one-off factorisations (3D reduction: 14 s against "
-            "107 s on Rotor 37); each pypardiso `solve` re-checks the matrix and refines: "
-            "3.7 ms against 0.26 ms for SuperLU on the 20,000-unknown bar.\n\n"
-            f"Energy bookkeeping still costs {f(e1k.get('femrub_us'))} against "
-            f"{f(s1k.get('femrub_us'))} µs per step at 1000 nodes (quadratic forms on each "
-            "chunk; a single transposed copy per chunk would save part of it).",
+            "is not sparse-aware in this configuration), hence the widening gap.\n\n"
+            f"The energy balance costs {f(e1k.get('femrub_us'))} against "
+            f"{f(s1k.get('femrub_us'))} µs per step at 1000 nodes (its quadratic forms on each "
+            "chunk of steps).",
         ]
     )
 
@@ -252,49 +239,126 @@ def _read(path: Path, script: str) -> str:
     return path.read_text().strip() if path.exists() else f"Not run (`{script}`)."
 
 
-def render(out: Path, doc: Path) -> Path:
-    """Rebuild ``doc`` (performance.md) from the JSON files in ``out``."""
+#: the pages rendered into the data folder: file name -> title
+PAGES = {
+    "speed-and-accuracy.md": "Speed against accuracy on the paper's bar",
+    "against-siconos.md": "Speed against Siconos",
+    "hard-case-stability.md": "Stability on hard cases",
+    "cost-against-size.md": "3D: assembly, reduction and per-step cost against size",
+    "exponential-stepper.md": 'Exponential Moreau stepper (`scheme.name = "exponential"`)',
+}
+#: pages of the section written by other benchmarks (listed in the overview, not rendered)
+OTHER_PAGES = {
+    "blade-scale.md": "Blade scale: sparse solvers, model cache, progress",
+    "rotor37-costs.md": "Rotor 37: mesh to reduced model, the frictional step, output",
+    "speed-map-costs.md": "A 40-speed interaction map: where a sweep point's time goes",
+    "prestress-campbell-costs.md": "Centrifugal prestress and Campbell diagrams",
+}
+
+#: the full tables the studies write (linked from the overview)
+TABLES = {
+    "work_precision.md": "Work–precision: every run",
+    "siconos.md": "femrub and Siconos: every run",
+    "hard_cases.md": "Hard cases: every run",
+    "exponential.md": "Exponential stepper: every run",
+    "solvers.md": "Sparse solvers on Rotor 37",
+    "mutation_smoke.md": "Mutation smoke check",
+}
+
+
+def _stamp(study: str, data) -> str:
+    """Where a study's numbers come from: its script, date, commit and machine."""
+    if data is None:
+        return f"Not run (`benchmarks/{study}.py`)."
+    m = data.get("machine") or {}
+    when = m.get("date") or "date not recorded"
+    commit = f"commit {m['commit']}" if m.get("commit") else "commit not recorded"
+    where = (
+        f"Python {m.get('python', '?')}, numpy {m.get('numpy', '?')}, {m.get('cores', '?')} "
+        f"cores, load average {m.get('load_average', '?')} at its start"
+    )
+    return f"*Measured by `python benchmarks/{study}.py` ({when}, {commit}; {where}).*"
+
+
+def _demote(text: str) -> str:
+    """Headings one level up, for a section that becomes a page of its own."""
+    return re.sub(r"^#(#+) ", r"\1 ", text, flags=re.M)
+
+
+def _page_texts(out: Path) -> dict[str, str]:
+    """Markdown of every page of ``PAGES`` from the JSON files in ``out``."""
     wp, sc, hc = (_load(out, s) for s in STUDIES[:3])
-    mach = next((d["machine"] for d in (wp, sc, hc) if d), C.machine())
     cost = out / "cost_3d.md"
     cost_text = cost.read_text() if cost.exists() else "Not run (`benchmarks/cost_3d.py`)."
+    bodies = {
+        "speed-and-accuracy.md": [
+            _stamp("work_precision", wp),
+            "## Error measures\n\n" + MEASURES,
+            "## Work–precision\n\n" + _demote(_wp_section(wp)),
+        ],
+        "against-siconos.md": [_stamp("siconos_compare", sc), _demote(_siconos_section(sc))],
+        "hard-case-stability.md": [_stamp("hard_cases", hc), _demote(_hard_section(hc))],
+        "cost-against-size.md": [cost_text.strip(), COST_3D_NOTES],
+        "exponential-stepper.md": [
+            _demote(_read(out / "exponential_section.md", "benchmarks/exponential.py"))
+        ],
+    }
+    return {
+        name: "\n\n".join([f"# {PAGES[name]}", *bodies[name]]).replace("performance/", "") + "\n"
+        for name in PAGES
+    }
+
+
+def _overview(out: Path, rel: str) -> str:
+    """The section's front page: headline numbers from the JSON files, then the pages."""
+    sc = _load(out, "siconos_compare")
+    lines = [
+        "# Performance",
+        "How fast femrub is, against what accuracy, measured on a 2-core machine shared with "
+        "other jobs (CPU times carry about ±20 % noise; SI units). Every table and number on "
+        "these pages is rendered by `python benchmarks/run_all.py --render-only` from the JSON "
+        "files the studies write into `docs/performance/`, each page stamped with where its "
+        "numbers come from; `python benchmarks/run_all.py` runs the studies again (`--quick` "
+        "for a fast pass into `build/`). Speed targets live in the benchmarks, not in the "
+        "test suite.",
+    ]
+    if sc is not None:
+        rows = {(r["N"], r["variant"]): r for r in sc["ratios"]}
+        heads = ["## Headline numbers", _stamp("siconos_compare", sc), ""]
+        for n in (20, 1000):
+            r = rows.get((n, "femrub"))
+            if r:
+                heads.append(
+                    f"* Bar of {n} nodes hitting an obstacle: {C.fmt(r['femrub_us'])} µs per "
+                    f"θ-method step, {C.fmt(r['ratio'])}× faster than Siconos' Moreau–Jean "
+                    f"({C.fmt(r['siconos_us'])} µs)."
+                )
+        if sc.get("costs"):
+            w = sc["costs"]["femrub_paper"]
+            heads.append(
+                f"* `femrub paper` (all figures, {w['runs']} runs, a warm compile cache): "
+                f"{w['wall']:.1f} s wall, {w['cpu']:.1f} s CPU, peak resident memory "
+                f"{w['peak_rss_mib']:.0f} MiB."
+            )
+        lines.append("\n".join(heads))
+    prefix = f"{rel}/" if rel != "." else ""
+    pages = {**PAGES, **OTHER_PAGES}
+    tables = {name: title for name, title in TABLES.items() if (out / name).exists()}
+    for heading, listed in (("Pages", pages), ("Every run, as the studies wrote it", tables)):
+        links = (f"* [{title}]({prefix}{name})" for name, title in listed.items())
+        lines.append(f"## {heading}\n\n" + "\n".join(links))
+    toc = "\n".join(f"{prefix}{name.removesuffix('.md')}" for name in (*pages, *tables))
+    lines.append("```{toctree}\n:hidden:\n\n" + toc + "\n```")
+    return "\n\n".join(lines) + "\n"
+
+
+def render(out: Path, doc: Path) -> Path:
+    """Write the pages of ``PAGES`` into ``out`` and the overview ``doc`` from its JSON files."""
+    for name, text in _page_texts(out).items():
+        (out / name).write_text(text)
     rel = Path(*out.relative_to(doc.parent).parts) if out.is_relative_to(doc.parent) else out
-    text = "\n\n".join(
-        [
-            "# Performance: speed against error, and stability on hard cases",
-            f"Measured by `python benchmarks/run_all.py` on the 2-core reference machine "
-            f"(Python {mach['python']}, numpy {mach['numpy']}, {mach['cores']} cores; load "
-            f"average {mach['load_average']} at the start of a study: the machine is shared "
-            "with other jobs, so CPU times carry about ±20 % noise). SI units. "
-            "`--quick` gives a fast pass; each study also runs alone "
-            "(`benchmarks/work_precision.py`, `siconos_compare.py`, `hard_cases.py`, "
-            "`cost_3d.py`).",
-            "## 1. Error measures\n\n" + MEASURES,
-            "## 2. Work–precision\n\n" + _wp_section(wp),
-            "## 3. Speed against Siconos\n\n" + _siconos_section(sc),
-            "## 4. Hard cases\n\n" + _hard_section(hc),
-            "## 5. 3D: assembly, reduction and per-step cost against dofs\n\n"
-            + cost_text
-            + "\n\n"
-            + COST_3D_NOTES,
-            '## 6. Exponential Moreau stepper (`scheme.name = "exponential"`)\n\n'
-            + _read(out / "exponential_section.md", "benchmarks/exponential.py"),
-        ]
-    ).replace("performance/", f"{rel.as_posix()}/")
-    doc.write_text(text.rstrip() + "\n" + _later_sections(doc))
+    doc.write_text(_overview(out, rel.as_posix()))
     return doc
-
-
-def _later_sections(doc: Path) -> str:
-    """The sections after §6 of an existing ``doc``, written by other benchmarks (kept)."""
-    if not doc.exists():
-        return ""
-    lines = doc.read_text().splitlines(keepends=True)
-    for i, line in enumerate(lines):
-        head = line.removeprefix("## ").split(".", 1)[0]
-        if line.startswith("## ") and head.isdigit() and int(head) > 6:
-            return "\n" + "".join(lines[i:])
-    return ""
 
 
 def main(argv=None) -> None:

@@ -19,7 +19,7 @@ Skips with a message when the Rotor 37 reference data (``../shared/data``) are a
 CPU = ``time.process_time()`` of the process (all its threads), wall = ``perf_counter``,
 peak = ``ru_maxrss``; the machine load (``os.getloadavg``) is recorded with each row, as
 the 2-core machine is shared. Writes ``docs/performance/solvers.{json,md}`` and the
-section between the ``solvers`` markers of ``docs/performance.md``.
+section between the ``solvers`` markers of ``docs/performance/blade-scale.md``.
 """
 
 from __future__ import annotations
@@ -365,7 +365,7 @@ def _write(doc: dict) -> None:
     (OUT / "solvers.json").write_text(json.dumps(doc, indent=1, default=str))
     text = _tables(doc)
     (OUT / "solvers.md").write_text("# Sparse solvers on Rotor 37\n\n" + text)
-    perf = ROOT / "docs" / "performance.md"
+    perf = OUT / "blade-scale.md"
     begin, end = "<!-- solvers:begin -->", "<!-- solvers:end -->"
     doc_text = perf.read_text()
     if begin in doc_text and end in doc_text:

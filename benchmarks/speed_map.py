@@ -1,4 +1,4 @@
-"""The 40-speed × 50-revolution interaction map of Rotor 37 (issue 13, target 6), one command.
+"""The 40-speed × 50-revolution interaction map of Rotor 37 (target: ≤ 10 min), one command.
 
 Runs ``femrub sweep rotor37 --param loads.rotation_speed=850:1825:25`` (reduced, friction
 on, 50,000 steps per point; no VTK frames, no PNG plots in the points, ``history.csv`` at one
@@ -8,7 +8,7 @@ and the largest resident memory of the processes (``getrusage`` of the children)
 1-minute load at the start, at the end and its median (sampled every 15 s), the points'
 statuses, the median of each stage of a point (``summary.json["timings"]``) and the size of
 the model cache at the end. Appends a row to the table between the ``speed_map`` markers of
-``docs/performance.md`` (``--no-write``: print it).
+``docs/performance/speed-map-costs.md`` (``--no-write``: print it).
 
 Run: ``flock /tmp/femrub-heavy.lock python benchmarks/speed_map.py`` (both cores for about
 10 minutes); ``--speeds 1300:1400:25`` for a smaller map. Skips without ``../shared/data``.
@@ -150,7 +150,7 @@ def main(argv=None) -> int:
     line = row(r)
     print(line)
     if not a.no_write:
-        doc = DOCS / "performance.md"
+        doc = DOCS / "performance" / "speed-map-costs.md"
         text = doc.read_text()
         begin, end = "<!-- speed_map:begin -->", "<!-- speed_map:end -->"
         old = text[text.index(begin) + len(begin) : text.index(end)] if begin in text else ""

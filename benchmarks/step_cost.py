@@ -1,4 +1,4 @@
-"""Per-step cost of a reduced frictional θ-method run, and its floor (issue 13, target 3).
+"""Per-step cost of a reduced frictional θ-method run, and its floor (target: ≤ 50 µs).
 
 Builds ``SCENE`` (default ``rotor37``; through the model cache, so a second call loads the
 reduced model in seconds), then steps it ``--revolutions`` revolutions without output
@@ -15,7 +15,7 @@ reduced model in seconds), then steps it ``--revolutions`` revolutions without o
   loading them from the cache costs (both happen when a stepper is built).
 
 Writes a table between ``<!-- step_cost:begin -->`` and ``<!-- step_cost:end -->`` in
-``docs/performance.md`` with the machine's load (``os.getloadavg``).
+``docs/performance/rotor37-costs.md`` with the machine's load (``os.getloadavg``).
 
 Run: ``python benchmarks/step_cost.py [--scene rotor37] [--revolutions 5] [--no-vtk] [--no-write]``
 (Rotor 37 needs ``../shared/data``; wrap the first, uncached call in
@@ -288,7 +288,7 @@ def _vtk_table(row: dict) -> str:
     )
 
 
-def write(text: str, path: Path = ROOT / "docs" / "performance.md") -> None:
+def write(text: str, path: Path = ROOT / "docs" / "performance" / "rotor37-costs.md") -> None:
     doc = path.read_text()
     block = f"<!-- step_cost:begin -->\n{text}<!-- step_cost:end -->"
     pat = re.compile(r"<!-- step_cost:begin -->.*?<!-- step_cost:end -->", re.S)

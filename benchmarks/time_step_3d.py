@@ -1,4 +1,4 @@
-"""Time-step convergence of a scene's model: the same model at h, h/2, h/4, ... (issue 17).
+"""Time-step convergence of a scene's model: the same model at h, h/2, h/4, ....
 
 Builds ``SCENE`` (default ``rotor37-thermal``, through the model cache) as ``femrub run``
 does, then steps the model that runs (reduced or full) at ``h / f`` for each ``--factors``

@@ -1,6 +1,6 @@
 """Work–precision study: error against CPU time and against the step h, for every scheme.
 
-Three cases (definitions of the error measures in ``docs/performance.md``):
+Three cases (definitions of the error measures in ``docs/performance/speed-and-accuracy.md``):
 
 * ``paper``: the paper's coupled bar (α = 3 m/s) over ``t_paper`` (0.1 s: four contact
   phases); reference = θ-method ("paper" rule) at ``h_ref`` = 1e-7 s, checked against

@@ -1,6 +1,7 @@
 """`femrub paper` end to end: figures, CSVs, summary.json with the paper's findings."""
 
 import json
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -114,7 +115,7 @@ def test_fig4_reduced_models(summary):
 
 def test_output_size_bounded(paper_out):
     total = sum(f.stat().st_size for f in paper_out.rglob("*") if f.is_file())
-    assert total < 30e6  # issue 13's bound (docs/performance.md: about 25 MB)
+    assert total < 30e6  # the output budget (docs/performance/rotor37-costs.md: about 25 MB)
 
 
 def test_npz_histories(paper_out, summary):
@@ -142,3 +143,23 @@ def test_bad_cli_input(capsys):
     assert main(["paper", "--figures", "fig99", "--out", "/tmp/femrub-none"]) == 2
     err = capsys.readouterr().err
     assert "unknown figure" in err and err.count("\n") == 1
+
+
+#: what a run of ``femrub paper`` computes (its timings excluded)
+DOCUMENTED = ("first_contact_time", "contact_phases", "impacts", "max_contact_force")
+DOCUMENTED += ("tip_temperature_end", "n_dofs", "status", "stability_limit")
+
+
+def test_documented_numbers_are_current(summary):
+    """docs/paper-reproduction.md renders its numbers from docs/paper/summary.json: a fresh
+    run must reproduce that file (else copy the new ``femrub paper`` summary.json there)."""
+    path = Path(__file__).resolve().parents[1] / "docs" / "paper" / "summary.json"
+    documented = json.loads(path.read_text())["runs"]
+    assert len(documented) == len(summary)
+    for old, new in zip(documented, summary, strict=True):
+        assert (old["figure"], old["label"]) == (new["figure"], new["label"])
+        for key in DOCUMENTED:
+            if isinstance(old[key], float):
+                assert new[key] == pytest.approx(old[key], rel=1e-6), (old["label"], key)
+            else:
+                assert new[key] == old[key], (old["label"], key)
