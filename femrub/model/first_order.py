@@ -305,7 +305,8 @@ class FirstOrderModel:
 
     def with_parameters(self, **values) -> FirstOrderModel:
         """This model at other parameter values (``rotation_speed=`` Ω in rad/s), sharing
-        every matrix (module docstring).
+        every matrix (module docstring). The contacts are those the builder kept at the
+        model's own speed (its reach filter is not run again).
 
         Raises
         ------
