@@ -121,8 +121,15 @@ def blade_scene():
     return scene, build_rub(load_blade(scene), tr.rub_config(scene))
 
 
-def test_python_blade_is_the_scene_blade(blade_scene):
+def test_python_blade_is_the_scene_blade(blade_scene, monkeypatch):
     scene, built = blade_scene
+    builds = []  # what solid_model's build decided (the reach filter's deflection, ...)
+
+    def spy(*args, **kw):
+        builds.append(build_rub(*args, **kw))
+        return builds[-1]
+
+    monkeypatch.setattr("femrub.model.builder.build_rub", spy)
     kept = built.model.n_contacts
     assert 0 < kept < built.candidates.n  # the reach filter dropped some candidates
     g = scene["geometry"]
@@ -156,8 +163,15 @@ def test_python_blade_is_the_scene_blade(blade_scene):
         gap_reference="outermost",
         tip_force=(np.array([0.0, 50.0, 0.0]), ForceLaw("sin", omega)),
     )
+    monkeypatch.undo()
     np.testing.assert_array_equal(blade.mesh.p, load_blade(scene).mesh.p)
     _assert_same_model(model, built.model)
+    python_reach = builds[0].reach  # harmonic deflection at the force's frequency too
+    assert (python_reach.deflection, python_reach.reach) == (
+        built.reach.deflection,
+        built.reach.reach,
+    )
+    np.testing.assert_array_equal(python_reach.keep, built.reach.keep)
     assert model.info["rotation_speed"] == scene["loads"]["rotation_speed"] == omega
     np.testing.assert_array_equal(model.contact.friction, np.full(kept, 0.1))
     assert model.contact.Gvt is not None and model.contact.heat_law == "power"

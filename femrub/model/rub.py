@@ -242,19 +242,26 @@ def solid_model(
     candidate, a length (m) sets the reach; ``gap_reference="outermost"``: the clearance
     is the outermost contact's. ``damping_ratio`` ζ gives Rayleigh damping
     with ratio ζ at the first and fifth clamped modes; ``tip_force``: ``(force vector N,
-    signal)``; ``centrifugal``: prestress method at Ω (``"linear"``, ``"nonlinear"``;
-    default ``None``: none, unlike a scene's ``loads.centrifugal = "auto"``). Returns
-    ``(model, fields)``.
+    signal)`` (a harmonic :class:`~femrub.model.config.ForceLaw` also gives the reach filter
+    its frequency, as a scene's ``sin`` law); ``centrifugal``: prestress method at Ω
+    (``"linear"``, ``"nonlinear"``; default ``None``: none, unlike a scene's
+    ``loads.centrifugal = "auto"``). Returns ``(model, fields)``.
     """
     from .builder import build_rub  # the builder composes this module's rub_model
-    from .config import ContactConfig, ForceConfig, RubConfig
+    from .config import ContactConfig, ForceConfig, ForceLaw, RubConfig
 
     force = None
     if tip_force is not None:
         vector, signal = tip_force
         vector = np.asarray(vector, dtype=float)
         amplitude = float(np.linalg.norm(vector))
-        force = ForceConfig(amplitude, signal, direction=tuple(vector / (amplitude or 1.0)))
+        harmonic = isinstance(signal, ForceLaw) and signal.law == "sin"
+        force = ForceConfig(
+            amplitude,
+            signal,
+            frequency=signal.omega if harmonic else None,
+            direction=tuple(vector / (amplitude or 1.0)),
+        )
     config = RubConfig(
         material,
         ContactConfig(
