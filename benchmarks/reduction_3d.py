@@ -73,8 +73,8 @@ def box_model(nx: int, ny: int, nz: int) -> fr.FirstOrderModel:
         contact=ContactSpec(normals=normals, gap=GAP, heat_dofs=heat, heat_coefficient=ALPHA),
         loads=[Load(f, lambda t: np.sin(OMEGA * t), "u", "tip_force")],
         observe={"tip_displacement": ("u", rows), "tip_temperature": ("theta", heat)},
+        info={"n_fe": mats.n_u + mats.n_t, "n_u_fe": mats.n_u, "n_t_fe": mats.n_t},
     )
-    model.info.update(n_fe=mats.n_u + mats.n_t, n_u_fe=mats.n_u, n_t_fe=mats.n_t)
     return model
 
 

@@ -107,7 +107,7 @@ def blade():
     """A coarse 3D box blade rubbing a casing (P1, two contact points), interior > 400 dofs."""
     mesh = box_blade(h=0.008, n_contact=2)
     mat = Material(young=110e9, rho=4500.0, rho_c=4500.0 * 585.0, conductivity=7.0)
-    model, _ = solid_model(mesh, mat, rotation_speed=1000.0, friction=0.3, order=1)
+    model, _ = solid_model(mesh, mat, rotation_speed=1000.0, friction=0.3, order=1, reach="all")
     return model
 
 

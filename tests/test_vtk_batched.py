@@ -14,7 +14,8 @@ import pyvista as pv
 import femrub as fr
 from femrub.contact.casing import Lobed
 from femrub.geometry import box_blade
-from femrub.model.rub import solid_model
+from femrub.model.builder import build_rub
+from femrub.model.config import ContactConfig, RubConfig
 from femrub.output.vtk import VTKSeries
 
 H, STRIDE = 1e-5, 20
@@ -24,14 +25,18 @@ H, STRIDE = 1e-5, 20
 def rub():
     blade = box_blade(span=0.1, chord=0.03, thickness=0.003, h=0.006, hub_radius=0.3, n_contact=5)
     mat = fr.Material(young=110e9, rho=4500.0, rho_c=4500 * 585.0, conductivity=7.0)
-    model, fields = solid_model(
-        blade,
+    # frictionless contacts heating the tip (α = 20 m/s): the fields these tests compare
+    config = RubConfig(
         mat,
-        casing=Lobed(clearance=2e-6, depth=3e-6, lobes=2),
+        ContactConfig(
+            casing=Lobed(clearance=2e-6, depth=3e-6, lobes=2),
+            heat_law="alpha",
+            heat_coefficient=20.0,
+        ),
         rotation_speed=1000.0,
-        friction=0.05,
     )
-    return model, fields
+    built = build_rub(blade, config)
+    return built.model, built.fields
 
 
 def von_mises(fields, u_all):

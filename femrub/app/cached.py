@@ -384,11 +384,14 @@ def _detach(reduced, report, largest: int) -> tuple[dict, np.ndarray | None]:
 
 
 def _attach(hit: dict, full):
-    """The stored reduced model with the gap, heat and load functions of ``full``."""
+    """The stored reduced model with the gap, heat and load functions and the parameters
+    (rotation speed) of ``full``."""
     model = hit["model"]
     contact = (
         None if hit["contact"] is None else dataclasses.replace(full.contact, **hit["contact"])
     )
     loads = [dataclasses.replace(t, **a) for t, a in zip(full.loads, hit["loads"], strict=True)]
     info = dict(model.info, full_info=dict(full.info))
-    return model.with_(contact=contact, loads=loads, info=info)
+    return model.with_(
+        contact=contact, loads=loads, info=info, parameters=full.parameters, sweep=full.sweep
+    )

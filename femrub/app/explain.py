@@ -119,21 +119,25 @@ def _reduction(r: dict) -> list[str]:
     return lines
 
 
-def explain(report: dict, reach_key=None) -> str:
-    """Format a build report (:func:`femrub.app.simulation.build`) as aligned text."""
-    rows = [("scene", f"{report['scene']} ({report['source']})"), ("geometry", report["geometry"])]
+def _model_rows(report: dict) -> list[tuple[str, str]]:
+    """The model's size, material notes, thermal choice and what was dropped."""
     full, model = report["full"], report["model"]
     line = _dofs(model)
     if model["n_dofs"] != full["n_dofs"] or model["n_contacts"] != full["n_contacts"]:
         line += f"; full model {_dofs(full)}"
     if "fe_dofs" in full:
         line += f"; {full['fe_dofs']} FE dofs"
-    rows.append(("model", line))
+    rows = [("model", line)]
     rows += [("material", note) for note in report.get("material", [])]
     rows.append(("thermal", report["thermal"]))
-    for d in report["dropped"]:
-        rows.append(("dropped", d))
+    rows += [("dropped", d) for d in report["dropped"]]
     rows += [("prestress", x) for x in _centrifugal(report.get("centrifugal"))]
+    return rows
+
+
+def _casing_rows(report: dict) -> list[tuple[str, str]]:
+    """The abradable coating and the casing heat model, when there are."""
+    rows = []
     a = report.get("abradable")
     if a:
         rows.append(
@@ -153,8 +157,13 @@ def explain(report: dict, reach_key=None) -> str:
                 "closes the gaps",
             )
         )
+    return rows
+
+
+def _contact_rows(report: dict, reach_key) -> list[tuple[str, str]]:
+    """The contacts kept, the friction law and the build's warnings."""
     reach_key = reach_key or report.get("reach_key", "auto")
-    rows += [("contacts", x) for x in _contacts(report["contacts"], reach_key)]
+    rows = [("contacts", x) for x in _contacts(report["contacts"], reach_key)]
     f = report.get("friction")
     if f and f["mu"] > 0:
         rows.append(
@@ -164,18 +173,20 @@ def explain(report: dict, reach_key=None) -> str:
                 f"{f['heat_law']}, heat_partition {f['heat_partition']:g}",
             )
         )
-    for w in report.get("warnings", []):
-        rows.append(("warning", w))
-    rows += [("reduction", x) for x in _reduction(report["reduction"])]
+    return rows + [("warning", w) for w in report.get("warnings", [])]
+
+
+def _scheme_rows(report: dict) -> list[tuple[str, str]]:
+    """The scheme and the time-step check."""
     s = report["scheme"]
     opts = ", ".join(f"{k} {v}" for k, v in s.items() if k not in ("name", "h", "t_end", "steps"))
-    rows.append(
+    rows = [
         (
             "scheme",
             f"{s['name']}, h = {s['h']:g} s, t_end = {s['t_end']:g} s: "
             f"{s['steps']} steps" + (f" ({opts})" if opts else ""),
         )
-    )
+    ]
     ts = report.get("time_step")
     if ts:
         verdict = "within" if ts["estimate"] <= ts["tolerance"] else "EXCEEDS"
@@ -187,25 +198,35 @@ def explain(report: dict, reach_key=None) -> str:
                 f"({ts['decided_by']} {100 * ts['difference']:.2g} %), {ts['seconds']:.1f} s",
             )
         )
-    rows.append(("signals", ", ".join(report["signals"]) + " (+ gaps, contact forces, energy)"))
+    return rows
+
+
+def _output_rows(report: dict) -> list[tuple[str, str]]:
+    """Signals, stop limits, outputs, natural frequencies and timings."""
+    rows = [("signals", ", ".join(report["signals"]) + " (+ gaps, contact forces, energy)")]
     if report["signals_not_observed"]:
         rows.append(("not kept", ", ".join(report["signals_not_observed"]) + " (outputs.signals)"))
     if report["limits"]:
         rows.append(("limits", ", ".join(f"{k} <= {v:g}" for k, v in report["limits"].items())))
-    for note in report.get("ignored", []):
-        rows.append(("ignored", note))
+    rows += [("ignored", note) for note in report.get("ignored", [])]
     o = report["outputs"]
-    rows.append(
-        (
-            "outputs",
-            f"VTK every {o['vtk_stride']} steps"
-            if o["vtk_stride"]
-            else "no VTK (outputs.vtk_stride = 0)",
-        )
-    )
+    vtk = f"VTK every {o['vtk_stride']} steps" if o["vtk_stride"] else None
+    rows.append(("outputs", vtk or "no VTK (outputs.vtk_stride = 0)"))
     if report.get("natural_frequencies_hz"):
         rows.append(
             ("modes", ", ".join(f"{x:.4g}" for x in report["natural_frequencies_hz"]) + " Hz")
         )
     rows.append(("timings", format_timings(report.get("timings", {}))))
+    return rows
+
+
+def explain(report: dict, reach_key=None) -> str:
+    """Format a build report (:func:`femrub.app.simulation.build`) as aligned text."""
+    rows = [("scene", f"{report['scene']} ({report['source']})"), ("geometry", report["geometry"])]
+    rows += _model_rows(report)
+    rows += _casing_rows(report)
+    rows += _contact_rows(report, reach_key)
+    rows += [("reduction", x) for x in _reduction(report["reduction"])]
+    rows += _scheme_rows(report)
+    rows += _output_rows(report)
     return "\n".join(f"  {k:<10} {v}" for k, v in rows)

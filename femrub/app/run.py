@@ -17,6 +17,7 @@ import json
 import math
 from pathlib import Path
 
+from ..contact.casing import lobe_passing_frequency
 from ..output.folder import FINISHED, FolderError, claim, folder_status
 from ..output.jsonfile import write_json
 from ..output.run_folder import run_to_folder
@@ -56,8 +57,8 @@ def merge_time(scene: Scene) -> float | None:
             if force["frequency"] == "rotation"
             else force["frequency"]
         )
-    elif omega > 0:
-        w = omega * {"lobed": casing.get("lobes", 1), "two-lobe": 2}.get(casing["kind"], 1)
+    elif omega > 0:  # the lobes passing, or once per revolution
+        w = lobe_passing_frequency(casing, omega) or omega
     return 0.25 * 2.0 * math.pi / w if w else None
 
 

@@ -29,17 +29,14 @@ import numpy as np
 
 from .. import progress
 from ..contact import jit
-from ..contact.heat import heat_coefficients
-from ..contact.points import locate_contacts
-from ..contact.reach import contact_reach, normal_deflection
-from ..model.rub import rub_model, tip_load
+from ..model.builder import RubBuild, build_rub, length_scale
 from ..scene.run_checks import check_run
 from ..scene.spec import SceneError, fail
 from . import translate as tr
 from .blade import load_blade
 from .build_warnings import initial_penetration, warn
 from .cached import Stages
-from .casing import abradable_of, casing_grid, casing_heat_of, footprint_warning
+from .casing import footprint_warning
 from .explain import explain
 from .scheme import bare_stepper, stepper_of
 from .step_check import check_step
@@ -64,10 +61,9 @@ MAX_CLEARANCE_RATIO = 0.05
 
 
 def blade_size(scene, blade) -> float:
-    """Characteristic size of the blade (m): the bar's length, else the mesh's largest extent."""
-    if blade.dim == 1:
-        return float(scene["geometry"]["length"])
-    return float(np.ptp(blade.mesh.p, axis=1).max())
+    """Characteristic size of the blade (m): the bar's length, else the mesh's largest extent
+    (:func:`femrub.model.builder.length_scale`, the model's ``length_scale``)."""
+    return length_scale(blade)
 
 
 def default_limits(observed, size: float) -> dict:
@@ -171,131 +167,100 @@ def _build(scene, log, modes, stages, with_stepper=True) -> Simulation:
     if jit.compile_in_background() and log:  # the first run on this machine: overlapped
         log("compiling the contact kernels in a background process (first run here) ...")
     clock = _Clock(log)
-    c, p = scene["contact"], scene["physics"]
     report = {
         "scene": scene.name,
         "source": scene.source,
         "kind": scene["geometry"]["kind"],
         "dropped": [],
-        "reach_key": c["reach"],
+        "reach_key": scene["contact"]["reach"],
     }
     blade = load_blade(scene, log)
-    size = blade_size(scene, blade)
+    size = length_scale(blade)
     _check_scale(scene, size)
     report["geometry"] = blade.summary()
     report["blade_size"] = size
     clock.done("mesh", f"{blade.n_vertices} vertices")
+    built = _full_model(scene, blade, stages, log, report)
+    clock.done("assembly", f"{built.model.n_dofs} state dofs")
+    _report_full(scene, built, report)
+    model, limits = _select_signals(scene, built.model, report, size)
+    if modes:
+        report["natural_frequencies_hz"] = stages.frequencies(model, modes).tolist()
+    reduced, reductor, ran = _reduce(scene, model, built.model, stages, log, limits, report, clock)
+    report["model"] = {"n_dofs": reduced.n_dofs, **_layout(reduced)}
+    stepper = stepper_of(scene, reduced, report) if with_stepper else None
+    report["outputs"] = {
+        "vtk_stride": scene["outputs"]["vtk_stride"],
+        "plots": scene["outputs"]["plots"],
+    }
+    report["timings"] = clock.timings
+    return Simulation(
+        scene,
+        reduced,
+        built.model,
+        built.fields,
+        reductor,
+        stepper,
+        limits,
+        report,
+        clock.timings,
+        ran,
+    )
+
+
+def _full_model(scene, blade, stages, log, report) -> RubBuild:
+    """The scene's configuration (:func:`~femrub.app.translate.rub_config`) built by the one
+    builder; a value the schema cannot see (e.g. a singular clamp) is a :class:`SceneError`."""
     if log:
         log("assembling the full model ...")
     report["material"] = []
-    material = tr.material_of(scene, blade.info.get("material"), report["material"])
-    casing = tr.casing_of(scene)
+    config = tr.rub_config(scene, blade.info.get("material"), report["material"])
     for note in report["material"] if log else ():
         log(f"notice: {note}")
-    omega = scene["loads"]["rotation_speed"]
     try:
-        disc = stages.discretise(
-            blade, p["order"] if blade.dim == 3 else 1, clamped=scene["boundary"]["clamped"]
-        )
-        prestress = _prestress(scene, disc, material, omega, log, stages)
-        mats = stages.assemble(
-            disc,
-            material,
-            area=tr.area_of(scene),
-            lumping=p["lumping"],
-            conduction=p["conduction"],
-            coupling=tr.coupling_of(scene),
-            beta=p["beta"],
-            strain_heating=p["strain_heating"],
-            rayleigh=tuple(p["rayleigh"]),
-            prestress=prestress,
-        )
-        # modal damping once the contacts' boundary is known: its frequencies come through
-        # the interior factorisation the reduction reuses (femrub.reduction.modal_damping)
-        damping = p["damping_ratio"] and stages.damping(
-            p["damping_ratio"], tuple(p["damping_modes"])
-        )
-        candidates = locate_contacts(disc, spread=c["spread"])
-        growth = prestress.growth(candidates) if prestress is not None else np.zeros(candidates.n)
-        force = tr.force_law(scene)
-        loads = []
-        if force:
-            amplitude, signal, _ = force
-            vector = amplitude * tr.force_direction(scene, candidates)
-            loads = [tip_load(disc, mats, vector, signal)]
-        reach = contact_reach(
-            candidates,
-            casing,
-            rotation_speed=omega,
-            gap_reference=c["gap_reference"],
-            reach=c["reach"],
-            margin=c["reach_margin"],
-            growth=growth,
-            clearance=c["clearance"],
-            deflection=normal_deflection(
-                mats,
-                candidates.normal_rows(mats),
-                loads[0].vector if loads else None,
-                force and force[2],
-            ),
-        )
-        points = candidates.restrict(reach.keep)
-        law = tr.heat_law_of(scene)
-        mu = c["friction"] if blade.dim == 3 else 0.0
-        eta = tr.heat_partition_of(scene)
-        if law == "power":
-            alpha = np.zeros(points.n)
-            heated = mu > 0.0 and eta > 0.0
-        else:
-            alpha = heat_coefficients(
-                points.radii, "alpha", alpha=c["heat_coefficient"], heat_partition=eta
-            )
-            heated = bool(np.any(alpha > 0))
-        grid = casing_grid(scene, blade, points, omega, growth[reach.keep])
-        keep_t, report["thermal"] = tr.thermal_choice(scene, heated, points.n > 0)
-        full, fields = rub_model(
-            disc,
-            mats,
-            points,
-            material,
-            casing=casing,
-            rotation_speed=omega,
-            alpha=alpha,
-            restitution=c["restitution"],
-            offset=reach.offset[reach.keep],
-            loads=loads,
-            thermal=keep_t,
-            observe_at=points if points.n else candidates,
-            friction=mu,
-            heat_law="power" if law == "power" else "alpha",
-            heat_partition=eta,
-            wear=abradable_of(scene, grid),
-            casing_heat=casing_heat_of(scene, grid, eta, alpha, mu if law == "power" else 0.0),
-            damping=damping or None,
-        )
-        report["friction"] = {"mu": mu, "heat_law": law, "heat_partition": eta}
-        warn(initial_penetration(full), report, log)
-        warn(footprint_warning(scene, grid), report, log)
-    except ValueError as exc:  # a value the schema cannot see (e.g. a singular clamp)
+        built = build_rub(blade, config, stages=stages, log=log)
+    except ValueError as exc:
         if isinstance(exc, SceneError):
             raise
         raise SceneError(f"building the model of {scene.source}: {exc}") from None
-    clock.done("assembly", f"{full.n_dofs} state dofs")
+    heat = built.heat
+    report["thermal"] = built.thermal[1]
+    report["friction"] = {"mu": heat.mu, "heat_law": heat.law, "heat_partition": heat.eta}
+    warn(initial_penetration(built.model), report, log)
+    warn(footprint_warning(scene, built.grid), report, log)
+    return built
+
+
+def _report_full(scene, built: RubBuild, report: dict) -> None:
+    """What the report says of the full model: sizes, contacts kept, prestress, casing."""
+    full = built.model
     report["dropped"] += [d for d in full.info.get("dropped", []) if "temperature" not in d]
-    report["full"] = {"n_dofs": full.n_dofs, "fe_dofs": mats.n_u + mats.n_t, **_layout(full)}
-    report["contacts"] = _contacts_report(candidates, reach)
-    report["centrifugal"] = _centrifugal_report(scene, prestress, growth, reach)
-    wear = full.contact.wear if full.contact is not None else None
+    report["full"] = {
+        "n_dofs": full.n_dofs,
+        "fe_dofs": built.mats.n_u + built.mats.n_t,
+        **_layout(full),
+    }
+    report["contacts"] = _contacts_report(built.candidates, built.reach)
+    report["centrifugal"] = _centrifugal_report(scene, built.prestress, built.growth, built.reach)
+    contact = full.contact
+    wear = contact.wear if contact is not None else None
     report["abradable"] = wear.as_dict() if wear is not None else None
-    ch = full.contact.casing_heat if full.contact is not None else None
+    ch = contact.casing_heat if contact is not None else None
     report["casing_heat"] = (
         None
         if ch is None
-        else {"thickness": ch.b, "tau": ch.tau, "partition": eta, "expansion": ch.expansion}
+        else {
+            "thickness": ch.b,
+            "tau": ch.tau,
+            "partition": built.heat.eta,
+            "expansion": ch.expansion,
+        }
     )
-    model, limits = _select_signals(scene, full, report, size)
-    if modes:
-        report["natural_frequencies_hz"] = stages.frequencies(model, modes).tolist()
+
+
+def _reduce(scene, model, full, stages, log, limits, report, clock):
+    """The reduced model, its reductor and the run the reduction estimate (or the time-step
+    check) stepped when it is the scene's run (:func:`reusable_run`), else ``None``."""
     make = lambda m: bare_stepper(scene, m)  # noqa: E731  (the reduction error estimate)
     chosen = []  # (results, wall seconds, full states) of the estimate's run of the chosen sizes
     reduced, reductor, report["reduction"] = stages.reduce(
@@ -305,28 +270,20 @@ def _build(scene, log, modes, stages, with_stepper=True) -> Simulation:
     if ran is not None:  # the run itself: its time is the run's ``stepping``
         clock.exclude(ran[1])
     clock.done("reduction", f"{reduced.n_dofs} dofs")
-    if scene["scheme"]["step_check"]:
-        given = None  # the estimate's run: compared only, unless it is the run (kept whole)
-        if chosen:
-            res, _, states = chosen.pop()
-            given = (res if ran is not None else res.lean(), states)
-        report["time_step"], run_h, wall_h = check_step(
-            scene, reduced, full, lambda m, h: bare_stepper(scene, m, h), limits, run=given
-        )
-        if ran is None and wall_h is not None and reusable_run(model):
-            ran = (run_h[0], wall_h)  # the check stepped the run itself
-            clock.exclude(wall_h)
-        clock.done("step_check", f"time-step error {100 * report['time_step']['estimate']:.2g} %")
-    report["model"] = {"n_dofs": reduced.n_dofs, **_layout(reduced)}
-    stepper = stepper_of(scene, reduced, report) if with_stepper else None
-    report["outputs"] = {
-        "vtk_stride": scene["outputs"]["vtk_stride"],
-        "plots": scene["outputs"]["plots"],
-    }
-    report["timings"] = clock.timings
-    return Simulation(
-        scene, reduced, full, fields, reductor, stepper, limits, report, clock.timings, ran
+    if not scene["scheme"]["step_check"]:
+        return reduced, reductor, ran
+    given = None  # the estimate's run: compared only, unless it is the run (kept whole)
+    if chosen:
+        res, _, states = chosen.pop()
+        given = (res if ran is not None else res.lean(), states)
+    report["time_step"], run_h, wall_h = check_step(
+        scene, reduced, full, lambda m, h: bare_stepper(scene, m, h), limits, run=given
     )
+    if ran is None and wall_h is not None and reusable_run(model):
+        ran = (run_h[0], wall_h)  # the check stepped the run itself
+        clock.exclude(wall_h)
+    clock.done("step_check", f"time-step error {100 * report['time_step']['estimate']:.2g} %")
+    return reduced, reductor, ran
 
 
 def reusable_run(model) -> bool:
@@ -337,16 +294,6 @@ def reusable_run(model) -> bool:
     reference's twin) would overwrite: an abradable coating's wear or the casing's heat.
     """
     return model.contact is None or not model.contact.carried_state
-
-
-def _prestress(scene, disc, material, omega, log, stages):
-    """The scene's centrifugal prestress (:mod:`femrub.fem.prestress`), or ``None``."""
-    method = tr.centrifugal_of(scene)
-    if method is None:
-        return None
-    if log:
-        log(f"centrifugal prestress ({method}) at {omega:g} rad/s ...")
-    return stages.prestress(disc, material, omega, method)
 
 
 def _centrifugal_report(scene, prestress, growth, reach) -> dict:

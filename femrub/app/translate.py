@@ -1,22 +1,31 @@
-"""What a scene means for the builders: material, casing, heat law, tip force, coupling.
+"""What a scene means for the builder: the scene as a :class:`~femrub.model.config.RubConfig`.
 
-Pure functions of a :class:`~femrub.scene.Scene`, each used once by
-:class:`~femrub.app.simulation.Simulation`; they hold the few choices that depend on the
-geometry kind (the bar's coupling, heat law and lumped total mass).
+:func:`rub_config` turns a :class:`~femrub.scene.Scene` once into the frozen, typed
+configuration :func:`femrub.model.builder.build_rub` builds (SI units, the scene's ``auto``
+choices resolved); the other functions are its parts, pure functions of the scene that hold
+the few choices depending on the geometry kind (the bar's coupling, heat law and lumped
+total mass).
 """
 
 from __future__ import annotations
 
 import math
 
-import numpy as np
-
 from ..contact.casing import casing_profile
 from ..contact.casing_heat import effusivity_partition
 from ..fem.material import Material
+from ..model.config import (
+    CasingHeatConfig,
+    CoatingConfig,
+    ContactConfig,
+    ForceConfig,
+    ForceLaw,
+    RubConfig,
+)
 
 __all__ = [
     "ForceLaw",
+    "rub_config",
     "area_of",
     "casing_of",
     "centrifugal_of",
@@ -25,22 +34,7 @@ __all__ = [
     "force_law",
     "heat_law_of",
     "material_of",
-    "thermal_choice",
 ]
-
-
-class ForceLaw:
-    """Time signal of the tip force, times its amplitude (``law`` of ``loads.tip_force``)."""
-
-    def __init__(self, law: str, omega: float = 0.0, phase: float = 0.0, ramp_time: float = 1.0):
-        self.law, self.omega, self.phase, self.ramp_time = law, omega, phase, ramp_time
-
-    def __call__(self, t):
-        if self.law == "sin":
-            return np.sin(self.omega * t + self.phase)
-        if self.law == "ramp":
-            return np.minimum(np.asarray(t, dtype=float) / self.ramp_time, 1.0)
-        return np.ones_like(np.asarray(t, dtype=float))
 
 
 def force_law(scene):
@@ -50,22 +44,14 @@ def force_law(scene):
         return None
     omega = None
     if f["law"] == "sin":
-        omega = f["frequency"]
+        omega, order = f["frequency"], None
         if omega == "rotation":
-            omega = f["engine_order"] * scene["loads"]["rotation_speed"]
-        law = ForceLaw("sin", omega, math.radians(f["phase"]))
+            order = f["engine_order"]
+            omega = order * scene["loads"]["rotation_speed"]
+        law = ForceLaw("sin", omega, math.radians(f["phase"]), engine_order=order)
     else:
         law = ForceLaw(f["law"], ramp_time=f.get("ramp_time", 1.0))
     return f["amplitude"], law, omega
-
-
-def force_direction(scene, points) -> np.ndarray:
-    """Unit direction of the tip force: given, or the mean radial direction of the contacts."""
-    d = scene["loads"]["tip_force"]["direction"]
-    d = points.normals.mean(axis=1) if d == "radial" else np.asarray(d, dtype=float)
-    if not np.linalg.norm(d) > 0:
-        raise ValueError("loads.tip_force.direction = [0, 0, 0]: give a non-zero vector")
-    return d / np.linalg.norm(d)
 
 
 def is_bar(scene) -> bool:
@@ -155,31 +141,72 @@ def casing_of(scene):
     return casing_profile(kind, **params)
 
 
-def thermal_choice(scene, heated: bool, reachable: bool = True) -> tuple[bool, str]:
-    """Keep the temperature dofs? ``heated``: frictional heat on a reachable contact.
+def force_config(scene) -> ForceConfig | None:
+    """The tip force of ``loads.tip_force``, or ``None``."""
+    force = force_law(scene)
+    if force is None:
+        return None
+    amplitude, signal, omega = force
+    d = scene["loads"]["tip_force"]["direction"]
+    return ForceConfig(amplitude, signal, omega, d if d == "radial" else tuple(d))
 
-    ``reachable=False`` says that there is no contact the casing can reach.
-    """
-    mode = scene["physics"]["thermal"]
-    coupling = coupling_of(scene)
-    if mode == "on":
-        return True, f"kept (physics.thermal = 'on'; coupling {coupling!r})"
-    if mode == "off":
-        return False, "dropped (physics.thermal = 'off': frictional heat and coupling ignored)"
-    sources = ["frictional heat at the contacts"] if heated else []
-    if scene["physics"]["strain_heating"] and coupling != "none":
-        sources.append("strain-rate heating")
-    if sources:
-        return True, f"kept: {' and '.join(sources)} (coupling {coupling!r})"
+
+def _coating(scene) -> CoatingConfig | None:
+    a = scene["contact"]["abradable"]
+    if a["thickness"] <= 0.0:
+        return None
+    return CoatingConfig(a["thickness"], a["yield"], a["n_angle"], a["n_axial"], a["footprint"])
+
+
+def _casing_heat(scene) -> CasingHeatConfig | None:
+    h = scene["contact"]["casing_heat"]
+    if h["thickness"] <= 0.0:
+        return None
+    keys = ("density", "specific_heat", "conductivity", "expansion", "n_angle", "n_axial")
+    return CasingHeatConfig(h["thickness"], **{k: h[k] for k in keys})
+
+
+def contact_config(scene) -> ContactConfig:
+    """The contacts of ``contact.*`` (Coulomb μ only on a 3D blade)."""
     c = scene["contact"]
-    if not reachable:
-        why = "no contact the casing can reach"
-    elif heat_partition_of(scene) == 0.0:
-        why = "contact.heat_partition = 0"
-    elif is_bar(scene):
-        why = "contact.heat_coefficient = 0"
-    elif c["friction"] == 0.0:
-        why = "contact.friction = 0"
-    else:
-        why = "loads.rotation_speed = 0 (no sliding)"
-    return False, f"dropped: no heat source ({why}); the coupling has nothing to act on"
+    return ContactConfig(
+        casing=casing_of(scene),
+        friction=0.0 if is_bar(scene) else c["friction"],
+        heat_law=heat_law_of(scene),
+        heat_coefficient=c["heat_coefficient"],
+        heat_partition=heat_partition_of(scene),
+        restitution=c["restitution"],
+        spread=c["spread"],
+        reach=c["reach"],
+        reach_margin=c["reach_margin"],
+        gap_reference=c["gap_reference"],
+        clearance=c["clearance"],
+        abradable=_coating(scene),
+        casing_heat=_casing_heat(scene),
+    )
+
+
+def rub_config(scene, deck: dict | None = None, notes: list | None = None) -> RubConfig:
+    """The scene as the builder's configuration (module docstring); ``deck``, ``notes``: the
+    material read from the mesh file and the notes on it (:func:`material_of`)."""
+    p = scene["physics"]
+    thermal = {"on": True, "off": False}.get(p["thermal"], "auto")
+    return RubConfig(
+        material_of(scene, deck, notes),
+        contact_config(scene),
+        rotation_speed=scene["loads"]["rotation_speed"],
+        order=p["order"],
+        clamped=scene["boundary"]["clamped"],
+        area=area_of(scene),
+        lumping=p["lumping"],
+        conduction=p["conduction"],
+        coupling=coupling_of(scene),
+        beta=p["beta"],
+        strain_heating=p["strain_heating"],
+        rayleigh=tuple(p["rayleigh"]),
+        damping_ratio=p["damping_ratio"],
+        damping_modes=tuple(p["damping_modes"]),
+        thermal=thermal,
+        centrifugal=centrifugal_of(scene),
+        tip_force=force_config(scene),
+    )

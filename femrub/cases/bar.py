@@ -4,7 +4,8 @@ Defaults are the paper case of ``model-notes.md``: L = 0.30 m, A = 1 mm², E = 1
 mass 0.1 kg lumped along 20 elements (m/n per node, m/2n at the tip), ρ c = 4500 × 585
 J/(m³ K), λ_th = 3.35 W/(m K), root clamped and held at ambient, paper coupling
 ``K^uθ = β K^uu`` with β = −4.5e-7 m/K, tip force 7 sin(Ω t) N with Ω = 2000 rpm, gap 15 µm,
-restitution 0, frictional heat ``α λ`` at the tip.
+restitution 0, frictional heat ``α λ`` at the tip. Ω is :func:`~femrub.scene.units.rpm`,
+the scene's own conversion of ``"2000 rpm"``.
 """
 
 from __future__ import annotations
@@ -12,24 +13,24 @@ from __future__ import annotations
 import math
 from dataclasses import asdict, dataclass, field, replace
 
-import numpy as np
-
 from ..contact.casing import Concentric
-from ..contact.heat import heat_coefficients
-from ..contact.points import locate_contacts
 from ..fem.assembly import ThermoelasticMatrices
-from ..fem.discretisation import assemble, discretise
 from ..fem.material import Material, check_finite_positive
 from ..geometry.bar import bar_mesh
+from ..model.builder import build_rub
+from ..model.config import ContactConfig, ForceConfig, ForceLaw, RubConfig
 from ..model.first_order import FirstOrderModel
-from ..model.rub import rub_model, tip_load
+from ..scene.units import rpm
 
-__all__ = ["BarCase", "PAPER", "bar_matrices", "bar_model", "impact_bar_model", "rpm"]
-
-
-def rpm(value: float) -> float:
-    """Convert revolutions per minute to rad/s."""
-    return float(value) * 2.0 * math.pi / 60.0
+__all__ = [
+    "BarCase",
+    "PAPER",
+    "bar_config",
+    "bar_matrices",
+    "bar_model",
+    "impact_bar_model",
+    "rpm",
+]
 
 
 @dataclass(frozen=True)
@@ -59,6 +60,9 @@ class BarCase:
     force_frequency: float = field(default_factory=lambda: rpm(2000.0))
     initial_velocity: float = 0.0
     thermal: str | bool = "auto"
+    #: the reach filter (:mod:`femrub.contact.reach`): ``"all"`` keeps the tip whatever
+    #: the force (a free bar thrown at the casing has none), ``"auto"`` as a scene
+    reach: float | str = "all"
 
     def __post_init__(self):
         for name in ("length", "area", "young", "density", "specific_heat"):
@@ -114,58 +118,73 @@ class BarCase:
 PAPER = BarCase()
 
 
-def _bar_parts(case: BarCase):
-    """Discretisation, Eq. (2) blocks and contact point (the tip) of the bar."""
-    disc = discretise(bar_mesh(case.length, case.n_elements, case.grading), 1, clamped=case.clamped)
-    mats = assemble(
-        disc,
+def bar_config(case: BarCase = PAPER) -> RubConfig:
+    """The :class:`~femrub.model.config.RubConfig` of ``case`` (the built-in scene
+    ``paper`` turns into the same one): concentric casing at ``gap``, heat ``α λ``, tip force
+    ``force_amplitude sin(Ω t)`` with the rotation speed Ω = ``force_frequency`` (engine
+    order 1, as the scene's ``frequency = "rotation"``)."""
+    F0 = float(case.force_amplitude)
+    force = None
+    if F0 != 0.0:
+        omega = float(case.force_frequency)
+        force = ForceConfig(F0, ForceLaw("sin", omega, engine_order=1), frequency=omega)
+    return RubConfig(
         case.material,
+        ContactConfig(
+            casing=Concentric(case.gap),
+            heat_law="alpha",
+            heat_coefficient=case.alpha,
+            restitution=case.restitution,
+            reach=case.reach,
+        ),
+        rotation_speed=float(case.force_frequency),
+        order=1,
+        clamped=case.clamped,
         area=case.area,
         lumping=case.lumping,
         coupling=case.coupling,
         beta=case.beta,
         strain_heating=case.strain_heating,
-        rayleigh=case.rayleigh,
+        rayleigh=tuple(case.rayleigh),
+        thermal=case.thermal,
+        tip_force=force,
+        initial_velocity=case.initial_velocity,
     )
-    return disc, mats, locate_contacts(disc)
+
+
+def _bar_build(case: BarCase):
+    return build_rub(bar_mesh(case.length, case.n_elements, case.grading), bar_config(case))
+
+
+def _bar_parts(case: BarCase):
+    """Discretisation, Eq. (2) blocks and contact point (the tip) of the bar."""
+    built = _bar_build(case)
+    return built.fields.disc, built.mats, built.candidates
+
+
+def _tip_dof(built) -> int:
+    return int(built.mats.u_index(built.candidates.u_dofs[0])[0])
 
 
 def bar_matrices(case: BarCase = PAPER) -> tuple[ThermoelasticMatrices, int]:
     """The bar's Eq. (2) blocks (scikit-fem) and the tip's free displacement dof."""
-    _, mats, tip = _bar_parts(case)
-    return mats, int(mats.u_index(tip.u_dofs[0])[0])
+    built = _bar_build(case)
+    return built.mats, _tip_dof(built)
 
 
 def bar_model(case: BarCase = PAPER, **changes) -> FirstOrderModel:
     """First-order model of the bar rubbing a rigid casing at its tip (paper Sec. 1).
 
-    Built through the same path as a 3D blade (:func:`femrub.model.rub.rub_model`).
-    Observed signals: ``tip_displacement`` (m), ``tip_velocity`` (m/s), ``tip_temperature``
-    (K above ambient, when the thermal part is kept).
+    Built by the one builder of every rub model (:func:`femrub.model.builder.build_rub`,
+    configuration :func:`bar_config`): the same model as the built-in scene ``paper`` with
+    the same values. Observed signals: ``tip_displacement`` (m), ``tip_velocity`` (m/s),
+    ``tip_temperature`` (K above ambient, when the thermal part is kept).
     """
     if changes:
         case = case.with_(**changes)
-    disc, mats, tip = _bar_parts(case)
-    F0, Om = float(case.force_amplitude), float(case.force_frequency)
-    force = None if F0 == 0.0 else ([F0], lambda t: np.sin(Om * t))
-    model, _ = rub_model(
-        disc,
-        mats,
-        tip,
-        case.material,
-        casing=Concentric(case.gap),
-        alpha=heat_coefficients(tip.radii, "alpha", alpha=case.alpha),
-        restitution=case.restitution,
-        loads=[] if force is None else [tip_load(disc, mats, *force)],
-        thermal=case.thermal,
-    )
-    if case.initial_velocity:
-        x0 = np.zeros(model.n_dofs)
-        x0[model.layout.v] = case.initial_velocity
-        model = model.with_(x0=x0)
-    tip_dof = int(mats.u_index(tip.u_dofs[0])[0])
-    model.info.update(case=case.as_dict(), tip_dof=tip_dof)
-    return model
+    built = _bar_build(case)
+    model = built.model
+    return model.with_(info={**model.info, "case": case.as_dict(), "tip_dof": _tip_dof(built)})
 
 
 def impact_bar_model(

@@ -47,5 +47,4 @@ def paper_reduced_model(
     """
     red = paper_reductor(name, alpha, coupled, projection=projection)
     rom = red.reduce()
-    rom.info["label"] = name
-    return rom
+    return rom.with_(info={**rom.info, "label": name})

@@ -28,6 +28,8 @@ __all__ = [
     "Lobed",
     "TwoLobePiollet",
     "casing_profile",
+    "lobe_count",
+    "lobe_passing_frequency",
     "PROFILES",
     "swept_gap",
     "SweptGap",
@@ -39,6 +41,8 @@ class CasingProfile:
     """Base class: ``gap(angle)`` (m) of the undeformed blade at casing angle ``angle`` (rad)."""
 
     kind = "profile"
+    #: gap minima a contact passes per revolution (0: a gap that does not change)
+    lobes = 0
 
     def gap(self, angle):
         raise NotImplementedError
@@ -105,6 +109,7 @@ class TwoLobePiollet(CasingProfile):
     mean_gap: float = 0.356e-3
     width: float = 0.15
     kind = "two-lobe"
+    lobes = 2
 
     def __post_init__(self):
         check_finite_positive("casing mean_gap", self.mean_gap)
@@ -131,6 +136,20 @@ def casing_profile(kind: str, **params) -> CasingProfile:
         return PROFILES[kind](**params)
     except TypeError as exc:
         raise ValueError(f"casing profile {kind!r}: {exc}") from None
+
+
+def lobe_count(casing) -> int:
+    """Lobes of ``casing`` (a :class:`CasingProfile` or a scene's ``contact.casing`` table):
+    the gap minima a contact passes per revolution, 0 for a round casing."""
+    if isinstance(casing, CasingProfile):
+        return int(casing.lobes)
+    return int(casing.get("lobes", PROFILES[casing["kind"]].lobes))
+
+
+def lobe_passing_frequency(casing, rotation_speed: float) -> float:
+    """``lobes × |Ω|`` (rad/s): how often a casing lobe passes a contact (0 for a round
+    casing or at rest); the one place this frequency is derived (:func:`lobe_count`)."""
+    return float(lobe_count(casing)) * abs(float(rotation_speed))
 
 
 def swept_gap(profile: CasingProfile, angles, rotation_speed: float, offset=0.0):

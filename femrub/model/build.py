@@ -103,140 +103,154 @@ def contact_boundary(contact: ContactSpec | None, n_u: int) -> dict:
     return {"u": u}
 
 
-def first_order_model(
-    mats: ThermoelasticMatrices,
-    *,
-    contact: ContactSpec | None = None,
-    loads=(),
-    observe: dict | None = None,
-    thermal: str | bool = "auto",
-    x0=None,
-) -> FirstOrderModel:
-    """Assemble ``A``, ``B`` of Eq. (9) and the contact, load and energy data.
-
-    ``observe`` maps a signal name to ``(field, rows)`` with ``field`` in {"u", "v", "theta"}
-    and ``rows`` a (k, n_field) array/sparse matrix or an index array of free dofs.
-    """
-    nu, nt = mats.n_u, mats.n_t
-    heat_loads = [ld for ld in loads if ld.field == "theta"]
-    has_coupling = mats.Kut.count_nonzero() > 0 or mats.Ctu.count_nonzero() > 0
-    has_heat = contact is not None and (
-        callable(contact.heat_coefficient)
-        or np.any(np.asarray(contact.heat_coefficient) > 0)
-        or (
-            contact.heat_law == "power"
-            and np.any(np.asarray(contact.friction) > 0)
-            and np.any(np.asarray(contact.heat_partition) > 0)
-        )
+def _has_heat(contact: ContactSpec | None) -> bool:
+    """Whether ``contact`` heats the blade (a heat coefficient, or friction power)."""
+    if contact is None:
+        return False
+    if callable(contact.heat_coefficient) or np.any(np.asarray(contact.heat_coefficient) > 0):
+        return True
+    return bool(
+        contact.heat_law == "power"
+        and np.any(np.asarray(contact.friction) > 0)
+        and np.any(np.asarray(contact.heat_partition) > 0)
     )
-    dropped = []
+
+
+def _keep_thermal(mats, contact, loads, thermal) -> tuple[bool, list]:
+    """Keep the temperature dofs? ``(keep, dropped notes)`` (``thermal``: module docstring)."""
+    has_coupling = mats.Kut.count_nonzero() > 0 or mats.Ctu.count_nonzero() > 0
+    wanted = bool(has_coupling or _has_heat(contact) or any(ld.field == "theta" for ld in loads))
     if thermal == "auto":
-        keep = bool(has_coupling or has_heat or heat_loads)
-        if not keep:
-            dropped.append("temperature dofs: no thermal coupling, heat input or heat load")
-    else:
-        keep = bool(thermal)
-        if not keep and (has_coupling or has_heat or heat_loads):
-            dropped.append("temperature dofs dropped on request: coupling and heat ignored")
-    if not keep:
-        nt = 0
-    L = Layout(nu, nu, nt)
+        note = "temperature dofs: no thermal coupling, heat input or heat load"
+        return wanted, [] if wanted else [note]
+    keep = bool(thermal)
+    dropped = not keep and wanted
+    return keep, ["temperature dofs dropped on request: coupling and heat ignored"] * dropped
+
+
+def _zeros(r: int, c: int) -> sp.csr_matrix:
+    return sp.csr_matrix((r, c))
+
+
+def _operators(mats, L: Layout) -> tuple[sp.spmatrix, sp.spmatrix]:
+    """``A`` and ``B`` of Eq. (9) on the layout ``L``."""
+    nu, nt, Z = L.n_u, L.n_t, _zeros
     I_u = sp.identity(nu, format="csr")
-    Z = lambda r, c: sp.csr_matrix((r, c))  # noqa: E731
     A = sp.block_diag([I_u, mats.M] + ([mats.Ctt] if nt else []), format="csc")
-    if nt:
-        B = sp.bmat(
-            [
-                [Z(nu, nu), I_u, Z(nu, nt)],
-                [-mats.K, -mats.C, -mats.Kut],
-                [Z(nt, nu), -mats.Ctu, -mats.Ktt],
-            ],
-            format="csc",
-        )
-    else:
-        B = sp.bmat([[Z(nu, nu), I_u], [-mats.K, -mats.C]], format="csc")
-    n = L.n
+    if not nt:
+        return A, sp.bmat([[Z(nu, nu), I_u], [-mats.K, -mats.C]], format="csc")
+    B = sp.bmat(
+        [
+            [Z(nu, nu), I_u, Z(nu, nt)],
+            [-mats.K, -mats.C, -mats.Kut],
+            [Z(nt, nu), -mats.Ctu, -mats.Ktt],
+        ],
+        format="csc",
+    )
+    return A, B
 
-    def embed(block: str, vec) -> np.ndarray:
-        out = np.zeros(n)
-        out[getattr(L, block)] = np.asarray(vec, dtype=float).ravel()
-        return out
 
+def _embed(L: Layout, block: str, vec) -> np.ndarray:
+    out = np.zeros(L.n)
+    out[getattr(L, block)] = np.asarray(vec, dtype=float).ravel()
+    return out
+
+
+def _load_terms(loads, L: Layout) -> list[LoadTerm]:
+    """The state-space :class:`LoadTerm` of each :class:`Load` (heat loads only with θ)."""
     terms = []
     for ld in loads:
-        if ld.field == "u":
-            vec = embed("v", ld.vector)
-            terms.append(LoadTerm(vec, ld.signal, power=vec.copy(), heat=0.0, name=ld.name))
-        elif ld.field == "theta":
-            if nt:
-                vec = embed("t", ld.vector)
-                total = float(np.sum(ld.vector))
-                terms.append(LoadTerm(vec, ld.signal, power=np.zeros(n), heat=total, name=ld.name))
-        else:
+        if ld.field not in ("u", "theta"):
             raise ValueError(f"load field must be 'u' or 'theta', got {ld.field!r}")
+        if ld.field == "u":
+            vec = _embed(L, "v", ld.vector)
+            terms.append(LoadTerm(vec, ld.signal, power=vec.copy(), heat=0.0, name=ld.name))
+        elif L.n_t:
+            vec = _embed(L, "t", ld.vector)
+            heat = float(np.sum(ld.vector))
+            terms.append(LoadTerm(vec, ld.signal, power=np.zeros(L.n), heat=heat, name=ld.name))
+    return terms
 
-    con = None
+
+def _heat_columns(contact: ContactSpec, L: Layout, nc: int) -> np.ndarray:
+    """``Ht`` (N, n_c): where each contact's heat enters (zero without temperature dofs)."""
+    Ht = np.zeros((L.n, nc))
+    if not L.n_t or contact.heat_dofs is None:
+        return Ht
+    hd = np.asarray(contact.heat_dofs)
+    if hd.ndim == 1:
+        Ht[L.t.start + hd.astype(int), np.arange(nc)] = 1.0
+    else:
+        Ht[L.t] = hd.T
+    return Ht
+
+
+def _contact(contact: ContactSpec, L: Layout) -> tuple[Contact, dict]:
+    """The :class:`Contact` in gap form on the state of layout ``L`` and its boundary."""
+    nu, n = L.n_u, L.n
+    N = _rows(contact.normals, nu)
+    nc = N.shape[0]
+    G = np.zeros((n, nc))
+    G[L.u] = -N.T.toarray()
+    Gv = np.zeros((n, nc))
+    Gv[L.v] = -N.T.toarray()
+    Gvt = None
+    if contact.tangents is not None:
+        T = _rows(contact.tangents, nu)
+        Gvt = np.zeros((n, T.shape[0]))
+        Gvt[L.v] = T.T.toarray()
+    Ht = _heat_columns(contact, L, nc)
     boundary = {"u": np.zeros(0, dtype=int), "theta": np.zeros(0, dtype=int)}
-    if contact is not None:
-        N = _rows(contact.normals, nu)
-        nc = N.shape[0]
-        G = np.zeros((n, nc))
-        G[L.u] = -N.T.toarray()
-        Gv = np.zeros((n, nc))
-        Gv[L.v] = -N.T.toarray()
-        Gvt = None
-        if contact.tangents is not None:
-            T = _rows(contact.tangents, nu)
-            Gvt = np.zeros((n, T.shape[0]))
-            Gvt[L.v] = T.T.toarray()
-        Ht = np.zeros((n, nc))
-        if nt and contact.heat_dofs is not None:
-            hd = np.asarray(contact.heat_dofs)
-            if hd.ndim == 1:
-                Ht[L.t.start + hd.astype(int), np.arange(nc)] = 1.0
-            else:
-                Ht[L.t] = hd.T
-        boundary.update(contact_boundary(contact, nu))
-        boundary["theta"] = np.flatnonzero(np.any(Ht[L.t] != 0.0, axis=1))
-        con = Contact(
-            G=G,
-            Gv=Gv,
-            Hm=Gv.copy(),
-            Ht=Ht,
-            gap0=contact.gap,
-            restitution=contact.restitution,
-            heat_coefficient=contact.heat_coefficient if nt else 0.0,
-            names=list(contact.names or []),
-            gap_rate=contact.gap_rate,
-            Gvt=Gvt,
-            friction=contact.friction,
-            casing_velocity=contact.casing_velocity,
-            frames=contact.frames,
-            heat_law=contact.heat_law,
-            heat_partition=contact.heat_partition,
-            wear=contact.wear,
-            casing_heat=contact.casing_heat,
-        )
+    boundary.update(contact_boundary(contact, nu))
+    boundary["theta"] = np.flatnonzero(np.any(Ht[L.t] != 0.0, axis=1))
+    con = Contact(
+        G=G,
+        Gv=Gv,
+        Hm=Gv.copy(),
+        Ht=Ht,
+        gap0=contact.gap,
+        restitution=contact.restitution,
+        heat_coefficient=contact.heat_coefficient if L.n_t else 0.0,
+        names=list(contact.names or []),
+        gap_rate=contact.gap_rate,
+        Gvt=Gvt,
+        friction=contact.friction,
+        casing_velocity=contact.casing_velocity,
+        frames=contact.frames,
+        heat_law=contact.heat_law,
+        heat_partition=contact.heat_partition,
+        wear=contact.wear,
+        casing_heat=contact.casing_heat,
+    )
+    return con, boundary
 
-    observations = {}
+
+def _observations(observe: dict | None, L: Layout) -> dict:
+    """``observe`` (name -> (field, rows)) as rows on the whole state."""
+    out = {}
+    sizes = {"u": L.n_u, "v": L.n_v, "theta": L.n_t}
+    blocks = {"u": L.u, "v": L.v, "theta": L.t}
     for name, (fld, rows) in (observe or {}).items():
-        block = {"u": "u", "v": "v", "theta": "t"}[fld]
-        size = getattr(L, {"u": "n_u", "v": "n_v", "t": "n_t"}[block])
+        size, blk = sizes[fld], blocks[fld]
         if size == 0:
             continue
-        r = np.asarray(rows) if not sp.issparse(rows) else rows
+        r = rows if sp.issparse(rows) else np.asarray(rows)
         if not sp.issparse(r) and r.ndim == 1:
             r = sp.csr_matrix((np.ones(r.size), (np.arange(r.size), r)), shape=(r.size, size))
         r = sp.csr_matrix(r)
-        blk = getattr(L, block)
-        full = sp.hstack([Z(r.shape[0], blk.start), r, Z(r.shape[0], n - blk.stop)], format="csr")
-        observations[name] = full
+        k = r.shape[0]
+        out[name] = sp.hstack([_zeros(k, blk.start), r, _zeros(k, L.n - blk.stop)], format="csr")
+    return out
 
-    Zn = lambda: sp.csr_matrix((n, n))  # noqa: E731
-    Qk = sp.block_diag([Z(nu, nu), mats.M] + ([Z(nt, nt)] if nt else []), format="csr")
-    Qe = sp.block_diag([mats.K, Z(nu, nu)] + ([Z(nt, nt)] if nt else []), format="csr")
-    Pd = sp.block_diag([Z(nu, nu), -mats.C] + ([Z(nt, nt)] if nt else []), format="csr")
-    Pth = Zn()
+
+def _energy_forms(mats, L: Layout) -> EnergyForms:
+    """Kinetic, elastic, damping and thermal-stress forms, heat content and outflow."""
+    nu, nt, n, Z = L.n_u, L.n_t, L.n, _zeros
+    theta = [Z(nt, nt)] if nt else []
+    Qk = sp.block_diag([Z(nu, nu), mats.M] + theta, format="csr")
+    Qe = sp.block_diag([mats.K, Z(nu, nu)] + theta, format="csr")
+    Pd = sp.block_diag([Z(nu, nu), -mats.C] + theta, format="csr")
+    Pth = Z(n, n)
     heat_content = np.zeros(n)
     heat_outflow = np.zeros(n)
     if nt:
@@ -252,29 +266,55 @@ def first_order_model(
         heat_content[L.t] = mats.Ctt.T @ ones
         heat_outflow[L.v] = mats.Ctu.T @ ones
         heat_outflow[L.t] = mats.Ktt.T @ ones
-    energy = EnergyForms(Qk, Qe, Pth, Pd, heat_content, heat_outflow)
+    return EnergyForms(Qk, Qe, Pth, Pd, heat_content, heat_outflow)
 
+
+def first_order_model(
+    mats: ThermoelasticMatrices,
+    *,
+    contact: ContactSpec | None = None,
+    loads=(),
+    observe: dict | None = None,
+    thermal: str | bool = "auto",
+    x0=None,
+    info: dict | None = None,
+    **fields,
+) -> FirstOrderModel:
+    """Assemble ``A``, ``B`` of Eq. (9) and the contact, load and energy data.
+
+    ``observe`` maps a signal name to ``(field, rows)`` with ``field`` in {"u", "v", "theta"}
+    and ``rows`` a (k, n_field) array/sparse matrix or an index array of free dofs.
+    ``info``: entries added to the model's ``info``; ``fields``: other fields of the
+    :class:`FirstOrderModel` (``length_scale``, ``parameters``, ``sweep``).
+    """
+    keep, dropped = _keep_thermal(mats, contact, loads, thermal)
+    nt = mats.n_t if keep else 0
+    L = Layout(mats.n_u, mats.n_u, nt)
+    A, B = _operators(mats, L)
+    con, boundary = None, {"u": np.zeros(0, dtype=int), "theta": np.zeros(0, dtype=int)}
+    if contact is not None:
+        con, boundary = _contact(contact, L)
     Pu = mats.prolongation_u()
-    blocks = [Pu, Pu] + ([mats.prolongation_t()] if nt else [])
-    to_full = sp.block_diag(blocks, format="csr")
-    info = {
-        "n_u": nu,
-        "n_theta": nt,
-        "thermal": bool(nt),
-        "coupling": mats.info.get("coupling"),
-        "dropped": dropped,
-    }
+    to_full = sp.block_diag([Pu, Pu] + ([mats.prolongation_t()] if nt else []), format="csr")
     return FirstOrderModel(
         A=A,
         B=B,
         layout=L,
-        loads=terms,
+        loads=_load_terms(loads, L),
         contact=con,
-        observations=observations,
-        energy=energy,
+        observations=_observations(observe, L),
+        energy=_energy_forms(mats, L),
         blocks=mats if nt else mats.mechanical(),
         boundary=boundary,
         to_full=to_full,
         x0=x0,
-        info=info,
+        info={
+            "n_u": mats.n_u,
+            "n_theta": nt,
+            "thermal": bool(nt),
+            "coupling": mats.info.get("coupling"),
+            "dropped": dropped,
+            **(info or {}),
+        },
+        **fields,
     )

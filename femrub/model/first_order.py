@@ -8,11 +8,20 @@ coordinates and ``A`` may have off-diagonal blocks (``A_21``, ``A_23``, ...).
 Contact (paper Eq. 8b) is described in gap form, independent of the model's coordinates,
 by :class:`~femrub.contact.gap.Contact` (``g = g0(t) + Gᵀ X``, ``ġ = ġ0(t) + Gvᵀ X``, force
 ``Hm λ + Ht (α λ)``).
+
+Models are immutable (``with_`` returns a changed copy) and carry their parameters, in the
+spirit of pyMOR's ``mu``: ``model.parameters["rotation_speed"]`` (Ω, rad/s) and
+``model.with_parameters(rotation_speed=...)``, a model at another speed that shares every
+matrix (full or reduced alike: Ω enters only the contact's gap functions, the casing's
+sliding velocity and the loads whose frequency is an engine order, through
+:class:`CasingSweep`). A model whose stiffness was prestressed at Ω (centrifugal
+prestress) refuses another speed: its matrices depend on Ω, rebuild it.
 """
 
 from __future__ import annotations
 
-from collections.abc import Callable
+import math
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field, replace
 
 import numpy as np
@@ -21,7 +30,15 @@ import scipy.sparse as sp
 from ..contact.gap import Contact
 from ..fem.linalg import project
 
-__all__ = ["Layout", "LoadTerm", "Contact", "EnergyForms", "FirstOrderModel"]
+__all__ = [
+    "CasingSweep",
+    "Contact",
+    "EnergyForms",
+    "FirstOrderModel",
+    "Layout",
+    "LoadTerm",
+    "Parameters",
+]
 
 
 @dataclass(frozen=True)
@@ -49,6 +66,15 @@ class Layout:
         return slice(self.n_u + self.n_v, self.n)
 
 
+def _csc(a):
+    """``a`` as a CSC matrix (itself when it is one: a model at other parameters shares it)."""
+    return a if isinstance(a, sp.csc_matrix) else sp.csc_matrix(a)
+
+
+def _csr(a):
+    return a if isinstance(a, sp.csr_matrix) else sp.csr_matrix(a)
+
+
 def _as_signal(signal) -> Callable:
     if callable(signal):
         return signal
@@ -56,9 +82,9 @@ def _as_signal(signal) -> Callable:
     return lambda t: value * np.ones_like(np.asarray(t, dtype=float))
 
 
-@dataclass
+@dataclass(frozen=True)
 class LoadTerm:
-    """One load ``F_j s_j(t)``: a state-space vector times a time signal.
+    """One load ``F_j s_j(t)``: a state-space vector times a time signal (immutable).
 
     ``power`` is the state-space vector whose product with ``X`` is the mechanical power of
     the load per unit signal (``vᵀ f^u``); ``heat`` is the heat input per unit signal (W).
@@ -71,7 +97,79 @@ class LoadTerm:
     name: str = "load"
 
     def __post_init__(self):
-        self.signal = _as_signal(self.signal)
+        object.__setattr__(self, "signal", _as_signal(self.signal))
+
+
+class Parameters(Mapping):
+    """The parameters of a model (immutable mapping; ``rotation_speed``: Ω in rad/s)."""
+
+    __slots__ = ("_items",)
+
+    def __init__(self, values: Mapping | None = None, **more):
+        items = {**dict(values or {}), **more}
+        object.__setattr__(self, "_items", tuple(sorted((k, float(v)) for k, v in items.items())))
+
+    def __getitem__(self, key: str) -> float:
+        for k, v in self._items:
+            if k == key:
+                return v
+        raise KeyError(key)
+
+    def __iter__(self):
+        return (k for k, _ in self._items)
+
+    def __len__(self) -> int:
+        return len(self._items)
+
+    def __setattr__(self, name, value):
+        raise AttributeError("Parameters are immutable; use model.with_parameters(...)")
+
+    def __hash__(self) -> int:
+        return hash(self._items)
+
+    def __eq__(self, other) -> bool:
+        return isinstance(other, Mapping) and dict(self) == dict(other)
+
+    def __repr__(self) -> str:
+        return f"Parameters({dict(self._items)!r})"
+
+    def __reduce__(self):
+        return Parameters, (dict(self._items),)
+
+
+@dataclass(frozen=True)
+class CasingSweep:
+    """What the rotation speed Ω changes in a rub model, and nothing else.
+
+    ``casing`` (a :class:`~femrub.contact.casing.CasingProfile`), the contacts' ``angles``
+    (rad), ``offsets`` (m, added clearance) and ``radii`` (m): the swept gap ``g(Ω t + φ_i)
+    + offset_i`` and the casing's sliding velocity ``−Ω r_i`` (the model's contact, full or
+    reduced); ``prestress_speed``: Ω of a centrifugal prestress in the stiffness, or
+    ``None``.
+    """
+
+    casing: object
+    angles: np.ndarray
+    offsets: np.ndarray
+    radii: np.ndarray
+    prestress_speed: float | None = None
+
+    def contact_at(self, contact, omega: float):
+        """``contact`` with its gap functions and casing velocity at ``omega`` (rad/s)."""
+        from ..contact.casing import swept_gap
+
+        if contact.wear is not None or contact.casing_heat is not None:
+            raise ValueError(
+                "rotation_speed: an abradable coating or a casing heat model is swept at the "
+                "speed it was built for; build the model again at the new speed"
+            )
+        gap, rate = swept_gap(self.casing, self.angles, omega, self.offsets)
+        changes = {"gap0": gap, "gap_rate": rate}
+        if contact.casing_velocity is not None:
+            vc = np.zeros_like(np.asarray(contact.casing_velocity, dtype=float))
+            vc[:, 1] = -float(omega) * self.radii
+            changes["casing_velocity"] = vc
+        return replace(contact, **changes)
 
 
 @dataclass
@@ -117,9 +215,11 @@ class EnergyForms:
         )
 
 
-@dataclass
+@dataclass(frozen=True)
 class FirstOrderModel:
     """``A Ẋ = B X + Σ_j F_j s_j(t) + (Hm + Ht diag α) λ``, with contact in gap form.
+
+    Immutable: :meth:`with_` and :meth:`with_parameters` return new models.
 
     Attributes
     ----------
@@ -137,6 +237,10 @@ class FirstOrderModel:
         ``[u_all, v_all, θ_all]`` (Dirichlet dofs included); used for VTK output.
     x0 : initial state (zeros by default).
     info : free-form description (sizes, physics kept or dropped and why).
+    length_scale : the blade's characteristic size (m): the bar's length or the mesh's
+        largest extent, set by the builder and kept by every reduction; NaN when unknown.
+    parameters : :class:`Parameters` (``rotation_speed``, rad/s, of a rub model).
+    sweep : :class:`CasingSweep` of a rub model (what Ω changes), or ``None``.
     """
 
     A: sp.spmatrix
@@ -151,19 +255,30 @@ class FirstOrderModel:
     to_full: object = None
     x0: np.ndarray | None = None
     info: dict = field(default_factory=dict)
+    length_scale: float = float("nan")
+    parameters: Parameters = field(default_factory=Parameters)
+    sweep: CasingSweep | None = None
 
     def __post_init__(self):
-        self.A = sp.csc_matrix(self.A)
-        self.B = sp.csc_matrix(self.B)
         n = self.layout.n
-        if self.A.shape != (n, n) or self.B.shape != (n, n):
-            raise ValueError(f"A and B must be {n}x{n} to match the layout, got {self.A.shape}")
-        if self.x0 is None:
-            self.x0 = np.zeros(n)
-        self.x0 = np.asarray(self.x0, dtype=float)
-        if self.x0.shape != (n,) or not np.all(np.isfinite(self.x0)):
+        A, B = _csc(self.A), _csc(self.B)
+        if A.shape != (n, n) or B.shape != (n, n):
+            raise ValueError(f"A and B must be {n}x{n} to match the layout, got {A.shape}")
+        x0 = np.zeros(n) if self.x0 is None else np.asarray(self.x0, dtype=float)
+        if x0.shape != (n,) or not np.all(np.isfinite(x0)):
             raise ValueError(f"initial state must be a finite vector of length {n}")
-        self.observations = {k: sp.csr_matrix(v) for k, v in self.observations.items()}
+        fixed = {
+            "A": A,
+            "B": B,
+            "x0": x0,
+            "loads": list(self.loads),
+            "observations": {k: _csr(v) for k, v in self.observations.items()},
+            "info": dict(self.info),
+            "length_scale": float(self.length_scale),
+            "parameters": Parameters(self.parameters),
+        }
+        for name, value in fixed.items():
+            object.__setattr__(self, name, value)
 
     @property
     def n_dofs(self) -> int:
@@ -187,3 +302,53 @@ class FirstOrderModel:
     def with_(self, **changes) -> FirstOrderModel:
         """A copy with some fields changed (e.g. ``model.with_(x0=...)``)."""
         return replace(self, **changes)
+
+    def with_parameters(self, **values) -> FirstOrderModel:
+        """This model at other parameter values (``rotation_speed=`` Ω in rad/s), sharing
+        every matrix (module docstring). The contacts are those the builder kept at the
+        model's own speed (its reach filter is not run again).
+
+        Raises
+        ------
+        ValueError
+            An unknown parameter, a speed that is not finite, or a speed that changes a
+            matrix (a centrifugal prestress at another Ω) or a swept casing cell state
+            (an abradable coating, a casing heat model): rebuild the model then.
+        """
+        unknown = sorted(set(values) - {"rotation_speed"})
+        if unknown:
+            raise ValueError(f"unknown model parameter(s) {unknown}; known: rotation_speed")
+        if "rotation_speed" not in values:
+            return self
+        omega = float(values["rotation_speed"])
+        if not math.isfinite(omega):
+            raise ValueError(f"rotation_speed must be finite (rad/s), got {omega!r}")
+        if omega == self.parameters.get("rotation_speed"):
+            return self
+        return replace(self, **_at_speed(self, omega))
+
+
+def _at_speed(model: FirstOrderModel, omega: float) -> dict:
+    """The fields of ``model`` that change at the rotation speed ``omega`` (rad/s)."""
+    sweep = model.sweep
+    if sweep is None:
+        raise ValueError("rotation_speed: this model has no rotating casing (no CasingSweep)")
+    if sweep.prestress_speed is not None:
+        raise ValueError(
+            f"rotation_speed = {omega:g} rad/s: the stiffness holds the centrifugal prestress "
+            f"at {sweep.prestress_speed:g} rad/s; build the model again at the new speed"
+        )
+    loads = [_load_at(term, omega) for term in model.loads]
+    contact = None if model.contact is None else sweep.contact_at(model.contact, omega)
+    return {
+        "contact": contact,
+        "loads": loads,
+        "parameters": Parameters(model.parameters, rotation_speed=omega),
+        "info": {**model.info, "rotation_speed": omega},
+    }
+
+
+def _load_at(term: LoadTerm, omega: float) -> LoadTerm:
+    """``term`` with its signal at ``omega`` when its frequency is an engine order of Ω."""
+    at = getattr(term.signal, "at_rotation_speed", None)
+    return term if at is None else replace(term, signal=at(omega))

@@ -23,13 +23,12 @@ import scipy.sparse as sp
 import skfem as fem
 
 from ..contact.casing import CasingProfile, Concentric, swept_gap
-from ..contact.heat import heat_coefficients
-from ..contact.points import ContactPoints, locate_contacts
-from ..fem.discretisation import Discretisation, assemble, discretise
+from ..contact.points import ContactPoints
+from ..fem.discretisation import Discretisation
 from ..fem.forms import lame_parameters
 from ..fem.material import Material
 from .build import ContactSpec, Load, contact_boundary, first_order_model
-from .first_order import FirstOrderModel
+from .first_order import CasingSweep, FirstOrderModel, Parameters
 
 __all__ = ["DEFAULT_CLEARANCE", "FieldMap", "rub_model", "solid_model", "tip_load"]
 
@@ -126,6 +125,7 @@ def rub_model(
     wear=None,
     casing_heat=None,
     damping=None,
+    length_scale: float = float("nan"),
 ) -> tuple[FirstOrderModel, FieldMap]:
     """First-order model of ``disc`` rubbing ``casing`` at ``points`` (module docstring).
 
@@ -150,6 +150,7 @@ def rub_model(
         contacts' displacement boundary (:func:`~femrub.model.build.contact_boundary`) is
         known and before the model is built (the pipeline's modal damping, which takes the
         frequencies through the reduction's interior factorisation), or None.
+    length_scale : the blade's characteristic size (m; the model's ``length_scale``).
     """
     N, Q = points.normal_rows(mats), points.heat_rows(mats)
     if observe_at is None or observe_at is points:
@@ -178,9 +179,7 @@ def rub_model(
     )
     if damping is not None:
         mats = damping(mats, contact_boundary(spec, mats.n_u))
-    model = first_order_model(mats, contact=spec, loads=loads, observe=observe, thermal=thermal)
-    lam, mu = lame_parameters(material.young, material.poisson, disc.dim)
-    model.info.update(
+    info = dict(
         blade=disc.blade.source,
         order=disc.order,
         n_contacts=points.n,
@@ -189,6 +188,22 @@ def rub_model(
         rotation_speed=float(rotation_speed),
         rayleigh=mats.info.get("rayleigh", (0.0, 0.0)),
     )
+    offsets = np.broadcast_to(np.asarray(offset, dtype=float), (points.n,)).copy()
+    sweep = CasingSweep(
+        casing, points.angles, offsets, points.radii, mats.info.get("prestress_speed")
+    )
+    model = first_order_model(
+        mats,
+        contact=spec,
+        loads=loads,
+        observe=observe,
+        thermal=thermal,
+        info=info,
+        length_scale=length_scale,
+        parameters=Parameters(rotation_speed=rotation_speed),
+        sweep=sweep,
+    )
+    lam, mu = lame_parameters(material.young, material.poisson, disc.dim)
     return model, FieldMap(disc, points, lam, mu)
 
 
@@ -199,6 +214,7 @@ def solid_model(
     casing: CasingProfile | None = None,
     rotation_speed: float = 0.0,
     friction: float = 0.0,
+    heat_law: str = "power",
     heat_partition: float = 1.0,
     restitution: float = 0.0,
     order: int = 2,
@@ -209,42 +225,65 @@ def solid_model(
     lumping: str = "auto",
     tip_force=None,
     thermal: str | bool = "auto",
+    reach: float | str = "auto",
+    gap_reference: str = "per-node",
+    spread: str = "patch",
+    centrifugal: str | None = None,
 ) -> tuple[FirstOrderModel, FieldMap]:
-    """A blade rubbing a casing in one call: discretise, assemble, locate contacts, model.
+    """A blade rubbing a casing in one call: the scene's builder with Python arguments.
 
-    Vector P2 displacement (``order=2``, HRZ-lumped mass) and P1 temperature, root clamped
-    and held at ambient, heat law ``α_i = η μ |Ω| r_i`` (``friction`` μ, ``heat_partition``
-    η), casing default: concentric with :data:`DEFAULT_CLEARANCE`. ``damping_ratio`` ζ gives
-    Rayleigh damping with ratio ζ at the first and fifth clamped modes. Returns ``(model,
-    fields)``.
+    The same model as a scene with the same values (:func:`~femrub.model.builder.build_rub`):
+    vector P2 displacement (``order=2``, HRZ-lumped mass) and P1 temperature, root clamped
+    and held at ambient, Coulomb friction ``friction`` μ on every contact (the casing slides
+    past at ``Ω r``), frictional heat ``heat_partition`` η × friction power (``heat_law=
+    "power"``; ``"alpha"`` with α = 0 turns it off), casing default: concentric with
+    :data:`DEFAULT_CLEARANCE`. Only the contacts the casing can reach are kept, as in a
+    scene (``reach="auto"``, :mod:`femrub.contact.reach`); ``reach="all"`` keeps every
+    candidate, a length (m) sets the reach; ``gap_reference="outermost"``: the clearance
+    is the outermost contact's. ``damping_ratio`` ζ gives Rayleigh damping
+    with ratio ζ at the first and fifth clamped modes; ``tip_force``: ``(force vector N,
+    signal)`` (a harmonic :class:`~femrub.model.config.ForceLaw` also gives the reach filter
+    its frequency, as a scene's ``sin`` law); ``centrifugal``: prestress method at Ω
+    (``"linear"``, ``"nonlinear"``; default ``None``: none, unlike a scene's
+    ``loads.centrifugal = "auto"``). Returns ``(model, fields)``.
     """
-    disc = discretise(blade, order)
-    mats = assemble(
-        disc,
+    from .builder import build_rub  # the builder composes this module's rub_model
+    from .config import ContactConfig, ForceConfig, ForceLaw, RubConfig
+
+    force = None
+    if tip_force is not None:
+        vector, signal = tip_force
+        vector = np.asarray(vector, dtype=float)
+        amplitude = float(np.linalg.norm(vector))
+        harmonic = isinstance(signal, ForceLaw) and signal.law == "sin"
+        force = ForceConfig(
+            amplitude,
+            signal,
+            frequency=signal.omega if harmonic else None,
+            direction=tuple(vector / (amplitude or 1.0)),
+        )
+    config = RubConfig(
         material,
+        ContactConfig(
+            casing=casing or Concentric(DEFAULT_CLEARANCE),
+            friction=friction,
+            heat_law=heat_law,
+            heat_partition=heat_partition,
+            restitution=restitution,
+            spread=spread,
+            reach=reach,
+            gap_reference=gap_reference,
+        ),
+        rotation_speed=float(rotation_speed),
+        order=order,
         lumping=lumping,
         coupling=coupling,
         strain_heating=strain_heating,
-        rayleigh=rayleigh,
-        damping_ratio=damping_ratio,
-    )
-    points = locate_contacts(disc)
-    alpha = heat_coefficients(
-        points.radii,
-        "friction",
-        friction=friction,
-        rotation_speed=rotation_speed,
-        heat_partition=heat_partition,
-    )
-    return rub_model(
-        disc,
-        mats,
-        points,
-        material,
-        casing=casing or Concentric(DEFAULT_CLEARANCE),
-        rotation_speed=rotation_speed,
-        alpha=alpha,
-        restitution=restitution,
-        loads=[] if tip_force is None else [tip_load(disc, mats, *tip_force)],
+        rayleigh=tuple(rayleigh),
+        damping_ratio=damping_ratio or 0.0,
         thermal=thermal,
+        centrifugal=centrifugal,
+        tip_force=force,
     )
+    built = build_rub(blade, config)
+    return built.model, built.fields

@@ -15,6 +15,7 @@ import math
 
 import numpy as np
 
+from ..contact.casing import lobe_count
 from .plots import plt, savefig
 
 __all__ = ["engine_orders", "panels", "plot_interaction_map"]
@@ -41,7 +42,7 @@ def panels(rows, scene) -> list[tuple]:
 def engine_orders(scene) -> list[int]:
     """Engine orders that excite the blade: casing lobes (and harmonics) and the tip force."""
     casing = scene["contact"]["casing"]
-    lobes = {"lobed": casing.get("lobes", 0), "two-lobe": 2}.get(casing["kind"], 0)
+    lobes = lobe_count(casing)
     orders = {lobes * j for j in (1, 2, 3)} if lobes else {1, 2, 3}
     force = scene["loads"]["tip_force"]
     if force["law"] == "sin" and force["frequency"] == "rotation":

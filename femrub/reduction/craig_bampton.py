@@ -300,7 +300,15 @@ class ThermoelasticCraigBampton:
         }
         A, B = parts.pop("A"), parts.pop("B")
         return FirstOrderModel(
-            A=sp.csc_matrix(A), B=sp.csc_matrix(B), layout=layout, x0=x0, info=info, **parts
+            A=sp.csc_matrix(A),
+            B=sp.csc_matrix(B),
+            layout=layout,
+            x0=x0,
+            info=info,
+            length_scale=m.length_scale,
+            parameters=m.parameters,
+            sweep=m.sweep,
+            **parts,
         )
 
     def project(self) -> float:

@@ -37,6 +37,7 @@ import scipy.linalg as sla
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
+from ..contact.casing import lobe_passing_frequency
 from ..fem import eigen
 from ..scene.spec import SceneError, fail
 from .craig_bampton import ThermoelasticCraigBampton
@@ -202,11 +203,8 @@ def _checked(red, model, want, make_stepper, scene, report, log, limits, on_run=
 
 def lobe_passage(scene) -> float:
     """Duration (s) of one lobe passage of the casing (0 without lobes or rotation)."""
-    cas, omega = scene["contact"]["casing"], abs(scene["loads"]["rotation_speed"])
-    lobes = 0
-    if isinstance(cas, dict):  # the two-lobe casing of Piollet et al. has two, by definition
-        lobes = 2 if cas.get("kind") == "two-lobe" else cas.get("lobes", 0)
-    return 2.0 * np.pi / (omega * lobes) if lobes and omega else 0.0
+    w = lobe_passing_frequency(scene["contact"]["casing"], scene["loads"]["rotation_speed"])
+    return 2.0 * np.pi / w if w else 0.0
 
 
 def reduce_model(

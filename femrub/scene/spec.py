@@ -112,8 +112,7 @@ class Spec:
         try:
             x = to_si(value, self.dim)
         except ValueError as exc:
-            words = f", or one of {', '.join(map(repr, self.choices))}" if self.choices else ""
-            fail(key, value, f"{exc}{words}")
+            fail(key, value, f"{exc}{self._words(', or one of ')}")
         self._bounds(key, value, x)
         return x
 
@@ -124,47 +123,60 @@ class Spec:
                 return value
             if self.kind != "float":
                 fail(key, value, f"use one of {', '.join(map(repr, self.choices))} or a list")
-        k = self.kind
-        if k == "float":
-            return self._number(key, value)
-        if k == "int":
-            if isinstance(value, bool) or not isinstance(value, int):
-                fail(key, value, f"must be an integer{self._range()}")
-            self._bounds(key, value, value)
-            return int(value)
-        if k == "bool":
-            if not isinstance(value, bool):
-                fail(key, value, "must be true or false")
-            return value
-        if k == "str":
-            if not isinstance(value, str):
-                fail(key, value, "must be a string")
-            return value
-        if k == "choice":
-            if value not in self.choices:
-                fail(key, value, f"use one of {', '.join(map(repr, self.choices))}")
-            return value
-        if k in ("vec3", "pair"):
-            n = 3 if k == "vec3" else 2
-            if not isinstance(value, list) or len(value) != n:
-                words = f" or one of {', '.join(map(repr, self.choices))}" if self.choices else ""
-                fail(key, value, f"must be a list of {n} numbers{words}")
-            return [self._number(f"{key}[{i}]", v) for i, v in enumerate(value)]
-        if k == "ints":
-            ok = isinstance(value, list) and value
-            if not ok or any(isinstance(v, bool) or not isinstance(v, int) for v in value):
-                fail(key, value, "must be a non-empty list of integers")
-            return [int(v) for v in value]
-        if k == "strs":
-            if (
-                not isinstance(value, list)
-                or not value
-                or not all(isinstance(v, str) for v in value)
-            ):
-                words = f" or one of {', '.join(map(repr, self.choices))}" if self.choices else ""
-                fail(key, value, f"must be a non-empty list of strings{words}")
-            return list(value)
-        raise AssertionError(k)  # pragma: no cover
+        check = getattr(self, f"_check_{self.kind}", None)
+        if check is None:  # pragma: no cover
+            raise AssertionError(self.kind)
+        return check(key, value)
+
+    def _words(self, prefix: str) -> str:
+        """``prefix`` and the words accepted besides the value, or nothing."""
+        return f"{prefix}{', '.join(map(repr, self.choices))}" if self.choices else ""
+
+    def _check_float(self, key, value) -> float:
+        return self._number(key, value)
+
+    def _check_int(self, key, value) -> int:
+        if isinstance(value, bool) or not isinstance(value, int):
+            fail(key, value, f"must be an integer{self._range()}")
+        self._bounds(key, value, value)
+        return int(value)
+
+    def _check_bool(self, key, value) -> bool:
+        if not isinstance(value, bool):
+            fail(key, value, "must be true or false")
+        return value
+
+    def _check_str(self, key, value) -> str:
+        if not isinstance(value, str):
+            fail(key, value, "must be a string")
+        return value
+
+    def _check_choice(self, key, value) -> str:
+        if value not in self.choices:
+            fail(key, value, f"use one of {', '.join(map(repr, self.choices))}")
+        return value
+
+    def _numbers(self, key, value, n: int) -> list:
+        if not isinstance(value, list) or len(value) != n:
+            fail(key, value, f"must be a list of {n} numbers{self._words(' or one of ')}")
+        return [self._number(f"{key}[{i}]", v) for i, v in enumerate(value)]
+
+    def _check_vec3(self, key, value) -> list:
+        return self._numbers(key, value, 3)
+
+    def _check_pair(self, key, value) -> list:
+        return self._numbers(key, value, 2)
+
+    def _check_ints(self, key, value) -> list:
+        ok = isinstance(value, list) and value
+        if not ok or any(isinstance(v, bool) or not isinstance(v, int) for v in value):
+            fail(key, value, "must be a non-empty list of integers")
+        return [int(v) for v in value]
+
+    def _check_strs(self, key, value) -> list:
+        if not isinstance(value, list) or not value or not all(isinstance(v, str) for v in value):
+            fail(key, value, f"must be a non-empty list of strings{self._words(' or one of ')}")
+        return list(value)
 
 
 @dataclass(frozen=True)

@@ -7,6 +7,12 @@ angle is in degrees (``"0.35 rad"`` is accepted too). A string must carry its un
 quoted number without one (``clearance = "15"``) is refused, since its writer most likely
 meant a unit other than SI. :func:`to_si` converts and raises a
 one-line :class:`ValueError` naming the allowed units otherwise.
+
+:func:`convert` is the one conversion of a number in a unit to SI, used by the scene files
+and by the Python presets alike (:func:`rpm`, ``femrub.cases.bar``): a decimal factor
+(``um``, ``GPa``) gives the nearest double to the decimal result (``15 um`` is ``1.5e-05``,
+not ``1.4999999999999999e-05``), any other factor (``rpm``, ``Hz``, ``rad``) the product
+itself, so ``"2000 rpm"`` in a scene and ``rpm(2000)`` in Python are the same double.
 """
 
 from __future__ import annotations
@@ -14,7 +20,7 @@ from __future__ import annotations
 import math
 import re
 
-__all__ = ["UNITS", "SI_LABEL", "to_si"]
+__all__ = ["UNITS", "SI_LABEL", "convert", "rpm", "to_si"]
 
 _TWO_PI = 2.0 * math.pi
 
@@ -107,5 +113,23 @@ def to_si(value, dim: str) -> float:
         return number
     if unit not in units:
         raise ValueError(f"unit {unit!r} is not a unit of {dim.replace('_', ' ')}; use {allowed}")
-    value = number * units[unit]
-    return float(f"{value:.15g}") if math.isfinite(value) else value
+    return convert(number, unit, dim)
+
+
+def _is_decimal(factor: float) -> bool:
+    """Whether ``factor`` is a decimal number of at most 15 significant digits."""
+    return float(f"{factor:.15g}") == factor
+
+
+def convert(number: float, unit: str, dim: str) -> float:
+    """``number`` in ``unit`` (a unit of dimension ``dim``) in SI (module docstring)."""
+    factor = UNITS[dim][unit]
+    value = float(number) * factor
+    if _is_decimal(factor) and math.isfinite(value):
+        return float(f"{value:.15g}")
+    return value
+
+
+def rpm(value: float) -> float:
+    """Revolutions per minute in rad/s (the scene's ``"<value> rpm"``)."""
+    return convert(value, "rpm", "angular_speed")

@@ -101,103 +101,122 @@ def _check_damping(physics: dict) -> None:
         )
 
 
-def _cross_check(d: dict) -> None:
-    geo, contact, loads, physics = d["geometry"], d["contact"], d["loads"], d["physics"]
-    scheme, outputs, casing = d["scheme"], d["outputs"], d["contact"]["casing"]
-    kind = geo["kind"]
-    force = loads["tip_force"]
-    abr = contact["abradable"]
-    if abr["thickness"] > 0.0:
-        if abr["yield"] <= 0.0:
-            fail("contact.abradable.yield", abr["yield"], "give the coating's yield force (N) > 0")
-        if scheme["name"] != "theta":
-            fail(
-                "contact.abradable.thickness",
-                abr["thickness"],
-                "an abradable coating needs scheme.name = 'theta' (bounded impulses)",
-            )
-    if kind == "bar":
-        if casing["kind"] != "concentric":
-            fail(
-                "contact.casing.kind",
-                casing["kind"],
-                "the 1D bar has a fixed gap; use 'concentric'",
-            )
-        if contact["friction"] != 0.0:
-            fail(
-                "contact.friction",
-                contact["friction"],
-                "the 1D bar has no sliding speed; "
-                "give its heat coefficient as contact.heat_coefficient (m/s)",
-            )
-        if contact["group"] != "contact" or contact.get("nodes") is not None:
-            key = "contact.nodes" if contact.get("nodes") is not None else "contact.group"
-            fail(
-                key,
-                contact.get("nodes") or contact["group"],
-                "the 1D bar's only contact is its tip; remove the key",
-            )
-        if outputs["vtk_stride"]:
-            fail(
-                "outputs.vtk_stride",
-                outputs["vtk_stride"],
-                "VTK output needs a 3D geometry (geometry.kind = 'bar' has no mesh); use 0",
-            )
-        if force.get("direction", "radial") != "radial":
-            fail(
-                "loads.tip_force.direction",
-                force["direction"],
-                "the bar's tip force is axial; use 'radial'",
-            )
-        if d["boundary"].get("root") is not None:
-            fail("boundary.root", d["boundary"]["root"], "the bar is clamped at x = 0; remove it")
-        if loads["centrifugal"] in ("linear", "nonlinear"):
-            fail(
-                "loads.centrifugal",
-                loads["centrifugal"],
-                "the 1D bar has no rotation axis; use 'auto' or 'off'",
-            )
-    else:
-        if contact["heat_coefficient"] != 0.0:
-            fail(
-                "contact.heat_coefficient",
-                contact["heat_coefficient"],
-                "3D contacts take their "
-                "heat coefficient from contact.friction (α = friction Ω r); remove the key",
-            )
-        if physics["coupling"] == "paper":
-            fail(
-                "physics.coupling",
-                "paper",
-                "the paper coupling (β K^uu) is the 1D bar's; use "
-                "'physical', 'none' or 'auto' in 3D",
-            )
-        if not d["boundary"]["clamped"]:
-            fail("boundary.clamped", False, "3D blades are clamped at boundary.root; use true")
-        if contact.get("nodes") is not None and kind != "mesh":
-            fail(
-                "contact.nodes",
-                contact["nodes"],
-                "node numbers need geometry.kind = 'mesh'; use contact.group",
-            )
-        if kind == "sections" and (geo.get("path") is None) == (geo.get("files") is None):
-            raise SceneError(
-                "geometry: give exactly one of geometry.path (a folder) and "
-                "geometry.files (a list of section files)"
-            )
-        if kind == "naca":
-            from ..geometry.errors import GeometryError
-            from ..geometry.naca import naca4_parameters
+def _check_coating(d: dict) -> None:
+    """An abradable coating needs a yield force and the θ-method (bounded impulses)."""
+    abr = d["contact"]["abradable"]
+    if abr["thickness"] <= 0.0:
+        return
+    if abr["yield"] <= 0.0:
+        fail("contact.abradable.yield", abr["yield"], "give the coating's yield force (N) > 0")
+    if d["scheme"]["name"] != "theta":
+        fail(
+            "contact.abradable.thickness",
+            abr["thickness"],
+            "an abradable coating needs scheme.name = 'theta' (bounded impulses)",
+        )
 
-            try:
-                naca4_parameters(geo["code"])
-            except GeometryError as exc:
-                fail("geometry.code", geo["code"], str(exc))
-        if kind in ("box", "naca") and geo.get("h_min") is not None and geo.get("h") is not None:
-            if geo["h_min"] > geo["h"]:
-                fail("geometry.h_min", geo["h_min"], f"must be <= geometry.h = {geo['h']:g} m")
+
+def _check_bar_contact(d: dict) -> None:
+    """The bar's one contact: its tip, under a concentric casing, without friction."""
+    contact = d["contact"]
+    casing = contact["casing"]
+    if casing["kind"] != "concentric":
+        fail("contact.casing.kind", casing["kind"], "the 1D bar has a fixed gap; use 'concentric'")
+    if contact["friction"] != 0.0:
+        fail(
+            "contact.friction",
+            contact["friction"],
+            "the 1D bar has no sliding speed; "
+            "give its heat coefficient as contact.heat_coefficient (m/s)",
+        )
+    if contact["group"] != "contact" or contact.get("nodes") is not None:
+        key = "contact.nodes" if contact.get("nodes") is not None else "contact.group"
+        fail(
+            key,
+            contact.get("nodes") or contact["group"],
+            "the 1D bar's only contact is its tip; remove the key",
+        )
+
+
+def _check_bar(d: dict) -> None:
+    """Keys a 1D bar cannot honour (it has no mesh, no rotation axis, an axial force)."""
+    _check_bar_contact(d)
+    outputs, loads = d["outputs"], d["loads"]
+    force = loads["tip_force"]
+    if outputs["vtk_stride"]:
+        fail(
+            "outputs.vtk_stride",
+            outputs["vtk_stride"],
+            "VTK output needs a 3D geometry (geometry.kind = 'bar' has no mesh); use 0",
+        )
+    if force.get("direction", "radial") != "radial":
+        fail(
+            "loads.tip_force.direction",
+            force["direction"],
+            "the bar's tip force is axial; use 'radial'",
+        )
+    if d["boundary"].get("root") is not None:
+        fail("boundary.root", d["boundary"]["root"], "the bar is clamped at x = 0; remove it")
+    if loads["centrifugal"] in ("linear", "nonlinear"):
+        fail(
+            "loads.centrifugal",
+            loads["centrifugal"],
+            "the 1D bar has no rotation axis; use 'auto' or 'off'",
+        )
+
+
+def _check_blade_physics(d: dict) -> None:
+    """A 3D blade: heat from friction, physical coupling, clamped root, node numbers of a mesh."""
+    contact, kind = d["contact"], d["geometry"]["kind"]
+    if contact["heat_coefficient"] != 0.0:
+        fail(
+            "contact.heat_coefficient",
+            contact["heat_coefficient"],
+            "3D contacts take their "
+            "heat coefficient from contact.friction (α = friction Ω r); remove the key",
+        )
+    if d["physics"]["coupling"] == "paper":
+        fail(
+            "physics.coupling",
+            "paper",
+            "the paper coupling (β K^uu) is the 1D bar's; use 'physical', 'none' or 'auto' in 3D",
+        )
+    if not d["boundary"]["clamped"]:
+        fail("boundary.clamped", False, "3D blades are clamped at boundary.root; use true")
+    if contact.get("nodes") is not None and kind != "mesh":
+        fail(
+            "contact.nodes",
+            contact["nodes"],
+            "node numbers need geometry.kind = 'mesh'; use contact.group",
+        )
+
+
+def _check_blade_geometry(geo: dict) -> None:
+    """The geometry keys of a 3D blade that depend on each other."""
+    kind = geo["kind"]
+    if kind == "sections" and (geo.get("path") is None) == (geo.get("files") is None):
+        raise SceneError(
+            "geometry: give exactly one of geometry.path (a folder) and "
+            "geometry.files (a list of section files)"
+        )
+    if kind == "naca":
+        from ..geometry.errors import GeometryError
+        from ..geometry.naca import naca4_parameters
+
+        try:
+            naca4_parameters(geo["code"])
+        except GeometryError as exc:
+            fail("geometry.code", geo["code"], str(exc))
+    h, h_min = geo.get("h"), geo.get("h_min")
+    if kind in ("box", "naca") and h_min is not None and h is not None and h_min > h:
+        fail("geometry.h_min", h_min, f"must be <= geometry.h = {h:g} m")
+
+
+def _check_signals(d: dict) -> None:
+    """``outputs.signals`` and ``limits`` name signals the geometry kind observes."""
+    kind = d["geometry"]["kind"]
     known = signals_for(kind)
-    sig = outputs["signals"]
+    sig = d["outputs"]["signals"]
     for name in [] if sig == "all" else sig:
         if name not in known or name == "contact_force":
             fail(
@@ -213,7 +232,11 @@ def _cross_check(d: dict) -> None:
                 d["limits"][name],
                 f"no such signal for geometry.kind = {kind!r}; limits apply to {', '.join(known)}",
             )
-    _check_damping(physics)
+
+
+def _check_scheme(d: dict) -> None:
+    """The scheme against the contact law, its number of steps and the forcing."""
+    scheme, contact, loads = d["scheme"], d["contact"], d["loads"]
     if scheme["name"] in ("carpenter", "penalty") and contact["restitution"] > 0.0:
         fail(
             "contact.restitution",
@@ -231,6 +254,7 @@ def _cross_check(d: dict) -> None:
             f"gives {t_end / h:.3g} steps to t_end = {t_end:g} s; at most "
             f"{MAX_STEPS:.0e} allowed (raise h or lower t_end)",
         )
+    force = loads["tip_force"]
     if force["law"] == "sin" and force["frequency"] == "rotation" and loads["rotation_speed"] == 0:
         fail(
             "loads.tip_force.frequency",
@@ -238,6 +262,19 @@ def _cross_check(d: dict) -> None:
             "with loads.rotation_speed = 0 the force "
             "would vanish; give a frequency in rad/s or a rotation speed",
         )
+
+
+def _cross_check(d: dict) -> None:
+    """The checks that involve several keys, one concept each."""
+    _check_coating(d)
+    if d["geometry"]["kind"] == "bar":
+        _check_bar(d)
+    else:
+        _check_blade_physics(d)
+        _check_blade_geometry(d["geometry"])
+    _check_signals(d)
+    _check_damping(d["physics"])
+    _check_scheme(d)
 
 
 def resolve_path(text: str, base_dir: Path) -> Path:
