@@ -36,6 +36,20 @@ def measure(rule: str, h: float, alpha: float) -> dict:
     }
 
 
+#: what the rules do with Coulomb friction (the paper case above is frictionless)
+FRICTION_NOTE = [
+    "## With friction",
+    "",
+    "With Coulomb friction (`contact.friction > 0`) the impulses solve Signorini–Coulomb with",
+    "Newton's velocity law, and the rule chooses the contacts of that solve: `paper` (the",
+    "default with friction) and `predicted` have this frictional form. `position` and `capped`",
+    "state the normal law at the position level and `plain` on the free step; they have no",
+    "frictional form, and a frictional model refuses them (`ThetaMethod`: `ValueError`; the",
+    "scene: `scheme.activation`, before anything is built). `femrub run --explain` prints the",
+    "rule that runs.",
+]
+
+
 def main() -> None:
     t0 = time.perf_counter()
     ref = {a: measure(DEFAULT_RULE, 1e-6, a) for a in (1.0, 3.0, 7.0)}
@@ -64,7 +78,7 @@ def main() -> None:
                 f"{m[3.0]['dW_max']:.1e} | {1e6 * m[3.0]['penetration']:.2f} |"
             )
             print(lines[-1], flush=True)
-    lines += ["", f"Wall time {time.perf_counter() - t0:.0f} s."]
+    lines += ["", *FRICTION_NOTE, "", f"Wall time {time.perf_counter() - t0:.0f} s."]
     (DOCS / "activation_rules.md").write_text("\n".join(lines) + "\n")
 
 

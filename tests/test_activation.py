@@ -79,3 +79,49 @@ def test_two_contacts_complementarity_and_no_open_push(rule):
     res = fr.ThetaMethod(model, 1e-4, activation=rule).run(0.1)
     assert res.status == "ok" and res.energy_error() < 1e-9
     assert np.all(np.diff(res.energy["contact_work"]) <= 1e-15)
+
+
+def _landing(rule=None):
+    """A mass falling 10.85 µm onto a belt (friction 0.3), lands, slides: a θ-method run.
+    At t = 1.4 ms its gap ``g_k`` is 0.75 h |ġ_k|: the free step crosses the belt (``"paper"``
+    acts) but ``g_k + h ġ_k / 2 > 0`` (``"predicted"`` waits a step)."""
+    from dataclasses import replace
+
+    from test_friction import block_model
+
+    model = block_model(v_belt=0.1)
+    model = model.with_(contact=replace(model.contact, gap0=1.085e-5))
+    st = fr.ThetaMethod(model, 1e-4, activation=rule)
+    return st, st.run(0.01)
+
+
+@pytest.mark.parametrize("rule", ["position", "capped", "plain"])
+def test_a_rule_without_a_frictional_form_is_refused_with_friction(rule):
+    with pytest.raises(ValueError, match=f"activation '{rule}' with friction.*'paper' or"):
+        _landing(rule)
+
+
+def test_frictional_contacts_run_the_paper_rule_by_default_and_the_rule_changes_the_run():
+    st, default = _landing()
+    assert st.activation == "paper"
+    _, paper = _landing("paper")
+    _, predicted = _landing("predicted")
+    for res in (default, paper, predicted):
+        assert res.status == "ok" and res.impulse.max() > 0
+    np.testing.assert_array_equal(default.impulse, paper.impulse)
+    assert not np.array_equal(paper.impulse, predicted.impulse)
+    assert not np.array_equal(paper.friction_force, predicted.friction_force)
+
+
+def test_the_scene_refuses_a_rule_without_a_frictional_form_and_explain_prints_the_rule():
+    from femrub.app.scheme import stepper_of
+    from femrub.scene import SceneError, load_scene
+
+    with pytest.raises(SceneError, match=r"scheme\.activation.*'position'.*contact\.friction"):
+        load_scene("twisted-naca", {"contact.friction": 0.3, "scheme.activation": "position"})
+    scene = load_scene("twisted-naca", {"contact.friction": 0.3})
+    assert scene["scheme"].get("activation") is None  # the stepper's default for its contacts
+    st, _ = _landing()
+    report = {}
+    stepper_of(scene, st.model, report)
+    assert report["scheme"]["activation"] == "paper"

@@ -162,3 +162,34 @@ def test_theta_run_with_several_frictional_contacts_meets_coulomb():
     )
     assert check["cone"] <= 1e-8 and check["slip_equality"] <= 1e-8
     assert check["direction"] <= 1e-8 and check["slip_steps"] > 0
+
+
+def test_power_heat_fixed_point_meets_its_heat_and_skips_without_feedback():
+    """The ``"power"`` heat fixed point (one implementation for every stepper): the final
+    impulses solve the step with the heat's velocity shift, and the heat is
+    ``η (−P_t · w_mid)`` of those impulses; without a shift (``W_θ = 0``) the first solve
+    stands."""
+    from femrub.contact.friction import power_heat_fixed_point, solve_frictional_contact
+
+    rng = np.random.default_rng(7)
+    n = 3
+    a = rng.normal(size=(3 * n, 3 * n))
+    W = a @ a.T + 0.5 * np.eye(3 * n)
+    q = np.column_stack([-np.ones(n), rng.normal(size=(n, 2))])
+    mu, eta, active = np.full(n, 0.4), np.full(n, 0.6), np.ones(n, dtype=bool)
+    w_before = rng.normal(size=(n, 2))
+    first = solve_frictional_contact(W, q, mu, active)
+    Wt = 1e-3 * rng.normal(size=(3 * n, n))
+    res, heat = power_heat_fixed_point(first, w_before, eta, W, q, Wt, mu, active)
+    assert np.all(heat != 0.0) and not np.array_equal(res.P, first.P)
+    w_mid = 0.5 * (w_before + res.u[:, 1:])
+    np.testing.assert_allclose(heat, eta * -np.einsum("ij,ij->i", res.P[:, 1:], w_mid), rtol=1e-10)
+    shifted = solve_frictional_contact(W, q + (Wt @ heat).reshape(n, 3), mu, active, warm=res.P)
+    np.testing.assert_allclose(res.P, shifted.P, rtol=1e-9, atol=1e-12 * np.abs(res.P).max())
+    same, heat0 = power_heat_fixed_point(first, w_before, eta, W, q, 0 * Wt, mu, active)
+    assert np.array_equal(same.P, first.P) and np.array_equal(same.u, first.u)
+    np.testing.assert_allclose(
+        heat0,
+        eta * -np.einsum("ij,ij->i", first.P[:, 1:], 0.5 * (w_before + first.u[:, 1:])),
+        rtol=1e-14,
+    )

@@ -144,16 +144,17 @@ def test_load_polynomials_of_a_block_are_those_of_each_step():
     from femrub.steppers.exponential.loads import BLOCK
 
     st = fr.ExponentialMoreau(fr.bar_model(alpha=3.0), 1e-4)
-    assert all(st._vector) and st._m0 == 1
+    loads = st._loads
+    assert all(loads._vector) and loads.n_s == 1
     for k in (0, 1, BLOCK - 1, BLOCK, BLOCK + 5):
         t = st.t0 + k * st.h
-        st._sk = st._signal_values(t)
-        s0 = st._sk.copy()
-        b = st._load_poly(t).copy()
-        assert len(st._blocks) == BLOCK and np.array_equal(st._blocks[t][1], b)  # a block's
-        end = st._sk.copy()
-        st._sk = s0
-        assert b == pytest.approx(st._step_poly(t), rel=1e-14, abs=1e-14)
-        assert end == pytest.approx(st._sk, rel=1e-15, abs=0.0)
-        st._sk = s0  # the same step again (a slide's second pass): the same polynomial
-        assert np.array_equal(st._load_poly(t), b)
+        loads.sk = loads.values(t)
+        s0 = loads.sk.copy()
+        b = loads.poly(t).copy()
+        assert len(loads._blocks) == BLOCK and np.array_equal(loads._blocks[t][1], b)  # a block's
+        end = loads.sk.copy()
+        loads.sk = s0
+        assert b == pytest.approx(loads._step_poly(t), rel=1e-14, abs=1e-14)
+        assert end == pytest.approx(loads.sk, rel=1e-15, abs=0.0)
+        loads.sk = s0  # the same step again (a slide's second pass): the same polynomial
+        assert np.array_equal(loads.poly(t), b)

@@ -20,7 +20,7 @@ def scheme_options(scene) -> dict:
         return {
             "gamma": s["gamma"],
             "gamma_thermal": s.get("gamma_thermal"),
-            "activation": s["activation"],
+            "activation": s.get("activation"),
         }
     if s["name"] == "penalty":
         return {"stiffness": s["stiffness"], "damping": s["damping"], "method": s["method"]}
@@ -58,6 +58,8 @@ def stepper_of(scene, model, report):
         "steps": stepper.steps_to(s["t_end"]),
         **{k: v for k, v in options.items() if v is not None},
     }
+    if hasattr(stepper, "activation"):  # the rule that runs (the default of the contacts)
+        report["scheme"]["activation"] = stepper.activation
     if s["name"] == "carpenter":
         limit = stepper.stability_limit()
         report["scheme"]["stability_limit"] = limit

@@ -42,6 +42,14 @@ except ``"plain"``:
 * ``"predicted"``: Moreau–Jean (Siconos) rule ``g_k + γ h ġ_k <= 0``, ``e = 1`` on
   separating contacts.
 
+**With Coulomb friction** the impulses ``(P_n, P_t)`` solve Signorini–Coulomb with Newton's
+law in velocity form (:mod:`femrub.contact.friction`) and the rule chooses the contacts of
+that solve: ``"paper"`` (the default with friction, :data:`DEFAULT_FRICTIONAL_RULE`) and
+``"predicted"`` (:data:`FRICTIONAL_RULES`, :func:`frictional_fixed_point`). ``"position"``
+and ``"capped"`` state the normal law on the gap and ``"plain"`` on the free step, laws the
+Coulomb solve does not state: :func:`rule_for` refuses them with friction (one line naming
+the fix) rather than running another rule under their name.
+
 Every rule takes an optional bound ``upper`` (n_c,) on the impulses, ``0 <= P <= upper``
 (:func:`femrub.contact.impulses.cap`): an abradable coating yields at ``upper = h F_y``
 (:mod:`femrub.contact.abradable`), and a contact held at its bound may penetrate the worn
@@ -62,7 +70,11 @@ from .theta_block import ONE_RULES, impulse_one_code
 __all__ = [
     "RULES",
     "DEFAULT_RULE",
+    "DEFAULT_FRICTIONAL_RULE",
+    "FRICTIONAL_RULES",
     "check_rule",
+    "frictionless_only",
+    "rule_for",
     "frictional_fixed_point",
     "rule_code",
     "impulse_one",
@@ -73,12 +85,40 @@ __all__ = [
 
 RULES = ("position", "capped", "paper", "plain", "predicted")
 DEFAULT_RULE = "position"
+#: the rules with a frictional form: they choose the contacts of the frictional solve
+FRICTIONAL_RULES = ("paper", "predicted")
+#: the rule of frictional contacts when none is asked for
+DEFAULT_FRICTIONAL_RULE = "paper"
 
 
 def check_rule(rule: str) -> str:
     """Return ``rule`` or raise a one-line error naming the valid rules."""
     if rule not in RULES:
         raise ValueError(f"unknown activation rule {rule!r}; use one of {', '.join(RULES)}")
+    return rule
+
+
+def frictionless_only(rule: str) -> str | None:
+    """Why ``rule`` cannot run with friction (the fix in words), or ``None`` if it can."""
+    if rule in FRICTIONAL_RULES:
+        return None
+    law = "position-level" if rule in ("position", "capped") else "free-step"
+    return (
+        f"the {law} rule {rule!r} has no frictional form; use "
+        f"{' or '.join(map(repr, FRICTIONAL_RULES))} (the default with friction)"
+    )
+
+
+def rule_for(rule: str | None, frictional: bool) -> str:
+    """The rule a step runs: ``rule``, or when ``None`` the default of the contacts
+    (:data:`DEFAULT_FRICTIONAL_RULE` with friction, else :data:`DEFAULT_RULE`). A rule
+    without a frictional form on frictional contacts raises a one-line ``ValueError``."""
+    if rule is None:
+        return DEFAULT_FRICTIONAL_RULE if frictional else DEFAULT_RULE
+    check_rule(rule)
+    why = frictionless_only(rule) if frictional else None
+    if why:
+        raise ValueError(f"activation {rule!r} with friction μ > 0: {why}, or μ = 0")
     return rule
 
 
@@ -291,26 +331,29 @@ def compile_blocks() -> None:
     )
     friction_block(*head, *rows)
     ints = np.zeros(1, dtype=np.int64)
+    X0, T, Y1, Y0, sig, S, off, Z, W, GZ, code, mu, e3, U3, warm, use_warm, h, gamma = head[:18]
+    alpha, tol, max_iter = head[18:]
     rub_block(
-        *head,
-        True,
-        np.zeros((N, 1)),
-        np.zeros((3, 1)),
-        one * 0.5,
-        20,
-        True,
-        E(0),
-        E(0),
-        np.zeros((0, 1)),
-        np.zeros((1, N)),
-        z.copy(),
-        z.copy(),
-        ints,
-        np.ones(5),
-        np.ones(2, dtype=np.int64),
-        z.copy(),
-        np.zeros(3),
-        *rows,
-        E(0),
+        X0,
+        (T, Y1, Y0, sig, h, gamma),
+        (S, off, Z, W, GZ, code, mu, e3, U3, alpha, tol, max_iter),
+        warm,
+        use_warm,
+        (True, np.zeros((N, 1)), np.zeros((3, 1)), one * 0.5, 20),
+        (
+            True,
+            E(0),
+            E(0),
+            np.zeros((0, 1)),
+            np.zeros((1, N)),
+            z.copy(),
+            z.copy(),
+            ints,
+            np.ones(5),
+            np.ones(2, dtype=np.int64),
+            z.copy(),
+            np.zeros(3),
+        ),
+        (*rows, E(0)),
     )
     cut_sweeps(z.copy(), ints, z.copy(), one * 0.5, z.copy(), z.copy(), 1.0, 1, 1, 0.0)

@@ -42,6 +42,8 @@ __all__ = [
     "PREDICTED",
     "frictional_fixed_point",
     "frictional_solve",
+    "power_heat",
+    "MAX_HEAT_ITERATIONS",
     "alart_curnier",
     "newton_law",
 ]
@@ -139,6 +141,31 @@ SMALL_SYSTEM = 36
 
 
 @njit
+def _eliminate(M, x):
+    """Forward elimination with partial pivoting of ``M x = b`` in place (``x`` holds
+    ``b``): ``M`` upper triangular on return; ``False`` for a singular ``M``."""
+    n = x.size
+    for k in range(n):
+        p, big = k, abs(M[k, k])
+        for i in range(k + 1, n):
+            if abs(M[i, k]) > big:
+                p, big = i, abs(M[i, k])
+        if not big > 0.0:
+            return False
+        if p != k:
+            for j in range(k, n):
+                M[k, j], M[p, j] = M[p, j], M[k, j]
+            x[k], x[p] = x[p], x[k]
+        for i in range(k + 1, n):
+            f = M[i, k] / M[k, k]
+            if f != 0.0:
+                for j in range(k + 1, n):
+                    M[i, j] -= f * M[k, j]
+                x[i] -= f * x[k]
+    return True
+
+
+@njit
 def _solve(J, b):
     """``(J⁻¹ b, ok)``: Gaussian elimination with partial pivoting for small systems (a
     LAPACK call costs more than the arithmetic there), ``numpy.linalg.solve`` above
@@ -151,24 +178,9 @@ def _solve(J, b):
             return b, False
     M = J.copy()
     x = b.copy()
-    for k in range(n):
-        p, big = k, abs(M[k, k])
-        for i in range(k + 1, n):
-            if abs(M[i, k]) > big:
-                p, big = i, abs(M[i, k])
-        if not big > 0.0:
-            return x, False
-        if p != k:
-            for j in range(k, n):
-                M[k, j], M[p, j] = M[p, j], M[k, j]
-            x[k], x[p] = x[p], x[k]
-        for i in range(k + 1, n):
-            f = M[i, k] / M[k, k]
-            if f != 0.0:
-                for j in range(k + 1, n):
-                    M[i, j] -= f * M[k, j]
-                x[i] -= f * x[k]
-    for k in range(n - 1, -1, -1):
+    if not _eliminate(M, x):
+        return x, False
+    for k in range(n - 1, -1, -1):  # back substitution
         s = x[k]
         for j in range(k + 1, n):
             s -= M[k, j] * x[j]
@@ -351,6 +363,53 @@ def frictional_solve(W, q, mu, e, ub, U, active, warm, use_warm, tol, max_iter):
     return P, u, state, res, it, status
 
 
+#: fixed-point iterations between the contact solve and the frictional heat of a step
+MAX_HEAT_ITERATIONS = 20
+
+
+@njit
+def power_heat(P, u, st, w_k, eta, W, q, W3t, mu, e, ub, U, active, tol, max_iter, max_heat):
+    """The ``"power"`` heat of a frictional impulse, fixed point with the contact solve.
+
+    The blade receives ``Q_i = η_i (−P_t,i · w_t,i^mid)``, ``w_t^mid = (w_t,k + u_t) / 2``
+    (W s = J; ``w_k`` (n, 2) the slip velocity before the step or impact, ``u`` the local
+    velocities after it), in the same step; through the thermal coupling it shifts the
+    local velocities by ``W3t Q`` (``W3t`` the local rows of the heat columns), so::
+
+        Q⁰ = 0,   P^j = solve(W, q + W3t Q^{j−1}, active),   Q^j = η (−P_t^j · w_t^mid(P^j))
+
+    from the solution ``(P, u, st)`` of ``solve(W, q, active)``, stopped when
+    ``max |Q^j − Q^{j−1}| <= 1e-12 max |Q^j|``, at most ``max_heat`` solves, and at once
+    when the heat moves no velocity (``W3t = 0``). Each solve is :func:`frictional_solve`
+    of ``(W, ·, mu, e, ub, U, active)`` warm-started from the previous one.
+
+    Returns ``(P, u, state, Q, residual, status)``.
+    """
+    n = mu.size
+    feedback = np.any(W3t != 0.0)
+    heat = np.zeros(n)
+    new = heat
+    res, status = 0.0, 0
+    for _ in range(max_heat):
+        new = np.empty(n)
+        diff, big = 0.0, 0.0
+        for i in range(n):
+            a = P[i, 1] * (0.5 * (w_k[i, 0] + u[i, 1]))
+            new[i] = eta[i] * -(a + P[i, 2] * (0.5 * (w_k[i, 1] + u[i, 2])))
+            diff = max(diff, abs(new[i] - heat[i]))
+            big = max(big, abs(new[i]))
+        if diff <= 1e-12 * big or not feedback:
+            break
+        heat = new
+        qh = q + np.dot(W3t, heat).reshape((n, 3))
+        P, u, st, res, it, status = frictional_solve(
+            W, qh, mu, e, ub, U, active, P, True, tol, max_iter
+        )
+        if status != 0:
+            break
+    return P, u, st, new, res, status
+
+
 #: rule codes of the compiled fixed point: the Moreau–Jean rule, or the "paper" fixed point
 FIXED_POINT, PREDICTED = 0, 1
 
@@ -365,9 +424,9 @@ def frictional_fixed_point(
     :mod:`femrub.contact.activation`, which exports this function). ``PREDICTED`` is the
     Moreau–Jean rule ``g_k + γ h ġ_k <= 0``; every other rule uses the ``"paper"`` fixed
     point: closed at ``t_k`` or closed at ``t_{k+1}`` after the impulse
-    (``g_p + GZ3 P <= 0``, ``GZ3 = ∂g_{k+1}/∂P`` (n_c, 3 n_c)). The position-level rules
-    (``"position"``, ``"capped"``) have no frictional form yet, so with friction the
-    velocity-level Newton law holds on the active contacts. If no consistent set exists
+    (``g_p + GZ3 P <= 0``, ``GZ3 = ∂g_{k+1}/∂P`` (n_c, 3 n_c)). These are the rules with a
+    frictional form (:data:`femrub.contact.activation.FRICTIONAL_RULES`; the others are
+    refused with friction before a step). If no consistent set exists
     the contact is kept active (the union of the last two sets; when that union was solved
     already in this step, its solution is returned, not solved again). Each solve is
     :func:`frictional_solve` of ``(W, q, mu, e, ub, U)``, warm-started from the previous

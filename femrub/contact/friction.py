@@ -36,7 +36,17 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .coulomb import NON_POSITIVE, OPEN, SLIP, SOLVED, STICK, frictional_solve, newton_law
+from .coulomb import (
+    MAX_HEAT_ITERATIONS,
+    NON_POSITIVE,
+    OPEN,
+    SLIP,
+    SOLVED,
+    STICK,
+    frictional_solve,
+    newton_law,
+    power_heat,
+)
 from .impulses import solve_impulses
 
 __all__ = [
@@ -47,6 +57,7 @@ __all__ = [
     "coulomb_check",
     "coulomb_check_rows",
     "merge_coulomb_checks",
+    "power_heat_fixed_point",
     "solve_frictional_contact",
 ]
 
@@ -82,6 +93,15 @@ def _per_contact(value, n, default=0.0):
     """``value`` broadcast to a writable, contiguous (n,) float array (kernel argument)."""
     v = default if value is None else value
     return np.array(np.broadcast_to(np.asarray(v, dtype=float), (n,)), dtype=float)  # a copy
+
+
+def _kernel_args(W, q, mu, active, restitution, u_before, upper):
+    """``(W, q, mu, active, e, u_before, U)`` as the compiled kernels take them."""
+    q = np.array(np.asarray(q, dtype=float).reshape(-1, 3), order="C")
+    n = q.shape[0]
+    active = np.array(np.broadcast_to(np.asarray(active, dtype=bool), (n,)))
+    e, ub = _per_contact(restitution, n), _per_contact(u_before, n)
+    return _as_local(W, n), q, _per_contact(mu, n), active, e, ub, _per_contact(upper, n, np.inf)
 
 
 def check_status(status: int, residual: float) -> None:
@@ -129,12 +149,8 @@ def solve_frictional_contact(
     FloatingPointError
         No solution within ``sqrt(tol)`` (non-positive Delassus block, divergence).
     """
-    q = np.array(np.asarray(q, dtype=float).reshape(-1, 3), order="C")
+    W, q, mu, active, e, ub, U = _kernel_args(W, q, mu, active, restitution, u_before, upper)
     n = q.shape[0]
-    W = _as_local(W, n)
-    active = np.array(np.broadcast_to(np.asarray(active, dtype=bool), (n,)))
-    mu, e = _per_contact(mu, n), _per_contact(restitution, n)
-    ub, U = _per_contact(u_before, n), _per_contact(upper, n, np.inf)
     if active.any() and not np.any(mu[active] > 0.0):
         # frictionless: the exact LCP on the normal part (pivoting; one-contact closed form)
         idx = np.flatnonzero(active)
@@ -153,6 +169,62 @@ def solve_frictional_contact(
     )
     check_status(status, res)
     return FrictionResult(P, u, state, float(res), int(it))
+
+
+def power_heat_fixed_point(
+    first: FrictionResult,
+    slip_before,
+    heat_partition,
+    W,
+    q,
+    W_heat,
+    mu,
+    active,
+    *,
+    restitution=0.0,
+    u_before=None,
+    upper=None,
+    tol: float = 1e-12,
+    max_iter: int = 60,
+) -> tuple[FrictionResult, np.ndarray]:
+    """The ``"power"`` heat of a frictional step and the solve that meets it (the fixed
+    point :func:`femrub.contact.coulomb.power_heat`, the one implementation).
+
+    Parameters
+    ----------
+    first : the solution of :func:`solve_frictional_contact` with ``(W, q, mu, active, …)``.
+    slip_before : (n, 2) slip velocity before the step (m/s).
+    heat_partition : (n,) or scalar η, the blade's share of the friction power.
+    W_heat : (3n, n) the local velocities' change per unit heat of each contact (m/s/J).
+    W, q, mu, active, restitution, u_before, upper, tol, max_iter : as
+        :func:`solve_frictional_contact`.
+
+    Returns
+    -------
+    (FrictionResult, heat) with ``heat`` (n,) the blade's heat ``η (−P_t · w_t^mid)`` (J).
+    """
+    W, q, mu, active, e, ub, U = _kernel_args(W, q, mu, active, restitution, u_before, upper)
+    n = q.shape[0]
+    P, u, state, heat, res, status = power_heat(
+        np.array(first.P, dtype=float, order="C"),
+        np.array(first.u, dtype=float, order="C"),
+        np.array(first.state, dtype=np.int8),
+        np.array(np.asarray(slip_before, dtype=float).reshape(n, 2), order="C"),
+        _per_contact(heat_partition, n),
+        W,
+        q,
+        np.array(W_heat, dtype=float, order="C"),
+        mu,
+        e,
+        ub,
+        U,
+        active,
+        tol,
+        max_iter,
+        MAX_HEAT_ITERATIONS,
+    )
+    check_status(status, res)
+    return FrictionResult(P, u, state, max(float(res), first.residual), first.iterations), heat
 
 
 #: rows of a run checked together by :func:`coulomb_check` (bounds its temporaries)

@@ -3,17 +3,15 @@
 :func:`femrub.contact.theta_block.friction_block` advances steps whose contact terms are
 known before the block. Two things make a step depend on the steps before it inside the
 block, and :func:`rub_block` adds them to the same step (the same functions:
-:func:`~femrub.contact.theta_block.friction_step`, :func:`femrub.contact.coulomb.frictional_solve`,
+:func:`~femrub.contact.theta_block.friction_step`, :func:`femrub.contact.coulomb.power_heat`,
 :mod:`femrub.contact.wear_map`):
 
 * **Frictional heat with the ``"power"`` law on a thermoelastic model.** The blade receives
   ``Q_i = η_i (−P_t,i · w_t,i^mid)``, ``w_t^mid = (w_t,k + w_t,k+1) / 2``, in the same step;
   through the thermal coupling it shifts the local velocities by ``W_θ Q`` (``W_θ`` the
-  local rows of ``D⁻¹ H_t``), so the step is the fixed point (:func:`power_heat`)::
-
-      Q⁰ = 0,   P^j = solve(W, q + W_θ Q^{j−1}, active),   Q^j = η (−P_t^j · w_t^mid(P^j))
-
-  stopped when ``max |Q^j − Q^{j−1}| <= 1e-12 max |Q^j|`` (at most ``max_heat`` solves), and
+  local rows of ``D⁻¹ H_t``), so the step is the fixed point
+  :func:`femrub.contact.coulomb.power_heat` (the one implementation, also run by the
+  per-step path and the exponential stepper's impulses), and
   ``X_{k+1} = X_p + Z P + D⁻¹ H_t Q``.
 * **An abradable coating** (:mod:`femrub.contact.abradable`). The gap is read on the worn
   surface and its rate over the step, ``g0 += w(t)``, ``ġ0 += (w(t) − w(t − h)) / h``
@@ -34,45 +32,15 @@ import math
 
 import numpy as np
 
-from .coulomb import frictional_solve
+from .coulomb import power_heat
 from .jit import njit
 from .theta_block import _predict, friction_step
 from .wear_map import cut_sweeps, depth_under, positions
 
-__all__ = ["MAX_HEAT_ITERATIONS", "power_heat", "rub_block", "WEAR_GRID"]
+__all__ = ["rub_block", "WEAR_GRID"]
 
-#: fixed-point iterations between the contact solve and the frictional heat of a step
-MAX_HEAT_ITERATIONS = 20
 #: entries of the float vector ``grid`` of :func:`rub_block`
 WEAR_GRID = ("omega", "scale", "thickness", "cap", "footprint")
-
-
-@njit
-def power_heat(P, u, st, w_k, eta, W, q, W3t, mu, e, ub, U, active, tol, max_iter, max_heat):
-    """The heat fixed point of one step (module docstring): ``(P, u, state, Q, residual,
-    status)``, ``Q`` (n,) the blade's heat (J); ``w_k`` (n, 2) the slip velocity at ``t_k``."""
-    n = mu.size
-    heat = np.zeros(n)
-    new = heat
-    res, status = 0.0, 0
-    for _ in range(max_heat):
-        new = np.empty(n)
-        diff, big = 0.0, 0.0
-        for i in range(n):
-            a = P[i, 1] * (0.5 * (w_k[i, 0] + u[i, 1]))
-            new[i] = eta[i] * -(a + P[i, 2] * (0.5 * (w_k[i, 1] + u[i, 2])))
-            diff = max(diff, abs(new[i] - heat[i]))
-            big = max(big, abs(new[i]))
-        if diff <= 1e-12 * big:
-            break
-        heat = new
-        qh = q + np.dot(W3t, heat).reshape((n, 3))
-        P, u, st, res, it, status = frictional_solve(
-            W, qh, mu, e, ub, U, active, P, True, tol, max_iter
-        )
-        if status != 0:
-            break
-    return P, u, st, new, res, status
 
 
 @njit
@@ -111,63 +79,32 @@ def _wear_cut(depth, GT, X, P, t, g0, angles, axial_cell, grid, dims, last_r, ws
 
 
 @njit
-def rub_block(
-    X,
-    T,
-    Y1,
-    Y0,
-    sig,
-    S,
-    off,
-    Z,
-    W,
-    GZ,
-    code,
-    mu,
-    e3,
-    U3,
-    warm,
-    use_warm,
-    h,
-    gamma,
-    alpha,
-    tol,
-    max_iter,
-    power,
-    Zt,
-    W3t,
-    eta,
-    max_heat,
-    wear,
-    t1,
-    ta,
-    g0a,
-    GT,
-    depth,
-    angles,
-    axial_cell,
-    grid,
-    dims,
-    last_r,
-    wstate,
-    Xout,
-    Pout,
-    Ptout,
-    heat_out,
-    state_out,
-    hist,
-):
+def rub_block(X, prediction, contact, warm, use_warm, heating, wearing, out):
     """``Xout.shape[0]`` frictional steps with the ``"power"`` heat fixed point (``power``)
-    and/or the wear map (``wear``) (module docstring).
+    and/or the wear map (``wear``) (module docstring). The arguments come in groups
+    (tuples: one compiled signature, no copies):
 
-    ``off`` (m + 1, 4 n_c): the casing terms at ``t_k``, then the casing profile's at each
-    step's end ``t1`` (the worn surface is added here, in place); ``ta``, ``g0a`` (m, n_c):
-    the times of the cuts and the profile's gap there; ``depth`` the flat wear map (cut in
-    place); ``grid``: :data:`WEAR_GRID`; ``dims``: ``(n_angle, n_axial)``; ``hist`` (m,): the
-    deepest wear after each step's cut (``nan``: none). Returns ``(steps done, status,
-    residual, warm)``; a step whose solve failed is not written (nor cut), and the block
-    stops there.
+    * ``prediction = (T, Y1, Y0, sig, h, gamma)``: ``X_p = T X_k + Y1 s_{k+1} + Y0 s_k``;
+    * ``contact = (S, off, Z, W, GZ, code, mu, e3, U3, alpha, tol, max_iter)``: the local
+      rows ``S``, the casing terms ``off`` (m + 1, 4 n_c) at ``t_k``, then the casing
+      profile's at each step's end ``t1`` (the worn surface is added here, in place), the
+      impulse columns, the rule's code, the Coulomb solve's parameters;
+    * ``heating = (power, Zt, W3t, eta, max_heat)``: the ``"power"`` heat fixed point;
+    * ``wearing = (wear, t1, ta, g0a, GT, depth, angles, axial_cell, grid, dims, last_r,
+      wstate)``: ``ta``, ``g0a`` (m, n_c) the times of the cuts and the profile's gap there;
+      ``depth`` the flat wear map (cut in place); ``grid``: :data:`WEAR_GRID`; ``dims``:
+      ``(n_angle, n_axial)``;
+    * ``out = (Xout, Pout, Ptout, heat_out, state_out, hist)``: the rows written, ``hist``
+      (m,) the deepest wear after each step's cut (``nan``: none).
+
+    Returns ``(steps done, status, residual, warm)``; a step whose solve failed is not
+    written (nor cut), and the block stops there.
     """
+    T, Y1, Y0, sig, h, gamma = prediction
+    S, off, Z, W, GZ, code, mu, e3, U3, alpha, tol, max_iter = contact
+    power, Zt, W3t, eta, max_heat = heating
+    wear, t1, ta, g0a, GT, depth, angles, axial_cell, grid, dims, last_r, wstate = wearing
+    Xout, Pout, Ptout, heat_out, state_out, hist = out
     n = mu.size
     omega, scale, thickness, cap = grid[0], grid[1], grid[2], grid[3]
     U = U3.copy()

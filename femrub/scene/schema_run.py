@@ -6,7 +6,7 @@ Part of :data:`femrub.scene.schema.SCHEMA` (``scheme``, ``reduction``, ``outputs
 
 from __future__ import annotations
 
-from ..contact.activation import DEFAULT_RULE, RULES
+from ..contact.activation import DEFAULT_FRICTIONAL_RULE, DEFAULT_RULE, FRICTIONAL_RULES, RULES
 from .spec import NONNEG, POS, REQUIRED, Spec, Variant
 from .spec import float_spec as _f
 
@@ -47,7 +47,12 @@ SCHEME = Variant(
                 hi=1.0,
             ),
             "activation": Spec(
-                C, DEFAULT_RULE, choices=RULES, doc="contact rule (femrub.contact.activation)"
+                C,
+                None,
+                choices=RULES,
+                doc=f"contact rule (femrub.contact.activation; default {DEFAULT_RULE!r}, "
+                f"{DEFAULT_FRICTIONAL_RULE!r} with friction, the only rules with friction: "
+                f"{' and '.join(map(repr, FRICTIONAL_RULES))})",
             ),
         },
         "carpenter": {},

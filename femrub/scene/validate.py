@@ -12,6 +12,7 @@ import copy
 import os
 from pathlib import Path
 
+from .activation import check_activation
 from .bounds import check_physical
 from .schema import SCHEMA, TOP
 from .spec import REQUIRED, SceneError, Variant, fail, unknown_key
@@ -53,6 +54,7 @@ def normalize(doc) -> dict:
     for section, spec in SCHEMA.items():
         out[section] = _table(section, doc.get(section, {}), spec)
     _cross_check(out)
+    check_activation(out)
     return out
 
 

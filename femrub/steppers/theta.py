@@ -17,7 +17,7 @@ impact law in velocity form (Eqs. 21–23), an LCP::
 
 which for one contact is the paper's prox formula (Eq. 25b). Which contacts take an impulse
 and under which law (Newton's law, capped or not, midpoint law on separating contacts) is
-the activation rule of :mod:`femrub.contact.activation`; the default ``"safe"`` never
+the activation rule of :mod:`femrub.contact.activation`; the default ``"position"`` never
 pushes at an open gap and never creates energy.
 
 The heat input ``α P`` enters the same step as the impulse. Penetration is not prevented at
@@ -28,19 +28,25 @@ the position level; it stays below ``h |ġ|`` (paper Sec. 4.3).
 velocities ``(ġ_{k+1}, w_{t,k+1})`` (gap velocity, slip velocity relative to the casing
 surface) are affine in ``P`` through the Delassus operator ``W₃ = [Gv, Gvt]ᵀ Z₃``. Each step
 solves Signorini–Coulomb with Newton's law exactly
-(:func:`femrub.contact.friction.solve_frictional_contact`) inside the same activation rule.
+(:func:`femrub.contact.friction.solve_frictional_contact`) on the contacts the activation
+rule chooses: ``"paper"`` (the default with friction) or ``"predicted"``, the rules with a
+frictional form; the position-level and free-step rules are refused with friction.
 With the ``"power"`` heat law the blade then receives ``η (−P_t · w_t,m)`` per contact, with
 ``w_t,m`` the slip velocity at the mid-step state (the value the energy balance uses), as a
 heat input of the same step; its effect on the step's velocities through the thermal
 coupling is fed back into the contact solve by a fixed point (contact solve, heat, contact
 solve with the heat's velocity shift ``W_θ Q``, ...) until the heat repeats to 1e-12.
 
-``run()`` on a dense model advances whole chunks of steps in one compiled call
-(:mod:`femrub.steppers.theta_blocks`): the same step, the same contact algebra, written into
-the recorder's rows; with frictional contacts this includes the ``"power"`` heat fixed
-point above and an abradable coating's wear map (:mod:`femrub.contact.rub_block`). Casing
-heat, a time-dependent α, frictionless contacts beyond the one-contact case and sparse
-models go step by step, as do ``step()`` and ``iterate()``.
+Three step paths, as the physics needs: frictionless contacts (the activation rule's
+LCPs), frictional contacts (the compiled active-set fixed point with the Coulomb solve and
+the ``"power"`` heat fixed point), and the compiled blocks. ``run()`` on a dense model
+advances whole chunks of steps in one compiled call (:mod:`femrub.steppers.theta_blocks`):
+the same step, the same contact algebra, written into the recorder's rows; with frictional
+contacts this includes the ``"power"`` heat fixed point above and an abradable coating's
+wear map (:mod:`femrub.contact.rub_block`); one frictionless contact on a fixed obstacle
+takes the closed-form impulse of the one-contact block, which ``step()`` runs as a block of
+one step. Casing heat, a time-dependent α, frictionless contacts beyond the one-contact
+case and sparse models go step by step, as do ``step()`` and ``iterate()``.
 """
 
 from __future__ import annotations
@@ -49,17 +55,15 @@ import numpy as np
 import scipy.sparse as sp
 
 from ..contact.activation import (
-    DEFAULT_RULE,
     RULES,
-    check_rule,
     compile_kernels,
     frictional_fixed_point,
-    impulse_one,
     impulses,
     rule_code,
+    rule_for,
 )
-from ..contact.friction import check_status, solve_frictional_contact
-from ..contact.rub_block import MAX_HEAT_ITERATIONS
+from ..contact.friction import FrictionResult, check_status, power_heat_fixed_point
+from ..contact.theta_block import ONE_RULES, one_contact_block
 from ..fem.linalg import Factorised, compact
 from .base import Stepper
 from .theta_blocks import advance_block, prepare
@@ -82,7 +86,10 @@ class ThetaMethod(Stepper):
         conductivity) its stiff thermal modes ring from step to step, and through the
         coupling and the frictional heat this can drive a spurious runaway. 1 (backward
         Euler on the heat rows) damps them while the mechanics stays trapezoidal.
-    activation : one of :data:`femrub.contact.activation.RULES` (default ``"safe"``).
+    activation : one of :data:`femrub.contact.activation.RULES`; ``None`` (default):
+        ``"position"``, or ``"paper"`` with friction. With friction only the rules of
+        :data:`~femrub.contact.activation.FRICTIONAL_RULES` have a frictional form (the
+        others raise a one-line ``ValueError``).
     """
 
     name = "theta"
@@ -99,7 +106,7 @@ class ThetaMethod(Stepper):
         *,
         gamma: float = 0.5,
         gamma_thermal: float | None = None,
-        activation: str = DEFAULT_RULE,
+        activation: str | None = None,
         t0=0.0,
     ):
         gamma = float(gamma)
@@ -107,7 +114,8 @@ class ThetaMethod(Stepper):
         for name, val in (("gamma", gamma), ("gamma_thermal", gamma_t)):
             if not (0.5 <= val <= 1.0):
                 raise ValueError(f"{name} must be in [0.5, 1] for a stable θ-method, got {val!r}")
-        check_rule(activation)
+        c = getattr(model, "contact", None)
+        activation = rule_for(activation, c is not None and c.has_friction)
         self.gamma, self.gamma_thermal, self.activation = gamma, gamma_t, activation
         super().__init__(model, h, t0=t0)
 
@@ -139,9 +147,9 @@ class ThetaMethod(Stepper):
             self._Zm = self._lu.solve(c.Hm)
             self._Zt = self._lu.solve(c.Ht)
             self._Wm, self._Wt = c.GvT @ self._Zm, c.GvT @ self._Zt
-            # one contact, constant gap and α, fixed obstacle, dense: scalar fast path, with
-            # Contact.gap and gap_velocity written out for that contact (the paper case's
-            # step is a few dot products; method calls and arrays would dominate it)
+            # one contact, constant gap and α, fixed obstacle, dense: the closed-form impulse
+            # of the compiled one-contact block, also for step() (a block of one step), with
+            # Contact.gap and gap_velocity written out for that contact
             if (
                 c.n == 1
                 and self._lu.dense
@@ -215,44 +223,55 @@ class ThetaMethod(Stepper):
     def _signal_values(self, t):
         return np.array([float(sig(t)) for sig in self._signals])
 
-    def _step_fast(self, Xk, Xp):
-        """One contact (see ``_setup``): the impulse in closed form (``impulse_one``)."""
-        g_p = self._g0 + self._gr @ Xp
-        P = impulse_one(
-            self.activation,
-            self._g0 + self._gr @ Xk,
-            self._gv @ Xk,
-            g_p,
-            self._gv @ Xp,
-            self._w,
-            self._gz,
-            self._e,
-            self.h,
-            self.gamma,
-        )
-        if P == 0.0:
-            return Xp, np.zeros(1)
-        return Xp + P * self._z, np.array([P])
-
     def _step(self):
-        m, h, g = self.model, self.h, self.gamma
-        t1 = self.t + h
-        Xk = self.X
+        t1 = self.t + self.h
         s1 = self._signal_values(t1)
         s0, self._sk = self._sk, s1
+        if self._fast:
+            return self._step_one(s0, s1)
+        Xk = self.X
         if self._lu.dense:
             Xp = self._T @ Xk
             if self._Y1 is not None:
                 Xp += self._Y1 @ s1 + self._Y0 @ s0
         else:
             Xp = Xk + self._lu.solve(self._hB @ Xk + self._hF1 @ s1 + self._hF0 @ s0)
-        if self._fast:
-            return self._step_fast(Xk, Xp)
-        c = m.contact
-        if c is None:
+        if self.model.contact is None:
             return Xp, np.zeros(0)
         if self._friction:
             return self._step_friction(Xk, Xp, t1)
+        return self._step_frictionless(Xk, Xp, t1)
+
+    def _step_one(self, s0, s1):
+        """One contact (see ``_setup``): a block of one step of the compiled block path
+        (:func:`~femrub.contact.theta_block.one_contact_block`, the impulse in closed form)."""
+        X, P = np.empty((1, self.model.n_dofs)), np.empty((1, 1))
+        sig = np.vstack([s0, s1])[:, : self._bns]
+        one_contact_block(
+            self.X,
+            self._bT,
+            self._bY1,
+            self._bY0,
+            sig,
+            ONE_RULES[self.activation],
+            self._g0,
+            self._gr,
+            self._gv,
+            self._z,
+            self._w,
+            self._gz,
+            self._e,
+            self.h,
+            self.gamma,
+            np.inf,
+            X,
+            P,
+        )
+        return X[0], P[0]
+
+    def _step_frictionless(self, Xk, Xp, t1):
+        """Frictionless contacts: the impulses of the activation rule (LCPs)."""
+        c, h = self.model.contact, self.h
         alpha = c.alpha_at(t1)
         Z = self._Zm + self._Zt * alpha
         W = self._Wm + self._Wt * alpha
@@ -267,7 +286,7 @@ class ThetaMethod(Stepper):
             c.GT @ Z,
             np.broadcast_to(np.asarray(c.restitution, dtype=float), (c.n,)),
             h,
-            g,
+            self.gamma,
             self._warm,
             upper=c.impulse_cap(t1, h, g_k, g_p),
         )
@@ -315,29 +334,22 @@ class ThetaMethod(Stepper):
         check_status(status, res_)
         heat = alpha * P[:, 0]  # the α λ heat is already in Z's normal columns
         power = c.heat_law == "power" and self.model.layout.n_t > 0
-        if power:
-            # the heat η (−P_t · w_t,mid) moves the step's velocities through the thermal
-            # coupling: fixed point on it, so the final state meets Coulomb's law
-            w_k = c.slip_velocity(Xk)
-            heat = np.zeros(n)
-            for _ in range(MAX_HEAT_ITERATIONS):
-                w_mid = 0.5 * (w_k + u[:, 1:])
-                new = c.heat_partition * -np.einsum("ij,ij->i", P[:, 1:], w_mid)
-                if np.max(np.abs(new - heat), initial=0.0) <= 1e-12 * np.max(np.abs(new)):
-                    break
-                heat = new
-                res = solve_frictional_contact(
-                    W,
-                    q + (self._W3t @ heat).reshape(n, 3),
-                    c.friction,
-                    active,
-                    restitution=e,
-                    u_before=gdot_k,
-                    warm=P,
-                    upper=upper,
-                )
-                P, u, state = res.P, res.u, res.state
-            heat = new
+        if power:  # the heat moves the step's velocities: fixed point with the solve
+            first = FrictionResult(P, u, state, res_, 0)
+            res, heat = power_heat_fixed_point(
+                first,
+                c.slip_velocity(Xk),
+                c.heat_partition,
+                W,
+                q,
+                self._W3t,
+                c.friction,
+                active,
+                restitution=e,
+                u_before=gdot_k,
+                upper=upper,
+            )
+            P, state = res.P, res.state
         self._warm3 = P
         X = Xp + Z @ P.reshape(-1) if active.any() else Xp
         if power:

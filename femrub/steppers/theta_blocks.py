@@ -25,9 +25,10 @@ import math
 import numpy as np
 
 from ..contact.activation import compile_blocks
+from ..contact.coulomb import MAX_HEAT_ITERATIONS
 from ..contact.friction import check_status
 from ..contact.gap import _over_times
-from ..contact.rub_block import MAX_HEAT_ITERATIONS, rub_block
+from ..contact.rub_block import rub_block
 from ..contact.theta_block import ONE_RULES, friction_block, one_contact_block
 
 __all__ = ["block_kind", "prepare", "advance_block"]
@@ -254,12 +255,8 @@ def _rub(st, sig, t1, off, warm, use_warm, X, P, Pt, heat, state) -> tuple:
         wstate = np.array(
             [last is not None, 0.0 if last is None else last[0], w.history[-1][1]], dtype=float
         )
-    done, status, res, warm = rub_block(
-        st.X,
-        st._bT,
-        st._bY1,
-        st._bY0,
-        sig,
+    prediction = (st._bT, st._bY1, st._bY0, sig, h, st.gamma)
+    contact = (
         st._bS,
         off,
         st._bZ,
@@ -269,18 +266,12 @@ def _rub(st, sig, t1, off, warm, use_warm, X, P, Pt, heat, state) -> tuple:
         st._mu3,
         st._e3,
         st._U3,
-        warm,
-        use_warm,
-        h,
-        st.gamma,
         st._balpha,
         1e-12,
         60,
-        st._bpower,
-        st._bZt,
-        st._bW3t,
-        st._beta,
-        MAX_HEAT_ITERATIONS,
+    )
+    heating = (st._bpower, st._bZt, st._bW3t, st._beta, MAX_HEAT_ITERATIONS)
+    wearing = (
         st._bwear,
         t1,
         ta,
@@ -293,12 +284,10 @@ def _rub(st, sig, t1, off, warm, use_warm, X, P, Pt, heat, state) -> tuple:
         st._bdims,
         last_r,
         wstate,
-        X,
-        P,
-        Pt,
-        heat,
-        state,
-        hist,
+    )
+    out = (X, P, Pt, heat, state, hist)
+    done, status, res, warm = rub_block(
+        st.X, prediction, contact, warm, use_warm, heating, wearing, out
     )
     if w is not None and done:
         cut = np.flatnonzero(~np.isnan(hist[:done]))

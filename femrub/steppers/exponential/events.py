@@ -30,7 +30,7 @@ _XTOL = 1e-10  # relative tolerance (of h) on an event time
 
 class EventLocation:
     """Event location of :class:`~femrub.steppers.exponential.ExponentialMoreau` (mixin: it
-    reads the stepper's model, ``h``, ``t``, ``probes``, flows and load polynomial helpers)."""
+    reads the stepper's model, ``h``, ``t``, ``probes``, its flows and load polynomials)."""
 
     # -- events --------------------------------------------------------------------------------
     def _event(self, S, Xa, a, Xe, b, V=None):
@@ -41,64 +41,101 @@ class EventLocation:
         on a part step: probe rows and cached sub-step flows); the first sign change is then
         located on the exact flow (cached sub-step flows over ``h / probes × 2^e``).
         """
-        c, h, t, flows, q = self.model.contact, self.h, self.t, self._flows, self.probes
-        n_s, d = len(S), h / self.probes
+        h, q, n_s = self.h, self.probes, len(S)
         if a == 0.0 and V is not None:  # the whole step's grid, read off the flight
             if self._quiet(S, V):
                 return None
-            grid, states = np.append(d * np.arange(q), h), {0: (Xa, np.zeros(n_s))}
+            grid = np.append(h / q * np.arange(q), h)
+            states = {0: (Xa, np.zeros(n_s))}
         else:
             grid, V, states = self._part_grid(S, Xa, a, Xe, b)
-        gv, lv = V[:, : c.n], V[:, c.n :]
-        # closing: the gap falls below min(g(a), 0) after having been above it
+        cand = self._closings(S, V, b)
+        if cand is None:  # the common case: free flight, nothing closes
+            return None
+        held = self._held_events(S, V, b)
+        if held and held[0] == 0:  # pulled away (or stopped sliding) already: now
+            return a, held[1], held[2], Xa, np.zeros(n_s)
+        cand += held[1:] if held else []
+        if not cand:
+            return None
+        return self._locate(S, cand, grid, states, b)
+
+    def _closings(self, S, V, b):
+        """Closing candidates on the grid rows ``V``: the gap falls below ``min(g(a), 0)``
+        after having been above it. Each candidate is ``(bracket j, kind, contact,
+        f(τ, X) -> (value, d/dτ), row)`` with ``row = (r, c0)`` when ``f`` is linear on the
+        augmented state, ``f = r·z + c0`` (a compiled root search). ``None``: no held
+        contact and nothing closes (no other event can happen)."""
+        c, h, t, flows = self.model.contact, self.h, self.t, self._flows
+        gv = V[:, : c.n]
         f_cl = gv - np.minimum(gv[0], 0.0)
         closing = (f_cl[1:] < 0.0).any(axis=0)
         if S:
             closing[list(S)] = False
-        elif not closing.any():  # the common case: free flight, nothing closes
+        elif not closing.any():
             return None
-        # (bracket j, kind, contact, f(τ, X) -> (value, d/dτ), row): ``row = (r, c0)`` when
-        # f is linear on the augmented state, ``f = r·z + c0`` (a compiled root search)
-        cand = []
-        lam, c_n = (flows.generator(S)[2], self.model.n_dofs) if S else (None, 0)
         g0 = self._fixed_gap()
+        cand = []
         for i in np.flatnonzero(closing):
             ref = min(gv[0, i], 0.0)
             row = None if g0 is None else (self._z_row(S, x=c.GT[i]), g0[i] - ref)
 
             def f(tau, X, i=i, ref=ref):
                 rate = c.rate_at(t + tau)[i] if callable(c.gap_rate) else 0.0
-                dX = flows.rate(S, X, self._u(b, tau / h))
+                dX = flows.rate(S, X, self._loads.u(b, tau / h))
                 return c.gap(t + tau, X)[i] - ref, rate + c.GT[i] @ dX
 
             cand.append((1 + int(np.argmax(f_cl[1:, i] < 0.0)), "closing", int(i), f, row))
-        slides = flows.sliding(S)
+        return cand
+
+    def _held_events(self, S, V, b):
+        """Release (a held multiplier turns negative) and stick (a held slide's slip turns
+        negative) candidates on the grid rows ``V``, as :meth:`_closings`; a first entry
+        ``(0, kind, contact)`` when one is negative at the part step's start already."""
+        if not S:
+            return []
+        n_s = len(S)
+        slides = self._flows.sliding(S)
+        lv = V[:, self.model.contact.n :]
+        cand = [None]
         for k in np.flatnonzero(np.any(lv < 0.0, axis=0)):
             j = int(np.argmax(lv[:, k] < 0.0))
             i = S[k] if k < n_s else slides[k - n_s]  # a multiplier, or a slip (stick)
             kind = "release" if k < n_s else "stick"
-            if j == 0:  # pulled away (or stopped sliding) already: now
-                return a, kind, i, Xa, np.zeros(n_s)
-
-            def f(tau, X, k=k):
-                u = self._u(b, tau / h)
-                if k >= n_s:  # the slip σ = R_σ X + σ0 of a sliding held contact
-                    r = flows.slip[0][slides[k - n_s]]
-                    return r @ X + flows.slip[1][slides[k - n_s]], r @ flows.rate(S, X, u)
-                du = self._du(b, tau / h)
-                lx, lu = lam[k, :c_n], lam[k, c_n:]
-                val = lx @ X + (lu @ u if lu.size else 0.0)
-                return val, lx @ flows.rate(S, X, u) + (lu @ du if lu.size else 0.0)
-
-            if k >= n_s:
-                row = (self._z_row(S, x=flows.slip[0][i]), flows.slip[1][i])
-            else:
-                row = (self._z_row(S, x=lam[k, :c_n], u=lam[k, c_n:]), 0.0)
+            if j == 0:
+                return [0, kind, i]
+            f, row = self._slip_event(S, i, b) if k >= n_s else self._release_event(S, k, b)
             cand.append((j, kind, i, f, row))
-        if not cand:
-            return None
+        return cand
+
+    def _release_event(self, S, k, b):
+        """``(f, row)`` of the ``k``-th held multiplier ``λ_k = l_x·X + l_u·u``."""
+        h, flows, c_n = self.h, self._flows, self.model.n_dofs
+        lam = flows.generator(S)[2]
+        lx, lu = lam[k, :c_n], lam[k, c_n:]
+
+        def f(tau, X):
+            u, du = self._loads.u(b, tau / h), self._loads.du(b, tau / h)
+            val = lx @ X + (lu @ u if lu.size else 0.0)
+            return val, lx @ flows.rate(S, X, u) + (lu @ du if lu.size else 0.0)
+
+        return f, (self._z_row(S, x=lx, u=lu), 0.0)
+
+    def _slip_event(self, S, i, b):
+        """``(f, row)`` of the slip ``σ = R_σ X + σ0`` of held contact ``i`` sliding."""
+        h, flows = self.h, self._flows
+        r, off = flows.slip[0][i], flows.slip[1][i]
+
+        def f(tau, X):
+            return r @ X + off, r @ flows.rate(S, X, self._loads.u(b, tau / h))
+
+        return f, (self._z_row(S, x=r), off)
+
+    def _locate(self, S, cand, grid, states, b):
+        """The earliest zero among the candidates of the first bracket that has any:
+        ``(τ, kind, i, X(τ), P_S(a..τ))`` or ``None``."""
+        flows, d = self._flows, self.h / self.probes
         j = min(x[0] for x in cand)
-        lo = grid[j - 1]
         if j - 1 not in states:  # march the cached flows to the bracket
             k = max(states)
             Xk, Pk = states[k]
@@ -109,7 +146,7 @@ class EventLocation:
         for jj, kind, i, f, row in cand:
             if jj != j:
                 continue
-            found = self._root(S, f, lo, grid[j], X0, b, row)
+            found = self._root(S, f, grid[j - 1], grid[j], X0, b, row)
             if found is not None and (best is None or found[0] < best[0]):
                 best = (*found, kind, i)
         if best is None:

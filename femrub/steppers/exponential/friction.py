@@ -14,7 +14,8 @@ The blade's heat of the impulse is ``α P_n`` (heat law ``"alpha"``: ``α`` on t
 columns of ``W₃``) or ``η (−P_t · (w_t⁻ + w_t⁺) / 2)`` (``"power"``: the work of the
 tangential impulse on the slip velocity, exact for an impulse); with the latter a heat that
 moves the velocities (``V₃ᵀ A⁻¹ Ht ≠ 0``) is fed back into the solve by the θ-method's fixed
-point. Work of the impulse on the structure: ``P · V₃ᵀ (X⁻ + X⁺) / 2`` (normal and tangential).
+point (:func:`femrub.contact.friction.power_heat_fixed_point`, one implementation). Work of
+the impulse on the structure: ``P · V₃ᵀ (X⁻ + X⁺) / 2`` (normal and tangential).
 
 **Held contacts slide along their slip, one direction per step.** A held contact (closed,
 ``ġ = 0``) with ``μ > 0`` slides against a casing moving at ``v_c``. Over a flight its friction
@@ -50,14 +51,17 @@ from __future__ import annotations
 
 import numpy as np
 
-from ...contact.friction import OPEN, SLIP, STICK, solve_frictional_contact
+from ...contact.friction import (
+    OPEN,
+    SLIP,
+    STICK,
+    power_heat_fixed_point,
+    solve_frictional_contact,
+)
 from ...output.recorder import StepRefused
 from .slide import SlideDirections
 
-__all__ = ["FrictionalContact", "MAX_HEAT_ITERATIONS"]
-
-#: fixed-point iterations between a frictional impulse and its "power" heat
-MAX_HEAT_ITERATIONS = 20
+__all__ = ["FrictionalContact"]
 
 
 class FrictionalContact(SlideDirections):
@@ -178,25 +182,18 @@ class FrictionalContact(SlideDirections):
         )
         heat = alpha * res.P[:, 0]
         if self._power:  # η (−P_t · w_mid), fed back into the solve when it moves velocities
-            heat = np.zeros(c.n)
-            for _ in range(MAX_HEAT_ITERATIONS):
-                w_mid = 0.5 * (w_before + res.u[:, 1:])
-                new = self._eta * -np.einsum("ij,ij->i", res.P[:, 1:], w_mid)
-                if np.max(np.abs(new - heat), initial=0.0) <= 1e-12 * np.max(np.abs(new)):
-                    break
-                heat = new
-                if not np.any(self._W3t):
-                    break
-                res = solve_frictional_contact(
-                    W,
-                    q + (self._W3t @ heat).reshape(c.n, 3),
-                    self._mu,
-                    active,
-                    restitution=e,
-                    u_before=gd,
-                    warm=res.P,
-                )
-            heat = new
+            res, heat = power_heat_fixed_point(
+                res,
+                w_before,
+                self._eta,
+                W,
+                q,
+                self._W3t,
+                self._mu,
+                active,
+                restitution=e,
+                u_before=gd,
+            )
         Pi = res.P
         Xn = X + self._Z3 @ Pi.reshape(-1) + self._Zt @ heat
         v = c.V3T @ (X + Xn) / 2  # mean local structure velocity of the impulse

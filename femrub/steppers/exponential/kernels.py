@@ -315,6 +315,21 @@ def _at_row(Z, kt, kz, nk, tau, r, rM, c0, d_min):
 
 
 @njit
+def _open_side(Z, kt, kz, lo, hi, r, rM, c0, d_min):
+    """A row event at the surface at ``lo`` (``f(lo) <= 0``): the bracket halved towards
+    ``lo`` until ``f > 0`` (at most 40 times), that point kept as the second known state
+    (``kt[1]``, ``kz[1]``). Returns ``(x, f(x))``, ``f(x) <= 0`` when none was found."""
+    x, fx = hi, 0.0
+    for _ in range(40):
+        x = lo + 0.5 * (x - lo)
+        zx, fx, dfx = _at_row(Z, kt, kz, 1, x, r, rM, c0, d_min)
+        if fx > 0.0:
+            kt[1], kz[1] = x, zx
+            break
+    return x, fx
+
+
+@njit
 def first_zero_row(Z, z_lo, r, rM, c0, lo, hi, tol, d_min):
     """First zero in ``(lo, hi]`` of the row event ``f(τ) = r·z(τ) + c0`` (``df/dτ =
     rM·z``, ``rM = Mᵀ r``) on the flow composed of the levels ``Z`` (smallest ``d_min``)
@@ -326,19 +341,12 @@ def first_zero_row(Z, z_lo, r, rM, c0, lo, hi, tol, d_min):
     kz = np.empty((128, z_lo.size))
     kt[0], kz[0], nk = lo, z_lo, 1
     f_lo, df_lo = r @ z_lo + c0, rM @ z_lo
-    if f_lo <= 0.0:  # at the surface at lo: halve the bracket towards lo until f > 0
-        x, ok = hi, False
-        for _ in range(40):
-            x = lo + 0.5 * (x - lo)
-            zx, fx, dfx = _at_row(Z, kt, kz, nk, x, r, rM, c0, d_min)
-            if fx > 0.0:
-                kt[nk], kz[nk], nk, ok = x, zx, nk + 1, True
-                break
-        if not ok:
+    a, f_a = lo, f_lo
+    if f_lo <= 0.0:  # at the surface at lo: the open side first
+        a, f_a = _open_side(Z, kt, kz, lo, hi, r, rM, c0, d_min)
+        if not f_a > 0.0:
             return False, hi, z_lo
-        a, f_a = x, fx
-    else:
-        a, f_a = lo, f_lo
+        nk = 2
     x = hi
     z, fx, dfx = _at_row(Z, kt, kz, nk, x, r, rM, c0, d_min)
     if fx > 0.0 and nk < kt.size:

@@ -150,13 +150,11 @@ class SlideDirections:
         ang = self._slip_angles(new, X)
         self._set_angles({i: round(a / DIRECTION_STEP) for i, a in ang.items()})
 
-    def _step(self):
-        """One step (:meth:`_one_step`); with held slides, repeated from its start until each
+    def _slide_passes(self):
+        """One step with held slides: :meth:`_one_step` repeated from its start until each
         held slide's direction is its slip's at the end of its held flight in the step (see
         module docstring; at most :data:`MAX_DIRECTION_ITERATIONS` passes)."""
-        if not (self._fric and self._hold):
-            return self._one_step()
-        start = (self._S, self._warm3, self._sk)
+        start = (self._S, self._warm3, self._loads.sk)
         self._fixed = {int(i) for i in start[0]}
         for it in range(MAX_DIRECTION_ITERATIONS):
             self._target = {}  # contact -> state at the end of its held flight
@@ -173,7 +171,7 @@ class SlideDirections:
             ]
             if max(off, default=0.0) <= 0.75 * DIRECTION_STEP or it == MAX_DIRECTION_ITERATIONS - 1:
                 break
-            self._S, self._warm3, self._sk = start
+            self._S, self._warm3, self._loads.sk = start
             self._fixed = set(ang)
             self._set_angles({i: round(a / DIRECTION_STEP) for i, a in ang.items()})
         new = {i: round(a / DIRECTION_STEP) for i, a in ang.items() if i not in self._slid}

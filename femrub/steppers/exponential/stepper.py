@@ -64,7 +64,7 @@ MAX_PROBES = 512
 ZENO_HITS = 3
 
 
-class ExponentialMoreau(EventLocation, FrictionalContact, LoadPolynomial, Stepper):
+class ExponentialMoreau(EventLocation, FrictionalContact, Stepper):
     """Exact-in-time Moreau stepper for moderate-size models (see module docstring).
 
     Parameters
@@ -147,10 +147,10 @@ class ExponentialMoreau(EventLocation, FrictionalContact, LoadPolynomial, Steppe
                 AinvH = self._Zm + self._Zt * c.heat_coefficient
             if self._hold:
                 self._n_a = c.n if moving else 0
-        self._m0 = len(self._signals)
         G = np.hstack([G, np.zeros((m.n_dofs, self._n_a))])
         p = self.load_degree if G.shape[1] else 0
-        self._loads_setup(p)
+        rates = c.rate_at if self._n_a else None
+        self._loads = LoadPolynomial(self._signals, rates, h, self.t0, self.t, p)
         self._flows = FlowFamily(L, G, AinvH, GvT, h, p, n_acc=self._n_a)
         if self._fric and self._hold:
             self._flows.slip = self._slip
@@ -220,9 +220,18 @@ class ExponentialMoreau(EventLocation, FrictionalContact, LoadPolynomial, Steppe
         if self._measure and self._Wth is not None:
             self._w[2] += float((Xn - X) @ self._Wth @ (Xn + X)) / 2
 
+    def _step(self):
+        """One step: :meth:`_one_step`, or with held slides the passes of
+        :meth:`~.slide.SlideDirections._slide_passes` (the fixed point on their directions)."""
+        if self._fric and self._hold:
+            return self._slide_passes()
+        return self._one_step()
+
     def _one_step(self):
+        """One step: flights of the held set between located events (an impulse or a
+        release at each), then the step end's releases and impulses."""
         h, t, c = self.h, self.t, self.model.contact
-        b = self._load_poly(t)
+        b = self._loads.poly(t)
         X, S, a = self.X, self._S, 0.0
         P = np.zeros(self.model.n_contacts)
         hits = np.zeros(self.model.n_contacts, dtype=int)
@@ -231,14 +240,7 @@ class ExponentialMoreau(EventLocation, FrictionalContact, LoadPolynomial, Steppe
         if self._fric:
             self._friction_step_start()
         for n_events in range(MAX_EVENTS + 1):
-            rest = V = None  # the flight's integrals to the step end and its check grid
-            calm = False  # a whole step whose check grid shows no event
-            if a == 0.0:  # the whole step, its integrals and check grid in one product
-                Xe, PS, rest, V, calm = self._flight(S, X, b)
-            elif self._integ(S) is not None:  # after an event: flight and integrals at once
-                Xe, PS, rest = self._integrate(S, X, a, h, b, state=True)
-            else:  # after an event: cached sub-step flows
-                Xe, PS = self._flows.advance(S, X, a, h, b, h / self.probes)
+            Xe, PS, rest, V, calm = self._to_step_end(S, X, a, b)
             if c is None:
                 self._add(self._integrate(S, X, a, h, b) if rest is None else rest)
                 return Xe, P
@@ -247,33 +249,54 @@ class ExponentialMoreau(EventLocation, FrictionalContact, LoadPolynomial, Steppe
                 ev = self._event(S, X, a, Xe, b, V)
             if ev is None:
                 break
-            tau, kind, i, Xn, PSa = ev
-            w = self._add(self._integrate(S, X, a, tau, b))
-            a, X = tau, Xn
-            P[list(S)] += PSa
-            if self._fric:
-                X = self._held_segment(S, PSa, w, X)
-            if kind == "stick":
-                self._refuse_stick(i, t + a, X)
-            if kind == "release":
-                S = tuple(j for j in S if j != i)
-            else:  # a third bounce of one contact in a step: Zeno, end it plastically
-                hits[i] += 1
-                X, S = self._impact(t + a, X, S, P, forced=i, plastic=hits >= ZENO_HITS)
+            a, X, S = self._at_event(ev, S, X, a, b, P, hits)
         w = self._add(self._integrate(S, X, a, h, b) if rest is None else rest)
         X = Xe
         P[list(S)] += PS
         if self._fric:
             X = self._held_segment(S, PS, w, X)
-        if S and not self.events:  # releases (and stops of sliding) at step ends
-            lam = self._flows.multiplier(S, X, self._u(b, 1.0))
-            S = tuple(j for j, lj in zip(S, lam) if lj > 0.0)
-            for j in S:
-                if not self._still_sliding(j, X):
-                    self._refuse_stick(j, t + h, X)
+        if S and not self.events:
+            S = self._release_at_end(S, X, b)
         X, S = (X, S) if calm and self._opened else self._impact(t + h, X, S, P)
         self._S = S
         return (X, P, self._friction_extra(S)) if self._fric else (X, P)
+
+    def _to_step_end(self, S, X, a, b):
+        """The flight of ``S`` from ``(a, X)`` to the step end: ``(X(h), P_S, integrals or
+        None, check grid or None, calm)`` (``calm``: a whole step whose grid shows no event)."""
+        if a == 0.0:  # the whole step, its integrals and check grid in one product
+            return self._flight(S, X, b)
+        if self._integ(S) is not None:  # after an event: flight and integrals at once
+            return (*self._integrate(S, X, a, self.h, b, state=True), None, False)
+        Xe, PS = self._flows.advance(S, X, a, self.h, b, self.h / self.probes)
+        return Xe, PS, None, None, False
+
+    def _at_event(self, ev, S, X, a, b, P, hits):
+        """Fly to the located event ``ev`` and act on it (a release, a stick refused, an
+        impulse; a third bounce of one contact in a step ends plastically: Zeno). Returns
+        the new ``(a, X, S)``; adds the held impulses to ``P``."""
+        tau, kind, i, Xn, PSa = ev
+        w = self._add(self._integrate(S, X, a, tau, b))
+        a, X = tau, Xn
+        P[list(S)] += PSa
+        if self._fric:
+            X = self._held_segment(S, PSa, w, X)
+        if kind == "stick":
+            self._refuse_stick(i, self.t + a, X)
+        if kind == "release":
+            return a, X, tuple(j for j in S if j != i)
+        hits[i] += 1
+        X, S = self._impact(self.t + a, X, S, P, forced=i, plastic=hits >= ZENO_HITS)
+        return a, X, S
+
+    def _release_at_end(self, S, X, b):
+        """Without event location: releases (and stops of sliding) at the step end."""
+        lam = self._flows.multiplier(S, X, self._loads.u(b, 1.0))
+        S = tuple(j for j, lj in zip(S, lam) if lj > 0.0)
+        for j in S:
+            if not self._still_sliding(j, X):
+                self._refuse_stick(j, self.t + self.h, X)
+        return S
 
     def _add(self, w):
         """Add a flight segment's integrals (or ``None``) to the step's; return them."""
@@ -305,7 +328,7 @@ class ExponentialMoreau(EventLocation, FrictionalContact, LoadPolynomial, Steppe
             act = np.asarray(act, dtype=np.int64)
             self._fused[key] = (np.ascontiguousarray(F), k, act, np.ascontiguousarray(off))
         F, k, act, off = self._fused[key]
-        u = np.concatenate([X, (self._T01 @ b).ravel()])
+        u = np.concatenate([X, (self._loads.T01 @ b).ravel()])
         works = np.zeros(NQ + 2)
         y, V, calm, self._opened = flight(
             F, u, k, q, self._gap_grid(), off, self._held(S), nz, act, integ is not None, works
