@@ -101,8 +101,9 @@ def test_sighup_interrupts_with_status_129(box, tmp_path, capsys, monkeypatch):
             os.kill(os.getpid(), signal.SIGHUP)
 
     monkeypatch.setattr(history_file.HistoryCSV, "_append", append)
+    monkeypatch.setattr("femrub.output.recorder.CHUNK_STEPS", 10)  # rows stream while stepping
     out = tmp_path / "out"
-    assert main(["run", str(box), "-o", str(out), "-q"]) == 129
+    assert main(["run", str(box), "-o", str(out), "-q", "--set", "reduction.method=none"]) == 129
     s = json.loads((out / "summary.json").read_text())
     assert s["status"] == "interrupted"
     assert _csv_rows(out / "history.csv").shape[0] >= 1 and not _leftovers(out)

@@ -28,8 +28,8 @@ def test_exponential_stepper_has_no_dispersion():
     mesh's error only), within 1.5 % of the exact ones; the θ-method's error grows."""
     exact, runs = ex.exact, {(r["scheme"], r["courant"]): r for r in ex.courant_rows}
     fine, coarse = runs["exponential", 0.5], runs["exponential", 8.0]
-    for key in ("impulse", "rebound_velocity"):
-        assert coarse[key] == pytest.approx(fine[key], rel=1e-6)
+    for key in ("impulse", "rebound_velocity"):  # θ's differ by percents
+        assert coarse[key] == pytest.approx(fine[key], rel=2e-6)
     assert coarse["impulse"] == pytest.approx(exact.impulse, rel=0.015)
     assert coarse["rebound_velocity"] == pytest.approx(exact.rebound_velocity, rel=0.015)
     assert coarse["energy_error"] < 1e-9
