@@ -33,6 +33,7 @@ from ..contact.heat import heat_coefficients
 from ..contact.points import locate_contacts
 from ..contact.reach import contact_reach, normal_deflection
 from ..model.rub import rub_model, tip_load
+from ..output.limits import MAX_DISPLACEMENT_RATIO, MAX_TEMPERATURE_RISE, default_limits
 from ..scene.spec import SceneError, fail
 from . import translate as tr
 from .blade import load_blade
@@ -54,10 +55,6 @@ __all__ = [
     "reusable_run",
 ]
 
-#: default stop limit on temperature signals (K above ambient; titanium melts ~1650 K above)
-MAX_TEMPERATURE_RISE = 1500.0
-#: default stop limit on displacement signals, relative to the blade's size
-MAX_DISPLACEMENT_RATIO = 0.1
 #: largest casing clearance (or lobe depth) relative to the blade's size
 MAX_CLEARANCE_RATIO = 0.05
 
@@ -67,17 +64,6 @@ def blade_size(scene, blade) -> float:
     if blade.dim == 1:
         return float(scene["geometry"]["length"])
     return float(np.ptp(blade.mesh.p, axis=1).max())
-
-
-def default_limits(observed, size: float) -> dict:
-    """Physical stop limits on the ``observed`` signals (see the module docstring)."""
-    out = {}
-    for name in observed:
-        if name.endswith("temperature"):
-            out[name] = MAX_TEMPERATURE_RISE
-        elif name.endswith("displacement"):
-            out[name] = MAX_DISPLACEMENT_RATIO * size
-    return out
 
 
 def _check_scale(scene, size: float) -> None:

@@ -22,6 +22,7 @@ import numpy as np
 
 from ..blas import SERIAL_SETUP_DOFS, one_blas_thread
 from ..model.first_order import FirstOrderModel
+from ..output.limits import run_limits
 from ..output.recorder import Recorder, State
 from ..output.results import Results
 from ..output.verdict import assess
@@ -228,6 +229,7 @@ class Stepper:
         tolerances: dict | None = None,
         merge_time: float | None = None,
         lean: int = 0,
+        default_limits: bool = True,
     ) -> Results:
         """Integrate to ``t_end`` and collect :class:`~femrub.output.results.Results`.
 
@@ -237,7 +239,8 @@ class Stepper:
         progress : show a progress bar.
         limits : physical stop criteria, ``{signal name: max |value|}``; the key
             ``"contact_force"`` limits the contact force (N). Reaching one ends the run with
-            status ``"diverged-physically"``.
+            status ``"diverged-physically"``. They replace the model's default limits of
+            their signals (:mod:`femrub.output.limits`; ``inf``: no limit on that signal).
         energy : keep the energy balance (needs ``model.energy``); it also detects numerical
             blow-up (energy created from nothing).
         store_every : keep the full state every that many steps (0: never).
@@ -253,6 +256,8 @@ class Stepper:
             results ``k h``); gaps, friction rows and the energy balance are never stored,
             the verdict reads its measures of them taken as the steps were recorded
             (:mod:`femrub.output.kept_rows`, ``Results.checks``).
+        default_limits : also stop on the model's default physical limits
+            (:func:`femrub.output.limits.model_limits`; ``False``: only ``limits``).
         """
         self._check_owner()
         recorder = Recorder(
@@ -262,7 +267,7 @@ class Stepper:
             scheme=self.name,
             stability_limit=self.stability_limit(),
             energy=energy,
-            limits=limits,
+            limits=run_limits(self.model, limits, default_limits),
             store_every=store_every,
             on_state=on_state,
             on_rows=on_rows,
