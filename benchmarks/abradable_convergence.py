@@ -24,11 +24,11 @@ from pathlib import Path
 
 import numpy as np
 
+from femrub.analysis import make_stepper
 from femrub.app.cache import DEFAULT_LIMIT, ModelCache
 from femrub.app.scheme import scheme_options
 from femrub.app.simulation import build
 from femrub.scene.scene import load_scene
-from femrub.steppers import make_stepper
 
 DOC = Path(__file__).resolve().parents[1] / "docs" / "abradable.md"
 HEADING = "\n## Time-step convergence of the coated rub"

@@ -75,10 +75,10 @@ def measure(res, wear, h: float, revolution: float) -> dict:
 
 
 def study(scene, factors, revolutions: float, n_angles, log=print) -> list[dict]:
+    from femrub.analysis import make_stepper
     from femrub.app.cache import ModelCache
     from femrub.app.scheme import scheme_options
     from femrub.app.simulation import build
-    from femrub.steppers import make_stepper
 
     model = build(scene, log=log, cache=ModelCache()).model
     wear0 = model.contact.wear

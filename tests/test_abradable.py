@@ -340,8 +340,8 @@ def test_a_mass_entering_the_coating_is_held_only_after_it_reaches_it():
     """A free mass m at speed v meets a fresh coating (yield F_y) at t_c inside a step: that
     step's impulse is F_y (t_{k+1} − t_c), then F_y h per step until the mass has lost m v;
     the cut depth is the plastic stopping distance m v² / (2 F_y) to O(h v)."""
+    from femrub.analysis import make_stepper
     from femrub.model.first_order import FirstOrderModel, Layout
-    from femrub.steppers import make_stepper
 
     m, v, F_y, d, h = 2.0, 0.5, 400.0, 1.3e-6, 1e-6  # stops in m v / F_y = 2.5 ms
     grid = CasingGrid([0.0], [0.0], 0.3, 0.0, n_angle=1, n_axial=1)
@@ -406,9 +406,9 @@ def test_steppers_of_one_coated_model_each_start_on_a_fresh_coating(tmp_path):
     """A stepper built before another stepper of the same model ran still starts on a fresh
     coating (the time-step check builds its h/2 stepper before it runs at h); steppers that
     interleave their steps on one coating are refused."""
+    from femrub.analysis import make_stepper
     from femrub.app.scheme import scheme_options
     from femrub.app.simulation import build
-    from femrub.steppers import make_stepper
 
     path = tmp_path / "bar.toml"
     path.write_text(SCENE.format(e=50e-6))

@@ -9,7 +9,7 @@ from __future__ import annotations
 import math
 
 from ..scene.spec import SceneError, fail
-from ..steppers import make_stepper
+from ..analysis.steppers import make_stepper
 
 __all__ = ["bare_stepper", "scheme_options", "stepper_of"]
 

@@ -42,7 +42,7 @@ from .cached import Stages
 from .casing import abradable_of, casing_grid, casing_heat_of, footprint_warning
 from .explain import explain
 from .scheme import bare_stepper, stepper_of
-from .step_check import check_step
+from ..analysis.step_check import check_step
 
 __all__ = [
     "MAX_CLEARANCE_RATIO",

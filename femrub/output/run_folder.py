@@ -113,7 +113,7 @@ def run_to_folder(
     reduced run (:mod:`femrub.reduction.estimate`, with its ``tolerance``), written as
     ``summary.json["reduction_error"]`` and judged by the ``reduction`` rule of
     :mod:`~femrub.output.verdict` (``inaccurate`` above the tolerance); ``step_error``: the
-    time-step error estimate (:mod:`femrub.app.step_check`), written as
+    time-step error estimate (:mod:`femrub.analysis.step_check`), written as
     ``summary.json["time_step_error"]`` and judged by the ``time_step`` rule. ``ran``: ``(results,
     wall seconds)`` of this very run already stepped (``stepper.model`` from its initial state
     to ``t_end`` with ``limits``, e.g. by the reduction error estimate): it is judged and

@@ -1,16 +1,23 @@
-"""Common machinery of the time steppers: ``step()``, ``iterate()`` and ``run()``.
+"""The integrator protocol every time stepper follows: ``advance()``, ``step()``, ``iterate()``.
 
-A stepper works on any :class:`~femrub.model.first_order.FirstOrderModel` and advances
-``t_{k+1} = t0 + (k + 1) h``. Subclasses implement ``_step()`` (advance one step, return the
-new state and the contact impulses); the public ``step()`` returns the new :class:`State`,
-``iterate()`` yields states, ``run()`` hands the steps to a
-:class:`~femrub.output.recorder.Recorder`, which collects the
-:class:`~femrub.output.results.Results` (energy balance, progress bar, physical stop criteria,
-protection against numerical blow-up). Whatever stops a run (instability, a stop criterion,
-Ctrl-C, SIGTERM, an exception), ``run()`` returns what was computed so far; a run the
-recorder ends as ``ok`` is then judged by :func:`femrub.output.verdict.assess` (balance
-tolerances -> ``inaccurate``, resolution warnings). Every stepper refuses a model that
-starts inside the casing (initial penetration) and a run longer than :data:`MAX_STEPS`.
+A stepper is a pure integrator on any :class:`~femrub.model.first_order.FirstOrderModel`: it
+advances ``t_{k+1} = t0 + (k + 1) h`` and knows nothing of scenes, files, stop limits,
+verdicts or estimates. Subclasses implement ``_step()`` (advance one step from
+``(self.t, self.X)``; return ``(X_new, impulse)`` or, with friction,
+``(X_new, impulse, friction)``, a :class:`~femrub.steppers.record.Friction`). The public
+methods:
+
+* :meth:`Stepper.advance`: one step, its typed :class:`~femrub.steppers.record.StepRecord`;
+* :meth:`Stepper.step`: one step, the new :class:`~femrub.steppers.record.State`;
+* :meth:`Stepper.iterate`: the initial state, then the state after every step to ``t_end``;
+* :meth:`Stepper.block_writer`: a compiled writer of whole blocks of steps into given rows
+  (the fast path of the θ-method), or ``None``;
+* :meth:`Stepper.measure_works`: ask for the exact works of each step in its record (steppers
+  that can integrate them).
+
+Recording, stop limits and the verdict live in the analysis layer above
+(:mod:`femrub.analysis`, whose runnable subclasses add ``run()``). Every stepper refuses a
+model that starts inside the casing (initial penetration).
 """
 
 from __future__ import annotations
@@ -22,13 +29,9 @@ import numpy as np
 
 from ..blas import SERIAL_SETUP_DOFS, one_blas_thread
 from ..model.first_order import FirstOrderModel
-from ..output.limits import run_limits
-from ..output.recorder import Recorder, State
-from ..output.results import Results
-from ..output.verdict import assess
-from ..scene.validate import MAX_STEPS
+from .record import Friction, State, StepRecord
 
-__all__ = ["MAX_STEPS", "PENETRATION_TOLERANCE", "State", "Stepper", "check_step"]
+__all__ = ["Friction", "PENETRATION_TOLERANCE", "State", "StepRecord", "Stepper", "check_step"]
 
 #: identifies the stepper that owns a contact's state (:meth:`Stepper._check_owner`)
 _TOKENS = itertools.count(1)
@@ -55,7 +58,7 @@ class Stepper:
     """Base class; see the module docstring. ``h`` is the time step (s)."""
 
     name = "stepper"
-    #: the recorder stops a run whose energy balance opens (numerical blow-up)
+    #: a recorder may stop a run whose energy balance opens (numerical blow-up)
     blowup_check = True
     #: the step locates contact events inside itself (no contact-resolution check needed)
     locates_events = False
@@ -70,17 +73,11 @@ class Stepper:
         self.k = 0
         self.t0 = self.t = float(t0)
         self.X = model.x0.copy()
-        nc = model.n_contacts
-        self.impulse = np.zeros(nc)
-        self.extra = None
+        self.impulse = np.zeros(model.n_contacts)
+        #: the frictional quantities of the last step (:class:`Friction`), or ``None``
+        self.friction = None
         self._h_lim = None
-        wear = None if model.contact is None else model.contact.wear
-        if wear is not None:
-            if not self.supports_wear:
-                raise ValueError(
-                    f"an abradable coating needs scheme.name = 'theta' (the {self.name} "
-                    "scheme does not bound its contact impulses)"
-                )
+        self._refuse_wear()
         self._token = next(_TOKENS)
         self._owned_states = bool(self._contact_states())
         self._claim_contact_state()
@@ -90,6 +87,15 @@ class Stepper:
                 self._setup()
         else:
             self._setup()
+
+    def _refuse_wear(self) -> None:
+        """An abradable coating needs a stepper that bounds its impulses."""
+        c = self.model.contact
+        if c is not None and c.wear is not None and not self.supports_wear:
+            raise ValueError(
+                f"an abradable coating needs scheme.name = 'theta' (the {self.name} "
+                "scheme does not bound its contact impulses)"
+            )
 
     def _contact_states(self) -> list:
         """:attr:`~femrub.contact.gap.Contact.carried_state` of the model's contact."""
@@ -151,14 +157,8 @@ class Stepper:
 
     def _step(self) -> tuple:
         """Advance from ``(self.t, self.X)`` by ``h``; return ``(X_new, impulse)`` or, with
-        friction, ``(X_new, impulse, extra)``: ``extra`` holds ``friction_impulse``
-        (n_c, 2), the blade's ``heat`` (n_c,) (J) and the contact ``state`` (n_c,) of the step."""
+        friction, ``(X_new, impulse, friction)`` (:class:`Friction`)."""
         raise NotImplementedError
-
-    def _block_writer(self):
-        """A writer of whole blocks of steps for :meth:`Recorder.record` (``block``), or
-        ``None``: ``run()`` then advances step by step."""
-        return None
 
     def _stability_limit(self) -> float:
         """Largest stable step (s); ``inf`` for unconditionally stable schemes."""
@@ -171,6 +171,24 @@ class Stepper:
             self._h_lim = self._stability_limit()
         return self._h_lim
 
+    def block_writer(self):
+        """A writer of whole blocks of steps, or ``None`` (then steps go one by one).
+
+        ``block(m, X, t, P, Pt, heat, state) -> (steps done, friction rows written, error)``
+        advances ``m`` steps and writes them into the given rows (states ``X`` (m, N), times,
+        impulses and the frictional rows of :class:`Friction`); ``error``, an exception or
+        ``None``, is what :meth:`advance` would have raised after the steps done.
+        """
+        return None
+
+    def measure_works(self, on: bool) -> None:
+        """Fill the records' ``works`` with the exact energy-balance integrals of each step
+        when the stepper can integrate them (``on``); the others ignore it."""
+
+    def start_run(self) -> None:
+        """Before a run from the current state: the contact's history is this stepper's."""
+        self._check_owner()
+
     @property
     def state(self) -> State:
         c, t, X = self.model.contact, self.t, self.X
@@ -178,35 +196,29 @@ class Stepper:
             return State(self.k, t, X, self.impulse, np.zeros(0), np.zeros(0))
         return State(self.k, t, X, self.impulse, c.gap(t, X), c.gap_velocity(t, X))
 
-    def _advance(self) -> tuple:
-        """One step; return the new ``(t, X, impulse, extra)`` (``extra``: see ``_step``)."""
+    def advance(self) -> StepRecord:
+        """One step of size ``h``; its :class:`StepRecord`."""
         if self._owned_states:
             self._check_owner()
-        out = self._step()
-        X, impulse = out[0], out[1]
-        self.extra = out[2] if len(out) > 2 else None
+        X, impulse, *friction = self._step()
+        self.friction = friction[0] if friction else None
         self.k += 1
         self.t = self.t0 + self.k * self.h
         if self.model.contact is not None:
-            self.model.contact.after_step(self.t, X, impulse, self.h, self.extra)
+            Pt = None if self.friction is None else self.friction.impulse
+            self.model.contact.after_step(self.t, X, impulse, self.h, Pt)
         self.X, self.impulse = X, impulse
-        return self.t, X, impulse, self.extra
+        return StepRecord(self.t, X, impulse, self.friction)
 
     def step(self) -> State:
         """Advance one step of size ``h`` and return the new :class:`State`."""
-        self._advance()
+        self.advance()
         return self.state
 
     def steps_to(self, t_end: float) -> int:
         """Number of steps from the current time to ``t_end`` (validated)."""
         check_step(self.h, t_end)
-        n = int(round((t_end - self.t) / self.h))
-        if n > MAX_STEPS:
-            raise ValueError(
-                f"h = {self.h:g} s to t_end = {t_end:g} s gives {n:.3g} steps; at most "
-                f"{MAX_STEPS:.0e} allowed (raise h or lower t_end)"
-            )
-        return n
+        return int(round((t_end - self.t) / self.h))
 
     def iterate(self, t_end: float):
         """Yield the initial state, then the state after every step until ``t_end``."""
@@ -214,71 +226,3 @@ class Stepper:
         yield self.state
         for _ in range(n):
             yield self.step()
-
-    def run(
-        self,
-        t_end: float,
-        *,
-        progress: bool = False,
-        limits: dict[str, float] | None = None,
-        energy: bool = True,
-        store_every: int = 0,
-        on_state=None,
-        on_rows=None,
-        label: str | None = None,
-        tolerances: dict | None = None,
-        merge_time: float | None = None,
-        lean: int = 0,
-        default_limits: bool = True,
-    ) -> Results:
-        """Integrate to ``t_end`` and collect :class:`~femrub.output.results.Results`.
-
-        Parameters
-        ----------
-        t_end : end time (s).
-        progress : show a progress bar.
-        limits : physical stop criteria, ``{signal name: max |value|}``; the key
-            ``"contact_force"`` limits the contact force (N). Reaching one ends the run with
-            status ``"diverged-physically"``. They replace the model's default limits of
-            their signals (:mod:`femrub.output.limits`; ``inf``: no limit on that signal).
-        energy : keep the energy balance (needs ``model.energy``); it also detects numerical
-            blow-up (energy created from nothing).
-        store_every : keep the full state every that many steps (0: never).
-        on_state : callback ``f(state)`` after each step (e.g. streaming VTK output).
-        on_rows : callback ``f(arrays)`` per checked block of rows (e.g. a streamed history).
-        label : name of the run (progress bar and ``Results.info``).
-        tolerances, merge_time : see :func:`femrub.output.verdict.assess` (balance
-            tolerances; contact impulses closer than ``merge_time`` s form one episode of
-            the resolution check, ``None``: no check).
-        lean : 0: results with every per-step array. ``k >= 1``: a run held only to be
-            compared with another: only times, impulses, signals and the stored states, at
-            every ``k``-th step with the impulses summed over each ``k`` steps (``h`` of the
-            results ``k h``); gaps, friction rows and the energy balance are never stored,
-            the verdict reads its measures of them taken as the steps were recorded
-            (:mod:`femrub.output.kept_rows`, ``Results.checks``).
-        default_limits : also stop on the model's default physical limits
-            (:func:`femrub.output.limits.model_limits`; ``False``: only ``limits``).
-        """
-        self._check_owner()
-        recorder = Recorder(
-            self.model,
-            self.h,
-            self.steps_to(t_end),
-            scheme=self.name,
-            stability_limit=self.stability_limit(),
-            energy=energy,
-            limits=run_limits(self.model, limits, default_limits),
-            store_every=store_every,
-            on_state=on_state,
-            on_rows=on_rows,
-            label=label,
-            blowup_check=self.blowup_check,
-            lean=lean,
-        )
-        res = recorder.record(
-            self.state, self._advance, progress=progress, block=self._block_writer()
-        )
-        del recorder  # its per-step arrays that the results do not hold: before the checks
-        if self.locates_events:
-            merge_time = None
-        return assess(res, tolerances=tolerances, merge_time=merge_time)
