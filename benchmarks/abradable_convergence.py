@@ -63,6 +63,7 @@ def study(scene, t_end: float, factors) -> list[dict]:
         temps = res.signals.get("contact_temperature")
         row["T_max"] = float(np.max(temps)) if temps is not None else float("nan")
         if wear is not None:
+            wear = stepper.model.contact.wear  # this run's coating
             cap = h * wear.yield_force
             held = P >= (1.0 - 1e-9) * cap
             active = P > 0

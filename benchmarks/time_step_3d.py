@@ -57,7 +57,7 @@ def ladder(scene, factors, gammas, log=print) -> list[dict]:
             load0, c0 = os.getloadavg()[0], time.process_time()
             res = st.run(t_end, store_every=f * every, limits=sim.limits)
             cpu = time.process_time() - c0
-            wear = model.contact.wear if model.contact is not None else None
+            wear = st.model.contact.wear if st.model.contact is not None else None
             row = {
                 "gamma_thermal": opts.get("gamma_thermal"),
                 "f": f,

@@ -109,10 +109,10 @@ def checked_sizes(red, model, want, make_stepper, scene, report, log, limits, on
     tol, t_end = scene["reduction"]["tolerance"], scene["scheme"]["t_end"]
     window = lobe_passage(scene)
     most = (red.n_uv, red.n_theta)
-    # a run that carries state outside X (wear, casing heat) is stepped again as the
-    # scene's run (the estimate's later runs restart that state): every run here recorded
-    # lean (only what estimate() reads, so that the runs it holds together stay small);
-    # otherwise those that are never the run
+    # a run that carries a history outside X (wear, casing heat) is stepped again as the
+    # scene's run (whose stepper keeps the history the results folder writes): every run
+    # here recorded lean (only what estimate() reads, so that the runs it holds together
+    # stay small); otherwise those that are never the run
     whole = model.contact is None or not model.contact.carried_state
     cands = [want] if want is not None else ladder(most)
     lean = int(not whole or (want is not None and want != most))  # the reference

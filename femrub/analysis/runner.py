@@ -56,7 +56,6 @@ def run(stepper, t_end: float, options: RunOptions | None = None) -> Results:
             blowup_check=stepper.blowup_check,
             lean=o.lean,
         )
-        stepper.start_run()
         res = recorder.record(
             stepper.state, stepper.advance, progress=o.progress, block=stepper.block_writer()
         )

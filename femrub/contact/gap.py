@@ -247,9 +247,19 @@ class Contact:
 
     @property
     def carried_state(self) -> list:
-        """The state a run carries outside ``X`` (an abradable coating's wear map, the
-        casing's heat): each run starts it afresh and leaves it as its last step did."""
+        """The history a run carries outside ``X`` (an abradable coating's wear map, the
+        casing's heat); a stepper runs its own copy (:meth:`with_fresh_history`)."""
         return [s for s in (self.wear, self.casing_heat) if s is not None]
+
+    def with_fresh_history(self, h: float) -> Contact:
+        """This contact with a history of its own, started afresh (an unworn coating, a cold
+        casing) for a run of step ``h`` (s): the run's state. The contact it is copied from
+        keeps its own history untouched (``self`` when there is none)."""
+        if not self.carried_state:
+            return self
+        wear = None if self.wear is None else self.wear.fresh(h)
+        heat = None if self.casing_heat is None else self.casing_heat.fresh()
+        return replace(self, wear=wear, casing_heat=heat)
 
     # -- friction --------------------------------------------------------------------------
     @property

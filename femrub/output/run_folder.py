@@ -147,7 +147,7 @@ def run_to_folder(
 
 
 def _judged(ran, tolerances, merge_time):
-    """``(results, wall)`` of a run stepped elsewhere, judged as ``Stepper.run`` judges.
+    """``(results, wall)`` of a run stepped elsewhere, judged as ``femrub.analysis.run`` judges.
 
     Its results were judged without these ``tolerances`` and ``merge_time``; the recorder
     ends a run ``ok`` or with a stop status and only the verdict turns ``ok`` into

@@ -20,7 +20,7 @@ The recorder ends a run as ``unstable`` (blow-up), ``diverged-physically`` (a st
   while sliding, or not opposite to the slip velocity) beyond ``tolerances["coulomb"]``
   (relative, :func:`femrub.contact.friction.coulomb_check`) -> ``"inaccurate"``.
 
-A lean record (``Stepper.run(lean=k)``, :mod:`femrub.output.kept_rows`) keeps neither the
+A lean record (``RunOptions.lean = k``, :mod:`femrub.output.kept_rows`) keeps neither the
 energy balance nor the friction rows; the balance and Coulomb rules read the same measures
 taken on its rows as they were recorded (``Results.checks``).
 

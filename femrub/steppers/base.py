@@ -18,11 +18,16 @@ methods:
 Recording, stop limits and the verdict live in the analysis layer above
 (:mod:`femrub.analysis`, whose runnable subclasses add ``run()``). Every stepper refuses a
 model that starts inside the casing (initial penetration).
+
+A contact's history outside ``X`` (an abradable coating's wear map, the casing's heat) is the
+run's state: a stepper runs ``model.with_(contact=contact.with_fresh_history(h))``, its own
+copy started afresh, as ``stepper.model`` (read the wear of a run from
+``stepper.model.contact.wear``); the model it was given is never changed, and steppers of
+one model may step in any order.
 """
 
 from __future__ import annotations
 
-import itertools
 import math
 
 import numpy as np
@@ -33,8 +38,6 @@ from .record import Friction, State, StepRecord
 
 __all__ = ["Friction", "PENETRATION_TOLERANCE", "State", "StepRecord", "Stepper", "check_step"]
 
-#: identifies the stepper that owns a contact's state (:meth:`Stepper._check_owner`)
-_TOKENS = itertools.count(1)
 #: initial gaps below minus this (m) are an initial penetration
 PENETRATION_TOLERANCE = 1e-12
 
@@ -68,8 +71,11 @@ class Stepper:
     def __init__(self, model: FirstOrderModel, h: float, *, t0: float = 0.0):
         if not isinstance(model, FirstOrderModel):
             raise TypeError("a stepper needs a femrub.FirstOrderModel")
-        self.model = model
         self.h = check_step(h)
+        if model.contact is not None and model.contact.carried_state:
+            # the contact's history (wear map, casing heat) is this run's own state
+            model = model.with_(contact=model.contact.with_fresh_history(self.h))
+        self.model = model
         self.k = 0
         self.t0 = self.t = float(t0)
         self.X = model.x0.copy()
@@ -78,9 +84,6 @@ class Stepper:
         self.friction = None
         self._h_lim = None
         self._refuse_wear()
-        self._token = next(_TOKENS)
-        self._owned_states = bool(self._contact_states())
-        self._claim_contact_state()
         self._check_initial_gap()
         if model.n_dofs <= SERIAL_SETUP_DOFS:  # no BLAS worker left spinning into the steps
             with one_blas_thread:
@@ -96,36 +99,6 @@ class Stepper:
                 f"an abradable coating needs scheme.name = 'theta' (the {self.name} "
                 "scheme does not bound its contact impulses)"
             )
-
-    def _contact_states(self) -> list:
-        """:attr:`~femrub.contact.gap.Contact.carried_state` of the model's contact."""
-        c = self.model.contact
-        return [] if c is None else c.carried_state
-
-    def _claim_contact_state(self) -> None:
-        """Start the contact's states afresh for this stepper (a fresh coating, a cold
-        casing) and mark them as its own."""
-        for state in self._contact_states():
-            if state is self.model.contact.wear:
-                state.reset(self.h)
-            else:
-                state.reset()
-            state.owner = self._token
-
-    def _check_owner(self) -> None:
-        """Before stepping: the contact's states are this stepper's. Another stepper of the
-        same model built or run since this one was built has reset or worn them: before the
-        first step they are started afresh again, after it the run cannot go on."""
-        for state in self._contact_states():
-            if getattr(state, "owner", None) != self._token:
-                if self.k:
-                    raise RuntimeError(
-                        "another stepper of this model has used its contact's state (wear "
-                        "map, casing heat) since this run started; run the steppers of one "
-                        "model one after the other"
-                    )
-                self._claim_contact_state()
-                return
 
     def _check_initial_gap(self) -> None:
         """Refuse a model that starts inside the casing (no scheme can undo it honestly)."""
@@ -185,10 +158,6 @@ class Stepper:
         """Fill the records' ``works`` with the exact energy-balance integrals of each step
         when the stepper can integrate them (``on``); the others ignore it."""
 
-    def start_run(self) -> None:
-        """Before a run from the current state: the contact's history is this stepper's."""
-        self._check_owner()
-
     @property
     def state(self) -> State:
         c, t, X = self.model.contact, self.t, self.X
@@ -198,8 +167,6 @@ class Stepper:
 
     def advance(self) -> StepRecord:
         """One step of size ``h``; its :class:`StepRecord`."""
-        if self._owned_states:
-            self._check_owner()
         X, impulse, *friction = self._step()
         self.friction = friction[0] if friction else None
         self.k += 1
