@@ -24,11 +24,11 @@ from pathlib import Path
 
 import numpy as np
 
+from femrub.analysis import make_stepper
 from femrub.app.cache import DEFAULT_LIMIT, ModelCache
 from femrub.app.scheme import scheme_options
 from femrub.app.simulation import build
 from femrub.scene.scene import load_scene
-from femrub.steppers import make_stepper
 
 DOC = Path(__file__).resolve().parents[1] / "docs" / "abradable.md"
 HEADING = "\n## Time-step convergence of the coated rub"
@@ -63,6 +63,7 @@ def study(scene, t_end: float, factors) -> list[dict]:
         temps = res.signals.get("contact_temperature")
         row["T_max"] = float(np.max(temps)) if temps is not None else float("nan")
         if wear is not None:
+            wear = stepper.model.contact.wear  # this run's coating
             cap = h * wear.yield_force
             held = P >= (1.0 - 1e-9) * cap
             active = P > 0

@@ -75,10 +75,10 @@ def measure(res, wear, h: float, revolution: float) -> dict:
 
 
 def study(scene, factors, revolutions: float, n_angles, log=print) -> list[dict]:
+    from femrub.analysis import make_stepper
     from femrub.app.cache import ModelCache
     from femrub.app.scheme import scheme_options
     from femrub.app.simulation import build
-    from femrub.steppers import make_stepper
 
     model = build(scene, log=log, cache=ModelCache()).model
     wear0 = model.contact.wear
@@ -96,7 +96,7 @@ def study(scene, factors, revolutions: float, n_angles, log=print) -> list[dict]
             res = st.run(revolutions * revolution)
             row = {"n_angle": wear.n_angle, "f": f, "h": s["h"] / f, "status": res.status}
             row["cpu"] = time.process_time() - c0
-            row.update(measure(res, wear, s["h"] / f, revolution))
+            row.update(measure(res, st.model.contact.wear, s["h"] / f, revolution))
             row["balances"] = (res.energy_error(), res.heat_error())
             row["load"] = (load0, os.getloadavg()[0])
             rows.append(row)

@@ -19,11 +19,11 @@ from __future__ import annotations
 import os
 import time
 
+from femrub.analysis.reduction_check import lobe_passage, reduce_checked
 from femrub.app.cli import _changes
 from femrub.app.scheme import bare_stepper
 from femrub.app.simulation import build
 from femrub.reduction.estimate import QUANTITIES, compare, field_norms
-from femrub.reduction.sizes import lobe_passage, reduce_model
 from femrub.scene.scene import load_scene
 
 #: stored states per run (fields and lowest temperature are judged at these times)
@@ -41,8 +41,8 @@ def measure(name: str, sets: list[str]) -> dict:
     """Run ``name`` with its defaults and unreduced; return the numbers (module docstring).
 
     The full model is assembled once (``reduction.method = "none"``) and reduced as
-    ``femrub run`` reduces it (:func:`~femrub.reduction.sizes.reduce_model` with the scene's
-    stepper for the estimate).
+    ``femrub run`` reduces it (:func:`~femrub.analysis.reduction_check.reduce_checked` with
+    the scene's stepper for the estimate).
     """
     changes = {"outputs.vtk_stride": 0, **_changes(type("A", (), {"set": sets}))}
     scene = load_scene(name, changes)
@@ -53,7 +53,7 @@ def measure(name: str, sets: list[str]) -> dict:
     t_build_full = time.perf_counter() - t0
     t0 = time.perf_counter()
     make = lambda m: bare_stepper(scene, m)  # noqa: E731
-    model, red, rep = reduce_model(fsim.model, scene, make_stepper=make)
+    model, red, rep = reduce_checked(fsim.model, scene, make_stepper=make)
     t_build_red = time.perf_counter() - t0
     res_r, wall_r, cpu_r = _run(make(model), t_end)
     info = model.info

@@ -37,10 +37,10 @@ from pathlib import Path
 
 import numpy as np
 
+from femrub.analysis.reduction_check import lobe_passage
 from femrub.app.simulation import build
 from femrub.reduction import PROJECTIONS, ThermoelasticCraigBampton
 from femrub.reduction.estimate import compare, field_norms
-from femrub.reduction.sizes import lobe_passage
 from femrub.scene.scene import load_scene
 
 DOCS = Path(__file__).resolve().parents[1] / "docs"

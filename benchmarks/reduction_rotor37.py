@@ -26,16 +26,16 @@ import time
 
 import numpy as np
 
+from femrub.analysis import make_stepper
+from femrub.analysis.reduction_check import lobe_passage, twin
+from femrub.analysis.step_check import coarsen
 from femrub.app.cache import ModelCache
 from femrub.app.cli import _changes
 from femrub.app.scheme import bare_stepper, scheme_options
 from femrub.app.simulation import build
-from femrub.app.step_check import coarsen
 from femrub.reduction import ThermoelasticCraigBampton
-from femrub.reduction.estimate import PERTURBATION, compare, field_norms, twin
-from femrub.reduction.sizes import lobe_passage
+from femrub.reduction.estimate import PERTURBATION, compare, field_norms
 from femrub.scene.scene import load_scene
-from femrub.steppers import make_stepper
 
 #: stored states per run (fields are compared at these times)
 STORED = 50

@@ -5,7 +5,7 @@ reduced model in seconds), then steps it ``--revolutions`` revolutions without o
 (``run(energy=False)`` and the default ``run()`` with the energy balance), in this process:
 
 * CPU per step (``time.process_time``), and split between the steps where no contact takes
-  an impulse and those where some do (wall time of each ``_advance``, median);
+  an impulse and those where some do (wall time of each ``advance``, median);
 * the floor: the dense ``T X`` product of the step and one ``numpy.linalg.solve`` of the
   Delassus block of the contacts active together (the small contact solve), each timed alone;
 * a VTK series at stride 50 over the same run, as ``femrub run`` writes it (background
@@ -45,7 +45,7 @@ def _per_step(
     """CPU (all threads) and wall time per step of ``run()`` alone (``blocks``: the
     compiled blocks of steps, else step by step; ``on_state``: an output callback, e.g. a
     VTK series, whose frames are all on disk when ``run`` returns)."""
-    from femrub.steppers import make_stepper
+    from femrub.analysis import make_stepper
 
     st = make_stepper(scheme["name"], model, scheme["h"], **opts)
     st.block_steps = blocks
@@ -66,8 +66,8 @@ def _per_step(
 def _bare_blocks(model, scheme: dict, opts: dict, t_end: float) -> dict:
     """CPU per step of the compiled blocks alone (chunks of 512 steps into preallocated
     rows, no recorder): the kernel's cost with the casing terms and signals of each block."""
+    from femrub.analysis import make_stepper
     from femrub.output.recorder import CHUNK_STEPS
-    from femrub.steppers import make_stepper
     from femrub.steppers.theta_blocks import advance_block
 
     st = make_stepper(scheme["name"], model, scheme["h"], **opts)
@@ -137,8 +137,8 @@ def _vtk(sim, scheme: dict, opts: dict, stride: int, t_end: float, repeats: int 
 
 def _split(model, scheme: dict, opts: dict, t_end: float) -> dict:
     """Median wall time of a step without / with an impulse (the per-step path,
-    ``_advance``), and the contacts active."""
-    from femrub.steppers import make_stepper
+    ``advance``), and the contacts active."""
+    from femrub.analysis import make_stepper
 
     st = make_stepper(scheme["name"], model, scheme["h"], **opts)
     n = st.steps_to(t_end)
@@ -146,9 +146,9 @@ def _split(model, scheme: dict, opts: dict, t_end: float) -> dict:
     with threadpool_limits(limits=1, user_api="blas"):
         for i in range(n):
             t0 = time.perf_counter()
-            out = st._advance()
+            out = st.advance()
             dt[i] = time.perf_counter() - t0
-            act[i] = np.count_nonzero(out[2] > 0.0)
+            act[i] = np.count_nonzero(out.impulse > 0.0)
     on = act > 0
     T = getattr(st, "_T", None)
     floor = {}

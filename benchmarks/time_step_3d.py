@@ -3,7 +3,7 @@
 Builds ``SCENE`` (default ``rotor37-thermal``, through the model cache) as ``femrub run``
 does, then steps the model that runs (reduced or full) at ``h / f`` for each ``--factors``
 ``f`` (and each ``--gamma-thermal`` variant of the θ-method's heat rows), each run coarsened
-to the steps of ``h`` (:func:`femrub.app.step_check.coarsen`). Consecutive runs are compared
+to the steps of ``h`` (:func:`femrub.analysis.step_check.coarsen`). Consecutive runs are compared
 with the measures of ``scheme.step_check`` (:func:`femrub.reduction.estimate.estimate`:
 contact impulse per lobe passage, contact temperature history, fields at 5 checkpoints),
 so each row's ``difference`` is what the check would see at that step and twice it is the
@@ -32,13 +32,13 @@ DOC = ROOT / "docs" / "rotor37.md"
 
 def ladder(scene, factors, gammas, log=print) -> list[dict]:
     """One row per (γ_θ, f): the run at ``h/f`` against the run at the previous factor."""
+    from femrub.analysis import make_stepper
+    from femrub.analysis.reduction_check import lobe_passage
+    from femrub.analysis.step_check import CHECKPOINTS, coarsen, full_states
     from femrub.app.cache import ModelCache
     from femrub.app.scheme import scheme_options
     from femrub.app.simulation import build
-    from femrub.app.step_check import CHECKPOINTS, coarsen, full_states
     from femrub.reduction.estimate import DECISIVE, estimate
-    from femrub.reduction.sizes import lobe_passage
-    from femrub.steppers import make_stepper
 
     sim = build(scene, log=log, cache=ModelCache())
     model, full = sim.model, sim.full
@@ -57,7 +57,7 @@ def ladder(scene, factors, gammas, log=print) -> list[dict]:
             load0, c0 = os.getloadavg()[0], time.process_time()
             res = st.run(t_end, store_every=f * every, limits=sim.limits)
             cpu = time.process_time() - c0
-            wear = model.contact.wear if model.contact is not None else None
+            wear = st.model.contact.wear if st.model.contact is not None else None
             row = {
                 "gamma_thermal": opts.get("gamma_thermal"),
                 "f": f,

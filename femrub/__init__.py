@@ -29,11 +29,12 @@ _LAZY = {
     "Layout": ".model.first_order",
     "LoadTerm": ".model.first_order",
     "Results": ".output.results",
-    "Carpenter": ".steppers",
-    "Penalty": ".steppers",
-    "ExponentialMoreau": ".steppers",
-    "ThetaMethod": ".steppers",
-    "make_stepper": ".steppers",
+    "Carpenter": ".analysis.steppers",
+    "Penalty": ".analysis.steppers",
+    "ExponentialMoreau": ".analysis.steppers",
+    "ThetaMethod": ".analysis.steppers",
+    "make_stepper": ".analysis.steppers",
+    "RunOptions": ".analysis.options",
 }
 
 __all__ = [
@@ -53,6 +54,7 @@ __all__ = [
     "Penalty",
     "Results",
     "RubConfig",
+    "RunOptions",
     "ThermoelasticMatrices",
     "ThetaMethod",
     "assemble_thermoelastic",

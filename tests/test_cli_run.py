@@ -5,8 +5,8 @@ import json
 
 import pytest
 
+from femrub.analysis import ThetaMethod
 from femrub.app.cli import main
-from femrub.steppers import ThetaMethod
 
 TINY = """
 name = "tiny"

@@ -11,7 +11,7 @@ from femrub.contact.friction import SLIP, coulomb_check
 from femrub.model.first_order import Contact, EnergyForms, FirstOrderModel, Layout, LoadTerm
 
 
-def belt_model(
+def belt_model(  # noqa: PLR0913 (the belt's parameters, all with defaults)
     n=1,
     m=2.0,
     N=20.0,

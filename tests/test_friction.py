@@ -6,9 +6,9 @@ import numpy as np
 import pytest
 import scipy.sparse as sp
 
+from femrub.analysis import Carpenter, Penalty, ThetaMethod
 from femrub.contact.friction import SLIP, STICK, coulomb_check, solve_frictional_contact
 from femrub.model.first_order import Contact, EnergyForms, FirstOrderModel, Layout, LoadTerm
-from femrub.steppers import Carpenter, Penalty, ThetaMethod
 
 
 def block_model(m=1.0, k=100.0, N=10.0, mu=0.3, v_belt=0.0, pull=None):

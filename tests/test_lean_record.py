@@ -10,9 +10,9 @@ import pytest
 from test_rub_blocks import SCENE  # a frictional coated blade, power heat, 300 steps
 
 import femrub as fr
-from femrub.app.step_check import coarsen
+from femrub.analysis import make_stepper
+from femrub.analysis.step_check import coarsen
 from femrub.contact.friction import coulomb_check
-from femrub.steppers import make_stepper
 
 
 @pytest.fixture(scope="module")
@@ -159,11 +159,10 @@ def test_the_step_check_and_the_estimate_are_those_of_whole_records(blade, monke
     """The time-step error (fine run and twin recorded lean at k = 2) and the reduction
     estimate (its runs recorded lean) equal, bit for bit, what whole records coarsened
     afterwards gave, with the same statuses."""
+    from femrub.analysis import reduction_check as est
+    from femrub.analysis import step_check as sc
     from femrub.app import build
-    from femrub.app import step_check as sc
     from femrub.app.scheme import bare_stepper
-    from femrub.reduction import estimate as est
-    from femrub.reduction.sizes import _checked
     from femrub.scene import load_scene
 
     # a step tolerance low enough that the round-off twin is stepped too
@@ -181,7 +180,7 @@ def test_the_step_check_and_the_estimate_are_those_of_whole_records(blade, monke
     def estimate():
         report, red = {}, sim.reductor
         want = (scene["reduction"]["n_uv"], scene["reduction"]["n_theta"])
-        _checked(
+        est.checked_sizes(
             red, red.fom, want, lambda m: bare_stepper(scene, m), scene, report, None, sim.limits
         )
         return {k: v for k, v in report["error"].items() if k != "seconds"}
@@ -202,6 +201,7 @@ def test_rows_a_step_leaves_unwritten_stay_zero_across_chunks(monkeypatch, lean)
     """The per-step buffers are reused chunk after chunk: a step without friction rows
     (or works) reads as zeros, not as the row a previous chunk left there."""
     from femrub.output.recorder import Recorder
+    from femrub.steppers.record import Friction, StepRecord
 
     monkeypatch.setattr("femrub.output.recorder.CHUNK_STEPS", 4)
     model = fr.bar_model(alpha=3.0)
@@ -210,8 +210,10 @@ def test_rows_a_step_leaves_unwritten_stay_zero_across_chunks(monkeypatch, lean)
 
     def advance():  # friction rows on odd steps only
         i = next(k)
-        info = {"heat": np.array([float(i)]), "state": np.array([1])} if i % 2 else None
-        return i * 1e-4, model.x0, np.zeros(1), info
+        friction = (
+            Friction(np.zeros((0, 2)), np.array([float(i)]), np.array([1])) if i % 2 else None
+        )
+        return StepRecord(i * 1e-4, model.x0, np.zeros(1), friction)
 
     rec = Recorder(model, 1e-4, n, scheme="test", stability_limit=np.inf, energy=False, lean=lean)
     rows = []

@@ -16,10 +16,10 @@ import pytest
 from bar_scenes import bar_scene
 
 import femrub.app.sweep as sweep_mod
+from femrub.analysis import ThetaMethod
 from femrub.app.cli import main
 from femrub.output.folder import claim
 from femrub.output.results import Results
-from femrub.steppers import ThetaMethod
 
 ROOT = Path(__file__).resolve().parents[1]
 

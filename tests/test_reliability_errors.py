@@ -8,11 +8,11 @@ import pytest
 from bar_scenes import bar_scene
 
 import femrub.app.run as run_mod
+from femrub.analysis import ThetaMethod
 from femrub.app.cli import main
 from femrub.cases.bar import bar_model
 from femrub.output.results import Results
 from femrub.scene import SceneError, loads_scene
-from femrub.steppers import ThetaMethod
 
 TINY = bar_scene("tiny", 5, 0.01)
 

@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 from bar_scenes import bar_scene
 
+from femrub.analysis import Carpenter, Penalty, ThetaMethod
 from femrub.app import build
 from femrub.app.blade import _check_mesh
 from femrub.app.cli import main
@@ -17,7 +18,6 @@ from femrub.cases.paper_models import paper_reduced_model
 from femrub.geometry import box_blade
 from femrub.output.verdict import assess
 from femrub.scene import SceneError, load_scene, loads_scene
-from femrub.steppers import Carpenter, Penalty, ThetaMethod
 
 BAR = bar_scene("bar", 10, 0.4)
 

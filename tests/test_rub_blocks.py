@@ -63,14 +63,15 @@ def blade():
     return sim.model, scene["scheme"], scheme_options(scene)
 
 
-def _run(model, scheme, opts, blocks):
-    """A run, the stepper, and a copy of the coating's state the run left."""
-    from femrub.steppers import make_stepper
+def _run(model, scheme, opts, blocks, **run):
+    """A run (``run``: its options), the stepper, and a copy of the coating's state the run
+    left."""
+    from femrub.analysis import make_stepper
 
     st = make_stepper(scheme["name"], model, scheme["h"], **opts)
     st.block_steps = blocks
-    res = st.run(scheme["t_end"])
-    w = model.contact.wear
+    res = st.run(scheme["t_end"], **run)
+    w = st.model.contact.wear  # the run's own coating
     coat = None
     if w is not None:
         coat = {
@@ -84,8 +85,10 @@ def _run(model, scheme, opts, blocks):
     return res, st, coat
 
 
-def _compare(model, scheme, opts, kind):
-    (a, sa, ca), (b, sb, cb) = (_run(model, scheme, opts, blocks) for blocks in (True, False))
+def _compare(model, scheme, opts, kind, **run):
+    (a, sa, ca), (b, sb, cb) = (
+        _run(model, scheme, opts, blocks, **run) for blocks in (True, False)
+    )
     assert sa._block_kind == sb._block_kind == kind
     assert a.status == b.status == "ok", (a.message, b.message)
     assert int((a.contact_state > 0).any(axis=1).sum()) > 50  # rubs, several contacts
@@ -101,19 +104,9 @@ def _compare(model, scheme, opts, kind):
     )
     _close(sa.X, sb.X, 1e-9)
     assert (sa.k, sa.t) == (sb.k, sb.t)
-    # the stepper goes on from where the block left it, as after step() calls (both
-    # steppers share the model's coating: each steps from the state the runs left it in,
-    # handed to it as its own, which steppers otherwise refuse mid-run)
-    w = model.contact.wear
-    if w is not None:
-        last = None if w._last is None else (w._last[0], w._last[1].copy())
-        kept = (w.depth.copy(), list(w.history), last)
-        w.owner = sa._token
-    after_blocks = sa.step().X
-    if w is not None:
-        w.depth[:], w.history = kept[0], kept[1]
-        w._last, w.owner = kept[2], sb._token
-    _close(after_blocks, sb.step().X, 1e-9)
+    # the stepper goes on from where the block left it, as after step() calls (each
+    # stepper runs its own coating: both step from the state their runs left it in)
+    _close(sa.step().X, sb.step().X, 1e-9)
     return a, sa, ca, cb
 
 
@@ -157,7 +150,9 @@ def test_footprint_blocks_equal_the_steps(blade):
 def test_power_heat_without_a_coating(blade):
     model, scheme, opts = blade
     bare = model.with_(contact=replace(model.contact, wear=None))
-    a, _, ca, _ = _compare(bare, scheme, opts, "rub")
+    # without the coating the tips pass the default 1500 K stop limit before t_end: the
+    # paths are compared over the whole run
+    a, _, ca, _ = _compare(bare, scheme, opts, "rub", default_limits=False)
     assert ca is None and a.energy["friction_heat"][-1] > 0
 
 
@@ -172,8 +167,8 @@ def test_alpha_heat_with_a_coating(blade):
 
 
 def test_casing_heat_and_alpha_of_time_keep_the_per_step_path(blade):
+    from femrub.analysis import make_stepper
     from femrub.contact.casing_heat import CasingHeat
-    from femrub.steppers import make_stepper
     from femrub.steppers.theta_blocks import block_kind
 
     model, scheme, opts = blade
@@ -187,7 +182,7 @@ def test_casing_heat_and_alpha_of_time_keep_the_per_step_path(blade):
         st = make_stepper(
             scheme["name"], model.with_(contact=replace(c, **changes)), scheme["h"], **opts
         )
-        assert block_kind(st) is None and st._block_writer() is None
+        assert block_kind(st) is None and st.block_writer() is None
 
 
 def test_a_failed_solve_in_a_rub_block_keeps_the_coating_of_the_steps_before(blade, monkeypatch):
@@ -281,11 +276,11 @@ _CHILD = """
 import json, pickle, sys
 import numpy as np
 from femrub.contact.jit import compiled
-from femrub.steppers import make_stepper
+from femrub.analysis import make_stepper
 d = pickle.load(open(sys.argv[1], "rb"))
 st = make_stepper(d["scheme"]["name"], d["model"], d["scheme"]["h"], **d["opts"])
 r = st.run(d["scheme"]["t_end"])
-w = d["model"].contact.wear
+w = st.model.contact.wear
 print(json.dumps({"jit": compiled(), "kind": st._block_kind, "P": r.impulse.tolist(),
                   "Pt": r.friction_force.tolist(), "depth": w.depth.tolist(),
                   "heat": r.energy["friction_heat"].tolist(), "history": w.history}))

@@ -100,16 +100,16 @@ def test_csv_stride_streamed_or_written_at_the_end(sim, tmp_path, every):
 
 def test_run_scene_steps_once(tmp_path, monkeypatch):
     """``femrub run`` without VTK writes the estimate's run; its time is ``stepping``."""
-    from femrub.steppers import theta
+    from femrub.analysis import steppers as runnable
 
     calls = []
-    original = theta.ThetaMethod.run
+    original = runnable.ThetaMethod.run
 
     def counted(self, *a, **kw):
         calls.append(kw.get("store_every", 0))
         return original(self, *a, **kw)
 
-    monkeypatch.setattr(theta.ThetaMethod, "run", counted)
+    monkeypatch.setattr(runnable.ThetaMethod, "run", counted)
     res, built = run_scene(load_scene("twisted-naca", SMALL), tmp_path / "run")
     s = json.loads((tmp_path / "run/summary.json").read_text())
     # the estimate's reference, its run at the chosen sizes (the run) and possibly a twin

@@ -1,15 +1,15 @@
-"""The a-posteriori time-step check (``scheme.step_check``, femrub.app.step_check)."""
+"""The a-posteriori time-step check (``scheme.step_check``, femrub.analysis.step_check)."""
 
 import json
 
 import numpy as np
 import pytest
 
+from femrub.analysis import ThetaMethod
+from femrub.analysis.step_check import ORDER, coarsen
 from femrub.app.simulation import build
-from femrub.app.step_check import ORDER, coarsen
 from femrub.scene import load_scene
 from femrub.scene.spec import SceneError
-from femrub.steppers import ThetaMethod
 
 T_END = 0.06  # s: two contact phases of the paper case
 

@@ -74,8 +74,8 @@ def naca():
 
 
 def test_frictional_blocks_equal_the_steps(naca):
+    from femrub.analysis import make_stepper
     from femrub.app.scheme import scheme_options
-    from femrub.steppers import make_stepper
 
     sim, scene = naca
     s = scene["scheme"]
@@ -112,7 +112,7 @@ from femrub.cases.bar import bar_model
 from femrub.app import build
 from femrub.app.scheme import scheme_options
 from femrub.scene import load_scene
-from femrub.steppers import make_stepper
+from femrub.analysis import make_stepper
 from femrub.contact.jit import compiled
 r = fr.ThetaMethod(bar_model(), 1e-4, activation="paper").run(0.05)
 scene = load_scene("twisted-naca", json.loads(%r))
@@ -161,8 +161,8 @@ def test_a_failed_frictional_solve_in_a_block_ends_the_run_unstable(naca, monkey
     """A contact solve that fails inside a block: the steps before it are checked and kept,
     the run ends ``unstable`` with the solver's message (as step by step)."""
     import femrub.steppers.theta_blocks as tb
+    from femrub.analysis import make_stepper
     from femrub.app.scheme import scheme_options
-    from femrub.steppers import make_stepper
 
     real = tb.friction_block
 

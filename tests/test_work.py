@@ -60,11 +60,11 @@ def test_integrals_match_quadrature_on_the_exact_flow(S):
 
 
 def test_integral_keys_are_the_meter_keys():
-    from femrub.output.energy import SCHEME_INTEGRALS
     from femrub.steppers.exponential.work import METER_ORDER
+    from femrub.steppers.record import WORK_KEYS
 
     # the stepper hands them in this order
-    assert tuple((QUADRATIC + LINEAR)[i] for i in METER_ORDER) == SCHEME_INTEGRALS
+    assert tuple((QUADRATIC + LINEAR)[i] for i in METER_ORDER) == WORK_KEYS
 
 
 @pytest.mark.parametrize("h", [5e-3, 5e-4])

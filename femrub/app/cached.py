@@ -12,7 +12,8 @@ cache it only calls them:
   factorisation that the reduction then reuses (``reduce`` hands it on); key: the assembly
   key, the boundary, ζ and the two modes; stored: ``(a, b)`` and the frequencies (on a hit
   ``C = a M + b K`` is formed, nothing is factorised);
-* ``reduce``: the reduced model (:func:`femrub.reduction.sizes.reduce_model`) and its
+* ``reduce``: the reduced model
+  (:func:`femrub.analysis.reduction_check.reduce_checked`) and its
   report; key: the assembly key, every state-space array of the full model the reduction
   projects (``A``, ``B``, contact rows, load vectors, observations, energy forms, map to the
   mesh, boundary dofs, initial state), the ``reduction`` options and, for ``"auto"``, the
@@ -58,10 +59,11 @@ import time
 
 import numpy as np
 
+from ..analysis.reduction_check import reduce_checked
 from ..fem.discretisation import assemble, discretise
 from ..fem.prestress import centrifugal_prestress
 from ..reduction.modal_damping import modal_rayleigh
-from ..reduction.sizes import natural_frequencies, reduce_model
+from ..reduction.sizes import natural_frequencies
 from ..reduction.truncation import ColumnMap
 from .cache import content_key
 
@@ -241,22 +243,23 @@ class Stages:
         )
 
     def reduce(self, model, scene, log=None, make_stepper=None, limits=None, on_run=None):
-        """:func:`~femrub.reduction.sizes.reduce_model`: ``(reduced, reductor, report)``.
+        """:func:`~femrub.analysis.reduction_check.reduce_checked`: ``(reduced, reductor,
+        report)``.
 
         ``make_stepper`` (for the reduction error estimate, which steps the run itself)
         puts the scene's ``scheme``, ``loads`` and ``contact`` and the stop ``limits`` it
-        applies to its runs into the key. ``on_run``: see ``reduce_model`` (not called on a
+        applies to its runs into the key. ``on_run``: see ``reduce_checked`` (not called on a
         cache hit: nothing is stepped).
         """
         stiffness, self._stiffness = self._stiffness, None
         kw = {"limits": limits, "on_run": on_run, "stiffness": stiffness}
         if self.cache is None or self._mats_key is None:
-            out = reduce_model(model, scene, log, make_stepper, **kw)
+            out = reduce_checked(model, scene, log, make_stepper, **kw)
             _say_phases(self._say, out[0].info.get("timings", {}))
             return out
         opts = dict(scene["reduction"])
         if opts["method"] == "none":
-            return reduce_model(model, scene, log, make_stepper, **kw)  # nothing stored
+            return reduce_checked(model, scene, log, make_stepper, **kw)  # nothing stored
         t_end = scene["scheme"]["t_end"] if opts["method"] == "auto" else None
         run = None  # what the estimate's runs depend on
         if make_stepper:
@@ -277,7 +280,7 @@ class Stages:
         kept = _REDUCTORS.get(bases)
         if kept is None and bases is not None:  # built by another process (sweep worker)
             kept = self._fetch("bases", bases)
-        reduced, reductor, report = reduce_model(
+        reduced, reductor, report = reduce_checked(
             model, scene, log, make_stepper, reductor=kept, **kw
         )
         if bases is not None:

@@ -192,7 +192,7 @@ def _run_claimed(scene, out, progress, log, on_built, modes, cache):
             f"stepping done in {t.get('stepping', 0.0):.2f} s ({res.steps} steps, "
             f"{per_step:.0f} µs/step wall), output {t.get('output', 0.0):.2f} s"
         )
-    contact = built.model.contact
+    contact = built.stepper.model.contact  # the run's own history (wear map, casing heat)
     if contact is not None and contact.wear is not None:
         from ..output.wear import write_wear
 

@@ -8,8 +8,8 @@ from __future__ import annotations
 
 import math
 
+from ..analysis.steppers import make_stepper
 from ..scene.spec import SceneError, fail
-from ..steppers import make_stepper
 
 __all__ = ["bare_stepper", "scheme_options", "stepper_of"]
 

@@ -28,8 +28,10 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .. import progress
+from ..analysis.step_check import check_step
 from ..contact import jit
 from ..model.builder import RubBuild, build_rub, length_scale
+from ..output.limits import MAX_DISPLACEMENT_RATIO, MAX_TEMPERATURE_RISE, default_limits
 from ..scene.run_checks import check_run
 from ..scene.spec import SceneError, fail
 from . import translate as tr
@@ -39,7 +41,6 @@ from .cached import Stages
 from .casing import footprint_warning
 from .explain import explain
 from .scheme import bare_stepper, stepper_of
-from .step_check import check_step
 
 __all__ = [
     "MAX_CLEARANCE_RATIO",
@@ -52,10 +53,6 @@ __all__ = [
     "reusable_run",
 ]
 
-#: default stop limit on temperature signals (K above ambient; titanium melts ~1650 K above)
-MAX_TEMPERATURE_RISE = 1500.0
-#: default stop limit on displacement signals, relative to the blade's size
-MAX_DISPLACEMENT_RATIO = 0.1
 #: largest casing clearance (or lobe depth) relative to the blade's size
 MAX_CLEARANCE_RATIO = 0.05
 
@@ -64,17 +61,6 @@ def blade_size(scene, blade) -> float:
     """Characteristic size of the blade (m): the bar's length, else the mesh's largest extent
     (:func:`femrub.model.builder.length_scale`, the model's ``length_scale``)."""
     return length_scale(blade)
-
-
-def default_limits(observed, size: float) -> dict:
-    """Physical stop limits on the ``observed`` signals (see the module docstring)."""
-    out = {}
-    for name in observed:
-        if name.endswith("temperature"):
-            out[name] = MAX_TEMPERATURE_RISE
-        elif name.endswith("displacement"):
-            out[name] = MAX_DISPLACEMENT_RATIO * size
-    return out
 
 
 def _check_scale(scene, size: float) -> None:

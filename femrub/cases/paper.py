@@ -28,6 +28,8 @@ from pathlib import Path
 import numpy as np
 
 from .. import __version__
+from ..analysis.runner import MAX_STEPS
+from ..analysis.steppers import make_stepper
 from ..contact.activation import DEFAULT_RULE
 from ..output.csv_rows import decimate_columns
 from ..output.folder import claim
@@ -35,8 +37,6 @@ from ..output.interrupts import interruptible
 from ..output.jsonfile import write_json
 from ..output.plots import energy_panel, savefig, tip_panels
 from ..output.results import UNITS
-from ..steppers import make_stepper
-from ..steppers.base import MAX_STEPS
 from .bar import PAPER, bar_model
 
 __all__ = ["Run", "FIGURES", "ALPHA_DEFAULT", "LIMITS", "MODELS", "run_case", "reproduce"]

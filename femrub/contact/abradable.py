@@ -42,6 +42,7 @@ the θ-method's blocks of steps also call (:mod:`femrub.contact.rub_block`).
 
 from __future__ import annotations
 
+import copy
 import math
 
 import numpy as np
@@ -158,6 +159,13 @@ class Abradable:
         self.reset()
 
     # -- state --------------------------------------------------------------------------
+    def fresh(self, h: float | None = None) -> Abradable:
+        """A copy of this coating, unworn, for a run of step ``h`` (s): its own wear map and
+        history (the grid and the material are shared, never changed)."""
+        out = copy.copy(self)
+        out.reset(h)
+        return out
+
     def reset(self, h: float | None = None) -> None:
         """A fresh coating: no wear, empty history; ``h``: the time step of the stepper that
         runs it (for :meth:`rate_at`; ``None``: no rate)."""

@@ -30,6 +30,7 @@ Heat partition from the effusivities ``e = √(k ρ c)`` of blade and casing whe
 
 from __future__ import annotations
 
+import copy
 import math
 
 import numpy as np
@@ -75,7 +76,15 @@ class CasingHeat:
         self.power_per_impulse = (1.0 - eta) / eta * np.asarray(alpha, dtype=float)  # m/s
         self.reset()
 
+    def fresh(self) -> CasingHeat:
+        """A copy of this casing, cold, for a run: its own cell temperatures and history
+        (the grid and the wall's properties are shared, never changed)."""
+        out = copy.copy(self)
+        out.reset()
+        return out
+
     def reset(self) -> None:
+        """Cold: no temperature rise, no heat received."""
         shape = (self.grid.n_angle * self.grid.n_axial,)
         self.T = np.zeros(shape)
         self.t_last = np.zeros(shape)

@@ -171,7 +171,7 @@ def solve_frictional_contact(
     return FrictionResult(P, u, state, float(res), int(it))
 
 
-def power_heat_fixed_point(
+def power_heat_fixed_point(  # noqa: PLR0913 (the arrays handed to the compiled kernel)
     first: FrictionResult,
     slip_before,
     heat_partition,

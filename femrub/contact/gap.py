@@ -159,12 +159,17 @@ class Contact:
         return None if self.wear is None else self.wear.impulse_cap(t, h, gap_k, gap_p)
 
     def after_step(
-        self, t: float, X: np.ndarray, impulse: np.ndarray, h: float, extra: dict | None = None
+        self,
+        t: float,
+        X: np.ndarray,
+        impulse: np.ndarray,
+        h: float,
+        friction_impulse: np.ndarray | None = None,
     ) -> None:
         """Remove the coating the blade penetrated where it yielded (impulse at its cap), and
         heat the casing with its share of the step's frictional heat.
 
-        ``extra``: the step's extra output (``friction_impulse`` (n_c, 2), N s) for the
+        ``friction_impulse``: the step's tangential impulses (n_c, 2) (N s) for the
         ``"power"`` heat law: the casing takes ``(1 − η) (−P_t · w_t)`` with the slip
         velocity ``w_t`` at the end of the step; with the ``"alpha"`` law it takes
         ``(1 − η)/η α P`` (:mod:`femrub.contact.casing_heat`).
@@ -174,7 +179,7 @@ class Contact:
         if self.casing_heat is not None:
             ch = self.casing_heat
             if self.heat_law == "power":
-                Pt = None if extra is None else extra.get("friction_impulse")
+                Pt = friction_impulse
                 heat = np.zeros(self.n)
                 if Pt is not None:
                     w = self.slip_velocity(X)
@@ -242,9 +247,19 @@ class Contact:
 
     @property
     def carried_state(self) -> list:
-        """The state a run carries outside ``X`` (an abradable coating's wear map, the
-        casing's heat): each run starts it afresh and leaves it as its last step did."""
+        """The history a run carries outside ``X`` (an abradable coating's wear map, the
+        casing's heat); a stepper runs its own copy (:meth:`with_fresh_history`)."""
         return [s for s in (self.wear, self.casing_heat) if s is not None]
+
+    def with_fresh_history(self, h: float) -> Contact:
+        """This contact with a history of its own, started afresh (an unworn coating, a cold
+        casing) for a run of step ``h`` (s): the run's state. The contact it is copied from
+        keeps its own history untouched (``self`` when there is none)."""
+        if not self.carried_state:
+            return self
+        wear = None if self.wear is None else self.wear.fresh(h)
+        heat = None if self.casing_heat is None else self.casing_heat.fresh()
+        return replace(self, wear=wear, casing_heat=heat)
 
     # -- friction --------------------------------------------------------------------------
     @property

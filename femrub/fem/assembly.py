@@ -133,7 +133,7 @@ def _free(n: int, fixed) -> np.ndarray:
     return np.flatnonzero(mask)
 
 
-def assemble_thermoelastic(
+def assemble_thermoelastic(  # noqa: PLR0913 (keyword-only options, one per scene key)
     basis_u: Basis,
     basis_t: Basis,
     material: Material,

@@ -77,7 +77,7 @@ def naca_sections(
     return sections
 
 
-def naca_blade(
+def naca_blade(  # noqa: PLR0913 (keyword options, one per `femrub mesh naca` flag)
     code: str = "0012",
     span: float = 0.1,
     root_chord: float = 0.05,

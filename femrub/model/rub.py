@@ -105,7 +105,7 @@ def _friction_spec(points: ContactPoints, mats, friction: float, rotation_speed:
     }
 
 
-def rub_model(
+def rub_model(  # noqa: PLR0913 (the parts of a rub model, all keyword-only but the FE ones)
     disc: Discretisation,
     mats,
     points: ContactPoints,
@@ -207,7 +207,7 @@ def rub_model(
     return model, FieldMap(disc, points, lam, mu)
 
 
-def solid_model(
+def solid_model(  # noqa: PLR0913 (the Python preset: keyword-only options, one per scene key)
     blade,
     material: Material,
     *,

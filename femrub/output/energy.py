@@ -34,20 +34,10 @@ import numpy as np
 
 from ..fem.linalg import compact
 from ..model.first_order import EnergyForms, FirstOrderModel
+from ..steppers.record import WORK_KEYS
 from .results import ENERGY_KEYS
 
-__all__ = ["BLOWUP_FACTOR", "EnergyMeter", "SCHEME_INTEGRALS"]
-
-#: per-step works and heats a scheme may compute itself (exactly) instead of the quadrature
-SCHEME_INTEGRALS = (
-    "contact_work",
-    "external_work",
-    "thermal_work",
-    "damping_work",
-    "heat_load",
-    "heat_outflow",
-    "tangential_work",
-)
+__all__ = ["BLOWUP_FACTOR", "EnergyMeter"]
 
 # a balance residual this many times the energy exchanged so far is created from nothing
 # (a physical runaway keeps the balance closed): numerical blow-up
@@ -110,9 +100,10 @@ class EnergyMeter:
     def update(self, i0, X, impulse, t, h, work=None, friction=None) -> None:
         """Fill rows ``i0 + 1 .. i0 + m`` from a block of states (see class docstring).
 
-        ``work``: ``{key: (m,)}``, the works and heats (:data:`SCHEME_INTEGRALS`) of each
-        step as the scheme computed them (impulses given inside the step, exact flight: the
-        exponential stepper); the others by the quadratures above (contact: ``Pᵀ Gvᵀ X_m``).
+        ``work``: ``{key: (m,)}``, the works and heats of each step that the stepper computed
+        itself (the step records' ``works``, keys in
+        :data:`~femrub.steppers.record.WORK_KEYS`; e.g. impulses given inside the step, an
+        exact flight); the others by the quadratures above (contact: ``Pᵀ Gvᵀ X_m``).
         ``friction``: ``(P_t (m, n_c, 2), blade heat (m, n_c))`` of the steps, or ``None``.
         """
         f, d = self.forms, self.data
@@ -157,7 +148,7 @@ class EnergyMeter:
                 if c.heat_law == "power":
                     inc["heat_to_casing"] = inc.get("friction_work", 0.0) - inc["friction_heat"]
         inc["heat_outflow"] = h * (Xm @ f.heat_outflow)
-        for k in ("external_work", "thermal_work", "damping_work", "heat_load", "heat_outflow"):
+        for k in WORK_KEYS[1:6]:  # the stepper's own, where it gave them
             if k in own:
                 inc[k] = own[k]
         for k, v in inc.items():

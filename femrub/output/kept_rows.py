@@ -11,7 +11,7 @@ the buffers' row 0 being row ``i0``), and the store makes the
 * :class:`LeanRows`: what :meth:`~femrub.output.results.Results.lean` keeps (times, impulses,
   signals; the checkpoint states are the recorder's) at rows ``0, k, 2k, …`` with the
   impulses summed over each ``k`` steps, ``h`` becoming ``k h``: the run seen on the steps
-  of ``k h`` (:func:`femrub.app.step_check.coarsen`), rows of an incomplete last group
+  of ``k h`` (:func:`femrub.analysis.step_check.coarsen`), rows of an incomplete last group
   dropped. Gaps, friction rows and the energy balance are never stored; what the verdict
   reads of them is measured as the rows pass, into ``Results.checks``: the largest balance
   residuals and the scales :meth:`~femrub.output.results.Results.energy_error` and

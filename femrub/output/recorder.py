@@ -32,21 +32,17 @@ from tqdm.auto import tqdm
 from ..blas import one_blas_thread
 from ..fem.linalg import compact
 from ..model.first_order import FirstOrderModel
-from .energy import SCHEME_INTEGRALS, EnergyMeter
+from ..steppers.record import WORK_KEYS, State, StepRefused
+from .energy import EnergyMeter
 from .kept_rows import AllRows, LeanRows
 from .limits import limit_hit as _limit_hit
 from .limits import limit_index as _limit_index
 from .results import Results
-from .state import State
 
 __all__ = ["CHUNK_STEPS", "CHUNK_VALUES", "Recorder", "State", "StepRefused"]
 
 CHUNK_STEPS = 512  # steps post-processed together (row products; a blow-up reported soon)
 CHUNK_VALUES = 2_000_000  # most state values buffered per chunk (16 MB of float64)
-
-
-class StepRefused(ValueError):
-    """A stepper cannot go on (its contact model no longer applies): status ``failed``."""
 
 
 class _Stop(Exception):
@@ -81,7 +77,7 @@ class Recorder:
         meter's quadratures, not the scheme, would open its balance).
     """
 
-    def __init__(
+    def __init__(  # noqa: PLR0913 (a run's options as the recorder needs them)
         self,
         model: FirstOrderModel,
         h: float,
@@ -134,7 +130,10 @@ class Recorder:
             self.message = (
                 f"h = {h:.3g} s exceeds the stability limit {stability_limit:.3g} s of {scheme}"
             )
-        self._work, self._n_work = None, 0
+        self._work, self._work_cols = None, {}  # the steps' own integrals (_work_row)
+        self._i = self._j = self._i0 = self._end = (
+            0  # steps done, chunk row, chunk start, last kept
+        )
         self.buf = np.empty((self.chunk + 1, N))
         self.kept = AllRows(self) if not lean else LeanRows(self, lean)
 
@@ -150,104 +149,106 @@ class Recorder:
     def record(
         self, start: State, advance: Callable, *, progress: bool = False, block=None
     ) -> Results:
-        """Record ``start`` and ``n_steps`` calls of ``advance() -> (t, X, impulse, extra)``.
+        """Record ``start`` and ``n_steps`` calls of ``advance() ->``
+        :class:`~femrub.steppers.record.StepRecord`.
 
-        ``block`` (optional) replaces ``advance`` by whole blocks of steps:
-        ``block(m, X, t, P, Pt, heat, state) -> (steps done, friction rows written, error)``
-        writes ``m`` steps into the given rows of the recorder (states, times, impulses and
-        the friction rows of :meth:`_friction_rows`); ``error``, an exception or ``None``,
-        ends the run as ``advance`` raising it would.
-
-        ``extra`` (dict or ``None``): the step's friction quantities (``friction_impulse``,
-        ``heat``, ``state``: ``Stepper._step``) and ``contact_work`` (J, impulses inside the
-        step) or ``works`` (J, :data:`~femrub.output.energy.SCHEME_INTEGRALS` in order, exact
-        flight) as the scheme computed them; the energy balance then uses them.
+        ``block`` (optional, :meth:`Stepper.block_writer
+        <femrub.steppers.base.Stepper.block_writer>`) replaces ``advance`` by whole blocks of
+        steps written into the recorder's rows; its ``error`` ends the run as ``advance``
+        raising it would. A record's ``friction`` fills the friction rows, its ``works`` the
+        energy meter's own integrals of the step (:data:`~femrub.steppers.record.WORK_KEYS`).
         """
-        n, buf, t, imp = self.n, self.buf, self.t, self.imp
-        nc = self.model.n_contacts
         cpu0 = time.process_time()
         bar = tqdm(
-            total=n, disable=not progress, unit="step", desc=self.label or self.scheme, leave=False
+            total=self.n,
+            disable=not progress,
+            unit="step",
+            desc=self.label or self.scheme,
+            leave=False,
         )
-        i_end = i0 = j = 0
+        take = self._take_block if block is not None else self._take_step
         # one BLAS thread: per-step products are small, threads only add latency (a busy
         # 2-core machine showed 0.4-17 ms for a 20000-long dot product with two threads);
         # a blow-up overflows before the next check, and non-finite states are reported
-        with (
-            one_blas_thread,
-            np.errstate(over="ignore", invalid="ignore"),
-        ):
+        with one_blas_thread, np.errstate(over="ignore", invalid="ignore"):
             try:
                 self._start(start)
-                i = 0
-                while i < n:
-                    if block is not None:  # a block of steps in one call, into the rows
-                        m = min(self.chunk - j, n - i)
-                        r = slice(j + 1, j + 1 + m)
-                        done, friction, err = block(
-                            m,
-                            buf[j + 1 : j + 1 + m],
-                            t[r],
-                            imp[r],
-                            self.imp_t[r],
-                            self.heat[r],
-                            self.cstate[r],
-                        )
-                        self.has_friction |= friction
-                        i, j = i + done, j + done
-                        if err is not None:
-                            i_end = self._flush(i0, j)
-                            raise _Stop("unstable", f"{type(err).__name__}: {err}", i_end)
-                    else:
-                        i += 1
-                        try:
-                            ti, X, P, *more = advance()
-                        except (FloatingPointError, ArithmeticError) as exc:
-                            i_end = self._flush(i0, j)
-                            raise _Stop("unstable", f"{type(exc).__name__}: {exc}", i_end) from None
-                        except StepRefused as exc:
-                            i_end = self._flush(i0, j)
-                            raise _Stop("failed", f"{self.scheme}: {exc}", i_end) from None
-                        j += 1
-                        buf[j], t[j] = X, ti
-                        if nc:
-                            imp[j] = P
-                        info = more[0] if more else None
-                        if info:
-                            if "works" in info:  # the scheme's own works and heats
-                                self._work_rows(len(SCHEME_INTEGRALS))[j] = info["works"]
-                            elif "contact_work" in info:  # its own contact work
-                                self._work_rows(1)[j, 0] = info["contact_work"]
-                            if "state" in info:
-                                self._friction_rows(j, info)
-                    if j == self.chunk or i == n:
-                        i_end = self._flush(i0, j)
-                        self._deliver(i0, i_end)
-                        self._stream(i0, i_end)
-                        bar.update(j)
-                        self._next_chunk(j)
-                        i0, j = i, 0
+                while self._i < self.n:
+                    take(block or advance)
+                    if self._j == self.chunk or self._i == self.n:
+                        self._close_chunk(bar)
             except _Stop as stop:
-                i_end = self._stopped(stop, i0, j)
+                self._end = self._stopped(stop, self._i0, self._j)
             except KeyboardInterrupt:
-                self.status = "interrupted"
-                self.message = "interrupted by the user; results kept up to here"
-                # the last buffered step may be incomplete: keep the ones before it
-                try:
-                    i_end = self._flush(i0, j - 1) if j > 1 else i0
-                    self._deliver(i0, i_end)
-                except _Stop as stop:
-                    i_end = self._stopped(stop, i0, j - 1)
-                except KeyboardInterrupt:  # a second signal: keep the checked rows
-                    i_end = i0
-                self._stream(i0, i_end)
+                self._interrupted()
             except Exception as exc:  # keep what was computed
                 self.status, self.message = "failed", f"{type(exc).__name__}: {exc}"
-                self._stream(i0, i_end)
+                self._stream(self._i0, self._end)
             finally:
                 bar.close()
             self._flush_sink()
-        return self._results(i_end, time.process_time() - cpu0)
+        return self._results(self._end, time.process_time() - cpu0)
+
+    def _halt(self, status: str, message: str) -> _Stop:
+        """Check the buffered rows, then the stop at the last of them."""
+        self._end = self._flush(self._i0, self._j)
+        return _Stop(status, message, self._end)
+
+    def _take_block(self, block: Callable) -> None:
+        """A block of steps in one call of the stepper's block writer, into the rows."""
+        j = self._j
+        m = min(self.chunk - j, self.n - self._i)
+        r = slice(j + 1, j + 1 + m)
+        done, friction, err = block(
+            m, self.buf[r], self.t[r], self.imp[r], self.imp_t[r], self.heat[r], self.cstate[r]
+        )
+        self.has_friction |= friction
+        self._i, self._j = self._i + done, j + done
+        if err is not None:
+            raise self._halt("unstable", f"{type(err).__name__}: {err}")
+
+    def _take_step(self, advance: Callable) -> None:
+        """One step of the stepper, its record into the next row."""
+        self._i += 1
+        try:
+            rec = advance()
+        except (FloatingPointError, ArithmeticError) as exc:
+            raise self._halt("unstable", f"{type(exc).__name__}: {exc}") from None
+        except StepRefused as exc:
+            raise self._halt("failed", f"{self.scheme}: {exc}") from None
+        self._j += 1
+        j = self._j
+        self.buf[j], self.t[j] = rec.X, rec.t
+        if self.model.n_contacts:
+            self.imp[j] = rec.impulse
+        if rec.works:
+            self._work_row(j, rec.works)
+        if rec.friction is not None:
+            self._friction_rows(j, rec.friction)
+
+    def _close_chunk(self, bar) -> None:
+        """Check the chunk's rows, hand them on, start the next chunk."""
+        self._end = self._flush(self._i0, self._j)
+        self._deliver(self._i0, self._end)
+        self._stream(self._i0, self._end)
+        bar.update(self._j)
+        self._next_chunk(self._j)
+        self._i0, self._j = self._i, 0
+
+    def _interrupted(self) -> None:
+        """Ctrl-C or SIGTERM: keep the checked rows before the last buffered step (it may be
+        incomplete)."""
+        self.status = "interrupted"
+        self.message = "interrupted by the user; results kept up to here"
+        i0, j = self._i0, self._j
+        try:
+            self._end = self._flush(i0, j - 1) if j > 1 else i0
+            self._deliver(i0, self._end)
+        except _Stop as stop:
+            self._end = self._stopped(stop, i0, j - 1)
+        except KeyboardInterrupt:  # a second signal: keep the checked rows
+            self._end = i0
+        self._stream(i0, self._end)
 
     def _flush_sink(self) -> None:
         """``on_state.flush()`` if it holds states back (batched VTK frames), also after an
@@ -266,21 +267,22 @@ class Recorder:
             if a is not None:
                 a[1:] = 0
 
-    def _work_rows(self, k: int) -> np.ndarray:
-        """Per-step works and heats reported by the scheme (the first ``k`` of
-        :data:`~femrub.output.energy.SCHEME_INTEGRALS`; a chunk's rows, on first use)."""
+    def _work_row(self, i: int, works) -> None:
+        """The step's own energy-balance integrals (``{name in WORK_KEYS: J}``) in row ``i``."""
         if self._work is None:
-            self._work = np.zeros((self.chunk + 1, len(SCHEME_INTEGRALS)))
-        self._n_work = max(self._n_work, k)
-        return self._work
+            self._work = np.zeros((self.chunk + 1, len(WORK_KEYS)))
+        for key, value in works.items():
+            col = WORK_KEYS.index(key)
+            self._work[i, col] = value
+            self._work_cols[key] = col
 
-    def _friction_rows(self, i: int, extra: dict) -> None:
-        """Friction quantities of the step in row ``i`` of the buffers (``Stepper._step``)."""
+    def _friction_rows(self, i: int, friction) -> None:
+        """Frictional quantities (:class:`~femrub.steppers.record.Friction`) in row ``i``."""
         self.has_friction = True
         if self.tangents:
-            self.imp_t[i] = extra["friction_impulse"]
-        self.heat[i] = extra["heat"]
-        self.cstate[i] = extra["state"]
+            self.imp_t[i] = friction.impulse
+        self.heat[i] = friction.heat
+        self.cstate[i] = friction.state
 
     def _start(self, s: State) -> None:
         """Row 0: the initial state."""
@@ -339,10 +341,7 @@ class Recorder:
         if self.meter is not None and m:
             friction = (self.imp_t[b], self.heat[b]) if self.has_friction else None
             with np.errstate(all="ignore"):
-                work = None
-                if self._work is not None:
-                    keys = SCHEME_INTEGRALS[: self._n_work]
-                    work = {k: self._work[b, j] for j, k in enumerate(keys)}
+                work = {k: self._work[b, col] for k, col in self._work_cols.items()} or None
                 self.meter.update(0, X, self.imp[b], t[: m + 1], h, work, friction)
             bad = self.meter.blown_up(b) if self.blowup_check else None
             if bad is not None:

@@ -80,7 +80,7 @@ def _friction_summary(res) -> dict:
     return out
 
 
-def run_to_folder(
+def run_to_folder(  # noqa: PLR0913 (keyword-only output options)
     stepper,
     t_end: float,
     out,
@@ -115,7 +115,7 @@ def run_to_folder(
     reduced run (:mod:`femrub.reduction.estimate`, with its ``tolerance``), written as
     ``summary.json["reduction_error"]`` and judged by the ``reduction`` rule of
     :mod:`~femrub.output.verdict` (``inaccurate`` above the tolerance); ``step_error``: the
-    time-step error estimate (:mod:`femrub.app.step_check`), written as
+    time-step error estimate (:mod:`femrub.analysis.step_check`), written as
     ``summary.json["time_step_error"]`` and judged by the ``time_step`` rule. ``ran``: ``(results,
     wall seconds)`` of this very run already stepped (``stepper.model`` from its initial state
     to ``t_end`` with ``limits``, e.g. by the reduction error estimate): it is judged and
@@ -149,7 +149,7 @@ def run_to_folder(
 
 
 def _judged(ran, tolerances, merge_time):
-    """``(results, wall)`` of a run stepped elsewhere, judged as ``Stepper.run`` judges.
+    """``(results, wall)`` of a run stepped elsewhere, judged as ``femrub.analysis.run`` judges.
 
     Its results were judged without these ``tolerances`` and ``merge_time``; the recorder
     ends a run ``ok`` or with a stop status and only the verdict turns ``ok`` into
@@ -162,7 +162,7 @@ def _judged(ran, tolerances, merge_time):
     return assess(res, tolerances=tolerances, merge_time=merge_time), wall
 
 
-def _run(
+def _run(  # noqa: PLR0913 (run_to_folder's options passed on)
     stepper,
     t_end,
     out,
@@ -299,7 +299,7 @@ def _write_failed(res, exc: OSError, out: Path, doc: dict, summary_path: Path) -
         print(f"femrub: {summary_path} not written either: {res.message}", file=sys.stderr)
 
 
-def _finish(
+def _finish(  # noqa: PLR0913 (run_to_folder's options passed on)
     stepper,
     res,
     out,

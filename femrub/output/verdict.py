@@ -14,13 +14,13 @@ The recorder ends a run as ``unstable`` (blow-up), ``diverged-physically`` (a st
   the reduced dynamics can create energy: its largest relative energy growth rate
   (``energy_growth_rate``, 1/s) times the run's duration above ``tolerances["energy"]``;
 * ``time_step``: the run's estimated time-step error (``tolerances["time_step"]``: the dict
-  of :func:`femrub.app.step_check.check_step` with its ``tolerance``, as
+  of :func:`femrub.analysis.step_check.check_step` with its ``tolerance``, as
   ``summary.json["time_step_error"]``) above its tolerance -> ``"inaccurate"``;
 * ``coulomb``: the recorded friction forces break Coulomb's law (outside the cone, not on it
   while sliding, or not opposite to the slip velocity) beyond ``tolerances["coulomb"]``
   (relative, :func:`femrub.contact.friction.coulomb_check`) -> ``"inaccurate"``.
 
-A lean record (``Stepper.run(lean=k)``, :mod:`femrub.output.kept_rows`) keeps neither the
+A lean record (``RunOptions.lean = k``, :mod:`femrub.output.kept_rows`) keeps neither the
 energy balance nor the friction rows; the balance and Coulomb rules read the same measures
 taken on its rows as they were recorded (``Results.checks``).
 
@@ -105,7 +105,7 @@ def reduction(res, tol):
 
 def time_step(res, tol):
     """The run's estimated time-step error exceeds ``scheme.step_tolerance``
-    (``scheme.step_check``, :mod:`femrub.app.step_check`)."""
+    (``scheme.step_check``, :mod:`femrub.analysis.step_check`)."""
     err = tol.get("time_step")
     if not err:
         return None

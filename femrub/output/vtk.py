@@ -1,7 +1,7 @@
 """ParaView output: a ``.pvd`` collection of ``.vtu`` files, written as the run goes.
 
-:class:`VTKSeries` is a callback for ``Stepper.run(on_state=...)``: every ``stride`` steps it
-keeps the (reduced) state; batches of frames are mapped to the full mesh at once and
+:class:`VTKSeries` is a callback for ``stepper.run(t_end, on_state=...)``: every ``stride``
+steps it keeps the (reduced) state; batches of frames are mapped to the full mesh at once and
 written, in a background thread by default, as ``.vtu`` files with point data
 ``displacement`` (m, vector), ``velocity`` (m/s), ``temperature`` (K above ambient),
 ``contact_force`` and ``friction_force`` (N, vector, at the contact vertices) and cell data

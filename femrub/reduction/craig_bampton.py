@@ -72,6 +72,25 @@ MODE_TOL = 1e-10
 THERMAL = ("inputs", "boundary")
 
 
+def _check_arguments(fom, projection: str, thermal: str, boundary):
+    """Refuse what :class:`ThermoelasticCraigBampton` cannot reduce; the contact boundary
+    (``boundary``, else the model's)."""
+    if projection not in PROJECTIONS:
+        raise ValueError(f"unknown projection {projection!r}; use one of {PROJECTIONS}")
+    if thermal not in THERMAL:
+        raise ValueError(f"unknown thermal reduction {thermal!r}; use one of {THERMAL}")
+    if not isinstance(fom, FirstOrderModel):
+        raise TypeError("ThermoelasticCraigBampton needs a femrub.FirstOrderModel")
+    if fom.blocks is None:
+        raise ValueError(
+            "model.blocks is None: the model is already reduced (a full model of Eq. (9) "
+            "carries its blocks); reduce the full model"
+        )
+    if boundary is None and fom.boundary is None:
+        raise ValueError("the model has no contact boundary (model.boundary is None)")
+    return fom.boundary if boundary is None else boundary
+
+
 class ThermoelasticCraigBampton:
     """Reductor of a full first-order thermoelastic model (paper Sec. 2).
 
@@ -134,25 +153,12 @@ class ThermoelasticCraigBampton:
         keep_solver=True,
         stiffness=None,
     ):
-        if projection not in PROJECTIONS:
-            raise ValueError(f"unknown projection {projection!r}; use one of {PROJECTIONS}")
-        if thermal not in THERMAL:
-            raise ValueError(f"unknown thermal reduction {thermal!r}; use one of {THERMAL}")
+        given = _check_arguments(fom, projection, thermal, boundary)
         self.thermal = thermal
-        if not isinstance(fom, FirstOrderModel):
-            raise TypeError("ThermoelasticCraigBampton needs a femrub.FirstOrderModel")
-        if fom.blocks is None:
-            raise ValueError(
-                "model.blocks is None: the model is already reduced (a full model of Eq. (9) "
-                "carries its blocks); reduce the full model"
-            )
         self.fom, self.projection = fom, projection
         self._signature = (fom.layout, fom.A.shape, fom.B.shape)  # what for_model checks
         blocks, L = fom.blocks, fom.layout
         nu, nt = L.n_u, L.n_t
-        if boundary is None and fom.boundary is None:
-            raise ValueError("the model has no contact boundary (model.boundary is None)")
-        given = fom.boundary if boundary is None else boundary
         mb, tb = boundary_dofs(given, nu, nt)
         # contacts on patch means: reduce in the coordinates where they are dofs
         self.coordinates = coords = boundary_coordinates(given, nu)

@@ -20,15 +20,16 @@ for the quantities users read:
   whose norm can be a fraction of the largest).
 
 Both models are stepped with the scene's scheme and step, and stop at the run's stop limits
-(the estimate covers what the run itself can reach). The same comparison against the
-full model is :func:`compare` (benchmarks/reduction_convergence_3d.py).
+(the estimate covers what the run itself can reach), by the analysis layer
+(:mod:`femrub.analysis.reduction_check`); this module only compares given results. The same
+comparison against the full model is :func:`compare` (benchmarks/reduction_convergence_3d.py).
 
 *Sensitive (chaotic) responses.* A long frictional rub can be sensitive to its initial
 state: on Rotor 37 a 1e-15 m perturbation grows tenfold every five revolutions and the two
 trajectories differ by 5–15 % after 25. Two runs of the same model then differ as much as
 two sizes do, and a pointwise difference measures the chaos, not the reduction. When the
 pointwise estimate fails, a twin of the reference (same model, displacement perturbed by
-:data:`PERTURBATION` m) is stepped (:func:`twin`). Its distance to the reference is the
+:data:`PERTURBATION` m, :func:`perturbed`) is stepped. Its distance to the reference is the
 ``sensitivity`` floor; the *predictability horizon* ``t_p`` is the first stored time at
 which the twin's signals differ from the reference's by more than :data:`HORIZON_SHARE` of
 the tolerance or have grown :data:`AMPLIFICATION` times past their difference over the
@@ -47,17 +48,14 @@ from __future__ import annotations
 import numpy as np
 import scipy.sparse as sp
 
-from ..progress import phase
-
 __all__ = [
     "QUANTITIES",
     "compare",
     "estimate",
     "field_norms",
+    "perturbed",
     "reference_sizes",
-    "simulate",
     "statistics",
-    "twin",
 ]
 
 #: Relative errors reported (``summary.json["reduction_error"]``); the first three decide.
@@ -154,39 +152,12 @@ def compare(run, ref, fields_run, fields_ref, norms: dict, window: float) -> dic
     return out
 
 
-def simulate(reductor, sizes, make_stepper, t_end, checkpoints=5, limits=None, perturb=0.0, lean=0):
-    """Step ``reductor.reduce(*sizes)``; return the results and the full states stored.
-
-    ``limits``: the run's stop limits (``Stepper.run``): the estimate compares the models
-    over what the run itself can reach, not past a physical stop. ``perturb``: random
-    displacement (m) added to the initial state (:func:`twin`). ``lean = 1``: a run that is
-    only compared, recorded with what :func:`estimate` reads (``Stepper.run(lean=1)``:
-    ``Results.lean()``'s arrays, never the others).
-    """
-    what = "twin" if perturb else "run"
-    with phase(f"reduction error estimate: {what} of sizes {list(sizes)} to {t_end:g} s") as p:
-        m = reductor.reduce(*sizes)
-        res, states = _simulate(
-            m, reductor, sizes, make_stepper, t_end, checkpoints, limits, perturb, lean
-        )
-        p["detail"] = f"{res.steps} steps, {m.n_dofs} coordinates"
-    return res, states
-
-
-def _simulate(m, reductor, sizes, make_stepper, t_end, checkpoints, limits, perturb, lean):
-    if perturb:
-        x0 = np.array(m.x0, dtype=float)
-        x0[m.layout.u] += perturb * np.random.default_rng(0).standard_normal(m.layout.n_u)
-        m = m.with_(x0=x0)
-    st = make_stepper(m)
-    every = max(1, st.steps_to(t_end) // checkpoints)
-    res = st.run(t_end, store_every=every, limits=limits, lean=lean)
-    return res, reductor.reconstruct(res.states, *sizes)
-
-
-def twin(reductor, sizes, make_stepper, t_end, checkpoints=5, limits=None, lean=0):
-    """:func:`simulate` with the displacement perturbed by :data:`PERTURBATION` (m)."""
-    return simulate(reductor, sizes, make_stepper, t_end, checkpoints, limits, PERTURBATION, lean)
+def perturbed(model):
+    """``model`` with :data:`PERTURBATION` (m) of random displacement added to its initial
+    state (the round-off twin of a sensitive response)."""
+    x0 = np.array(model.x0, dtype=float)
+    x0[model.layout.u] += PERTURBATION * np.random.default_rng(0).standard_normal(model.layout.n_u)
+    return model.with_(x0=x0)
 
 
 def _signal_pairs(a, b, k1: int):
@@ -250,7 +221,7 @@ def _statistical(run, ref, k0: int) -> dict:
 def estimate(run, ref, fom, *, window=0.0, twin=None, tolerance=None) -> dict:
     """Estimated relative errors of ``run`` against the richer ``ref`` (module docstring).
 
-    ``run``, ``ref``: ``(sizes, results, full states)`` of :func:`simulate`; ``fom``: the
+    ``run``, ``ref``: ``(sizes, results, full states at the checkpoints)``; ``fom``: the
     full model (field norms). Returns the errors (:data:`QUANTITIES`), ``estimate`` (the
     largest of the decisive ones) and what they were measured on.
     """

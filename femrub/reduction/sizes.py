@@ -15,40 +15,44 @@ its bases that meets ``target``:
   capacity) and the simulated temperature error is mostly set by the mechanical shapes, so
   the thermal target is often missed at ``max_n_theta``: the report says so.
 
-These a-priori indicators are reported. When the caller gives the scene's stepper
-(``make_stepper``), the sizes are then picked a posteriori: the sub-basis models of
-:data:`LADDER` (``n_uv = n_θ = n``) are stepped in increasing order and the first whose
-estimated error (:mod:`femrub.reduction.estimate`, against the reductor's largest model)
-is within ``SAFETY × reduction.tolerance`` is kept. With given sizes
-(``"craig-bampton"``) the reductor is built at
-:func:`~femrub.reduction.estimate.reference_sizes` and the run's model is one of its
-sub-bases, so its error is estimated too (``report["error"]``).
+These a-priori indicators are reported. This module never steps a model: the a-posteriori
+choice (the sub-basis models of :func:`ladder` stepped in increasing order, the first whose
+estimated error is within a share of ``reduction.tolerance`` kept; with given sizes the
+reductor built at :func:`~femrub.reduction.estimate.reference_sizes` so that the run's
+model is one of its sub-bases and its error can be estimated) is made by the analysis layer
+(:func:`femrub.analysis.reduction_check.reduce_checked`) on :func:`prepare`'s reductor.
 
-The chosen model is then projected on the leading columns of that reductor's bases
-(``reductor.reduce(n_uv, n_theta)``): nothing is factorised or solved twice.
+:func:`prepare` builds the one reductor and its a-priori sizes, :func:`finish` projects the
+chosen model on the leading columns of its bases (``reductor.reduce(n_uv, n_theta)``):
+nothing is factorised or solved twice. :func:`reduce_model` is both, without an estimate.
 """
 
 from __future__ import annotations
 
-import time
+from dataclasses import dataclass
 
 import numpy as np
 import scipy.linalg as sla
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-from ..contact.casing import lobe_passing_frequency
 from ..fem import eigen
 from ..scene.spec import SceneError, fail
 from .craig_bampton import ThermoelasticCraigBampton
-from .estimate import estimate, reference_sizes, simulate, twin
+from .estimate import reference_sizes
 
-__all__ = ["natural_frequencies", "reduce_model"]
+__all__ = [
+    "LADDER",
+    "Prepared",
+    "finish",
+    "ladder",
+    "natural_frequencies",
+    "prepare",
+    "reduce_model",
+]
 
 #: Sizes ``n`` tried by ``"auto"`` (``n_uv = n_θ = n``, within the largest).
 LADDER = (2, 4, 8, 12, 16, 24, 32, 48, 64, 96, 128, 192, 256)
-#: ``"auto"`` keeps the first size whose estimate is within this share of the tolerance.
-SAFETY = 0.5
 #: Accuracy of the reference frequencies relative to the target: far below what is judged.
 REFERENCE_TOL_PER_TARGET = 1e-4
 
@@ -129,7 +133,7 @@ def _max_sizes(model, opts: dict) -> tuple[int, int]:
     return min(opts["max_n_uv"], 2 * n_i) // 2 * 2, min(opts["max_n_theta"], n_ti)
 
 
-def _ladder(most: tuple[int, int]) -> list[tuple[int, int]]:
+def ladder(most: tuple[int, int]) -> list[tuple[int, int]]:
     """Candidate sizes of ``"auto"``, increasing, ending at the reductor's largest."""
     out = []
     for n in LADDER:
@@ -139,113 +143,23 @@ def _ladder(most: tuple[int, int]) -> list[tuple[int, int]]:
     return out + [most]
 
 
-def _timed(*args, **kw):
-    """:func:`~femrub.reduction.estimate.simulate`, with its wall seconds appended."""
-    t0 = time.perf_counter()
-    return (*simulate(*args, **kw), time.perf_counter() - t0)
+@dataclass
+class Prepared:
+    """The one reductor of a scene's model and its sizes (:func:`prepare`)."""
+
+    #: the reductor (at the largest sizes for ``"auto"``, at the reference sizes of the sizes
+    #: asked for when they are to be checked)
+    reductor: ThermoelasticCraigBampton
+    #: the a-priori sizes ``(n_uv, n_theta)`` (``"auto"``: from the indicators)
+    sizes: tuple[int, int]
+    #: the sizes asked for (``"craig-bampton"``), within the reductor's; ``None``: ``"auto"``
+    want: tuple[int, int] | None
+    report: dict
+    #: seconds of the largest model's projection
+    projection: float
 
 
-def _checked(red, model, want, make_stepper, scene, report, log, limits, on_run=None):
-    """Sizes to run and their a-posteriori estimate (``report["error"]``).
-
-    ``want``: the sizes asked for (``None`` for ``"auto"``: the smallest of :func:`_ladder`
-    whose estimate is within ``SAFETY × tolerance``). The reference is the reductor's largest
-    model; the largest model itself is judged by its difference to the next smaller one.
-    ``on_run(results, seconds, full states)`` receives the estimate's run of the chosen sizes
-    (the run itself: same model, stepper and initial state, stepped to ``t_end`` with
-    ``limits``; its states at the estimate's checkpoints, reconstructed).
-    """
-    t0 = time.perf_counter()
-    tol, t_end = scene["reduction"]["tolerance"], scene["scheme"]["t_end"]
-    window = lobe_passage(scene)
-    most = (red.n_uv, red.n_theta)
-    # a run that carries state outside X (wear, casing heat) is stepped again as the
-    # scene's run (the estimate's later runs restart that state): every run here recorded
-    # lean (Stepper.run(lean=1): only what estimate() reads, so that the runs it holds
-    # together stay small); otherwise those that are never the run
-    whole = model.contact is None or not model.contact.carried_state
-    cands = [want] if want is not None else _ladder(most)
-    lean = int(not whole or (want is not None and want != most))  # the reference
-    *ref, ref_wall = _timed(red, most, make_stepper, t_end, limits=limits, lean=lean)
-    chosen, err, tried, tw = None, None, [], None
-    for c in cands:
-        if c == most:
-            break
-        *run, wall = _timed(red, c, make_stepper, t_end, limits=limits, lean=int(not whole))
-        kept = (run[0], wall, run[1])
-        err = estimate((c, *run), (most, *ref), model, window=window)
-        if err["estimate"] > SAFETY * tol:  # measure how sensitive the response is
-            tw = tw or twin(red, most, make_stepper, t_end, limits=limits, lean=1)
-            err = estimate((c, *run), (most, *ref), model, window=window, twin=tw, tolerance=tol)
-        tried.append({"sizes": list(c), "estimate": err["estimate"]})
-        if want is not None or err["estimate"] <= SAFETY * tol:
-            chosen = c
-            break
-    if chosen is None:  # the largest: judged against the next smaller candidate
-        chosen, kept = most, (ref[0], ref_wall, ref[1])
-        if tried:
-            err = dict(
-                err,
-                estimate=err["estimate"],
-                judged="largest model: difference to "
-                f"the next smaller one {tried[-1]['sizes']} (pessimistic)",
-            )
-        else:
-            err = {"estimate": 0.0, "note": "the run's model is the reference (no estimate)"}
-    err.update(tolerance=tol, tried=tried, seconds=time.perf_counter() - t0)
-    report["error"] = err
-    if on_run is not None:
-        on_run(*kept)
-    if log:
-        log(f"reduction error estimate {100 * err['estimate']:.2g} % at sizes {list(chosen)}")
-    return chosen
-
-
-def lobe_passage(scene) -> float:
-    """Duration (s) of one lobe passage of the casing (0 without lobes or rotation)."""
-    w = lobe_passing_frequency(scene["contact"]["casing"], scene["loads"]["rotation_speed"])
-    return 2.0 * np.pi / w if w else 0.0
-
-
-def reduce_model(
-    model,
-    scene,
-    log=None,
-    make_stepper=None,
-    reductor=None,
-    limits=None,
-    on_run=None,
-    stiffness=None,
-):
-    """Reduce ``model`` as ``scene["reduction"]`` asks; return ``(model, reductor, report)``.
-
-    ``reductor`` is the one reductor built (at the largest sizes for ``"auto"``, at
-    :func:`~femrub.reduction.estimate.reference_sizes` of the sizes asked for otherwise);
-    ``report["n_uv"]``, ``report["n_theta"]`` are the sizes of the returned model. With
-    ``make_stepper`` (``model -> stepper`` of the scene's scheme) the run's error is
-    estimated (``report["error"]``, :mod:`femrub.reduction.estimate`) and ``"auto"`` picks
-    the sizes from that estimate. ``reductor``: one built by an earlier call for a model with
-    the same matrices and the same ``reduction`` options (a point of a speed sweep): its
-    bases are reused (:meth:`~femrub.reduction.craig_bampton.ThermoelasticCraigBampton.for_model`)
-    with the operators projected on them, and only the estimate runs again. ``limits``: the
-    run's stop limits (``Stepper.run``), applied to the estimate's runs: they compare the
-    models over the part of the run that the run itself can reach. ``on_run(results,
-    seconds, states)``: called with the estimate's run of the returned model's sizes (its
-    :class:`~femrub.output.results.Results`, judged without the reduction rule, and its wall
-    time), which is the scene's run: the caller need not step it again (lean, and to be
-    stepped again, when the contact carries state outside ``X``:
-    :attr:`~femrub.contact.gap.Contact.carried_state`). ``stiffness``: an
-    :class:`~femrub.reduction.interior.InteriorStiffness` of the model's ``K_ii`` already
-    factorised (its modal damping, :mod:`femrub.reduction.modal_damping`), for the reductor
-    built here; released when unused.
-    """
-    opts = scene["reduction"]
-    method = opts["method"]
-    if stiffness is not None and (method == "none" or reductor is not None):
-        stiffness.free()  # no reductor is built here
-        stiffness = None
-    if method == "none":
-        return model, None, {"method": "none"}
+def _refuse_insulated(model, scene) -> None:
     if model.layout.n_t and scene["material"]["conductivity"] == 0.0:
         fail(
             "material.conductivity",
@@ -253,56 +167,87 @@ def reduce_model(
             "the thermal Craig-Bampton reduction needs a "
             "conducting blade (K^θθ is singular); use > 0 or reduction.method = 'none'",
         )
-    report = {"method": method, "projection": opts["projection"], "n_full": model.n_dofs}
-    if log:
-        log(f"reduction ({method}) of {model.n_dofs} dofs ...")
-    want = None
-    if method == "auto":
-        n_uv, n_theta = _max_sizes(model, opts)
-    else:
-        want = n_uv, n_theta = opts["n_uv"], opts["n_theta"]
-        if model.layout.n_t == 0 and n_theta:
-            report["note"] = f"reduction.n_theta = {n_theta} ignored: no temperature dofs"
-            want = n_uv, n_theta = n_uv, 0
-        if make_stepper is not None:  # a richer reductor: the reference of the estimate
-            L, bnd = model.layout, model.boundary
-            cap = (2 * (L.n_u - len(bnd["u"])), L.n_t)
-            if n_uv <= cap[0] and n_theta <= cap[1]:  # else the reductor names the key
-                n_uv, n_theta = reference_sizes(n_uv, n_theta, cap)
+
+
+def _asked_sizes(model, opts: dict, report: dict, reference: bool):
+    """``(sizes the reductor is built at, sizes asked for or None)`` of ``opts``."""
+    if opts["method"] == "auto":
+        return _max_sizes(model, opts), None
+    want = n_uv, n_theta = opts["n_uv"], opts["n_theta"]
+    if model.layout.n_t == 0 and n_theta:
+        report["note"] = f"reduction.n_theta = {n_theta} ignored: no temperature dofs"
+        want = n_uv, n_theta = n_uv, 0
+    if reference:  # a richer reductor: the reference of the estimate
+        L, bnd = model.layout, model.boundary
+        cap = (2 * (L.n_u - len(bnd["u"])), L.n_t)
+        if n_uv <= cap[0] and n_theta <= cap[1]:  # else the reductor names the key
+            n_uv, n_theta = reference_sizes(n_uv, n_theta, cap)
+    return (n_uv, n_theta), want
+
+
+def _reductor(model, opts: dict, sizes, reductor, stiffness, report: dict):
+    """The reductor at ``sizes`` (or ``reductor``'s bases reused for ``model``)."""
+    if reductor is not None:
+        report["bases"] = "reused (same matrices and reduction options)"
+        return reductor.for_model(model)
     try:
-        if reductor is not None:
-            red = reductor.for_model(model)
-            report["bases"] = "reused (same matrices and reduction options)"
-        else:
-            red = ThermoelasticCraigBampton(
-                model,
-                n_uv,
-                n_theta,
-                projection=opts["projection"],
-                thermal=opts["thermal"],
-                keep_solver=method == "auto",  # only "auto" solves again (_auto_sizes)
-                stiffness=stiffness,
-            )
-            stiffness = None  # the reductor's now
+        return ThermoelasticCraigBampton(
+            model,
+            *sizes,
+            projection=opts["projection"],
+            thermal=opts["thermal"],
+            keep_solver=opts["method"] == "auto",  # only "auto" solves again (_auto_sizes)
+            stiffness=stiffness,
+        )
     except ValueError as exc:
         text = str(exc)
         if stiffness is not None:
             stiffness.free()
+        method = opts["method"]
         key = next((f"reduction.{k}" for k in ("n_theta", "n_uv") if k in text), None)
         raise SceneError(f"{key or f'reduction.method = {method!r}'}: {text}") from None
+
+
+def prepare(model, scene, log=None, reductor=None, stiffness=None, reference=False) -> Prepared:
+    """The reductor of ``model`` as ``scene["reduction"]`` asks (not ``"none"``) and its
+    a-priori sizes.
+
+    ``reference``: the sizes asked for will be checked a posteriori, build the reductor at
+    their :func:`~femrub.reduction.estimate.reference_sizes`. ``reductor``: one built by an
+    earlier call for a model with the same matrices and the same ``reduction`` options (a
+    point of a speed sweep): its bases are reused
+    (:meth:`~femrub.reduction.craig_bampton.ThermoelasticCraigBampton.for_model`) with the
+    operators projected on them. ``stiffness``: an
+    :class:`~femrub.reduction.interior.InteriorStiffness` of the model's ``K_ii`` already
+    factorised (its modal damping), for the reductor built here; released when unused.
+    """
+    opts = scene["reduction"]
+    if stiffness is not None and reductor is not None:
+        stiffness.free()  # no reductor is built here
+        stiffness = None
+    _refuse_insulated(model, scene)
+    method = opts["method"]
+    report = {"method": method, "projection": opts["projection"], "n_full": model.n_dofs}
+    if log:
+        log(f"reduction ({method}) of {model.n_dofs} dofs ...")
+    sizes, want = _asked_sizes(model, opts, report, reference)
+    red = _reductor(model, opts, sizes, reductor, stiffness, report)
     if want is not None:
-        want = (min(want[0], red.n_uv), min(want[1], red.n_theta))
-    if method == "auto":
-        n_uv, n_theta = _auto_sizes(red, model, opts, scene["scheme"]["t_end"], report)
-        report["target"] = opts["target"]
+        want = sizes = (min(want[0], red.n_uv), min(want[1], red.n_theta))
     else:
-        n_uv, n_theta = want
+        sizes = _auto_sizes(red, model, opts, scene["scheme"]["t_end"], report)
+        report["target"] = opts["target"]
     red.solver.free()  # no more interior solves: release the factorisations' memory
     projection = red.project()  # once; every size is then a block of it (or projected)
-    if make_stepper is not None:
-        n_uv, n_theta = _checked(red, model, want, make_stepper, scene, report, log, limits, on_run)
+    return Prepared(red, sizes, want, report, projection)
+
+
+def finish(prepared: Prepared, sizes: tuple[int, int]):
+    """The reduced model of ``sizes`` of a :func:`prepare`'d reductor; its report completed."""
+    red, report = prepared.reductor, prepared.report
+    n_uv, n_theta = sizes
     reduced = red.reduce(n_uv, n_theta)
-    reduced.info["timings"]["projection"] += projection
+    reduced.info["timings"]["projection"] += prepared.projection
     if "error" in report:  # energy the reduced dynamics can create (verdict rule ``reduction``)
         report["error"]["energy_growth_rate"] = reduced.info["energy_growth_rate"]
     report.update(
@@ -313,4 +258,18 @@ def reduce_model(
         n_boundary_theta=int(red.n_theta_b),
         thermal=red.thermal,
     )
-    return reduced, red, report
+    return reduced
+
+
+def reduce_model(model, scene, log=None, reductor=None, stiffness=None):
+    """Reduce ``model`` as ``scene["reduction"]`` asks, at its a-priori sizes; return
+    ``(model, reductor, report)`` (``report["n_uv"]``, ``report["n_theta"]``: the sizes of
+    the returned model). See :func:`prepare`; with an a-posteriori estimate:
+    :func:`femrub.analysis.reduction_check.reduce_checked`.
+    """
+    if scene["reduction"]["method"] == "none":
+        if stiffness is not None:
+            stiffness.free()  # no reductor is built here
+        return model, None, {"method": "none"}
+    prepared = prepare(model, scene, log, reductor, stiffness)
+    return finish(prepared, prepared.sizes), prepared.reductor, prepared.report

@@ -25,7 +25,7 @@ SCHEME = Variant(
             B,
             False,
             doc="also step the model at h/2 and judge the run by the difference "
-            "(a-posteriori time-step error, femrub.app.step_check; doubles the stepping)",
+            "(a-posteriori time-step error, femrub.analysis.step_check; doubles the stepping)",
         ),
         "step_tolerance": _f(
             0.05,

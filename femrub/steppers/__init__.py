@@ -1,9 +1,14 @@
-"""Time steppers for first-order models with unilateral contact."""
+"""Time steppers for first-order models with unilateral contact: pure integrators.
 
-from .base import State, Stepper, check_step
+Each stepper advances a state and returns typed step records (:mod:`.record`); the runnable
+classes with ``run()`` (recording, stop limits, verdict) are in :mod:`femrub.analysis`.
+"""
+
+from .base import Stepper, check_step
 from .carpenter import Carpenter
 from .exponential import ExponentialMoreau
 from .penalty import Penalty
+from .record import Friction, State, StepRecord, StepRefused
 from .theta import ACTIVATION_RULES, ThetaMethod
 
 SCHEMES = {
@@ -14,13 +19,15 @@ SCHEMES = {
 }
 
 
-def make_stepper(scheme: str, model, h, **options) -> Stepper:
+def make_stepper(scheme: str, model, h, *, schemes=None, **options) -> Stepper:
     """Stepper by name: ``"theta"`` (paper Sec. 3), ``"carpenter"``, ``"penalty"`` or
-    ``"exponential"`` (exact flight between contact events)."""
+    ``"exponential"`` (exact flight between contact events), from ``schemes`` (default
+    :data:`SCHEMES`, the pure integrators)."""
+    schemes = SCHEMES if schemes is None else schemes
     try:
-        cls = SCHEMES[scheme]
+        cls = schemes[scheme]
     except KeyError:
-        raise ValueError(f"unknown scheme {scheme!r}; use one of {', '.join(SCHEMES)}") from None
+        raise ValueError(f"unknown scheme {scheme!r}; use one of {', '.join(schemes)}") from None
     return cls(model, h, **options)
 
 
@@ -28,9 +35,12 @@ __all__ = [
     "ACTIVATION_RULES",
     "Carpenter",
     "ExponentialMoreau",
+    "Friction",
     "Penalty",
     "SCHEMES",
     "State",
+    "StepRecord",
+    "StepRefused",
     "Stepper",
     "ThetaMethod",
     "check_step",

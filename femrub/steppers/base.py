@@ -1,36 +1,43 @@
-"""Common machinery of the time steppers: ``step()``, ``iterate()`` and ``run()``.
+"""The integrator protocol every time stepper follows: ``advance()``, ``step()``, ``iterate()``.
 
-A stepper works on any :class:`~femrub.model.first_order.FirstOrderModel` and advances
-``t_{k+1} = t0 + (k + 1) h``. Subclasses implement ``_step()`` (advance one step, return the
-new state and the contact impulses); the public ``step()`` returns the new :class:`State`,
-``iterate()`` yields states, ``run()`` hands the steps to a
-:class:`~femrub.output.recorder.Recorder`, which collects the
-:class:`~femrub.output.results.Results` (energy balance, progress bar, physical stop criteria,
-protection against numerical blow-up). Whatever stops a run (instability, a stop criterion,
-Ctrl-C, SIGTERM, an exception), ``run()`` returns what was computed so far; a run the
-recorder ends as ``ok`` is then judged by :func:`femrub.output.verdict.assess` (balance
-tolerances -> ``inaccurate``, resolution warnings). Every stepper refuses a model that
-starts inside the casing (initial penetration) and a run longer than :data:`MAX_STEPS`.
+A stepper is a pure integrator on any :class:`~femrub.model.first_order.FirstOrderModel`: it
+advances ``t_{k+1} = t0 + (k + 1) h`` and knows nothing of scenes, files, stop limits,
+verdicts or estimates. Subclasses implement ``_step()`` (advance one step from
+``(self.t, self.X)``; return ``(X_new, impulse)`` or, with friction,
+``(X_new, impulse, friction)``, a :class:`~femrub.steppers.record.Friction`). The public
+methods:
+
+* :meth:`Stepper.advance`: one step, its typed :class:`~femrub.steppers.record.StepRecord`;
+* :meth:`Stepper.step`: one step, the new :class:`~femrub.steppers.record.State`;
+* :meth:`Stepper.iterate`: the initial state, then the state after every step to ``t_end``;
+* :meth:`Stepper.block_writer`: a compiled writer of whole blocks of steps into given rows
+  (the fast path of the θ-method), or ``None``;
+* :meth:`Stepper.measure_works`: ask for the exact works of each step in its record (steppers
+  that can integrate them).
+
+Recording, stop limits and the verdict live in the analysis layer above
+(:mod:`femrub.analysis`, whose runnable subclasses add ``run()``). Every stepper refuses a
+model that starts inside the casing (initial penetration).
+
+A contact's history outside ``X`` (an abradable coating's wear map, the casing's heat) is the
+run's state: a stepper runs ``model.with_(contact=contact.with_fresh_history(h))``, its own
+copy started afresh, as ``stepper.model`` (read the wear of a run from
+``stepper.model.contact.wear``); the model it was given is never changed, and steppers of
+one model may step in any order.
 """
 
 from __future__ import annotations
 
-import itertools
 import math
 
 import numpy as np
 
 from ..blas import SERIAL_SETUP_DOFS, one_blas_thread
 from ..model.first_order import FirstOrderModel
-from ..output.recorder import Recorder, State
-from ..output.results import Results
-from ..output.verdict import assess
-from ..scene.validate import MAX_STEPS
+from .record import Friction, State, StepRecord
 
-__all__ = ["MAX_STEPS", "PENETRATION_TOLERANCE", "State", "Stepper", "check_step"]
+__all__ = ["Friction", "PENETRATION_TOLERANCE", "State", "StepRecord", "Stepper", "check_step"]
 
-#: identifies the stepper that owns a contact's state (:meth:`Stepper._check_owner`)
-_TOKENS = itertools.count(1)
 #: initial gaps below minus this (m) are an initial penetration
 PENETRATION_TOLERANCE = 1e-12
 
@@ -54,7 +61,7 @@ class Stepper:
     """Base class; see the module docstring. ``h`` is the time step (s)."""
 
     name = "stepper"
-    #: the recorder stops a run whose energy balance opens (numerical blow-up)
+    #: a recorder may stop a run whose energy balance opens (numerical blow-up)
     blowup_check = True
     #: the step locates contact events inside itself (no contact-resolution check needed)
     locates_events = False
@@ -64,25 +71,19 @@ class Stepper:
     def __init__(self, model: FirstOrderModel, h: float, *, t0: float = 0.0):
         if not isinstance(model, FirstOrderModel):
             raise TypeError("a stepper needs a femrub.FirstOrderModel")
-        self.model = model
         self.h = check_step(h)
+        if model.contact is not None and model.contact.carried_state:
+            # the contact's history (wear map, casing heat) is this run's own state
+            model = model.with_(contact=model.contact.with_fresh_history(self.h))
+        self.model = model
         self.k = 0
         self.t0 = self.t = float(t0)
         self.X = model.x0.copy()
-        nc = model.n_contacts
-        self.impulse = np.zeros(nc)
-        self.extra = None
+        self.impulse = np.zeros(model.n_contacts)
+        #: the frictional quantities of the last step (:class:`Friction`), or ``None``
+        self.friction = None
         self._h_lim = None
-        wear = None if model.contact is None else model.contact.wear
-        if wear is not None:
-            if not self.supports_wear:
-                raise ValueError(
-                    f"an abradable coating needs scheme.name = 'theta' (the {self.name} "
-                    "scheme does not bound its contact impulses)"
-                )
-        self._token = next(_TOKENS)
-        self._owned_states = bool(self._contact_states())
-        self._claim_contact_state()
+        self._refuse_wear()
         self._check_initial_gap()
         if model.n_dofs <= SERIAL_SETUP_DOFS:  # no BLAS worker left spinning into the steps
             with one_blas_thread:
@@ -90,35 +91,14 @@ class Stepper:
         else:
             self._setup()
 
-    def _contact_states(self) -> list:
-        """:attr:`~femrub.contact.gap.Contact.carried_state` of the model's contact."""
+    def _refuse_wear(self) -> None:
+        """An abradable coating needs a stepper that bounds its impulses."""
         c = self.model.contact
-        return [] if c is None else c.carried_state
-
-    def _claim_contact_state(self) -> None:
-        """Start the contact's states afresh for this stepper (a fresh coating, a cold
-        casing) and mark them as its own."""
-        for state in self._contact_states():
-            if state is self.model.contact.wear:
-                state.reset(self.h)
-            else:
-                state.reset()
-            state.owner = self._token
-
-    def _check_owner(self) -> None:
-        """Before stepping: the contact's states are this stepper's. Another stepper of the
-        same model built or run since this one was built has reset or worn them: before the
-        first step they are started afresh again, after it the run cannot go on."""
-        for state in self._contact_states():
-            if getattr(state, "owner", None) != self._token:
-                if self.k:
-                    raise RuntimeError(
-                        "another stepper of this model has used its contact's state (wear "
-                        "map, casing heat) since this run started; run the steppers of one "
-                        "model one after the other"
-                    )
-                self._claim_contact_state()
-                return
+        if c is not None and c.wear is not None and not self.supports_wear:
+            raise ValueError(
+                f"an abradable coating needs scheme.name = 'theta' (the {self.name} "
+                "scheme does not bound its contact impulses)"
+            )
 
     def _check_initial_gap(self) -> None:
         """Refuse a model that starts inside the casing (no scheme can undo it honestly)."""
@@ -150,14 +130,8 @@ class Stepper:
 
     def _step(self) -> tuple:
         """Advance from ``(self.t, self.X)`` by ``h``; return ``(X_new, impulse)`` or, with
-        friction, ``(X_new, impulse, extra)``: ``extra`` holds ``friction_impulse``
-        (n_c, 2), the blade's ``heat`` (n_c,) (J) and the contact ``state`` (n_c,) of the step."""
+        friction, ``(X_new, impulse, friction)`` (:class:`Friction`)."""
         raise NotImplementedError
-
-    def _block_writer(self):
-        """A writer of whole blocks of steps for :meth:`Recorder.record` (``block``), or
-        ``None``: ``run()`` then advances step by step."""
-        return None
 
     def _stability_limit(self) -> float:
         """Largest stable step (s); ``inf`` for unconditionally stable schemes."""
@@ -170,6 +144,20 @@ class Stepper:
             self._h_lim = self._stability_limit()
         return self._h_lim
 
+    def block_writer(self):
+        """A writer of whole blocks of steps, or ``None`` (then steps go one by one).
+
+        ``block(m, X, t, P, Pt, heat, state) -> (steps done, friction rows written, error)``
+        advances ``m`` steps and writes them into the given rows (states ``X`` (m, N), times,
+        impulses and the frictional rows of :class:`Friction`); ``error``, an exception or
+        ``None``, is what :meth:`advance` would have raised after the steps done.
+        """
+        return None
+
+    def measure_works(self, on: bool) -> None:
+        """Fill the records' ``works`` with the exact energy-balance integrals of each step
+        when the stepper can integrate them (``on``); the others ignore it."""
+
     @property
     def state(self) -> State:
         c, t, X = self.model.contact, self.t, self.X
@@ -177,35 +165,27 @@ class Stepper:
             return State(self.k, t, X, self.impulse, np.zeros(0), np.zeros(0))
         return State(self.k, t, X, self.impulse, c.gap(t, X), c.gap_velocity(t, X))
 
-    def _advance(self) -> tuple:
-        """One step; return the new ``(t, X, impulse, extra)`` (``extra``: see ``_step``)."""
-        if self._owned_states:
-            self._check_owner()
-        out = self._step()
-        X, impulse = out[0], out[1]
-        self.extra = out[2] if len(out) > 2 else None
+    def advance(self) -> StepRecord:
+        """One step of size ``h``; its :class:`StepRecord`."""
+        X, impulse, *friction = self._step()
+        self.friction = friction[0] if friction else None
         self.k += 1
         self.t = self.t0 + self.k * self.h
         if self.model.contact is not None:
-            self.model.contact.after_step(self.t, X, impulse, self.h, self.extra)
+            Pt = None if self.friction is None else self.friction.impulse
+            self.model.contact.after_step(self.t, X, impulse, self.h, Pt)
         self.X, self.impulse = X, impulse
-        return self.t, X, impulse, self.extra
+        return StepRecord(self.t, X, impulse, self.friction)
 
     def step(self) -> State:
         """Advance one step of size ``h`` and return the new :class:`State`."""
-        self._advance()
+        self.advance()
         return self.state
 
     def steps_to(self, t_end: float) -> int:
         """Number of steps from the current time to ``t_end`` (validated)."""
         check_step(self.h, t_end)
-        n = int(round((t_end - self.t) / self.h))
-        if n > MAX_STEPS:
-            raise ValueError(
-                f"h = {self.h:g} s to t_end = {t_end:g} s gives {n:.3g} steps; at most "
-                f"{MAX_STEPS:.0e} allowed (raise h or lower t_end)"
-            )
-        return n
+        return int(round((t_end - self.t) / self.h))
 
     def iterate(self, t_end: float):
         """Yield the initial state, then the state after every step until ``t_end``."""
@@ -213,67 +193,3 @@ class Stepper:
         yield self.state
         for _ in range(n):
             yield self.step()
-
-    def run(
-        self,
-        t_end: float,
-        *,
-        progress: bool = False,
-        limits: dict[str, float] | None = None,
-        energy: bool = True,
-        store_every: int = 0,
-        on_state=None,
-        on_rows=None,
-        label: str | None = None,
-        tolerances: dict | None = None,
-        merge_time: float | None = None,
-        lean: int = 0,
-    ) -> Results:
-        """Integrate to ``t_end`` and collect :class:`~femrub.output.results.Results`.
-
-        Parameters
-        ----------
-        t_end : end time (s).
-        progress : show a progress bar.
-        limits : physical stop criteria, ``{signal name: max |value|}``; the key
-            ``"contact_force"`` limits the contact force (N). Reaching one ends the run with
-            status ``"diverged-physically"``.
-        energy : keep the energy balance (needs ``model.energy``); it also detects numerical
-            blow-up (energy created from nothing).
-        store_every : keep the full state every that many steps (0: never).
-        on_state : callback ``f(state)`` after each step (e.g. streaming VTK output).
-        on_rows : callback ``f(arrays)`` per checked block of rows (e.g. a streamed history).
-        label : name of the run (progress bar and ``Results.info``).
-        tolerances, merge_time : see :func:`femrub.output.verdict.assess` (balance
-            tolerances; contact impulses closer than ``merge_time`` s form one episode of
-            the resolution check, ``None``: no check).
-        lean : 0: results with every per-step array. ``k >= 1``: a run held only to be
-            compared with another: only times, impulses, signals and the stored states, at
-            every ``k``-th step with the impulses summed over each ``k`` steps (``h`` of the
-            results ``k h``); gaps, friction rows and the energy balance are never stored,
-            the verdict reads its measures of them taken as the steps were recorded
-            (:mod:`femrub.output.kept_rows`, ``Results.checks``).
-        """
-        self._check_owner()
-        recorder = Recorder(
-            self.model,
-            self.h,
-            self.steps_to(t_end),
-            scheme=self.name,
-            stability_limit=self.stability_limit(),
-            energy=energy,
-            limits=limits,
-            store_every=store_every,
-            on_state=on_state,
-            on_rows=on_rows,
-            label=label,
-            blowup_check=self.blowup_check,
-            lean=lean,
-        )
-        res = recorder.record(
-            self.state, self._advance, progress=progress, block=self._block_writer()
-        )
-        del recorder  # its per-step arrays that the results do not hold: before the checks
-        if self.locates_events:
-            merge_time = None
-        return assess(res, tolerances=tolerances, merge_time=merge_time)

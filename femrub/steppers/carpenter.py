@@ -46,6 +46,7 @@ from ..contact.impulses import solve_impulses
 from ..fem.eigen import largest_modulus
 from ..fem.linalg import Factorised
 from .base import Stepper
+from .record import Friction
 
 __all__ = ["Carpenter"]
 
@@ -152,7 +153,7 @@ class Carpenter(Stepper):
             Xn = Xn + self._Ct @ heat
         self._vh = Xn[L.v].copy()
         self._a = self._deriv(Xn, m.load(t1))
-        return Xn, P[:, 0].copy(), {"friction_impulse": P[:, 1:], "heat": heat, "state": res.state}
+        return Xn, P[:, 0].copy(), Friction(P[:, 1:], heat, res.state)
 
     def _stability_limit(self) -> float:
         """Largest stable step (s): ``min(2 / ω_max, 2 / μ_max)`` of the explicit parts."""

@@ -66,6 +66,7 @@ from ..contact.friction import FrictionResult, check_status, power_heat_fixed_po
 from ..contact.theta_block import ONE_RULES, one_contact_block
 from ..fem.linalg import Factorised, compact
 from .base import Stepper
+from .record import Friction
 from .theta_blocks import advance_block, prepare
 
 __all__ = ["ThetaMethod", "ACTIVATION_RULES"]
@@ -191,7 +192,7 @@ class ThetaMethod(Stepper):
             self._n3 = c.n
         prepare(self)
 
-    def _block_writer(self):
+    def block_writer(self):
         if not (self.block_steps and self._block_kind):
             return None
         return lambda *rows: advance_block(self, *rows)
@@ -354,4 +355,4 @@ class ThetaMethod(Stepper):
         X = Xp + Z @ P.reshape(-1) if active.any() else Xp
         if power:
             X = X + self._Zt @ heat
-        return X, P[:, 0].copy(), {"friction_impulse": P[:, 1:], "heat": heat, "state": state}
+        return X, P[:, 0].copy(), Friction(P[:, 1:], heat, state)

@@ -30,6 +30,7 @@ from ..contact.friction import check_status
 from ..contact.gap import _over_times
 from ..contact.rub_block import rub_block
 from ..contact.theta_block import ONE_RULES, friction_block, one_contact_block
+from .record import Friction
 
 __all__ = ["block_kind", "prepare", "advance_block"]
 
@@ -216,11 +217,9 @@ def advance_block(st, m: int, X, t, P, Pt, heat, state) -> tuple:
         if done:
             st._warm3 = warm  # the last step's impulse
             st._memo = (k0 + done, t1[done - 1], off[done].copy())
-            st.extra = {
-                "friction_impulse": Pt[done - 1].copy(),
-                "heat": heat[done - 1].copy(),
-                "state": state[done - 1].copy(),
-            }
+            st.friction = Friction(
+                Pt[done - 1].copy(), heat[done - 1].copy(), state[done - 1].copy()
+            )
         friction = True
     if done:
         st.k = k0 + done

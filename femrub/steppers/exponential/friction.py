@@ -29,7 +29,7 @@ impulse of the step is opposite to the end slip as Coulomb's law wants; the casi
 ``−v_c / |v_c|`` is where the first hold starts. The slip along ``ŝ``,
 ``σ = ŝ · w_t = R_σ X + σ0``, is checked with the held multipliers; its first zero (stick or
 reversal) is located as an event and the run is refused there
-(:class:`~femrub.output.recorder.StepRefused`: status ``failed`` with a message, the results
+(:class:`~femrub.steppers.record.StepRefused`: status ``failed`` with a message, the results
 up to the step before kept): a sticking contact would need
 a held stick (a tangential constraint) that this stepper does not have, and velocity-level
 impulses alone let a pressed contact sink by ``g̈ h² / 2`` per step. For the same reason an
@@ -58,7 +58,7 @@ from ...contact.friction import (
     power_heat_fixed_point,
     solve_frictional_contact,
 )
-from ...output.recorder import StepRefused
+from ..record import Friction, StepRefused
 from .slide import SlideDirections
 
 __all__ = ["FrictionalContact"]
@@ -126,12 +126,12 @@ class FrictionalContact(SlideDirections):
         self._work_t = 0.0
         self._slid = set()  # contacts with a held flight in this step
 
-    def _friction_extra(self, S) -> dict:
-        """The step's ``friction_impulse``, blade ``heat`` and contact ``state``."""
+    def _friction_extra(self, S) -> Friction:
+        """The step's friction impulse, blade heat and contact state."""
         seen = self._seen
         seen[1, list(S)] = True
         state = np.where(seen[0], STICK, np.where(seen[1], SLIP, OPEN)).astype(np.int8)
-        return {"friction_impulse": self._Pt, "heat": self._heat, "state": state}
+        return Friction(self._Pt, self._heat, state)
 
     def _still_sliding(self, j: int, X) -> bool:
         """Held contact ``j`` still slides along ``ŝ`` at ``X`` (true without friction)."""

@@ -45,6 +45,7 @@ import numpy as np
 from ...contact.impulses import solve_impulses
 from ...fem.linalg import Factorised
 from ..base import Stepper
+from ..record import WORK_KEYS, StepRecord
 from .events import EventLocation
 from .flows import FlowFamily
 from .friction import FrictionalContact
@@ -190,23 +191,19 @@ class ExponentialMoreau(EventLocation, FrictionalContact, Stepper):
         self._g0grid = None  # a fixed casing's gaps on the check grid
 
     # -- one step ------------------------------------------------------------------------------
-    def run(self, t_end, *, energy: bool = True, **kwargs):
-        """:meth:`Stepper.run <femrub.steppers.base.Stepper.run>`; the exact works and heats
-        of the energy balance are integrated only when it is kept (``energy``)."""
-        self._measure = energy and self._integrals is not None
-        try:
-            return super().run(t_end, energy=energy, **kwargs)
-        finally:
-            self._measure = False
+    def measure_works(self, on: bool) -> None:
+        """Integrate the exact works and heats of each step into its record's ``works``
+        (the energy balance of a run that keeps it); the contact work always."""
+        self._measure = on and self._integrals is not None
 
-    def _advance(self):
-        t, X, P, extra = super()._advance()
-        out = {**(extra or {}), "contact_work": self._work}
-        if self._measure:  # the scheme's exact integrals replace the meter's quadrature
-            out["works"] = self._w[METER_ORDER]  # SCHEME_INTEGRALS order, impulses' work added
-            out["works"][0] += self._work
-            out["works"][6] += self._work_t
-        return t, X, P, out
+    def advance(self) -> StepRecord:
+        rec = super().advance()
+        if not self._measure:
+            return rec._replace(works={"contact_work": self._work})
+        w = self._w[METER_ORDER]  # WORK_KEYS order, the impulses' work added
+        w[0] += self._work
+        w[6] += self._work_t
+        return rec._replace(works=dict(zip(WORK_KEYS, w)))
 
     def _integ(self, S):
         """The work integrals the flight of ``S`` needs: all of them with the energy balance,

@@ -49,7 +49,7 @@ QUADRATIC = (
 LINEAR = ("heat_load", "heat_outflow")
 NQ = len(QUADRATIC)
 #: ``(QUADRATIC + LINEAR)[METER_ORDER]`` is the meter's
-#: :data:`~femrub.output.energy.SCHEME_INTEGRALS` (the held friction heat goes to the state)
+#: :data:`~femrub.steppers.record.WORK_KEYS` (the held friction heat goes to the state)
 METER_ORDER = np.array([0, 1, 2, 3, NQ, NQ + 1, 4])
 _TERMS = 8  # terms of the Taylor series of the integrals over short durations
 _FACTORIALS = np.array([math.factorial(k + 1) for k in range(_TERMS)], dtype=float)

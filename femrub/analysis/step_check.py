@@ -1,10 +1,10 @@
 """A-posteriori time-step error of a run: the same model stepped again at ``h/2``.
 
 A run is trustworthy only if its step is fine enough. ``scheme.step_check = true`` measures
-it the way the reduction error is measured (:mod:`femrub.reduction.estimate`): by the
+it the way the reduction error is measured (:mod:`femrub.analysis.reduction_check`): by the
 difference with a richer run, here the run's own model at half the step, from the same
 initial state to the same end time and stop limits. The fine run is recorded coarsened to
-the run's steps (``Stepper.run(lean=2)``, the rows :func:`coarsen` would keep: its impulses
+the run's steps (``RunOptions.lean = 2``, the rows :func:`coarsen` would keep: its impulses
 summed over each pair of steps, its signals at the run's times; fields at the same
 checkpoints; its per-step gaps, friction rows and energy balance never stored, its verdict
 measured on them as they pass: :mod:`femrub.output.kept_rows`) and both are compared with
@@ -34,8 +34,8 @@ import time
 import numpy as np
 
 from ..progress import phase
-from ..reduction.estimate import DECISIVE, PERTURBATION, estimate
-from ..reduction.sizes import SAFETY, lobe_passage
+from ..reduction.estimate import DECISIVE, estimate, perturbed
+from .reduction_check import SAFETY, lobe_passage
 
 __all__ = ["ORDER", "check_step", "coarsen", "full_states"]
 
@@ -52,7 +52,7 @@ def coarsen(res, factor: int):
     the fine impulses in it (so impulses per window and mean forces are preserved); the
     checkpoint states are kept (the fine run stores them at the same times). Every array is
     a copy: none keeps the fine run's per-step arrays alive. A run recorded with
-    ``Stepper.run(lean=factor)`` gives ``coarsen(res, factor).lean()`` without the fine rows.
+    ``RunOptions.lean = factor`` gives ``coarsen(res, factor).lean()`` without the fine rows.
     """
     factor = int(factor)
     if factor == 1:
@@ -82,17 +82,9 @@ def full_states(model, full):
 
 def _simulate(stepper, t_end, every, limits, fields, lean=0):
     """Run ``stepper`` to ``t_end``, full states stored every ``every`` steps (``lean``:
-    ``Stepper.run``'s)."""
+    :class:`~femrub.analysis.options.RunOptions`')."""
     res = stepper.run(t_end, store_every=every, limits=limits, lean=lean)
     return res, fields(res.states)
-
-
-def _perturbed(model):
-    """``model`` with :data:`~femrub.reduction.estimate.PERTURBATION` (m) of random
-    displacement added to its initial state (the estimate's round-off twin)."""
-    x0 = np.array(model.x0, dtype=float)
-    x0[model.layout.u] += PERTURBATION * np.random.default_rng(0).standard_normal(model.layout.n_u)
-    return model.with_(x0=x0)
 
 
 def check_step(scene, model, full, make_stepper, limits, run=None):
@@ -138,7 +130,7 @@ def check_step(scene, model, full, make_stepper, limits, run=None):
     if _richardson(err["estimate"]) > SAFETY * tol:  # how sensitive is the response?
         with phase(f"time-step check: twin at h/2 = {fine_h:g} s"):
             twin = _simulate(
-                make_stepper(_perturbed(model), fine_h), t_end, 2 * every, limits, fields, lean=2
+                make_stepper(perturbed(model), fine_h), t_end, 2 * every, limits, fields, lean=2
             )
         err = estimate((label, *run), (label, *fine), full, window=window, twin=twin, tolerance=tol)
     for key in ("sizes", "reference_sizes", "status_run", "status_reference"):

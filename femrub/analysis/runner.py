@@ -1,0 +1,66 @@
+"""Running a stepper: recorded, checked against stop limits and judged.
+
+:func:`run` drives any pure integrator (:class:`~femrub.steppers.base.Stepper`) to ``t_end``:
+it hands the stepper's steps (its :meth:`~femrub.steppers.base.Stepper.advance`, or its
+compiled block writer when it has one) to a :class:`~femrub.output.recorder.Recorder`, which
+checks them chunk by chunk (non-finite states and energy created from nothing: ``unstable``;
+the stop limits of :func:`~femrub.output.limits.run_limits`, on by default:
+``diverged-physically``), and judges what it recorded with
+:func:`~femrub.output.verdict.assess` (balance tolerances -> ``inaccurate``, resolution).
+Whatever stops a run (instability, a stop limit, Ctrl-C, SIGTERM, an exception), the results
+computed so far are returned. A run longer than :data:`MAX_STEPS` steps is refused before it
+starts (the memory of its histories).
+"""
+
+from __future__ import annotations
+
+from ..output.limits import run_limits
+from ..output.recorder import Recorder
+from ..output.results import Results
+from ..output.verdict import assess
+from ..scene.validate import MAX_STEPS
+from .options import RunOptions
+
+__all__ = ["MAX_STEPS", "RunOptions", "run", "steps_of"]
+
+
+def steps_of(stepper, t_end: float) -> int:
+    """Steps of ``stepper`` to ``t_end`` (s), at most :data:`MAX_STEPS`."""
+    n = stepper.steps_to(t_end)
+    if n > MAX_STEPS:
+        raise ValueError(
+            f"h = {stepper.h:g} s to t_end = {t_end:g} s gives {n:.3g} steps; at most "
+            f"{MAX_STEPS:.0e} allowed (raise h or lower t_end)"
+        )
+    return n
+
+
+def run(stepper, t_end: float, options: RunOptions | None = None) -> Results:
+    """Integrate ``stepper`` to ``t_end`` (s) and collect its judged
+    :class:`~femrub.output.results.Results` (see the module docstring)."""
+    o = options or RunOptions()
+    stepper.measure_works(o.energy)
+    try:
+        recorder = Recorder(
+            stepper.model,
+            stepper.h,
+            steps_of(stepper, t_end),
+            scheme=stepper.name,
+            stability_limit=stepper.stability_limit(),
+            energy=o.energy,
+            limits=run_limits(stepper.model, o.limits, o.default_limits),
+            store_every=o.store_every,
+            on_state=o.on_state,
+            on_rows=o.on_rows,
+            label=o.label,
+            blowup_check=stepper.blowup_check,
+            lean=o.lean,
+        )
+        res = recorder.record(
+            stepper.state, stepper.advance, progress=o.progress, block=stepper.block_writer()
+        )
+    finally:
+        stepper.measure_works(False)
+    del recorder  # its per-step arrays that the results do not hold: before the checks
+    merge_time = None if stepper.locates_events else o.merge_time
+    return assess(res, tolerances=o.tolerances, merge_time=merge_time)
