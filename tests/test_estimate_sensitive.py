@@ -1,4 +1,4 @@
-"""The reduction error estimate of a sensitive (chaotic) response (issue 12 / 11).
+"""The reduction error estimate of a sensitive (chaotic) response.
 
 Synthetic runs: the reference's round-off twin departs exponentially, as Rotor 37's does.
 A run with the same statistics but a different trajectory is judged by its statistics after

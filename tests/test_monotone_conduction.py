@@ -1,4 +1,4 @@
-"""Monotone conduction operator (femrub.fem.monotone, issue 11): no temperature below
+"""Monotone conduction operator (femrub.fem.monotone): no temperature below
 ambient without a sink on the twisted NACA mesh (the built-in scene's choice), the Galerkin
 default and the paper bar's matrix unchanged."""
 

@@ -1,4 +1,4 @@
-"""Issue 12/11: a reduced, damped, frictional 3D rub closes its energy balance.
+"""A reduced, damped, frictional 3D rub closes its energy balance.
 
 The Petrov–Galerkin Craig–Bampton model keeps the boundary rows of the full model; with
 Rayleigh damping its boundary velocity moves quasi-static shapes ``Γ = −K_ii⁻¹ C_ib``, so the

@@ -1,4 +1,4 @@
-"""Issue 11: reduced 3D models keep their balances, match the full model, and say so when not.
+"""Reduced 3D models keep their balances, match the full model, and say so when not.
 
 * balance closure: a reduced coupled box with frictional heat (thermal inputs basis, heat
   enters in impulses) closes the heat balance to round-off and the energy balance to 1 %;

@@ -56,7 +56,7 @@ open at ``t_k`` (``g_k > 0``) whose free motion ends the step inside the worn su
     U = h F_y (−g_p) / (g_k − g_p)
 
 A first cutting step no longer carries the yield force over the part of the step the
-blade spent in the air (``docs/rotor37.md``, session 9).
+blade spent in the air (``docs/abradable.md``).
 """
 
 from __future__ import annotations

@@ -101,9 +101,10 @@ class LoadTerm:
 
 
 class Parameters(Mapping):
-    """The parameters of a model (immutable mapping; ``rotation_speed``: Ω in rad/s)."""
+    """The parameters of a model (immutable mapping; ``rotation_speed``: Ω in rad/s).
 
-    __slots__ = ("_items",)
+    Its one attribute, ``_items`` (sorted ``(name, value)`` pairs), is plain data, so the
+    model cache stores it as such (:mod:`femrub.app.cache_codec`)."""
 
     def __init__(self, values: Mapping | None = None, **more):
         items = {**dict(values or {}), **more}

@@ -83,7 +83,7 @@ def _balance(kind: str):
 
 
 def reduction(res, tol):
-    """The reduced model's estimated error exceeds ``reduction.tolerance`` (issue 11)."""
+    """The reduced model's estimated error exceeds ``reduction.tolerance``."""
     err = tol.get("reduction")
     if not err:
         return None
