@@ -14,6 +14,8 @@ starts (the memory of its histories).
 
 from __future__ import annotations
 
+import math
+
 from ..output.limits import run_limits
 from ..output.recorder import Recorder
 from ..output.results import Results
@@ -21,7 +23,10 @@ from ..output.verdict import assess
 from ..scene.validate import MAX_STEPS
 from .options import RunOptions
 
-__all__ = ["MAX_STEPS", "RunOptions", "run", "steps_of"]
+__all__ = ["MAX_STEPS", "RunOptions", "run", "steps_of", "whole_steps_warning"]
+
+#: relative tolerance on a whole number of steps to ``t_end`` (round-off of ``t_end / h``)
+WHOLE_STEPS_TOLERANCE = 1e-6
 
 
 def steps_of(stepper, t_end: float) -> int:
@@ -39,6 +44,7 @@ def run(stepper, t_end: float, options: RunOptions | None = None) -> Results:
     """Integrate ``stepper`` to ``t_end`` (s) and collect its judged
     :class:`~femrub.output.results.Results` (see the module docstring)."""
     o = options or RunOptions()
+    t0 = stepper.t
     stepper.measure_works(o.energy)
     try:
         recorder = Recorder(
@@ -63,4 +69,24 @@ def run(stepper, t_end: float, options: RunOptions | None = None) -> Results:
         stepper.measure_works(False)
     del recorder  # its per-step arrays that the results do not hold: before the checks
     merge_time = None if stepper.locates_events else o.merge_time
-    return assess(res, tolerances=o.tolerances, merge_time=merge_time)
+    res = assess(res, tolerances=o.tolerances, merge_time=merge_time)
+    short = whole_steps_warning(t0, stepper.h, t_end)
+    if short:
+        res.warnings.append(short)
+    return res
+
+
+def whole_steps_warning(t0: float, h: float, t_end: float) -> str | None:
+    """A run takes ``round((t_end − t0) / h)`` steps of the constant ``h``: when that is not
+    a whole number it ends up to half a step from ``t_end``; the warning says where and
+    gives both fixes (a scene refuses such a step before any work: scene/run_checks.py)."""
+    n = (t_end - t0) / h
+    whole = round(n)
+    if abs(n - whole) <= WHOLE_STEPS_TOLERANCE * max(n, 1.0):
+        return None
+    up = math.ceil(n)
+    return (
+        f"t_end = {t_end:g} s is {n:.6g} steps of h = {h:g} s: the run ended at "
+        f"t = {t0 + whole * h:.6g} s; for t_end exactly use t_end = {t0 + up * h:.6g} s or "
+        f"h = {(t_end - t0) / up:.6g} s"
+    )
