@@ -14,19 +14,15 @@ starts (the memory of its histories).
 
 from __future__ import annotations
 
-import math
-
 from ..output.limits import run_limits
 from ..output.recorder import Recorder
 from ..output.results import Results
 from ..output.verdict import assess
+from ..scene.run_checks import fractional_steps
 from ..scene.validate import MAX_STEPS
 from .options import RunOptions
 
 __all__ = ["MAX_STEPS", "RunOptions", "run", "steps_of", "whole_steps_warning"]
-
-#: relative tolerance on a whole number of steps to ``t_end`` (round-off of ``t_end / h``)
-WHOLE_STEPS_TOLERANCE = 1e-6
 
 
 def steps_of(stepper, t_end: float) -> int:
@@ -80,13 +76,12 @@ def whole_steps_warning(t0: float, h: float, t_end: float) -> str | None:
     """A run takes ``round((t_end − t0) / h)`` steps of the constant ``h``: when that is not
     a whole number it ends up to half a step from ``t_end``; the warning says where and
     gives both fixes (a scene refuses such a step before any work: scene/run_checks.py)."""
-    n = (t_end - t0) / h
-    whole = round(n)
-    if abs(n - whole) <= WHOLE_STEPS_TOLERANCE * max(n, 1.0):
+    off = fractional_steps(t_end - t0, h)
+    if off is None:
         return None
-    up = math.ceil(n)
+    n, _, up = off
     return (
         f"t_end = {t_end:g} s is {n:.6g} steps of h = {h:g} s: the run ended at "
-        f"t = {t0 + whole * h:.6g} s; for t_end exactly use t_end = {t0 + up * h:.6g} s or "
+        f"t = {t0 + round(n) * h:.6g} s; for t_end exactly use t_end = {t0 + up * h:.6g} s or "
         f"h = {(t_end - t0) / up:.6g} s"
     )

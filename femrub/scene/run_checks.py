@@ -12,13 +12,27 @@ scene (every point of a sweep) before building anything.
 
 from __future__ import annotations
 
+import math
+
 from .spec import fail
 
-__all__ = ["MAX_FRICTION", "check_friction", "check_run", "check_steps"]
+__all__ = ["MAX_FRICTION", "check_friction", "check_run", "check_steps", "fractional_steps"]
 
 #: the largest Coulomb coefficient taken (metals on abradable coatings: about 0.1 to 1)
 MAX_FRICTION = 2.0
-_STEP_TOL = 1e-6
+#: relative tolerance on a whole number of steps (round-off of ``t_end / h``)
+WHOLE_STEPS_TOLERANCE = 1e-6
+
+
+def fractional_steps(span: float, h: float):
+    """``None`` when ``span`` (s) is a whole number of steps ``h`` (to
+    :data:`WHOLE_STEPS_TOLERANCE`), else ``(n, whole, up)``: the steps ``span / h``, the
+    whole number a stepper takes (``round``, at least 1) and the next whole number above."""
+    n = span / h
+    whole = max(round(n), 1)
+    if abs(n - whole) <= WHOLE_STEPS_TOLERANCE * max(n, 1.0):
+        return None
+    return n, whole, math.ceil(n)
 
 
 def check_steps(scene) -> None:
@@ -28,11 +42,10 @@ def check_steps(scene) -> None:
         return
     if h <= 0 or t_end <= 0:
         return
-    n = t_end / h
-    whole = max(round(n), 1)
-    if abs(n - whole) <= _STEP_TOL * max(n, 1.0):
+    off = fractional_steps(t_end, h)
+    if off is None:
         return
-    up = int(-(-n // 1))
+    n, whole, up = off
     fail(
         "scheme.t_end",
         t_end,
