@@ -19,3 +19,8 @@ def test_a_whole_number_of_steps_reaches_t_end_without_a_warning():
     res = fr.ThetaMethod(fr.bar_model(), h=2.5e-5).run(1e-4)
     assert res.t[-1] == pytest.approx(1e-4, rel=1e-12) and res.t.size == 5
     assert not [w for w in res.warnings if "steps of h" in w]
+
+
+def test_a_run_to_its_start_takes_no_step_and_no_warning():
+    res = fr.ThetaMethod(fr.bar_model(), h=2.5e-5).run(0.0)
+    assert res.t.size == 1 and not [w for w in res.warnings if "steps of h" in w]

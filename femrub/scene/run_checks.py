@@ -27,7 +27,10 @@ WHOLE_STEPS_TOLERANCE = 1e-6
 def fractional_steps(span: float, h: float):
     """``None`` when ``span`` (s) is a whole number of steps ``h`` (to
     :data:`WHOLE_STEPS_TOLERANCE`), else ``(n, whole, up)``: the steps ``span / h``, the
-    whole number a stepper takes (``round``, at least 1) and the next whole number above."""
+    whole number a stepper takes (``round``, at least 1) and the next whole number above.
+    A span of zero or less is no step at all: ``None``."""
+    if span <= 0:
+        return None
     n = span / h
     whole = max(round(n), 1)
     if abs(n - whole) <= WHOLE_STEPS_TOLERANCE * max(n, 1.0):
