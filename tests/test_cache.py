@@ -93,7 +93,7 @@ def test_speed_change_reuses_the_matrices_with_the_new_gap_and_heat(first):
     hit = _build(cache, notes, **{"loads.rotation_speed": 1700.0})
     assert any("assembly loaded" in n for n in notes)
     # the reduction error estimate steps the run at this speed: the reduced model is rebuilt,
-    # on the bases this process built for the first speed (same matrices)
+    # on the bases built for the first speed (same matrices), loaded from the cache
     assert "cache" not in hit.report["reduction"]
     assert hit.report["reduction"]["bases"].startswith("reused")
     assert not any("static shapes" in n for n in notes if n.startswith("reduction phases"))
@@ -104,11 +104,9 @@ def test_speed_change_reuses_the_matrices_with_the_new_gap_and_heat(first):
 
 def test_another_process_loads_the_bases(first, monkeypatch):
     """A process that did not build the bases (the other sweep worker) loads them."""
-    from femrub.app import cached
 
     cache, _, _ = first
     assert cache.info()["stages"]["bases"]["entries"] == 1
-    monkeypatch.setattr(cached, "_REDUCTORS", {})  # as in a new process
     notes = []
     hit = _build(cache, notes, **{"loads.rotation_speed": 1600.0})
     assert any("bases loaded" in n for n in notes)
@@ -170,10 +168,8 @@ def _stored(cache, stage):
 def test_one_map_to_the_mesh_for_every_speed(tmp_path, monkeypatch):
     """The reduced model's map to the mesh (columns of the reductor's largest map) is stored
     once, as its own entry, and each speed's reduction refers to it by its columns."""
-    from femrub.app import cached
     from femrub.reduction.truncation import ColumnMap
 
-    monkeypatch.setattr(cached, "_MAPS", {})
     local = ModelCache(tmp_path / "c")
     a = _build(local)
     b = _build(local, None, **{"loads.rotation_speed": 1700.0})
@@ -185,7 +181,6 @@ def test_one_map_to_the_mesh_for_every_speed(tmp_path, monkeypatch):
         entry = local.load(e["key"])
         assert entry["model"].to_full is None
         np.testing.assert_array_equal(entry["map"]["columns"], a.model.to_full.cols)
-    monkeypatch.setattr(cached, "_MAPS", {})  # a new process: the map from the cache
     notes = []
     hit = _build(local, notes, **{"loads.rotation_speed": 1700.0})
     assert hit.report["reduction"]["cache"] == "hit"
@@ -195,10 +190,8 @@ def test_one_map_to_the_mesh_for_every_speed(tmp_path, monkeypatch):
 
 @pytest.mark.parametrize("damage", ["corrupt", "missing"])
 def test_corrupt_or_missing_map_rebuilds_the_reduction(first, tmp_path, monkeypatch, damage):
-    from femrub.app import cached
 
     cache, sim, _ = first
-    monkeypatch.setattr(cached, "_MAPS", {})
     local = ModelCache(tmp_path / "c")
     _build(local)
     (entry,) = _stored(local, "map")
@@ -210,7 +203,6 @@ def test_corrupt_or_missing_map_rebuilds_the_reduction(first, tmp_path, monkeypa
     else:  # evicted (the size limit): both files gone
         path.unlink()
         path.with_suffix(".json").unlink()
-    monkeypatch.setattr(cached, "_MAPS", {})  # a new process: nothing kept in memory
     notes = []
     rebuilt = _build(local, notes)
     assert any("map to the mesh is not in the cache; rebuilding" in n for n in notes)
@@ -218,7 +210,6 @@ def test_corrupt_or_missing_map_rebuilds_the_reduction(first, tmp_path, monkeypa
     assert "cache" not in rebuilt.report["reduction"]  # rebuilt, not loaded
     _same_model(rebuilt.model, sim.model)
     assert len(_stored(local, "map")) == 1  # stored again
-    monkeypatch.setattr(cached, "_MAPS", {})
     again = _build(local)
     assert again.report["reduction"]["cache"] == "hit"
     _same_model(again.model, sim.model)

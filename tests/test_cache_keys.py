@@ -51,9 +51,7 @@ def _assemble(path, cache, notes):
 
 @pytest.mark.parametrize("node", [5, 11, 16], ids=["corner", "mid-side", "mid-side-2"])
 def test_one_coordinate_of_one_node_changes_the_key_and_the_matrices(tmp_path, node, monkeypatch):
-    from femrub.app import cached
 
-    monkeypatch.setattr(cached, "_ASSEMBLED", None)  # not kept in memory by an earlier test
     cache, notes = ModelCache(tmp_path / "cache"), []
     first = _assemble(_deck(tmp_path), cache, notes)
     notes.clear()

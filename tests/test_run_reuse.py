@@ -118,47 +118,41 @@ def test_run_scene_steps_once(tmp_path, monkeypatch):
     assert s["reduction_error"]["sizes"] == [8, 4] and s["status"] == res.status
 
 
-def test_a_sweep_worker_keeps_the_assembly(tmp_path, monkeypatch):
-    """After ``keep_assemblies`` the next build on the blade reads no assembly from disk."""
-    from femrub.app import cached
+def test_builds_in_a_row_keep_the_assembly(tmp_path):
+    """Builds in a row (a sweep worker's points) take the last assembly from memory."""
     from femrub.app.cache import ModelCache
+    from femrub.app.simulation import SceneBuilds
 
-    monkeypatch.setattr(cached, "_ASSEMBLED", None)
     cache, notes = ModelCache(tmp_path / "cache"), []
     scene = load_scene("twisted-naca", {**SMALL, "scheme.t_end": 2e-5})
     first = build(scene, cache=cache)
-    cached.keep_assemblies()
-    build(scene.with_changes({"loads.rotation_speed": 1400.0}), cache=cache, log=notes.append)
+    builds = SceneBuilds(cache)
+    builds.build(scene.with_changes({"contact.friction": 0.1}), log=notes.append)
     assert any("assembly loaded" in n for n in notes)  # from the cache folder, then kept
     notes.clear()
-    again = build(
-        scene.with_changes({"loads.rotation_speed": 1300.0}), cache=cache, log=notes.append
-    )
+    again = builds.build(scene.with_changes({"contact.friction": 0.2}), log=notes.append)
     assert any("assembly kept by this process" in n for n in notes)
     assert not any("assembly loaded" in n or "assembly stored" in n for n in notes)
     np.testing.assert_array_equal(again.full.A.toarray(), first.full.A.toarray())
 
 
-def test_a_sweep_worker_keeps_the_discretisation(tmp_path, monkeypatch):
-    """After ``keep_assemblies`` the next build on the same mesh reuses the bases (with its
-    own blade); the model is the one a fresh build gives; another mesh is discretised."""
-    from femrub.app import cached
+def test_builds_in_a_row_keep_the_discretisation(tmp_path):
+    """Builds in a row on the same mesh reuse its bases (with their own blade); the model is
+    the one a fresh build gives; another mesh is discretised."""
     from femrub.app.cache import ModelCache
+    from femrub.app.simulation import SceneBuilds
 
-    monkeypatch.setattr(cached, "_ASSEMBLED", None)
-    monkeypatch.setattr(cached, "_DISCRETISED", {})
     cache = ModelCache(tmp_path / "cache")
     scene = load_scene("twisted-naca", {**SMALL, "scheme.t_end": 2e-5})
-    other = scene.with_changes({"loads.rotation_speed": 1400.0})
+    other = scene.with_changes({"contact.friction": 0.1})
     fresh = build(other, cache=cache)
-    cached.keep_assemblies()
-    notes = []
-    build(scene, cache=cache, log=notes.append)
+    builds, notes = SceneBuilds(cache), []
+    builds.build(scene, log=notes.append)
     assert not any("discretisation kept" in n for n in notes)
     notes.clear()
-    kept = build(other, cache=cache, log=notes.append)
+    kept = builds.build(other, log=notes.append)
     assert any("discretisation kept by this process" in n for n in notes)
-    (disc,) = cached._DISCRETISED.values()
+    (disc,) = builds.kept.discretisation.values()
     assert kept.fields.basis_u is disc.basis_u  # the bases shared, not rebuilt
     for name in ("A", "B"):
         a, b = getattr(kept.full, name), getattr(fresh.full, name)
@@ -166,8 +160,54 @@ def test_a_sweep_worker_keeps_the_discretisation(tmp_path, monkeypatch):
     np.testing.assert_array_equal(kept.full.contact.G, fresh.full.contact.G)
     np.testing.assert_array_equal(kept.full.contact.gap_at(1e-5), fresh.full.contact.gap_at(1e-5))
     notes.clear()
-    build(scene.with_changes({"geometry.h": 0.035}), cache=cache, log=notes.append)
+    builds.build(scene.with_changes({"geometry.h": 0.035}), log=notes.append)
     assert not any("discretisation kept" in n for n in notes)  # another mesh
+
+
+@pytest.mark.parametrize("cached", [False, True], ids=["no-cache", "cache"])
+def test_a_point_at_another_speed_is_the_model_at_that_speed(tmp_path, cached):
+    """The next point of a speed sweep takes the previous point's model at its own speed (a
+    parameter): no mesh, assembly or bases built; the same model and run as a fresh build."""
+    from femrub.app.cache import ModelCache
+    from femrub.app.simulation import SceneBuilds
+
+    scene = load_scene("twisted-naca", SMALL)
+    faster = scene.with_changes({"loads.rotation_speed": "1650 rad/s"})
+    builds, notes = SceneBuilds(ModelCache(tmp_path / "c") if cached else None), []
+    first = builds.build(scene)
+    assert "parametric" not in first.report
+    sim = builds.build(faster, log=notes.append)
+    assert sim.report["parametric"] == {"from_rotation_speed": 1500.0, "rotation_speed": 1650.0}
+    assert "taken at 1650 rad/s" in sim.explain()
+    assert not any(w in n for n in notes for w in ("assembly loaded", "assembly stored", "mesh"))
+    assert sim.report["reduction"]["bases"].startswith("reused")
+    assert sim.model.parameters["rotation_speed"] == 1650.0
+    fresh = build(faster)
+    assert "parametric" not in fresh.report
+    assert sim.model.n_dofs == fresh.model.n_dofs
+    np.testing.assert_array_equal(sim.full.B.toarray(), fresh.full.B.toarray())
+    np.testing.assert_array_equal(sim.model.contact.gap_at(3e-4), fresh.model.contact.gap_at(3e-4))
+    a, b = sim.ran[0], fresh.ran[0]
+    assert a.status == b.status
+    np.testing.assert_allclose(a.impulse, b.impulse, rtol=0, atol=1e-9 * np.abs(b.impulse).max())
+    assert sim.report["reduction"]["error"]["estimate"] == pytest.approx(
+        fresh.report["reduction"]["error"]["estimate"], rel=1e-6
+    )
+
+
+def test_a_point_the_model_cannot_take_as_a_parameter_is_built_in_full():
+    """At rest, or with a prestress that depends on the speed, the point is built again."""
+    from femrub.app.simulation import SceneBuilds
+
+    scene = load_scene("twisted-naca", {**SMALL, "scheme.t_end": 2e-5})
+    builds = SceneBuilds()
+    builds.build(scene)
+    assert "parametric" not in builds.build(scene.with_changes({"contact.friction": 0.1})).report
+    prestressed = {"loads.centrifugal": "linear"}
+    builds.build(scene.with_changes(prestressed))
+    other = builds.build(scene.with_changes({**prestressed, "loads.rotation_speed": 1400.0}))
+    assert "parametric" not in other.report
+    assert other.full.parameters["rotation_speed"] == 1400.0
 
 
 def test_a_coated_reduced_run_is_estimated_on_lean_runs_and_stepped_again():

@@ -123,11 +123,12 @@ def test_the_map_draws_temperature_and_wear_only_where_the_scene_models_them():
 
 
 def test_the_first_point_fills_the_cache_alone():
-    """With a cache the first point runs alone and the others load what it stored; without
-    one every point starts at once."""
+    """With a cache the first point runs alone and the others load what it stored; the
+    points then run as one chunk of consecutive points per worker (at most one per point)."""
     from femrub.app.sweep import _batches
 
     todo, cache = [{"point": i} for i in range(4)], object()
-    assert _batches(todo, cache) == [todo[:1], todo[1:]]
-    assert _batches(todo, None) == [todo]
-    assert _batches(todo[:1], cache) == [todo[:1]]
+    assert _batches(todo, cache, 2) == [[todo[:1]], [todo[1:3], todo[3:]]]
+    assert _batches(todo, None, 2) == [[todo[:2], todo[2:]]]
+    assert _batches(todo, None, 8) == [[[r] for r in todo]]
+    assert _batches(todo[:1], cache, 2) == [[todo[:1]]]

@@ -38,18 +38,19 @@ functions and signals from the full model built in this run. Every key also hold
 On a hit ``Simulation.reductor`` is ``None`` (the reduced model carries what the run needs,
 including its map to the mesh).
 
-A sweep worker keeps the last assembly it built or loaded (:func:`keep_assemblies`): the
-next point of a speed sweep on the same dask worker takes it from memory instead of the
-cache folder; it keeps its discretisation (the finite-element bases of the mesh) likewise.
+Builds of one blade in a row (the points of a sweep in one worker,
+:class:`femrub.app.simulation.SceneBuilds`) share a :class:`Kept`: the last discretisation
+(the finite-element bases of the mesh), assembly, reductor and map to the mesh built or
+loaded, so the next build takes them from memory instead of the cache folder. A
+:class:`Stages` without one keeps nothing beyond its own build.
 
-A reduced model missing from the cache but whose bases this process already built (the
-next point of a speed sweep on a dask worker: same matrices, same ``reduction`` options,
-given sizes) reuses that reductor (:data:`_REDUCTORS`, the last one only) with the reduced
-operators it projected (:mod:`femrub.reduction.truncation`): only the reduction error
-estimate runs again; the static shapes, modes and projection do not. The reductor is also
-stored in the cache (stage ``bases``, without its full model; key: the reduced model's key
-without what only the run depends on), so that another process (the other sweep worker, a
-later sweep or run at another speed) loads it instead of building it.
+A reduced model missing from the cache whose bases the :class:`Kept` holds (same matrices,
+same ``reduction`` options, given sizes) reuses that reductor with the reduced operators it
+projected (:mod:`femrub.reduction.truncation`): only the reduction error estimate runs
+again; the static shapes, modes and projection do not. The reductor is also stored in the
+cache (stage ``bases``, without its full model; key: the reduced model's key without what
+only the run depends on), so that another process (the other sweep worker, a later sweep or
+run at another speed) loads it instead of building it.
 """
 
 from __future__ import annotations
@@ -67,35 +68,43 @@ from ..reduction.sizes import natural_frequencies
 from ..reduction.truncation import ColumnMap
 from .cache import content_key
 
-__all__ = ["Stages", "keep_assemblies"]
-
-#: the last reductor this process built, ``{key: reductor}`` (its bases are speed-free)
-_REDUCTORS: dict = {}
-#: the last map to the mesh of a largest reduced model this process stored or loaded,
-#: ``{key: (n, r) array}`` (the next point of a sweep on this worker: the same map)
-_MAPS: dict = {}
-#: the last discretisation of a sweep worker (:func:`keep_assemblies`), ``{key: disc}``
-_DISCRETISED: dict = {}
-#: the last assembly this process built or loaded, ``{key: blocks without their bases}``,
-#: once :func:`keep_assemblies` is called (``None``: not kept)
-_ASSEMBLED: dict | None = None
+__all__ = ["Kept", "Stages"]
 
 
-def keep_assemblies() -> None:
-    """Keep the last assembly in this process from now on (a sweep worker: every point on
-    the blade has the same blocks; they are then neither loaded nor assembled again)."""
-    global _ASSEMBLED
-    if _ASSEMBLED is None:
-        _ASSEMBLED = {}
+@dataclasses.dataclass
+class Kept:
+    """What builds of one blade in a row keep in memory, the last of each, ``{key: value}``.
+
+    ``discretisation``: the finite-element bases of the mesh; ``assembly``: the Eq. (2)
+    blocks without their bases (``assembly_key``: its key); ``reductor``: the last reductor
+    built or loaded, detached from its full model (its bases are speed-free); ``map``: the
+    map to the mesh of the largest reduced model (the same for every speed).
+    """
+
+    discretisation: dict = dataclasses.field(default_factory=dict)
+    assembly: dict = dataclasses.field(default_factory=dict)
+    reductor: dict = dataclasses.field(default_factory=dict)
+    map: dict = dataclasses.field(default_factory=dict)
+    assembly_key: str | None = None
+
+    @staticmethod
+    def last(memo: dict, key, value) -> None:
+        """Keep ``value`` under ``key`` in ``memo``, in place of what it held."""
+        memo.clear()
+        memo[key] = value
 
 
 class Stages:
-    """The cached stages; ``cache``: a :class:`~femrub.app.cache.ModelCache` or ``None``."""
+    """The cached stages; ``cache``: a :class:`~femrub.app.cache.ModelCache` or ``None``;
+    ``kept``: a :class:`Kept` shared with the builds before and after this one (``None``:
+    this build keeps nothing for another)."""
 
-    def __init__(self, cache=None, log=None):
+    def __init__(self, cache=None, log=None, kept: Kept | None = None):
         self.cache, self.log = cache, log
+        self.in_a_row = kept is not None
+        self.kept = kept if kept is not None else Kept()
         self.hits: dict[str, bool] = {}
-        self._mats_key = None
+        self._mats_key = self.kept.assembly_key if self.in_a_row else None
         self._stiffness = None  # the interior factorisation of the damping, for ``reduce``
         if cache is not None and log is not None and cache.log is None:
             cache.log = log
@@ -118,10 +127,10 @@ class Stages:
             self._say(f"cache: {stage} stored in {time.perf_counter() - t0:.2f} s ({key[:12]})")
 
     def discretise(self, blade, order: int, clamped: bool = True):
-        """:func:`~femrub.fem.discretisation.discretise` of ``blade``; a sweep worker
-        (:func:`keep_assemblies`) keeps the last one and hands its bases to the next point
-        on the same mesh (key: vertices, cells, node sets, curved edge midpoints, order)."""
-        if _ASSEMBLED is None:
+        """:func:`~femrub.fem.discretisation.discretise` of ``blade``; builds in a row
+        (:class:`Kept`) keep the last one and hand its bases to the next build on the same
+        mesh (key: vertices, cells, node sets, curved edge midpoints, order)."""
+        if not self.in_a_row:
             return discretise(blade, order, clamped=clamped)
         mesh = blade.mesh
         key = content_key(
@@ -134,13 +143,12 @@ class Stages:
             order,
             clamped,
         )
-        kept = _DISCRETISED.get(key)
+        kept = self.kept.discretisation.get(key)
         if kept is not None:
             self._say(f"discretisation kept by this process ({key[:12]})")
             return dataclasses.replace(kept, blade=blade)
         disc = discretise(blade, order, clamped=clamped)
-        _DISCRETISED.clear()
-        _DISCRETISED[key] = disc
+        Kept.last(self.kept.discretisation, key, disc)
         return disc
 
     def assemble(self, disc, material, **kw):
@@ -159,7 +167,7 @@ class Stages:
             kw,
         )
         self._mats_key = key
-        mats = _ASSEMBLED.get(key) if _ASSEMBLED is not None else None
+        mats = self.kept.assembly.get(key) if self.in_a_row else None
         if mats is not None:
             self.hits["assembly"] = True
             self._say(f"cache: assembly kept by this process ({key[:12]})")
@@ -169,9 +177,9 @@ class Stages:
             mats = assemble(disc, material, **kw)
             mats = dataclasses.replace(mats, basis_u=None, basis_t=None)
             self._keep("assembly", key, mats, f"{mats.n_u} + {mats.n_t} FE dofs")
-        if _ASSEMBLED is not None:  # the next point of a sweep on this worker: same blocks
-            _ASSEMBLED.clear()
-            _ASSEMBLED[key] = mats
+        if self.in_a_row:  # the next build on this blade: the same blocks
+            Kept.last(self.kept.assembly, key, mats)
+            self.kept.assembly_key = key
         return dataclasses.replace(mats, basis_u=disc.basis_u, basis_t=disc.basis_t)
 
     def damping(self, zeta: float, modes: tuple[int, int]):
@@ -249,73 +257,66 @@ class Stages:
         ``make_stepper`` (for the reduction error estimate, which steps the run itself)
         puts the scene's ``scheme``, ``loads`` and ``contact`` and the stop ``limits`` it
         applies to its runs into the key. ``on_run``: see ``reduce_checked`` (not called on a
-        cache hit: nothing is stepped).
+        cache hit: nothing is stepped). Builds in a row reuse the kept reductor of the same
+        matrices, with or without a cache.
         """
         stiffness, self._stiffness = self._stiffness, None
         kw = {"limits": limits, "on_run": on_run, "stiffness": stiffness}
-        if self.cache is None or self._mats_key is None:
-            out = reduce_checked(model, scene, log, make_stepper, **kw)
+        opts = dict(scene["reduction"])
+        stored = self.cache is not None and self._mats_key is not None
+        if opts["method"] == "none" or not (stored or self.in_a_row):
+            out = reduce_checked(model, scene, log, make_stepper, **kw)  # nothing stored
             _say_phases(self._say, out[0].info.get("timings", {}))
             return out
-        opts = dict(scene["reduction"])
-        if opts["method"] == "none":
-            return reduce_checked(model, scene, log, make_stepper, **kw)  # nothing stored
-        t_end = scene["scheme"]["t_end"] if opts["method"] == "auto" else None
-        run = None  # what the estimate's runs depend on
-        if make_stepper:
-            run = [dict(scene[k]) for k in ("scheme", "loads", "contact")] + [dict(limits or {})]
-            for key in ("step_check", "step_tolerance"):  # the time-step check's keys
-                run[0].pop(key, None)
-        model_key = self._model_key(model)  # hashed once: both keys below derive from it
-        key = content_key(model_key, "reduction", opts, t_end, run)
+        model_key = self._model_key(model)  # hashed once: the keys below derive from it
         map_key = content_key(model_key, "map", opts)  # the largest model's map: speed-free
-        hit = self._fetch("reduction", key)
-        if hit is not None:
-            hit = self._with_map(hit, map_key)
-        if hit is not None:
-            if stiffness is not None:
-                stiffness.free()
-            return _attach(hit, model), None, dict(hit["report"], cache="hit")
+        key = content_key(model_key, "reduction", opts, _run_key(scene, make_stepper, limits))
+        if stored:
+            hit = self._fetch("reduction", key)
+            hit = None if hit is None else self._with_map(hit, map_key)
+            if hit is not None:
+                if stiffness is not None:
+                    stiffness.free()
+                return _attach(hit, model), None, dict(hit["report"], cache="hit")
         bases = content_key(model_key, "bases", opts) if opts["method"] != "auto" else None
-        kept = _REDUCTORS.get(bases)
-        if kept is None and bases is not None:  # built by another process (sweep worker)
+        kept = self.kept.reductor.get(bases)
+        if kept is None and bases is not None and stored:  # built by another process
             kept = self._fetch("bases", bases)
         reduced, reductor, report = reduce_checked(
             model, scene, log, make_stepper, reductor=kept, **kw
         )
-        if bases is not None:
-            _REDUCTORS.clear()
-            _REDUCTORS[bases] = reductor.detached()  # not the model of this point
-            if kept is None:
-                self._keep(
-                    "bases",
-                    bases,
-                    _REDUCTORS[bases],
-                    f"{reductor.n_uv} + {reductor.n_theta} shapes on {model.n_dofs} dofs",
-                )
         _say_phases(self._say, reduced.info.get("timings", {}))
-        entry, shared = _detach(reduced, report, reductor.R.shape[1])
-        if shared is not None and _MAPS.get(map_key) is not shared:
-            self._keep("map", map_key, shared, f"map to the mesh {shared.shape}")
-            _MAPS.clear()
-            _MAPS[map_key] = shared
-        self._keep("reduction", key, entry, f"{reduced.n_dofs} dofs")
+        if bases is not None:
+            detached = reductor.detached()  # not the model of this point
+            Kept.last(self.kept.reductor, bases, detached)
+            if kept is None and stored:
+                shapes = f"{reductor.n_uv} + {reductor.n_theta} shapes on {model.n_dofs} dofs"
+                self._keep("bases", bases, detached, shapes)
+        if stored:
+            self._store_reduction(key, map_key, reduced, reductor, report)
         return reduced, reductor, report
+
+    def _store_reduction(self, key, map_key, reduced, reductor, report) -> None:
+        """Store ``reduced`` (entry ``reduction``) and its largest model's map (``map``)."""
+        entry, shared = _detach(reduced, report, reductor.R.shape[1])
+        if shared is not None and self.kept.map.get(map_key) is not shared:
+            self._keep("map", map_key, shared, f"map to the mesh {shared.shape}")
+            Kept.last(self.kept.map, map_key, shared)
+        self._keep("reduction", key, entry, f"{reduced.n_dofs} dofs")
 
     def _with_map(self, hit: dict, map_key: str):
         """A stored reduction with its map to the mesh (kept by this process, or the cache's
         ``map`` entry); ``None`` when that entry is missing or corrupt: the caller rebuilds."""
         if hit.get("map") is None:  # stored with its own map
             return hit
-        full = _MAPS.get(map_key)
+        full = self.kept.map.get(map_key)
         if full is None:
             full = self._fetch("map", map_key)
             if full is None:
                 self.hits["reduction"] = False
                 self._say("cache: the reduction's map to the mesh is not in the cache; rebuilding")
                 return None
-            _MAPS.clear()
-            _MAPS[map_key] = full
+            Kept.last(self.kept.map, map_key, full)
         cols = hit["map"]["columns"]
         to_full = full if cols is None else ColumnMap(full, cols)
         return dict(hit, model=hit["model"].with_(to_full=to_full))
@@ -330,6 +331,20 @@ class Stages:
             f = natural_frequencies(model, k)
             self._keep("frequencies", key, np.asarray(f), f"{k} frequencies")
         return f
+
+
+def _run_key(scene, make_stepper, limits) -> list:
+    """What a reduction's estimate depends on beyond the model: for ``"auto"`` the end time
+    that sets its thermal frequencies; with ``make_stepper`` the scene's ``scheme`` (without
+    the time-step check's keys), ``loads`` and ``contact`` and the stop ``limits``."""
+    opts = scene["reduction"]
+    t_end = scene["scheme"]["t_end"] if opts["method"] == "auto" else None
+    if not make_stepper:
+        return [t_end, None]
+    run = [dict(scene[k]) for k in ("scheme", "loads", "contact")] + [dict(limits or {})]
+    for key in ("step_check", "step_tolerance"):
+        run[0].pop(key, None)
+    return [t_end, run]
 
 
 def _mesh_parts(disc) -> tuple:

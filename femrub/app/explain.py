@@ -223,6 +223,15 @@ def _output_rows(report: dict) -> list[tuple[str, str]]:
 def explain(report: dict, reach_key=None) -> str:
     """Format a build report (:func:`femrub.app.simulation.build`) as aligned text."""
     rows = [("scene", f"{report['scene']} ({report['source']})"), ("geometry", report["geometry"])]
+    p = report.get("parametric")
+    if p:
+        rows.append(
+            (
+                "model",
+                f"the model built at {p['from_rotation_speed']:g} rad/s taken at "
+                f"{p['rotation_speed']:g} rad/s (its parameter; matrices and contacts shared)",
+            )
+        )
     rows += _model_rows(report)
     rows += _casing_rows(report)
     rows += _contact_rows(report, reach_key)

@@ -12,6 +12,7 @@ run, not a paper or sweep folder, no finished or unreadable result unless ``over
 from __future__ import annotations
 
 import copy
+import functools
 import hashlib
 import json
 import math
@@ -110,6 +111,7 @@ def run_scene(
     on_built=None,
     modes=0,
     cache=None,
+    builds=None,
 ):
     """Build and run ``scene`` into the folder ``out``; return ``(results, built)``.
 
@@ -124,12 +126,15 @@ def run_scene(
     on_built : callable ``f(built)`` called after the build, before the first step.
     modes : natural frequencies to compute and report (``build.natural_frequencies_hz``).
     cache : a :class:`~femrub.app.cache.ModelCache` of assembled and reduced models.
+    builds : a :class:`~femrub.app.simulation.SceneBuilds` that builds the scene (with its
+        own cache, in place of ``cache``) from what it built before (the points of a sweep).
     """
     out = Path(out)
     check_run(scene)
     _check_not_the_scene(scene, out)
     with claim(out, "run", overwrite=overwrite):
-        return _run_claimed(scene, out, progress, log, on_built, modes, cache)
+        make = builds or functools.partial(build, cache=cache)
+        return _run_claimed(scene, out, progress, log, on_built, modes, make)
 
 
 def _check_not_the_scene(scene: Scene, out: Path) -> None:
@@ -143,9 +148,9 @@ def _check_not_the_scene(scene: Scene, out: Path) -> None:
         )
 
 
-def _run_claimed(scene, out, progress, log, on_built, modes, cache):
+def _run_claimed(scene, out, progress, log, on_built, modes, make):
     try:
-        built = build(scene, log=log, modes=modes, cache=cache)
+        built = make(scene, log=log, modes=modes)
     except OSError as exc:  # a read error: the folder says so too
         write_json(out / "summary.json", {"status": "failed", "message": describe_os_error(exc)})
         raise

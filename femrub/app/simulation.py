@@ -23,7 +23,7 @@ the model a second time. The paper's bar and a 3D blade go through the same path
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -37,7 +37,7 @@ from ..scene.spec import SceneError, fail
 from . import translate as tr
 from .blade import load_blade
 from .build_warnings import initial_penetration, warn
-from .cached import Stages
+from .cached import Kept, Stages
 from .casing import footprint_warning
 from .explain import explain
 from .scheme import bare_stepper, stepper_of
@@ -46,6 +46,7 @@ __all__ = [
     "MAX_CLEARANCE_RATIO",
     "MAX_DISPLACEMENT_RATIO",
     "MAX_TEMPERATURE_RISE",
+    "SceneBuilds",
     "Simulation",
     "blade_size",
     "build",
@@ -106,13 +107,22 @@ class Simulation:
 
     @classmethod
     def from_scene(
-        cls, scene, *, log=None, modes: int = 0, cache=None, stepper: bool = True
+        cls,
+        scene,
+        *,
+        log=None,
+        modes: int = 0,
+        cache=None,
+        stepper: bool = True,
+        kept: Kept | None = None,
     ) -> Simulation:
         """Build ``scene``; ``modes``: natural frequencies to report; ``cache``: a
         :class:`~femrub.app.cache.ModelCache` for the assembled and reduced models
         (:mod:`femrub.app.cached`), ``None`` to build everything; ``stepper=False``: no
         stepper (``None``; e.g. a full Rotor 37 model to reduce, whose iteration matrix
-        would not be factorised on a small machine).
+        would not be factorised on a small machine); ``kept``: a
+        :class:`~femrub.app.cached.Kept` shared by builds of one blade in a row
+        (:class:`SceneBuilds`).
 
         Raises
         ------
@@ -121,12 +131,50 @@ class Simulation:
             the stability limit, ...).
         """
         with progress.reporting(log):  # factorisations, eigen-solves, reduction phases
-            return _build(scene, log, modes, Stages(cache, log), stepper)
+            return _build(scene, log, modes, Stages(cache, log, kept), stepper)
 
 
 def build(scene, *, log=None, modes: int = 0, cache=None, stepper: bool = True) -> Simulation:
     """:meth:`Simulation.from_scene`."""
     return Simulation.from_scene(scene, log=log, modes=modes, cache=cache, stepper=stepper)
+
+
+class SceneBuilds:
+    """Builds of scenes on one blade in a row (the points of a sweep in one worker).
+
+    Each build shares a :class:`~femrub.app.cached.Kept` with the others (the mesh's
+    bases, the assembled blocks, the reductor and the map to the mesh: the last of each).
+    A scene that differs from the previous one only in the rotation speed (both above 0,
+    no centrifugal prestress, no coating or casing heat, no tip force at an engine order)
+    is not built again: the previous full model at the new speed
+    (:meth:`~femrub.model.first_order.FirstOrderModel.with_parameters`, its matrices,
+    contacts and reach filter shared) is reduced with the kept reductor and checked
+    (reduction error estimate, time-step check) like any build. A refused scene is built
+    in full (``report["parametric"]`` says which).
+
+    Parameters
+    ----------
+    cache : a :class:`~femrub.app.cache.ModelCache` or ``None``.
+    """
+
+    def __init__(self, cache=None):
+        self.cache, self.kept, self._last = cache, Kept(), None
+
+    def build(self, scene, *, log=None, modes: int = 0) -> Simulation:
+        """The :class:`Simulation` of ``scene`` (the class docstring says what is reused)."""
+        sim = None
+        if self._last is not None and _differs_only_in_speed(self._last.scene, scene):
+            with progress.reporting(log):
+                sim = _at_speed(self._last, scene, Stages(self.cache, log, self.kept), log, modes)
+        if sim is None:
+            sim = Simulation.from_scene(
+                scene, log=log, modes=modes, cache=self.cache, kept=self.kept
+            )
+        # what the next build may take: the models, not this run's stepper or results
+        self._last = replace(sim, stepper=None, ran=None)
+        return sim
+
+    __call__ = build
 
 
 class _Clock:
@@ -169,10 +217,26 @@ def _build(scene, log, modes, stages, with_stepper=True) -> Simulation:
     built = _full_model(scene, blade, stages, log, report)
     clock.done("assembly", f"{built.model.n_dofs} state dofs")
     _report_full(scene, built, report)
-    model, limits = _select_signals(scene, built.model, report, size)
-    if modes:
+    full = _Full(built.model, built.fields, size)
+    return _runnable(scene, full, stages, log, modes, report, clock, with_stepper)
+
+
+@dataclass(frozen=True)
+class _Full:
+    """The full model of a build, its fields on the mesh and the blade's size (m)."""
+
+    model: object
+    fields: object
+    size: float
+
+
+def _runnable(scene, full: _Full, stages, log, modes, report, clock, with_stepper) -> Simulation:
+    """The :class:`Simulation` of a full model: its signals and limits, natural frequencies,
+    reduction (checked) and stepper."""
+    model, limits = _select_signals(scene, full.model, report, full.size)
+    if modes and len(report.get("natural_frequencies_hz", ())) != modes:
         report["natural_frequencies_hz"] = stages.frequencies(model, modes).tolist()
-    reduced, reductor, ran = _reduce(scene, model, built.model, stages, log, limits, report, clock)
+    reduced, reductor, ran = _reduce(scene, model, full.model, stages, log, limits, report, clock)
     report["model"] = {"n_dofs": reduced.n_dofs, **_layout(reduced)}
     stepper = stepper_of(scene, reduced, report) if with_stepper else None
     report["outputs"] = {
@@ -183,8 +247,8 @@ def _build(scene, log, modes, stages, with_stepper=True) -> Simulation:
     return Simulation(
         scene,
         reduced,
-        built.model,
-        built.fields,
+        full.model,
+        full.fields,
         reductor,
         stepper,
         limits,
@@ -192,6 +256,47 @@ def _build(scene, log, modes, stages, with_stepper=True) -> Simulation:
         clock.timings,
         ran,
     )
+
+
+#: what a build at another speed reports anew (the rest is the previous build's report)
+_PER_BUILD = ("reduction", "time_step", "model", "timings", "scene", "source")
+
+
+def _differs_only_in_speed(before, scene) -> bool:
+    """Whether ``scene`` is ``before`` at another rotation speed that the model of
+    ``before`` can take as its parameter (:class:`SceneBuilds`)."""
+    speeds = (before["loads"]["rotation_speed"], scene["loads"]["rotation_speed"])
+    force = scene["loads"]["tip_force"]
+    if min(speeds) <= 0.0 or force.get("frequency") == "rotation":
+        return False  # the reach filter depends on Ω: at rest, or the forcing frequency
+    if (before.source, before.base_dir) != (scene.source, scene.base_dir):
+        return False
+    return _but_speed(before.data) == _but_speed(scene.data)
+
+
+def _but_speed(data: dict) -> dict:
+    """The scene's data without its rotation speed."""
+    loads = {k: v for k, v in data["loads"].items() if k != "rotation_speed"}
+    return {**data, "loads": loads}
+
+
+def _at_speed(last: Simulation, scene, stages, log, modes) -> Simulation | None:
+    """``last`` at the rotation speed of ``scene`` (:class:`SceneBuilds`); ``None`` when its
+    model refuses the speed as a parameter (a prestress, a coating or casing heat)."""
+    omega = scene["loads"]["rotation_speed"]
+    try:
+        model = last.full.with_parameters(rotation_speed=omega)
+    except ValueError:
+        return None
+    check_run(scene)
+    clock = _Clock(log)
+    report = {k: v for k, v in last.report.items() if k not in _PER_BUILD}
+    report.update(scene=scene.name, source=scene.source)
+    before = last.full.parameters["rotation_speed"]
+    report["parametric"] = {"from_rotation_speed": before, "rotation_speed": omega}
+    clock.done("assembly", f"the model at {before:g} rad/s taken at {omega:g} rad/s")
+    full = _Full(model, last.fields, report["blade_size"])
+    return _runnable(scene, full, stages, log, modes, report, clock, True)
 
 
 def _full_model(scene, blade, stages, log, report) -> RubBuild:

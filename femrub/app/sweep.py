@@ -1,8 +1,10 @@
 """Parameter sweeps of a scene on dask.distributed, resumable, with an interaction map.
 
 ``femrub sweep SCENE --param rotation_speed=200:2000:50 -o DIR`` runs every point of the
-grid (cartesian product of the ``--param`` values) as one task that writes its own results
-folder ``DIR/runs/NNN_key=value/`` (:func:`femrub.scene.run_scene`). Tasks run on a
+grid (cartesian product of the ``--param`` values), each writing its own results folder
+``DIR/runs/NNN_key=value/`` (:func:`femrub.scene.run_scene`), in one chunk of consecutive
+points per worker (:func:`run_points`: a point at another speed reuses the model of the
+point before, the speed being its parameter). Chunks run on a
 ``LocalCluster`` of this machine (2 worker processes, 1 thread each, by default) or on the
 cluster behind ``--scheduler ADDRESS`` (the output folder must then be shared). A point
 whose folder holds a finished result is skipped, so rerunning the command after a failure
@@ -33,10 +35,10 @@ from ..output.safe_write import atomic_file, write_atomic
 from ..scene import SceneError, parse_value, resolve_key
 from ..scene.run_checks import check_run
 from ..scene.scene import Scene
-from .cached import keep_assemblies
 from .run import run_scene, scene_hash
+from .simulation import SceneBuilds
 
-__all__ = ["parse_param", "grid", "run_point", "point_metrics", "run_sweep"]
+__all__ = ["parse_param", "grid", "run_point", "run_points", "point_metrics", "run_sweep"]
 
 _RANGE = re.compile(r"^\s*([^:]+):([^:]+):([^:]+?)\s*([A-Za-zµμ/^]+[A-Za-z0-9µμ/^]*)?\s*$")
 #: natural frequencies computed for the Campbell diagram
@@ -137,16 +139,32 @@ def _rms(path, key):
     return float(np.sqrt(np.mean(x**2))) if x.size else None
 
 
+def run_points(scene_data: dict, source: str, base_dir: str, points: list, cache=None) -> list:
+    """Run ``points`` (``[(changes, folder), ...]``) in order in one worker and return their
+    rows; never raises: a failed point comes back as its row.
+
+    Their models come from one :class:`~femrub.app.simulation.SceneBuilds`: a point at
+    another rotation speed than the one before takes the previous point's model at its own
+    speed (its parameter) instead of building one; any other point shares the mesh's bases,
+    the assembled blocks and the reductor the points before it built. ``cache``: a
+    :class:`~femrub.app.cache.ModelCache` shared by the workers.
+    """
+    base = Scene(scene_data, source, Path(base_dir))
+    builds = SceneBuilds(cache)
+    return [_run_one(base.with_changes(changes), out, builds) for changes, out in points]
+
+
 def run_point(
     scene_data: dict, source: str, base_dir: str, changes: dict, out: str, cache=None
 ) -> dict:
-    """Run one point (in a worker); never raises: failures come back as a row.
+    """Run one point (:func:`run_points` of that point alone)."""
+    (row,) = run_points(scene_data, source, base_dir, [(changes, out)], cache)
+    return row
 
-    ``cache``: a :class:`~femrub.app.cache.ModelCache` shared by the points."""
-    keep_assemblies()  # the worker's next points load nothing the blade's blocks already hold
+
+def _run_one(scene: Scene, out: str, builds: SceneBuilds) -> dict:
     try:
-        scene = Scene(scene_data, source, Path(base_dir)).with_changes(changes)
-        run_scene(scene, out, overwrite=True, modes=N_MODES, cache=cache)
+        run_scene(scene, out, overwrite=True, modes=N_MODES, builds=builds)
     except Exception as exc:  # a bad point must not stop the sweep
         msg = f"{type(exc).__name__}: {exc}".splitlines()[0]
         try:
@@ -293,27 +311,27 @@ def _compute(scene, todo, scheduler, workers, progress, cache=None) -> None:
     from tqdm.auto import tqdm
 
     client, cluster = _client(scheduler, workers)
+    n_workers = len(client.scheduler_info().get("workers", {})) or workers
 
-    def submit(rows):
+    def submit(chunks):
         return {
             client.submit(
-                run_point,
+                run_points,
                 scene.data,
                 scene.source,
                 str(scene.base_dir),
-                r["params"],
-                r["folder"],
+                [(r["params"], r["folder"]) for r in chunk],
                 cache,
                 pure=False,
-                key=f"femrub-point-{r['point']}-{id(r)}",
-            ): r
-            for r in rows
+                key=f"femrub-points-{chunk[0]['point']}-{id(chunk)}",
+            ): chunk
+            for chunk in chunks
         }
 
     try:
         bar = tqdm(total=len(todo), disable=not progress, unit="point", desc="sweep")
-        for batch in _batches(todo, cache):
-            _collect(submit(batch), bar)
+        for chunks in _batches(todo, cache, n_workers):
+            _collect(submit(chunks), bar)
         bar.close()
     finally:
         client.close()
@@ -321,30 +339,37 @@ def _compute(scene, todo, scheduler, workers, progress, cache=None) -> None:
             cluster.close()
 
 
-def _batches(todo: list, cache) -> list[list]:
-    """The points to submit together, in order.
+def _batches(todo: list, cache, workers: int) -> list[list[list]]:
+    """The points to submit together, in order, as one chunk of consecutive points per
+    worker (:func:`run_points`: a chunk builds its model once and takes it at each speed).
 
     With a cache and more than one point, the first point runs alone and fills the cache
-    (assembly, damping, reduction bases, map to the mesh); every other point then loads
-    them (a sweep worker's first point would otherwise build them again: on Rotor 37 two
+    (assembly, damping, reduction bases, map to the mesh); the other chunks then load
+    them (a worker's first point would otherwise build them again: on Rotor 37 two
     workers building at once took longer each than one alone). The first point keeps the
     worker's one BLAS thread: its bases are then the same from run to run (a threaded
     sparse factorisation is not), and so are the verdicts of the points that share them."""
-    if cache is None or len(todo) < 2:
-        return [todo]
-    return [todo[:1], todo[1:]]
+    first = todo[:1] if cache is not None and len(todo) > 1 else []
+    rest = todo[len(first) :]
+    n = max(1, min(workers, len(rest)))
+    size, extra = divmod(len(rest), n)
+    cuts = np.cumsum([0] + [size + (i < extra) for i in range(n)])
+    chunks = [rest[a:b] for a, b in zip(cuts[:-1], cuts[1:]) if b > a]
+    return [[first]] * bool(first) + [chunks] * bool(chunks)
 
 
 def _collect(futures, bar) -> None:
     from dask.distributed import as_completed
 
     for fut in as_completed(futures):
-        r = futures[fut]
+        chunk = futures[fut]
         try:
-            r.update(fut.result())
+            for r, row in zip(chunk, fut.result(), strict=True):
+                r.update(row)
         except Exception as exc:  # worker lost, etc.
-            r.update(status="failed", message=f"{type(exc).__name__}: {exc}")
-        bar.update(1)
+            for r in chunk:
+                r.update(status="failed", message=f"{type(exc).__name__}: {exc}")
+        bar.update(len(chunk))
 
 
 def _x(scene, key) -> float:
