@@ -198,7 +198,8 @@ class _Clock:
 def _build(scene, log, modes, stages, with_stepper=True) -> Simulation:
     scene.check_files()
     check_run(scene)
-    if jit.compile_in_background() and log:  # the first run on this machine: overlapped
+    # the first run on this machine: the kernels it needs, compiled beside the build
+    if jit.compile_in_background(tr.kernel_kinds(scene)) and log:
         log("compiling the contact kernels in a background process (first run here) ...")
     clock = _Clock(log)
     report = {

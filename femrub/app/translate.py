@@ -63,6 +63,18 @@ def coupling_of(scene) -> str:
     return c if c != "auto" else ("paper" if is_bar(scene) else "physical")
 
 
+def kernel_kinds(scene) -> tuple[str, ...]:
+    """The contact kernel families a run of ``scene`` may step with
+    (:data:`femrub.contact.activation.KERNEL_KINDS`): one frictionless contact (the bar and
+    frictionless blades), Coulomb friction on a blade, and the rub block when the friction
+    heats the blade by its power or cuts an abradable coating."""
+    c = scene["contact"]
+    if is_bar(scene) or not c["friction"]:
+        return ("one",)
+    coated = c["abradable"]["thickness"] > 0.0
+    return ("friction", "rub") if coated or heat_law_of(scene) == "power" else ("friction",)
+
+
 def heat_law_of(scene) -> str:
     """``"alpha"`` (α given; the bar's default) or ``"power"`` (η × friction power; blades)."""
     law = scene["contact"].get("heat_law", "auto")

@@ -80,7 +80,7 @@ __all__ = [
     "impulse_one",
     "impulses",
     "compile_kernels",
-    "compile_blocks",
+    "KERNEL_KINDS",
 ]
 
 RULES = ("position", "capped", "paper", "plain", "predicted")
@@ -233,57 +233,36 @@ def rule_code(rule: str) -> int:
     return PREDICTED if check_rule(rule) == "predicted" else FIXED_POINT
 
 
-def compile_kernels() -> None:
-    """Compile :func:`frictional_fixed_point` and the frictional solve for the argument
-    types of a step (or load them from numba's on-disk cache), so that a run's first
-    contact step does not pay for it. Without compilation (``NUMBA_DISABLE_JIT=1``) a no-op.
+#: the kernel families a run may need: ``"one"`` (one frictionless contact on a fixed
+#: obstacle, the impulse in closed form), ``"friction"`` (the frictional fixed point and its
+#: block) and ``"rub"`` (the block with the power heat fixed point and the wear map's cut)
+KERNEL_KINDS = ("one", "friction", "rub")
+
+
+def compile_kernels(kinds=KERNEL_KINDS) -> None:
+    """Compile (or load from numba's on-disk cache) the contact kernels of ``kinds``
+    (:data:`KERNEL_KINDS`) for the argument types of a run, so that its first contact step
+    does not pay for it; no step is taken (blocks of zero rows). Only what a run needs is
+    compiled: a fresh machine's first frictionless run compiles one family, not three.
+    Without compilation (``NUMBA_DISABLE_JIT=1``) a no-op.
     """
-    from .friction import solve_frictional_contact
     from .jit import compiled, wait_background
 
+    unknown = sorted(set(kinds) - set(KERNEL_KINDS))
+    if unknown:
+        raise ValueError(f"unknown kernel kinds {unknown}; known: {list(KERNEL_KINDS)}")
     if not compiled():
         return
     wait_background()  # a build's child compiling them (jit.compile_in_background)
-    one, z, W = np.ones(1), np.zeros(1), np.eye(3)
-    q = np.array([[-1.0, 0.0, 0.0]])
-    for code in (FIXED_POINT, PREDICTED):
-        frictional_fixed_point(
-            code,
-            -one,
-            -one,
-            -one,
-            np.ones((1, 3)),
-            W,
-            q,
-            one * 0.1,
-            z,
-            z.copy(),
-            np.full(1, np.inf),
-            np.zeros((1, 3)),
-            False,
-            1.0,
-            0.5,
-            1e-12,
-            60,
-        )
-    solve_frictional_contact(W, q, 0.1, np.ones(1, dtype=bool))
-    compile_blocks()
+    for kind in KERNEL_KINDS:
+        if kind in kinds:
+            _COMPILE[kind]()
 
 
-def compile_blocks() -> None:
-    """Compile (or load) the θ-method's block kernels of :mod:`femrub.contact.theta_block`
-    and :mod:`femrub.contact.rub_block`, and the wear map's cut
-    (:func:`femrub.contact.wear_map.cut_sweeps`), for the argument types of a run (no step
-    is taken: blocks of zero rows)."""
-    from .jit import compiled, wait_background
-    from .rub_block import rub_block
-    from .theta_block import friction_block, one_contact_block
-    from .wear_map import cut_sweeps
+def _compile_one() -> None:
+    from .theta_block import one_contact_block
 
-    if not compiled():
-        return
-    wait_background()  # a build's child compiling them (jit.compile_in_background)
-    N, E, one, z = 2, np.empty, np.ones(1), np.zeros(1)
+    N, E = 2, np.empty
     T, Y, sig = np.eye(N), np.zeros((N, 0)), np.zeros((1, 0))
     one_contact_block(
         np.zeros(N),
@@ -305,6 +284,12 @@ def compile_blocks() -> None:
         E((0, N)),
         E((0, 1)),
     )
+
+
+def _block_arguments() -> tuple:
+    """Arguments of a frictional block of zero rows: ``(head, rows)``."""
+    N, E, one = 2, np.empty, np.ones(1)
+    T, Y, sig = np.eye(N), np.zeros((N, 0)), np.zeros((1, 0))
     rows = (E((0, N)), E((0, 1)), E((0, 1, 2)), E((0, 1)), E((0, 1), dtype=np.int8))
     head = (
         np.zeros(N),
@@ -329,7 +314,46 @@ def compile_blocks() -> None:
         1e-12,
         60,
     )
+    return head, rows
+
+
+def _compile_friction() -> None:
+    from .friction import solve_frictional_contact
+    from .theta_block import friction_block
+
+    one, z, W = np.ones(1), np.zeros(1), np.eye(3)
+    q = np.array([[-1.0, 0.0, 0.0]])
+    for code in (FIXED_POINT, PREDICTED):
+        frictional_fixed_point(
+            code,
+            -one,
+            -one,
+            -one,
+            np.ones((1, 3)),
+            W,
+            q,
+            one * 0.1,
+            z,
+            z.copy(),
+            np.full(1, np.inf),
+            np.zeros((1, 3)),
+            False,
+            1.0,
+            0.5,
+            1e-12,
+            60,
+        )
+    solve_frictional_contact(W, q, 0.1, np.ones(1, dtype=bool))
+    head, rows = _block_arguments()
     friction_block(*head, *rows)
+
+
+def _compile_rub() -> None:
+    from .rub_block import rub_block
+    from .wear_map import cut_sweeps
+
+    head, rows = _block_arguments()
+    N, E, one, z = 2, np.empty, np.ones(1), np.zeros(1)
     ints = np.zeros(1, dtype=np.int64)
     X0, T, Y1, Y0, sig, S, off, Z, W, GZ, code, mu, e3, U3, warm, use_warm, h, gamma = head[:18]
     alpha, tol, max_iter = head[18:]
@@ -357,3 +381,6 @@ def compile_blocks() -> None:
         (*rows, E(0)),
     )
     cut_sweeps(z.copy(), ints, z.copy(), one * 0.5, z.copy(), z.copy(), 1.0, 1, 1, 0.0)
+
+
+_COMPILE = {"one": _compile_one, "friction": _compile_friction, "rub": _compile_rub}

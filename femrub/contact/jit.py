@@ -11,11 +11,12 @@ file would keep a stale copy of a callee changed in another. The kernel files of
 :data:`KERNEL_FILES` are therefore stamped together (a change to any of them recompiles
 all of their kernels), through a cache locator registered with numba below.
 
-The first run on a machine compiles the kernels (about 20 s of one core). A build starts
-that compilation in a child process at its beginning when numba's cache of the kernels is
-cold (:func:`compile_in_background`), so it overlaps the assembly of the model; the first
-kernel call waits for the child (:func:`wait_background`) and loads the machine code it
-cached.
+The first run on a machine compiles the kernels it needs (a family of
+:data:`femrub.contact.activation.KERNEL_KINDS`, several seconds of one core each). A build
+starts that compilation in a child process at its beginning when numba's cache of those
+kernels is cold (:func:`compile_in_background`), so it overlaps the assembly of the model;
+the first kernel call waits for the child (:func:`wait_background`) and loads the machine
+code it cached.
 """
 
 from __future__ import annotations
@@ -114,27 +115,30 @@ def _cold(dispatcher) -> bool:
         return False
 
 
-def compile_in_background() -> bool:
-    """Compile the contact kernels in a child process if their on-disk cache is cold.
+def compile_in_background(kinds=("one", "friction", "rub")) -> bool:
+    """Compile the contact kernels of ``kinds`` in a child process if their on-disk cache is
+    cold.
 
-    The child runs :func:`femrub.contact.activation.compile_kernels` (which also compiles
-    the θ-method's block kernels) and writes numba's cache; this process goes on (the
-    build's assembly) and :func:`wait_background` joins it before the first kernel call.
-    At most one child per process; nothing without compilation or with a warm cache.
-    Returns whether a child was started.
+    The child runs :func:`femrub.contact.activation.compile_kernels` of ``kinds`` and writes
+    numba's cache; this process goes on (the build's assembly) and :func:`wait_background`
+    joins it before the first kernel call. At most one child per process; nothing without
+    compilation, without kinds or with a warm cache. Returns whether a child was started.
     """
-    if _CHILD or not compiled():
+    if _CHILD or not compiled() or not kinds:
         return False
-    from .theta_block import friction_block
+    from .rub_block import rub_block
+    from .theta_block import friction_block, one_contact_block
 
     _CHILD["started"] = True
-    if not _cold(friction_block):
+    kernels = {"one": one_contact_block, "friction": friction_block, "rub": rub_block}
+    kinds = tuple(k for k in kinds if _cold(kernels[k]))
+    if not kinds:
         return False
     root = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
     env = dict(
         os.environ, PYTHONPATH=os.pathsep.join(filter(None, (root, os.environ.get("PYTHONPATH"))))
     )
-    code = "from femrub.contact.activation import compile_kernels; compile_kernels()"
+    code = f"from femrub.contact.activation import compile_kernels; compile_kernels({kinds!r})"
     try:
         _CHILD["process"] = subprocess.Popen(
             [sys.executable, "-c", code],

@@ -185,7 +185,7 @@ class ThetaMethod(Stepper):
             self._e3 = np.array(np.broadcast_to(c.restitution, (c.n,)), dtype=float)
             self._U3 = np.full(c.n, np.inf)
             self._warm0 = np.zeros((c.n, 3))
-            compile_kernels()  # not in the first step's time
+            compile_kernels(("friction",))  # not in the first step's time
             # gap and local velocity rows in one product: [g, ġ, w_t] = S X + casing terms
             self._S = np.vstack([c.GT, c.V3T])
             self._memo = (None, 0.0, None)

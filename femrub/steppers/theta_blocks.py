@@ -24,7 +24,7 @@ import math
 
 import numpy as np
 
-from ..contact.activation import compile_blocks
+from ..contact.activation import compile_kernels
 from ..contact.coulomb import MAX_HEAT_ITERATIONS
 from ..contact.friction import check_status
 from ..contact.gap import _over_times
@@ -64,7 +64,7 @@ def prepare(st) -> None:
     kind = st._block_kind = block_kind(st)
     if kind is None:
         return
-    compile_blocks()  # not in the first block's time
+    compile_kernels((kind,))  # not in the first block's time
     N = st.model.n_dofs
     ns = len(st._signals)
     st._bY1 = np.zeros((N, 0)) if st._Y1 is None else np.ascontiguousarray(st._Y1)
