@@ -131,3 +131,32 @@ def test_damping_stage_is_cached(tmp_path):
     assert any("cache: damping loaded" in t for t in lines)
     assert second.full.blocks.info["rayleigh"] == b.info["rayleigh"]
     assert abs(second.full.blocks.C - b.C).max() == 0.0
+
+
+def test_each_mode_of_the_run_s_model_reports_its_own_rayleigh_ratio():
+    """``physics.damping_ratio`` is Rayleigh damping: the run's model has the ratio asked at
+    the two damping modes, its own ``a / 2ω + b ω / 2`` at every other one, and
+    ``--explain`` lists them."""
+    from test_cache import SMALL
+
+    from femrub.app.simulation import build
+    from femrub.model.modes import damped_modes
+    from femrub.scene import load_scene
+
+    scene = load_scene(
+        "twisted-naca",
+        {**SMALL, "scheme.t_end": 2e-5, "physics.damping_ratio": 0.005, "reduction.n_uv": 12},
+    )
+    sim = build(scene)
+    d = sim.report["damping"]
+    f, z = np.array(d["frequency_hz"]), np.array(d["ratio"])
+    a, b = d["rayleigh"]
+    w = 2 * np.pi * f
+    np.testing.assert_allclose(z, a / (2 * w) + b * w / 2, rtol=1e-6)  # Rayleigh, mode by mode
+    assert z[0] == pytest.approx(0.005, rel=1e-3) and z[4] == pytest.approx(0.005, rel=1e-2)
+    assert np.all(z[1:4] < 0.005) and z[-1] > 0.005  # less between, more above
+    assert "each mode its own ratio" in sim.explain() and f"{f[0]:.5g} Hz" in sim.explain()
+    import femrub as fr
+
+    undamped = damped_modes(fr.bar_model())
+    assert np.max(np.abs(undamped["ratio"])) < 1e-12 and undamped["rayleigh"] == [0.0, 0.0]

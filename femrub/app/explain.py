@@ -130,8 +130,37 @@ def _model_rows(report: dict) -> list[tuple[str, str]]:
     rows = [("model", line)]
     rows += [("material", note) for note in report.get("material", [])]
     rows.append(("thermal", report["thermal"]))
+    rows += [("damping", x) for x in _damping(report.get("damping"))]
     rows += [("dropped", d) for d in report["dropped"]]
     rows += [("prestress", x) for x in _centrifugal(report.get("centrifugal"))]
+    return rows
+
+
+#: modes listed one by one in the damping rows
+N_DAMPING_MODES = 6
+
+
+def _damping(d: dict | None) -> list[str]:
+    """The damping each vibration mode of the run's model gets (:mod:`femrub.model.modes`)."""
+    if not d:
+        return []
+    f, z = d["frequency_hz"], d["ratio"]
+    if not f:
+        return ["no vibration mode"]
+    rows = []
+    if d.get("rayleigh") and any(d["rayleigh"]):
+        a, b = d["rayleigh"]
+        rows.append(
+            f"Rayleigh C = a M + b K, a = {a:.4g} 1/s, b = {b:.4g} s: each mode its own ratio "
+            "ζ(ω) = a / 2ω + b ω / 2"
+        )
+    first = ", ".join(f"{fi:.5g} Hz {100 * zi:.3g} %" for fi, zi in zip(f, z[:N_DAMPING_MODES]))
+    rows.append(f"modes of the run's model (contacts open): {first}")
+    if len(f) > N_DAMPING_MODES:
+        rows.append(
+            f"{len(f)} modes up to {f[-1]:.5g} Hz: ratio {100 * min(z):.3g} % to "
+            f"{100 * max(z):.3g} % ({100 * z[-1]:.3g} % at the highest)"
+        )
     return rows
 
 

@@ -31,6 +31,7 @@ from .. import progress
 from ..analysis.step_check import check_step
 from ..contact import jit
 from ..model.builder import RubBuild, build_rub, length_scale
+from ..model.modes import damped_modes
 from ..output.limits import MAX_DISPLACEMENT_RATIO, MAX_TEMPERATURE_RISE, default_limits
 from ..scene.run_checks import check_run
 from ..scene.spec import SceneError, fail
@@ -239,6 +240,7 @@ def _runnable(scene, full: _Full, stages, log, modes, report, clock, with_steppe
         report["natural_frequencies_hz"] = stages.frequencies(model, modes).tolist()
     reduced, reductor, ran = _reduce(scene, model, full.model, stages, log, limits, report, clock)
     report["model"] = {"n_dofs": reduced.n_dofs, **_layout(reduced)}
+    report["damping"] = damped_modes(reduced)
     stepper = stepper_of(scene, reduced, report) if with_stepper else None
     report["outputs"] = {
         "vtk_stride": scene["outputs"]["vtk_stride"],
