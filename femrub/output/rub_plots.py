@@ -4,8 +4,8 @@
   first and last ``window`` revolutions;
 * :func:`spectrum_panel`: the amplitude spectrum of that response with the engine-order
   lines ``k Ω / 2π``;
-* :func:`contact_force_panel`: the normal (and friction) force of each contact against the
-  angular position of the rotor ``mod(Ω t, 360°)``.
+* :func:`contact_force_panel`: the summed normal (and friction) force of the contacts as a
+  map, rotor angle ``mod(Ω t, 360°)`` across and revolution up (:func:`force_map`).
 
 Inputs are :class:`~femrub.output.results.Results` and the rotation speed Ω (rad/s).
 """
@@ -16,7 +16,13 @@ import numpy as np
 
 from .plots import plt
 
-__all__ = ["contact_force_panel", "response_of", "response_panels", "spectrum_panel"]
+__all__ = [
+    "contact_force_panel",
+    "force_map",
+    "response_of",
+    "response_panels",
+    "spectrum_panel",
+]
 
 
 def response_of(res, node: int = 0) -> tuple[np.ndarray, str]:
@@ -67,23 +73,44 @@ def spectrum_panel(res, omega: float, *, node: int = 0, max_order: int = 20):
     return fig
 
 
+#: largest number of rotor-angle cells of a contact-force map
+MAX_ANGLE_CELLS = 360
+
+
+def force_map(t, force, omega: float, n_angle: int) -> tuple[np.ndarray, np.ndarray]:
+    """The largest ``force`` (one value per time of ``t``, s) in each cell of rotor angle
+    ``mod(Ω t, 2π)`` (``n_angle`` cells) and revolution ``floor(Ω t / 2π)``:
+    ``(revolution edges, (revolutions, n_angle) array)``, NaN where no time falls."""
+    turns = np.asarray(t, dtype=float) * omega / (2.0 * np.pi)
+    rev = np.floor(turns).astype(np.int64)
+    rev -= rev.min(initial=0)
+    cell = np.minimum((np.mod(turns, 1.0) * n_angle).astype(np.int64), n_angle - 1)
+    grid = np.full((int(rev.max(initial=0)) + 1, n_angle), -np.inf)
+    np.maximum.at(grid, (rev, cell), np.asarray(force, dtype=float))
+    grid[np.isneginf(grid)] = np.nan
+    first = np.floor(turns[0]) if turns.size else 0.0
+    return first + np.arange(grid.shape[0] + 1), grid
+
+
 def contact_force_panel(res, omega: float):
-    """Normal and friction force (N) of every contact vs the rotor angle ``mod(Ω t, 360°)``."""
-    angle = np.degrees(np.mod(res.t * omega, 2.0 * np.pi))
+    """The summed normal force (and friction force) of the contacts (N) as a map: rotor
+    angle ``mod(Ω t, 360°)`` across, revolution up; each cell holds the largest force of the
+    steps that fall in it (the lobes' passages line up, an interaction's drift shows)."""
     lam = res.force
+    total = lam.sum(axis=1)
     ff = res.friction_force
-    fig, ax = plt.subplots(2, 1, sharex=True, figsize=(7.5, 6))
-    for i in range(lam.shape[1]):
-        on = lam[:, i] > 0.0
-        ax[0].plot(angle[on], lam[on, i], ".", ms=1.5, label=f"contact {i}")
-        if ff is not None and ff.size:
-            ax[1].plot(angle[on], np.linalg.norm(ff[on, i], axis=-1), ".", ms=1.5)
-    ax[0].set_ylabel("normal force (N)")
-    ax[1].set_ylabel("friction force (N)")
-    ax[1].set_xlabel("rotor angle Ω t mod 360 (deg)")
-    if lam.shape[1] <= 16:
-        ax[0].legend(fontsize=6, ncol=4, markerscale=4)
-    for a in ax:
-        a.grid(True, lw=0.3, alpha=0.6)
+    friction = None if ff is None or not ff.size else np.linalg.norm(ff, axis=-1).sum(axis=1)
+    steps_per_rev = 2.0 * np.pi / max(omega * res.h, 1e-300)
+    n_angle = int(np.clip(steps_per_rev, 1, MAX_ANGLE_CELLS))
+    maps = [("normal", total)] + ([("friction", friction)] if friction is not None else [])
+    fig, ax = plt.subplots(1, len(maps), figsize=(6.0 * len(maps), 4.5), squeeze=False)
+    edges = np.linspace(0.0, 360.0, n_angle + 1)
+    for a, (name, values) in zip(ax[0], maps):
+        revs, grid = force_map(res.t, values, omega, n_angle)
+        im = a.pcolormesh(edges, revs, grid, shading="flat", cmap="viridis")
+        fig.colorbar(im, ax=a, label=f"summed {name} force (N)")
+        a.set_xlabel("rotor angle Ω t mod 360 (deg)")
+        a.set_ylabel("revolution")
+        a.set_title(f"{name} force of the {lam.shape[1]} contacts, largest per cell", fontsize=9)
     fig.tight_layout()
     return fig
