@@ -58,7 +58,11 @@ full, fields = solid_model(
     coupling="physical",
     thermal=True,
 )
-model, reductor = craig_bampton_thermal(full, n_uv=24, n_theta=20)
+# the scene's reduction: contact dofs with the inertia of their static shapes, a thermal
+# basis of the heat inputs (the heat balance exact; docs/reduction.md, sections 8 and 10)
+model, reductor = craig_bampton_thermal(
+    full, n_uv=24, n_theta=20, projection="static-mass", thermal="inputs"
+)
 results = run_to_folder(
     fr.ThetaMethod(model, h=H),
     T_END,

@@ -223,6 +223,7 @@ def solid_model(  # noqa: PLR0913 (the Python preset: keyword-only options, one 
     rayleigh: tuple[float, float] = (0.0, 0.0),
     damping_ratio: float | None = None,
     lumping: str = "auto",
+    conduction: str = "galerkin",
     tip_force=None,
     thermal: str | bool = "auto",
     reach: float | str = "auto",
@@ -245,7 +246,8 @@ def solid_model(  # noqa: PLR0913 (the Python preset: keyword-only options, one 
     signal)`` (a harmonic :class:`~femrub.model.config.ForceLaw` also gives the reach filter
     its frequency, as a scene's ``sin`` law); ``centrifugal``: prestress method at Ω
     (``"linear"``, ``"nonlinear"``; default ``None``: none, unlike a scene's
-    ``loads.centrifugal = "auto"``). Returns ``(model, fields)``.
+    ``loads.centrifugal = "auto"``); ``conduction``: ``"galerkin"`` or ``"monotone"`` (the
+    scene's ``physics.conduction``). Returns ``(model, fields)``.
     """
     from .builder import build_rub  # the builder composes this module's rub_model
     from .config import ContactConfig, ForceConfig, ForceLaw, RubConfig
@@ -277,6 +279,7 @@ def solid_model(  # noqa: PLR0913 (the Python preset: keyword-only options, one 
         rotation_speed=float(rotation_speed),
         order=order,
         lumping=lumping,
+        conduction=conduction,
         coupling=coupling,
         strain_heating=strain_heating,
         rayleigh=tuple(rayleigh),
