@@ -285,8 +285,9 @@ def section(doc) -> str:
         lines += [
             f"**Reduced twisted NACA blade** (`twisted-naca`, {b['n_dofs']} coordinates, lobed "
             f"casing, {b['t_end']} s; its Coulomb friction replaced by the α law of the same "
-            "heat at full slip, α = η μ Ω r_tip, for every method: the exponential stepper is "
-            f"frictionless; θ reference h = {doc['config']['blade_ref_h']:g} s; "
+            "heat at full slip, α = η μ Ω r_tip, for every method (the frictionless comparison; "
+            "the frictional one, every method with Coulomb friction, follows); θ reference "
+            f"h = {doc['config']['blade_ref_h']:g} s; "
             f"Carpenter's limit {b['carpenter_limit']:.3g} s).",
             "θ runs per step in Python on this model (no compiled path for two frictionless "
             "contacts on a moving casing); `θ compiled (μ = 1e-9)` is the same model with "

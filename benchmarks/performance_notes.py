@@ -10,21 +10,21 @@ thermal coupling on), reduced to n_uv = n_θ = 20 (`benchmarks/cost_3d.py`; each
 fresh process). The full model is stepped only while its sparse factorisation stays
 affordable; above a few 1e4 dofs the reduction is the way to run.
 
-What the costs depend on (measured by hand on the NASA Rotor 37 blade, 96,255 P2
-displacement dofs, and on the 10,000-node bar; not regenerated):
+What the costs depend on (on a blade of about 1e5 P2 displacement dofs such as Rotor 37;
+each solver is measured on it in [Blade scale](blade-scale.md), `benchmarks/solvers.py`):
 
 1. *Stiffness assembly*: the P2 gradients are integrated with the lowest exact rule (order
-   2 on straight tetrahedra, also exact for the P1×P2 coupling): 14.5 s on Rotor 37, where
-   the mass matrix's order-4 rule took 51.5 s for the same matrix.
+   2 on straight tetrahedra, also exact for the P1×P2 coupling), several times cheaper than
+   the mass matrix's order-4 rule on the same mesh.
 2. *Sparse factorisation* of the 3D stiffness (damping eigen-solve, the reduction's static
-   shapes and shift-invert modes): MKL Pardiso takes 14.5 s, SuperLU 107 s (minimum degree
-   on AᵀA) to 155 s (COLAMD). Per-step solves stay on SuperLU (Pardiso's per-call overhead:
-   3.7 ms against 0.26 ms on the bar).
+   shapes and shift-invert modes): MKL Pardiso where it is installed, several times faster
+   than SuperLU at this size. Per-step solves stay on SuperLU (Pardiso's per-call overhead
+   dominates a small reduced solve).
 3. *Per-step overhead*: one BLAS thread always, chunked post-processing of observations and
    energy.
 
 What dominates: the reduction's static shapes when the frictional heat is spread
-over many tip vertices (each is a thermal boundary dof: 134 on Rotor 37)."""
+over many tip vertices (each is a thermal boundary dof)."""
 
 MEASURES = """\
 Errors are measured on the tip of the bar against a reference (section 2):

@@ -8,7 +8,11 @@ normal and friction force per node, the friction work and heat, and the Coulomb 
 every step (|λ_t| <= μ λ to 1e-8, equality and direction where a contact slips). These are
 the numbers of ``docs/rotor37.md``.
 
-Run: ``python benchmarks/rotor37.py [--scene rotor37] [--out DIR] [--reuse]``.
+Run: ``python benchmarks/rotor37.py [--scene rotor37] [--out DIR] [--reuse]``. ``--docs``
+also keeps the numbers, stamped with the date, commit and machine, in
+``docs/rotor37/results-SCENE.json`` and renders the results section of ``docs/rotor37.md``
+from every such file; ``--render-only`` renders that section from the committed files (no
+run). A run needs the Rotor 37 deck of the shared data (``FEMRUB_SHARED_DATA``).
 """
 
 from __future__ import annotations
@@ -21,6 +25,12 @@ import sys
 from pathlib import Path
 
 import numpy as np
+
+ROOT = Path(__file__).resolve().parents[1]
+PAGE = ROOT / "docs" / "rotor37.md"
+DATA_DIR = ROOT / "docs" / "rotor37"
+SCENES = ("rotor37", "rotor37-thermal")
+MARKER = "rotor37-results"
 
 
 def metrics(out: Path, window: float = 5.0) -> dict:
@@ -50,6 +60,8 @@ def metrics(out: Path, window: float = 5.0) -> dict:
             "heat_to_blade",
             "heat_to_casing",
             "coulomb_check",
+            "reduction_error",
+            "time_step_error",
         )
     }
     row["rms_um_first"] = (1e6 * np.sqrt(np.mean(u[first] ** 2, axis=0))).tolist()
@@ -79,12 +91,109 @@ def table(row: dict) -> str:
     return "\n".join(lines)
 
 
+def _stamp(machine: dict | None) -> str:
+    m = machine or {}
+    when = m.get("date") or "date not recorded"
+    commit = f"commit {m['commit']}" if m.get("commit") else "commit not recorded"
+    return (
+        f"*Measured by `python benchmarks/rotor37.py --docs` ({when}, {commit}; Python "
+        f"{m.get('python', '?')}, {m.get('cores', '?')} cores, load average "
+        f"{m.get('load_average', '?')} at its start).*"
+    )
+
+
+def _estimate(doc) -> str:
+    if not isinstance(doc, dict) or doc.get("estimate") is None:
+        return "—"
+    return f"{100 * doc['estimate']:.2g} % ({doc.get('status', 'judged')})"
+
+
+def _coulomb(check) -> str:
+    if not isinstance(check, dict):
+        return "—"
+    return ", ".join(f"{k} {v:.2g}" for k, v in check.items() if isinstance(v, float))
+
+
+def summary_table(row: dict) -> str:
+    """The run's verdict and balances, from its ``summary.json``."""
+    timings = row.get("timings") or {}
+    times = ", ".join(f"{k} {v:.1f} s" for k, v in timings.items() if isinstance(v, float))
+    cpu = row.get("cpu_per_step_us")
+    forces = f"{row['max_contact_force']:.4g} / {row['max_friction_force'] or 0:.4g}"
+    rows = [
+        ("status", f"**{row['status']}**, {row['revolutions']:.1f} revolutions"),
+        ("steps", str(row["steps"])),
+        ("reduced / full state dofs", f"{row.get('n_dofs')} / {row.get('n_full')}"),
+        ("reduction error estimate", _estimate(row.get("reduction_error"))),
+        ("time-step error estimate", _estimate(row.get("time_step_error"))),
+        ("energy balance (`energy_error`)", f"{row['energy_error']:.2g}"),
+        ("largest normal / friction force (N)", forces),
+        ("friction work (J)", f"{row['friction_work'] or 0:.4g}"),
+        ("Coulomb check (`coulomb_check`)", _coulomb(row.get("coulomb_check"))),
+        ("CPU per step (µs)", f"{cpu:.3g}" if cpu else "—"),
+        ("times", times or "—"),
+    ]
+    return "\n".join(["| | |", "|---|---|", *(f"| {k} | {v} |" for k, v in rows)])
+
+
+def render(data: dict[str, dict]) -> str:
+    """The results section of ``docs/rotor37.md`` from ``{scene: results document}``."""
+    if not data:
+        return (
+            "Not measured on this version: `python benchmarks/rotor37.py --docs` (and "
+            "`--scene rotor37-thermal --docs`) runs the scenes and renders their numbers here."
+        )
+    parts = []
+    for scene, doc in data.items():
+        row = doc["results"]
+        parts += [
+            f"### `femrub run {scene}`",
+            _stamp(doc.get("machine")),
+            summary_table(row),
+            "Radial (normal) displacement of each contact node (negative: pushed inwards by "
+            "the casing), largest normal and friction force per node and fraction of the "
+            "steps in contact:",
+            table(row),
+        ]
+    return "\n\n".join(parts)
+
+
+def committed() -> dict[str, dict]:
+    """The results documents in ``docs/rotor37/``, in the order of :data:`SCENES`."""
+    found = {}
+    for scene in SCENES:
+        path = DATA_DIR / f"results-{scene}.json"
+        if path.exists():
+            found[scene] = json.loads(path.read_text())
+    return found
+
+
+def render_page() -> Path:
+    from _common import write_between
+
+    write_between(PAGE, MARKER, render(committed()))
+    return PAGE
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--scene", default="rotor37")
+    ap.add_argument("--scene", default="rotor37", choices=SCENES)
     ap.add_argument("--out", default=None)
     ap.add_argument("--reuse", action="store_true", help="post-process a finished folder")
+    ap.add_argument("--docs", action="store_true", help="keep the numbers and render the page")
+    ap.add_argument("--render-only", action="store_true", help="render the page, no run")
     a = ap.parse_args(argv)
+    if a.render_only:
+        print(f"wrote {render_page()}")
+        return 0
+    from femrub.geometry.rotor37 import shared_data_dir
+
+    if not (shared_data_dir() / "rotor37-fe-mesh").is_dir():
+        print(f"skipped: no Rotor 37 mesh under {shared_data_dir()} (set FEMRUB_SHARED_DATA)")
+        return 0
+    from _common import machine
+
+    stamp = machine()
     out = Path(a.out or f"out/bench-{a.scene}")
     if not (a.reuse and (out / "history.npz").exists()):
         cmd = [sys.executable, "-m", "femrub", "run", a.scene, "-o", str(out), "--overwrite"]
@@ -94,6 +203,11 @@ def main(argv=None) -> int:
     (out / "rotor37_results.md").write_text(table(row) + "\n")
     print(json.dumps({k: row[k] for k in ("status", "revolutions", "coulomb_check")}, indent=1))
     print(table(row))
+    if a.docs:
+        doc = {"scene": a.scene, "machine": stamp, "results": row}
+        path = DATA_DIR / f"results-{a.scene}.json"
+        path.write_text(json.dumps(doc, indent=1, default=str))
+        print(f"wrote {path} and {render_page()}")
     return 0
 
 

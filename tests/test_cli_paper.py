@@ -115,7 +115,7 @@ def test_fig4_reduced_models(summary):
 
 def test_output_size_bounded(paper_out):
     total = sum(f.stat().st_size for f in paper_out.rglob("*") if f.is_file())
-    assert total < 30e6  # the output budget (docs/performance/rotor37-costs.md: about 25 MB)
+    assert total < 30e6  # the output budget (docs/performance/rotor37-costs.md)
 
 
 def test_npz_histories(paper_out, summary):

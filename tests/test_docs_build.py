@@ -52,11 +52,19 @@ def _text(page: Path) -> str:
 
 
 def test_api_reference_documents_the_user_objects(site):
+    import femrub
+
     generated = site / "reference" / "generated"
-    for name in ("ThetaMethod", "Carpenter", "ExponentialMoreau", "Results", "bar_model"):
-        page = generated / f"femrub.{name}.html"
-        assert page.exists(), f"no API page for femrub.{name}"
+    missing = [n for n in femrub.__all__ if not (generated / f"femrub.{n}.html").exists()]
+    assert not missing, f"no API page for femrub.{missing}"
     assert "stability_limit" in _text(generated / "femrub.ThetaMethod.html")
+    assert "Eq." in _text(generated / "femrub.FirstOrderModel.html")
+    assert "load_results" in _text(site / "reference" / "api.html")
+
+
+def test_validation_has_the_rotor37_calculix_page(site):
+    text = _text(site / "validation" / "rotor37-calculix.html")
+    assert "CalculiX C3D15" in text and "commit" in text
 
 
 def test_scene_key_reference_lists_every_key(site):

@@ -49,6 +49,8 @@ def _formatted(run: dict, complete: dict) -> dict:
         "dT": f"{run['tip_temperature_end'] / complete['tip_temperature_end'] - 1:+.1%}",
         "dF": f"{run['max_contact_force'] / complete['max_contact_force'] - 1:+.1%}",
         "limit": f"{run['stability_limit']:.3g} s" if run.get("stability_limit") else "—",
+        "E": f"{run['energy_error']:.1g}",
+        "pen": f"{run['max_penetration']:.1g} m",
     }
 
 

@@ -65,5 +65,23 @@ SCHEMES = {
 
 
 def make_stepper(scheme: str, model, h, **options):
-    """A runnable stepper by name (:func:`femrub.steppers.make_stepper`)."""
+    """A runnable stepper by name (:func:`femrub.steppers.make_stepper`).
+
+    Parameters
+    ----------
+    scheme : {"theta", "carpenter", "penalty", "exponential"}
+        :class:`ThetaMethod` (paper Sec. 3, Eq. 16), :class:`Carpenter`, :class:`Penalty`
+        or :class:`ExponentialMoreau`.
+    model : :class:`~femrub.model.first_order.FirstOrderModel`
+        The model ``A Ẋ = B X + F + H λ`` of Eqs. (8)-(9), full or reduced.
+    h : float
+        Time step (s).
+    **options
+        The stepper's own options (e.g. ``gamma``, ``activation`` of the θ-method).
+
+    Returns
+    -------
+    Stepper
+        A stepper with ``run(t_end, options=None, **changes) -> Results``.
+    """
     return pure.make_stepper(scheme, model, h, schemes=SCHEMES, **options)

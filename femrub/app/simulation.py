@@ -87,7 +87,33 @@ def _check_scale(scene, size: float) -> None:
 
 @dataclass(frozen=True)
 class Simulation:
-    """A built scene (immutable): the model that runs, the full model, the stepper, the report."""
+    """A built scene (immutable): the model that runs, the full model, the stepper, the report.
+
+    Built by :meth:`from_scene` (or :func:`build`) through the one pipeline: scene → mesh →
+    Eq. (2) blocks → contact points → first-order model (Eqs. 8-9) → reduced model
+    (Eqs. 10-15, when ``reduction`` asks) → stepper.
+
+    Attributes
+    ----------
+    scene : Scene
+        The scene it was built from.
+    model : FirstOrderModel
+        The model the stepper runs (reduced, or the full one).
+    full : FirstOrderModel
+        The full model.
+    fields : object
+        What maps the model's state back to the mesh (VTK output).
+    reductor : ThermoelasticCraigBampton or None
+        The reductor of a reduced run.
+    stepper : Stepper or None
+        The stepper of ``scheme.*`` on ``model`` (``run(t_end)`` runs it).
+    limits : dict
+        Physical stop limits of the run (K for temperatures, m for displacements).
+    report : dict
+        What was built and why (:meth:`explain`; ``summary.json["inputs"]["build"]``).
+    timings : dict
+        Seconds spent in each stage of the build.
+    """
 
     scene: object
     model: object
@@ -136,7 +162,25 @@ class Simulation:
 
 
 def build(scene, *, log=None, modes: int = 0, cache=None, stepper: bool = True) -> Simulation:
-    """:meth:`Simulation.from_scene`."""
+    """Build ``scene`` into a :class:`Simulation` (:meth:`Simulation.from_scene`).
+
+    Parameters
+    ----------
+    scene : Scene
+        A scene from :func:`~femrub.scene.load_scene`.
+    log : callable, optional
+        Receives progress messages (factorisations, eigen-solves, reduction).
+    modes : int
+        Natural frequencies (Hz) to compute and report.
+    cache : ModelCache, optional
+        A cache of assembled and reduced models (``None``: build everything).
+    stepper : bool
+        Build the stepper (``False``: ``Simulation.stepper`` is ``None``).
+
+    Returns
+    -------
+    Simulation
+    """
     return Simulation.from_scene(scene, log=log, modes=modes, cache=cache, stepper=stepper)
 
 

@@ -35,7 +35,56 @@ __all__ = [
 
 @dataclass(frozen=True)
 class BarCase:
-    """Parameters of a 1D bar rub case (SI units); the defaults are the paper case."""
+    """Parameters of a 1D bar rub case (SI units); the defaults are the paper case.
+
+    The bar is the blade of the paper's Sec. 1: Eq. (2) on ``n_elements`` linear elements,
+    clamped at the root, its tip node rubbing a rigid concentric casing ``gap`` away under
+    the Signorini conditions and Newton's impact law (Eq. 3), heated by ``alpha × λ``.
+
+    Attributes
+    ----------
+    length : float
+        Bar length L (m).
+    area : float
+        Cross-section A (m²).
+    young : float
+        Young's modulus E (Pa).
+    total_mass : float or None
+        Mass of the bar (kg), lumped along it (m/n per node, m/2n at the tip); ``None``:
+        ``density × area × length``.
+    density, specific_heat, conductivity, expansion : float
+        ρ (kg/m³), c (J/(kg K)), λ_th (W/(m K)) and the expansion coefficient (1/K).
+    n_elements : int
+        Number of elements.
+    grading : float
+        Exponent p of the nodes ``x = L (1 − (1 − ξ)^p)`` (1: uniform; > 1: finer at the tip).
+    coupling : {"paper", "physical", "none"}
+        ``K^uθ = β K^uu`` (the paper's), ``E A α_th ∫ N_u' N_θ dx``, or none.
+    beta : float
+        β of the paper coupling (m/K).
+    strain_heating : bool
+        Keep the thermoelastic heating block ``C^θu`` of Eq. (2).
+    lumping : str
+        Mass lumping (``"row-sum"``, ``"hrz"`` or ``"consistent"``).
+    rayleigh : tuple of float
+        Rayleigh damping ``C = a M + b K`` as ``(a, b)`` (1/s, s).
+    clamped : bool
+        Clamp the root (``False``: a free bar).
+    gap : float
+        Initial tip-casing clearance d (m).
+    restitution : float
+        Coefficient of restitution e of the impact law, in [0, 1].
+    alpha : float
+        Frictional heat coefficient α (m/s): heat flux ``α λ`` (W) into the tip.
+    force_amplitude, force_frequency : float
+        Tip force ``F sin(Ω t)``: F (N) and Ω (rad/s; 2000 rpm by default).
+    initial_velocity : float
+        Uniform initial velocity of the bar (m/s).
+    thermal : bool or "auto"
+        Keep the temperature unknowns (``"auto"``: when something heats the blade).
+    reach : float or str
+        The reach filter of the contacts (:mod:`femrub.contact.reach`).
+    """
 
     length: float = 0.30
     area: float = 1e-6
@@ -167,7 +216,21 @@ def _tip_dof(built) -> int:
 
 
 def bar_matrices(case: BarCase = PAPER) -> tuple[ThermoelasticMatrices, int]:
-    """The bar's Eq. (2) blocks (scikit-fem) and the tip's free displacement dof."""
+    """The bar's Eq. (2) blocks (scikit-fem) and the tip's free displacement dof.
+
+    Parameters
+    ----------
+    case : BarCase
+        The bar (default :data:`PAPER`).
+
+    Returns
+    -------
+    matrices : ThermoelasticMatrices
+        ``M`` (kg), ``C`` (N s/m), ``K`` (N/m), ``K^uθ`` (N/K), ``C^θu``, ``C^θθ`` (J/K),
+        ``K^θθ`` (W/K) on the free dofs.
+    tip_dof : int
+        Index of the tip's displacement among the free displacement dofs.
+    """
     built = _bar_build(case)
     return built.mats, _tip_dof(built)
 

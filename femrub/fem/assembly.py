@@ -37,6 +37,25 @@ class ThermoelasticMatrices:
     ``free_u`` / ``free_t`` index the free dofs in the bases' full numbering; ``n_u_all`` /
     ``n_t_all`` are the full sizes. ``Kut`` is ``K^uθ`` (n_u × n_θ), ``Ctu`` is ``C^θu``
     (n_θ × n_u).
+
+    Attributes
+    ----------
+    M, C, K : scipy.sparse.csr_matrix
+        Mass (kg), damping (N s/m) and stiffness (N/m) of the displacement dofs.
+    Kut : scipy.sparse.csr_matrix
+        Thermal stresses' coupling ``K^uθ`` (N/K).
+    Ctu : scipy.sparse.csr_matrix
+        Thermoelastic heating ``C^θu`` (J/m, acting on the velocity).
+    Ctt, Ktt : scipy.sparse.csr_matrix
+        Heat capacity ``C^θθ`` (J/K) and conductivity ``K^θθ`` (W/K).
+    free_u, free_t : ndarray of int
+        Free dofs in the bases' numbering (Dirichlet dofs removed).
+    n_u_all, n_t_all : int
+        Sizes before the Dirichlet dofs are removed.
+    basis_u, basis_t : skfem.Basis or None
+        The scikit-fem bases, to map back to the mesh.
+    info : dict
+        What the assembly reports (sizes, timings).
     """
 
     M: sp.csr_matrix

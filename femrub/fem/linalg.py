@@ -1,4 +1,4 @@
-"""Small linear-algebra helpers: dense for small operators, sparse LU for large ones.
+"""Small linear-algebra routines: dense for small operators, sparse LU for large ones.
 
 A scipy sparse mat-vec costs several microseconds of Python overhead whatever its size; for
 the few-dozen-dof models of the paper (and for reduced models) dense numpy arrays are an

@@ -72,7 +72,23 @@ class ContactSpec:
 
 @dataclass
 class Load:
-    """A load ``vector × signal(t)`` on the displacement (``field="u"``) or temperature dofs."""
+    """A load ``vector × signal(t)`` on the displacement (``field="u"``) or temperature dofs.
+
+    One term ``f_j s_j(t)`` of ``f^u`` or ``f^θ`` in Eq. (2), placed into ``F`` of Eq. (8) by
+    :func:`first_order_model`.
+
+    Attributes
+    ----------
+    vector : (n_u,) or (n_θ,) array
+        Nodal forces (N) on the free displacement dofs, or nodal heat flows (W) on the free
+        temperature dofs, for a signal of 1.
+    signal : callable
+        ``s(t)`` (dimensionless, t in s).
+    field : {"u", "t"}
+        The dofs the load acts on.
+    name : str
+        The load's name in the energy balance.
+    """
 
     vector: np.ndarray
     signal: object

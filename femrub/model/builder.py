@@ -269,6 +269,25 @@ def build_rub(blade, config: RubConfig, *, stages=None, log=None) -> RubBuild:
 
     ``stages``: the expensive stages (default :class:`DirectStages`); ``log``: progress
     messages. The model's ``length_scale`` is :func:`length_scale` of ``blade``.
+
+    Mesh → Eq. (2) blocks (with the centrifugal prestress when asked) → contact points →
+    reach filter → heat law → first-order model ``A Ẋ = B X + F + H λ`` (Eqs. 8-9).
+
+    Parameters
+    ----------
+    blade : BladeMesh
+        Linear tetrahedra (or the bar's line) in metres, with ``root``, ``tip`` and contacts.
+    config : RubConfig
+        Material, casing, contacts, loads and options (SI units).
+
+    Returns
+    -------
+    RubBuild
+        ``model`` (the :class:`~femrub.model.first_order.FirstOrderModel`), ``fields`` (the
+        map back to the mesh), ``mats`` (the Eq. 2 blocks), ``candidates`` and ``reach``
+        (the contact points and those kept), ``prestress``, ``growth`` (tip growth of the
+        prestress, m), ``grid`` (casing cells), ``heat`` and ``thermal`` (the choices made
+        and why).
     """
     stages = stages or DirectStages(log)
     disc = stages.discretise(blade, config.order if blade.dim == 3 else 1, config.clamped)

@@ -43,7 +43,16 @@ __all__ = [
 
 @dataclass(frozen=True)
 class Layout:
-    """Sizes of the three state blocks ``[u, v, θ]`` (``n_t = 0`` when there is no thermal part)."""
+    """Sizes of the three state blocks ``[u, v, θ]`` (``n_t = 0`` when there is no thermal part).
+
+    The state of Eq. (8) is ``X = [u, v, θ]``: displacements (m), velocities (m/s) and
+    temperatures above ambient (K), or their reduced coordinates (Eqs. 10-15).
+
+    Attributes
+    ----------
+    n_u, n_v, n_t : int
+        Sizes of the displacement, velocity and temperature blocks.
+    """
 
     n_u: int
     n_v: int

@@ -86,7 +86,20 @@ class ResultExists(FileExistsError):
 
 
 def folder_status(out) -> str | None:
-    """Status of ``out/summary.json``: ``None`` when absent, :data:`CORRUPT` when unreadable."""
+    """Status of ``out/summary.json``: ``None`` when absent, :data:`CORRUPT` when unreadable.
+
+    Parameters
+    ----------
+    out : str or pathlib.Path
+        A results folder.
+
+    Returns
+    -------
+    str or None
+        ``"ok"``, ``"inaccurate"``, ``"unstable"``, ``"diverged-physically"`` (finished,
+        :data:`FINISHED`), ``"interrupted"``, ``"failed"``, ``"running"`` while a run writes
+        it, ``"corrupt"`` or ``None``.
+    """
     path = Path(out) / "summary.json"
     if not path.exists():
         return None

@@ -37,7 +37,24 @@ __all__ = [
 
 @dataclass(eq=False)
 class Scene:
-    """A validated scene (see ``docs/scenes.md``); compare with ``==`` on the data."""
+    """A validated scene (see ``docs/scenes.md``); compare with ``==`` on the data.
+
+    Made by :func:`load_scene` or :func:`loads_scene`, never by hand: every key checked
+    against the schema (its reference lists each key's type, unit, default and bounds),
+    defaults filled in, quantities converted to SI units (``"2000 rpm"`` → rad/s).
+
+    Attributes
+    ----------
+    data : dict
+        The normalised scene, sections as nested dicts (SI units); ``scene["loads.gap"]``
+        reads a dotted key.
+    source : str
+        Where the scene came from (a file name or ``built-in scene NAME``).
+    base_dir : pathlib.Path
+        Where the scene's relative paths start.
+    given : frozenset
+        The dotted keys the file or a change set wrote (the others are defaults).
+    """
 
     data: dict
     source: str = "<scene>"
@@ -117,7 +134,27 @@ def _without_none(node):
 
 
 def loads_scene(text: str, source: str = "<string>", base_dir=None) -> Scene:
-    """Parse and validate TOML text; relative paths start at ``base_dir`` (default cwd)."""
+    """Parse and validate TOML text; relative paths start at ``base_dir`` (default cwd).
+
+    Parameters
+    ----------
+    text : str
+        The scene as TOML.
+    source : str
+        Its name in error messages.
+    base_dir : str or pathlib.Path, optional
+        Where relative paths start (default: the working directory).
+
+    Returns
+    -------
+    Scene
+        Validated, defaults filled in, SI units.
+
+    Raises
+    ------
+    SceneError
+        Invalid TOML or an invalid key or value.
+    """
     try:
         doc = tomllib.loads(text)
         data = normalize(doc)
@@ -138,7 +175,14 @@ def _builtin_dir():
 
 
 def builtin_scenes() -> dict[str, str]:
-    """Built-in scene names and their one-line descriptions."""
+    """Built-in scene names and their one-line descriptions.
+
+    Returns
+    -------
+    dict of str to str
+        ``{name: description}``, sorted by name (``femrub scenes`` prints it); each name
+        loads with :func:`load_scene`.
+    """
     out = {}
     for entry in sorted(_builtin_dir().iterdir(), key=lambda p: p.name):
         if entry.name.endswith(".toml"):
@@ -156,7 +200,26 @@ def builtin_text(name: str) -> str:
 
 
 def load_scene(ref, changes: dict | None = None) -> Scene:
-    """Load a scene file, or a built-in scene by name, and apply dotted ``changes``."""
+    """Load a scene file, or a built-in scene by name, and apply dotted ``changes``.
+
+    Parameters
+    ----------
+    ref : str or pathlib.Path
+        A TOML scene file, or the name of a built-in scene (:func:`builtin_scenes`).
+    changes : dict, optional
+        Dotted keys to set, e.g. ``{"loads.rotation_speed": "1200 rpm"}`` (units as in a
+        scene file; SI when a bare number).
+
+    Returns
+    -------
+    Scene
+        Validated, defaults filled in, SI units.
+
+    Raises
+    ------
+    SceneError
+        One line naming the key, the value and the fix.
+    """
     path = Path(ref)
     if path.is_file():
         try:

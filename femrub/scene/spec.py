@@ -33,7 +33,11 @@ NONNEG = {"lo": 0.0}
 
 
 class SceneError(ValueError):
-    """Invalid scene: the message is one line naming the key, the value and what is allowed."""
+    """Invalid scene: the message is one line naming the key, the value and what is allowed.
+
+    A :class:`ValueError`, raised before any expensive work by :func:`load_scene`,
+    :func:`loads_scene`, :meth:`Scene.with_changes` and the build of a scene.
+    """
 
     def __init__(self, message: str) -> None:
         super().__init__(" ".join(str(message).split()))

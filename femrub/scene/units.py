@@ -131,5 +131,18 @@ def convert(number: float, unit: str, dim: str) -> float:
 
 
 def rpm(value: float) -> float:
-    """Revolutions per minute in rad/s (the scene's ``"<value> rpm"``)."""
+    """Revolutions per minute in rad/s (the scene's ``"<value> rpm"``).
+
+    ``Ω = 2π value / 60``: ``rpm(2000.0)`` is the paper's rotation speed, 209.44 rad/s.
+
+    Parameters
+    ----------
+    value : float
+        Speed (rev/min).
+
+    Returns
+    -------
+    float
+        Angular speed (rad/s).
+    """
     return convert(value, "rpm", "angular_speed")

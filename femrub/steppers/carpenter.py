@@ -52,7 +52,19 @@ __all__ = ["Carpenter"]
 
 
 class Carpenter(Stepper):
-    """Explicit central-difference scheme with forward-increment contact (see module doc)."""
+    """Explicit central-difference scheme with forward-increment contact (see module doc).
+
+    Carpenter, Taylor and Katona's scheme on the first-order model ``A Ẋ = B X + F + H λ``
+    (paper Eqs. 8-9): central differences for the mechanics, forward Euler for the heat
+    equation, the impulse ``P = h λ_{n+1}`` (N s) closing the predicted gap of ``t_{n+1}``.
+
+    Parameters
+    ----------
+    model : :class:`~femrub.model.first_order.FirstOrderModel`.
+    h : time step (s); below :meth:`stability_limit` (``2 / ω_max`` and ``2 / μ_max``, s),
+        above it a run reports ``status = "unstable"``.
+    t0 : start time (s).
+    """
 
     name = "carpenter"
 
