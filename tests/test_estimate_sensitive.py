@@ -68,3 +68,17 @@ def test_statistics_per_contact():
     s = statistics(ref[0])
     np.testing.assert_allclose(s["rms_contact_displacement"], 1e-4 / np.sqrt(2), rtol=0.02)
     assert s["max_force"].shape == (2,) and np.all(s["max_force"] <= 2e3 + 1e-9)
+
+
+def test_a_difference_the_dynamics_amplify_is_judged_by_statistics_from_where_it_grows():
+    """A twin whose round-off first shows a decaying transient sets a late horizon; a close
+    model whose small difference the dynamics amplify from the start leaves the reference
+    long before it. Its amplified difference is the chaos's, not the reduction's: judged by
+    its statistics from where it has grown tenfold, as a coarser model's would be."""
+    late_twin = _run(1e-8 * np.exp(-50 * T) + 1e-12 * np.exp(30 * T))
+    close = _run(1e-5 * np.exp(30 * T))
+    err = _est(close, ref, twin=late_twin)
+    assert err["predictability_horizon"] < 0.2  # where close's difference has grown tenfold
+    assert err["estimate"] < 0.05, err
+    wrong = _run(1e-5 * np.exp(30 * T), force_scale=1.2)
+    assert _est(wrong, ref, twin=late_twin)["estimate"] > 0.15  # statistics still decide

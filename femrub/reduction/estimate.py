@@ -34,7 +34,12 @@ pointwise estimate fails, a twin of the reference (same model, displacement pert
 which the twin's signals differ from the reference's by more than :data:`HORIZON_SHARE` of
 the tolerance or have grown :data:`AMPLIFICATION` times past their difference over the
 first lobe passage (beyond, the dynamics amplify any difference between two models: on
-Rotor 37 tenfold every 1.5 revolutions). The estimate is then
+Rotor 37 tenfold every 1.5 revolutions), or at which the run's own difference to the
+reference has grown :data:`AMPLIFICATION` times past its value over the first lobe passage
+(two models start further apart than the twin, so the dynamics amplify their difference
+sooner: with the twin's horizon alone a richer, closer basis could be judged pointwise
+longer, into its amplified difference, and fail where a coarser one passed). The estimate
+is then
 
 * pointwise (as above) on ``[0, t_p]`` (``contact_force`` per lobe passage, signals), and
 * statistical on ``[t_p, t_end]``: per contact, the mean and largest normal force and the
@@ -178,19 +183,37 @@ def _signal_gap(a, b, k1: int) -> float:
     return out
 
 
+def _departure(a, ref) -> np.ndarray:
+    """Relative difference of the contact signals of ``a`` and ``ref`` at each step (each
+    signal relative to its largest reference value)."""
+    n = min(len(a.t), len(ref.t))
+    d = np.zeros(n)
+    for x, y in _signal_pairs(a, ref, n):
+        scale = np.abs(y).max()
+        if scale > 0:
+            d = np.maximum(d, np.abs(x - y).reshape(n, -1).max(axis=1) / scale)
+    return d
+
+
 def _horizon(tw, ref, share: float, first: int) -> int:
     """Predictability horizon (a step): where the twin's signals have grown
     :data:`AMPLIFICATION` times past their largest difference over the first ``first``
     steps, or leave the reference by ``share``, whichever comes first (or the end)."""
-    n = min(len(tw.t), len(ref.t))
-    d = np.zeros(n)
-    for x, y in _signal_pairs(tw, ref, n):
-        scale = np.abs(y).max()
-        if scale > 0:
-            d = np.maximum(d, np.abs(x - y).reshape(n, -1).max(axis=1) / scale)
+    d = _departure(tw, ref)
     bound = min(share, AMPLIFICATION * d[: max(1, first)].max())
     off = np.flatnonzero(d > bound)
-    return max(int(off[0]) if off.size else n, first)
+    return max(int(off[0]) if off.size else len(d), first)
+
+
+def _amplified(run, ref, first: int) -> int:
+    """Where the difference of ``run`` to ``ref`` has grown :data:`AMPLIFICATION` times past
+    its largest value over the first ``first`` steps (or the end): on a sensitive response
+    the dynamics amplify a small difference between two models as they amplify the twin's
+    round-off perturbation, only sooner (they start further apart)."""
+    d = _departure(run, ref)
+    early = d[: max(1, first)].max()
+    off = np.flatnonzero(d > AMPLIFICATION * early) if early > 0 else np.array([], dtype=int)
+    return max(int(off[0]) if off.size else len(d), first)
 
 
 def statistics(res, k0: int = 0, k1: int | None = None) -> dict:
@@ -238,7 +261,7 @@ def estimate(run, ref, fom, *, window=0.0, twin=None, tolerance=None) -> dict:
         extra["sensitivity"] = float(sens)
         if tolerance is not None and sens > HORIZON_SHARE * tolerance:  # chaotic: split
             first = int(np.searchsorted(b.t, b.t[0] + (window or 0.0)))
-            kp = _horizon(tw, b, HORIZON_SHARE * tolerance, first)
+            kp = min(_horizon(tw, b, HORIZON_SHARE * tolerance, first), _amplified(a, b, first))
             early = max(_impulse_error(a, b, window, kp), _signal_gap(a, b, kp))
             stats = _statistical(a, b, kp)
             late = max(stats.values()) if stats else 0.0
