@@ -40,6 +40,7 @@ from .build_warnings import initial_penetration, warn
 from .cached import Stages
 from .casing import footprint_warning
 from .explain import explain
+from .probes import probe_observations, probe_points
 from .scheme import bare_stepper, stepper_of
 
 __all__ = [
@@ -163,13 +164,15 @@ def _build(scene, log, modes, stages, with_stepper=True) -> Simulation:
     blade = load_blade(scene, log)
     size = length_scale(blade)
     _check_scale(scene, size)
+    probe_at = probe_points(scene, blade)  # node numbers checked before any assembly
     report["geometry"] = blade.summary()
     report["blade_size"] = size
     clock.done("mesh", f"{blade.n_vertices} vertices")
     built = _full_model(scene, blade, stages, log, report)
     clock.done("assembly", f"{built.model.n_dofs} state dofs")
     _report_full(scene, built, report)
-    model, limits = _select_signals(scene, built.model, report, size)
+    probes = _probes(scene, built, probe_at, report, log, size)
+    model, limits = _select_signals(scene, built.model, report, size, probes)
     if modes:
         report["natural_frequencies_hz"] = stages.frequencies(model, modes).tolist()
     reduced, reductor, ran = _reduce(scene, model, built.model, stages, log, limits, report, clock)
@@ -306,7 +309,15 @@ def _centrifugal_report(scene, prestress, growth, reach) -> dict:
     }
 
 
-def _select_signals(scene, model, report, size):
+def _probes(scene, built, points, report, log, size) -> dict:
+    """The probes' rows on the full model (:mod:`femrub.app.probes`), reported and warned."""
+    obs, report["probes"], warnings = probe_observations(scene, built, points, size)
+    for msg in warnings:
+        warn(msg, report, log)
+    return obs
+
+
+def _select_signals(scene, model, report, size, probes):
     outputs, limits = scene["outputs"], scene["limits"]
     wanted = set(model.observations) if outputs["signals"] == "all" else set(outputs["signals"])
     wanted |= {k for k in limits if k != "contact_force"}
@@ -327,7 +338,9 @@ def _select_signals(scene, model, report, size):
     kept_limits.update(defaults)
     report["limits"], report["ignored"] = kept_limits, ignored
     report["limits_default"] = sorted(defaults)
-    return model.with_(observations=obs), kept_limits
+    units = {f"probe_{p['name']}": p["unit"] for p in report["probes"]}
+    info = {**model.info, "signal_units": units} if units else model.info
+    return model.with_(observations={**obs, **probes}, info=info), kept_limits
 
 
 def _contacts_report(points, reach) -> dict:

@@ -124,7 +124,24 @@ def point_metrics(folder) -> dict:
         "t_reached": s.get("t_reached"),
         "wall_seconds": s.get("wall_seconds"),
         "natural_frequencies_hz": build.get("natural_frequencies_hz", []),
+        "probes": _probe_metrics(folder / "history.npz", s.get("units", {})),
     }
+
+
+def _probe_metrics(path, units: dict) -> dict:
+    """``rms_probe_<name>_<unit>`` and ``max_probe_<name>_<unit>`` (largest magnitude) of
+    each probe in a ``history.npz`` (``outputs.probes``; SI units, ``m_s`` for m/s)."""
+    out = {}
+    try:
+        with np.load(path) as h:
+            probes = {k: np.asarray(h[k], dtype=float) for k in h.files if k.startswith("probe_")}
+    except (OSError, ValueError):
+        return out
+    for key, x in probes.items():
+        unit = units.get(key, "-").replace("/", "_")
+        out[f"rms_{key}_{unit}"] = float(np.sqrt(np.mean(x**2))) if x.size else None
+        out[f"max_{key}_{unit}"] = float(np.abs(x).max()) if x.size else None
+    return out
 
 
 def _rms(path, key):
@@ -354,6 +371,7 @@ def _x(scene, key) -> float:
 
 def _write_csv(rows, keys, path) -> None:
     n_f = max((len(r.get("natural_frequencies_hz") or []) for r in rows), default=0)
+    probes = list(dict.fromkeys(k for r in rows for k in r.get("probes") or {}))
     cols = [
         "point",
         *keys,
@@ -369,6 +387,7 @@ def _write_csv(rows, keys, path) -> None:
         "message",
         "rms_tip_displacement_m",
         "max_wear_depth_m",
+        *probes,
     ]
     with atomic_file(path, "w") as fh:
         w = csv.writer(fh)
@@ -391,5 +410,6 @@ def _write_csv(rows, keys, path) -> None:
                     r.get("message", ""),
                     r.get("rms_tip_displacement"),
                     r.get("max_wear_depth"),
+                    *[(r.get("probes") or {}).get(k) for k in probes],
                 ]
             )
