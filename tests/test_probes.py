@@ -254,3 +254,21 @@ def test_unknown_node_is_refused_before_the_assembly(deck):
     with pytest.raises(SceneError, match=r"outputs.probes\[0\].node = 99999: no such node"):
         build(_scene(deck, corner=99999), log=lines.append, stepper=False)
     assert not any("assembl" in line for line in lines), lines
+
+
+@pytest.mark.parametrize("name", ["rotor37", "rotor37-thermal"])
+def test_rotor37_scenes_probe_node_1353_along_y(name):
+    """The published response: the y displacement of deck node 1353, found in the deck."""
+    from femrub.app.blade import load_blade
+    from femrub.app.probes import probe_points
+    from femrub.geometry.rotor37 import shared_data_dir
+    from femrub.scene import load_scene
+
+    scene = load_scene(name)
+    assert scene["outputs"]["probes"] == [
+        {"name": "node1353_y", "node": 1353, "quantity": "displacement", "component": "y"}
+    ]
+    if not (shared_data_dir() / "rotor37-fe-mesh" / "blade.inp").is_file():
+        pytest.skip("Rotor 37 deck not found (set FEMRUB_SHARED_DATA to the shared data folder)")
+    (x,) = probe_points(scene, load_blade(scene))
+    np.testing.assert_allclose(x * 1e3, [600.4710848100, -32.156503437, 73.046422877], rtol=1e-12)
