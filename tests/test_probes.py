@@ -272,3 +272,11 @@ def test_rotor37_scenes_probe_node_1353_along_y(name):
         pytest.skip("Rotor 37 deck not found (set FEMRUB_SHARED_DATA to the shared data folder)")
     (x,) = probe_points(scene, load_blade(scene))
     np.testing.assert_allclose(x * 1e3, [600.4710848100, -32.156503437, 73.046422877], rtol=1e-12)
+
+
+def test_a_node_no_element_uses_is_refused(deck, tmp_path):
+    text = deck["path"].read_text().replace("*NODE\n", "*NODE\n5000, 131, 3, 1\n", 1)
+    (tmp_path / "blade.inp").write_text(text)
+    scene = _scene({**deck, "path": tmp_path / "blade.inp"}, corner=5000)
+    with pytest.raises(SceneError, match=r"probes\[0\].node = 5000: is .* from every node"):
+        build(scene, stepper=False)

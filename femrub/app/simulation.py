@@ -171,7 +171,7 @@ def _build(scene, log, modes, stages, with_stepper=True) -> Simulation:
     built = _full_model(scene, blade, stages, log, report)
     clock.done("assembly", f"{built.model.n_dofs} state dofs")
     _report_full(scene, built, report)
-    probes = _probes(scene, built, probe_at, report, log, size)
+    probes = _probes(scene, built, probe_at, report, log)
     model, limits = _select_signals(scene, built.model, report, size, probes)
     if modes:
         report["natural_frequencies_hz"] = stages.frequencies(model, modes).tolist()
@@ -309,9 +309,9 @@ def _centrifugal_report(scene, prestress, growth, reach) -> dict:
     }
 
 
-def _probes(scene, built, points, report, log, size) -> dict:
+def _probes(scene, built, points, report, log) -> dict:
     """The probes' rows on the full model (:mod:`femrub.app.probes`), reported and warned."""
-    obs, report["probes"], warnings = probe_observations(scene, built, points, size)
+    obs, report["probes"], warnings = probe_observations(scene, built, points)
     for msg in warnings:
         warn(msg, report, log)
     return obs
