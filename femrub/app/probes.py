@@ -17,14 +17,12 @@ from __future__ import annotations
 import numpy as np
 
 from ..model.probes import FIELDS, direction, mesh_nodes, probe_rows
+from ..output.results import PROBE_PREFIX
 from ..scene.schema_run import PROBE_QUANTITIES
 from ..scene.spec import SceneError, fail
 from ..scene.units import SI_LABEL
 
-__all__ = ["PREFIX", "probe_observations", "probe_points", "probe_unit"]
-
-#: the prefix of a probe's signal name (``history.npz`` key ``probe_<name>``)
-PREFIX = "probe_"
+__all__ = ["probe_observations", "probe_points", "probe_unit"]
 #: distance from a node number's own position to the model's node, relative to the mean edge
 #: length, above which it is no node of the model (a node no element uses); a quadratic
 #: deck's mid-side node is exact with P2 displacements and within this of the straight
@@ -128,7 +126,7 @@ def probe_observations(scene, built, points):
                 "displacement, or set physics.thermal = 'on'"
             ) from None
         name = probe["name"]
-        obs[PREFIX + name] = row
+        obs[PROBE_PREFIX + name] = row
         entry = {
             "name": name,
             "quantity": quantity,

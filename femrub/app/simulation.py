@@ -32,6 +32,7 @@ from ..analysis.step_check import check_step
 from ..contact import jit
 from ..model.builder import RubBuild, build_rub, length_scale
 from ..output.limits import MAX_DISPLACEMENT_RATIO, MAX_TEMPERATURE_RISE, default_limits
+from ..output.results import PROBE_PREFIX
 from ..scene.run_checks import check_run
 from ..scene.spec import SceneError, fail
 from . import translate as tr
@@ -338,7 +339,7 @@ def _select_signals(scene, model, report, size, probes):
     kept_limits.update(defaults)
     report["limits"], report["ignored"] = kept_limits, ignored
     report["limits_default"] = sorted(defaults)
-    units = {f"probe_{p['name']}": p["unit"] for p in report["probes"]}
+    units = {PROBE_PREFIX + p["name"]: p["unit"] for p in report["probes"]}
     info = {**model.info, "signal_units": units} if units else model.info
     return model.with_(observations={**obs, **probes}, info=info), kept_limits
 

@@ -29,6 +29,7 @@ import numpy as np
 
 from ..output.folder import FINISHED, FolderError, claim, folder_status
 from ..output.jsonfile import write_json
+from ..output.results import PROBE_PREFIX
 from ..output.safe_write import atomic_file, write_atomic
 from ..scene import SceneError, parse_value, resolve_key
 from ..scene.run_checks import check_run
@@ -134,7 +135,9 @@ def _probe_metrics(path, units: dict) -> dict:
     out = {}
     try:
         with np.load(path) as h:
-            probes = {k: np.asarray(h[k], dtype=float) for k in h.files if k.startswith("probe_")}
+            probes = {
+                k: np.asarray(h[k], dtype=float) for k in h.files if k.startswith(PROBE_PREFIX)
+            }
     except (OSError, ValueError):
         return out
     for key, x in probes.items():
