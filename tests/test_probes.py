@@ -280,3 +280,13 @@ def test_a_node_no_element_uses_is_refused(deck, tmp_path):
     scene = _scene({**deck, "path": tmp_path / "blade.inp"}, corner=5000)
     with pytest.raises(SceneError, match=r"probes\[0\].node = 5000: is .* from every node"):
         build(scene, stepper=False)
+
+
+def test_a_point_far_from_every_node_is_probed_with_a_warning(deck):
+    """Millimetres written as plain numbers (metres): the nearest node, and a warning."""
+    extra = '  { name = "far", point = [160, 10, 4], component = "x" },\n'
+    with pytest.warns(UserWarning, match=r"probes\[4\] \('far'\): the nearest node is .* check"):
+        built = build(_scene(deck, extra=extra), stepper=False)
+    far = built.report["probes"][4]
+    assert far["distance"] > 100.0
+    assert any("'far'" in w for w in built.report["warnings"])
