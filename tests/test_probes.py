@@ -290,3 +290,11 @@ def test_a_point_far_from_every_node_is_probed_with_a_warning(deck):
     far = built.report["probes"][4]
     assert far["distance"] > 100.0
     assert any("'far'" in w for w in built.report["warnings"])
+
+
+def test_the_bar_numbers_its_vertices_from_the_root(tmp_path):
+    text = bar_scene().replace(
+        "[loads]", '[outputs]\nprobes = [{ name = "tip", node = 6, component = "x" }]\n[loads]'
+    )
+    with pytest.raises(SceneError, match=r"node = 6: no such node .* indices 0\.\.5"):
+        build(loads_scene(text), stepper=False)

@@ -7,9 +7,10 @@ and its observation row (:mod:`femrub.model.probes`) on the full model, named
 ``probe_<name>``; the reduction projects these rows like the model's other signals.
 
 Node numbers: a CalculiX/Abaqus deck's node numbers (mid-side nodes included), a gmsh file's
-node tags; a mesh femrub builds (box, naca, sections) or the paper's bar has none, and its
-node number is the vertex index from 0 (the bar's vertex 0 is its root, ``n_elements`` its
-tip).
+node tags (corner nodes); a blade femrub builds (box, naca, sections) has the node tags of
+its gmsh mesh (the vertex index + 1, the tags ``femrub mesh KIND -o blade.msh`` writes);
+the paper's bar has none and its node number is the vertex index from 0 (vertex 0 is its
+root, ``n_elements`` its tip); another file read through meshio: femrub's vertex index.
 """
 
 from __future__ import annotations
@@ -51,7 +52,7 @@ def _node_point(blade, node: int, key: str) -> np.ndarray:
     numbering = (
         "the mesh's node numbers"
         if table is not None or blade.vertex_ids is not None
-        else f"vertex indices 0..{blade.n_vertices - 1} (a built-in mesh has no node numbers)"
+        else f"the vertex indices 0..{blade.n_vertices - 1} (this mesh has no node numbers)"
     )
     fail(key, node, f"no such node in {blade.source}; use one of {numbering}, or give point")
 

@@ -145,8 +145,9 @@ PROBE = {
         I,
         None,
         lo=0,
-        doc="the mesh's own node number (deck or gmsh node id; built-in blades and the bar: "
-        "the vertex index from 0); or give point",
+        doc="the mesh's own node number (a deck's node id, a .msh node tag; box, naca, "
+        "sections: the gmsh node tag, as femrub mesh writes it; the bar: the vertex index "
+        "from 0 at the root); or give point",
     ),
     "point": Spec(
         "vec3",
