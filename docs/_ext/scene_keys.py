@@ -94,7 +94,7 @@ def scene_key_lines() -> list[str]:
                     f"``{key}``",
                     spec.kind,
                     spec.unit,
-                    default_text(spec, REQUIRED),
+                    "—" if "[]" in key and spec.default is None else default_text(spec, REQUIRED),
                     bounds_text(spec),
                     _prose(spec.doc or "") + when,
                 ]

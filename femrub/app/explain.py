@@ -230,6 +230,19 @@ def _scheme_rows(report: dict) -> list[tuple[str, str]]:
     return rows
 
 
+def _probe_text(probe: dict) -> str:
+    """One probe: what it reads, where it was asked, the node read and its distance."""
+    what = " ".join(filter(None, (probe["component"], probe["quantity"])))
+    asked = f"node {probe['node']}" if "node" in probe else "point (%.6g, %.6g, %.6g) m"
+    if "point" in probe:
+        asked %= tuple([*probe["point"], 0.0, 0.0][:3])
+    at = ", ".join(f"{x:.6g}" for x in probe["position"])
+    return (
+        f"probe_{probe['name']}: {what} ({probe['unit']}) at {asked}; "
+        f"mesh node at ({at}) m, {probe['distance']:.3g} m away"
+    )
+
+
 def _output_rows(report: dict) -> list[tuple[str, str]]:
     """Signals, stop limits, outputs, natural frequencies and timings."""
     rows = [("signals", ", ".join(report["signals"]) + " (+ gaps, contact forces, energy)")]
@@ -238,6 +251,7 @@ def _output_rows(report: dict) -> list[tuple[str, str]]:
     if report["limits"]:
         rows.append(("limits", ", ".join(f"{k} <= {v:g}" for k, v in report["limits"].items())))
     rows += [("ignored", note) for note in report.get("ignored", [])]
+    rows += [("probe", _probe_text(p)) for p in report.get("probes", [])]
     o = report["outputs"]
     vtk = f"VTK every {o['vtk_stride']} steps" if o["vtk_stride"] else None
     rows.append(("outputs", vtk or "no VTK (outputs.vtk_stride = 0)"))

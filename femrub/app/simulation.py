@@ -33,6 +33,7 @@ from ..contact import jit
 from ..model.builder import RubBuild, build_rub, length_scale
 from ..model.modes import damped_modes
 from ..output.limits import MAX_DISPLACEMENT_RATIO, MAX_TEMPERATURE_RISE, default_limits
+from ..output.results import PROBE_PREFIX
 from ..scene.run_checks import check_run
 from ..scene.spec import SceneError, fail
 from . import translate as tr
@@ -41,6 +42,7 @@ from .build_warnings import initial_penetration, warn
 from .cached import Kept, Stages
 from .casing import footprint_warning
 from .explain import explain
+from .probes import probe_observations, probe_points
 from .scheme import bare_stepper, stepper_of
 
 __all__ = [
@@ -127,6 +129,8 @@ class Simulation:
     #: ``(results, wall seconds)`` of the scene's run of ``model`` to ``scheme.t_end``, stepped
     #: by the reduction error estimate (:func:`reusable_run`), else ``None``
     ran: tuple | None = None
+    #: the probes' observation rows on the full model, ``{probe_<name>: (1, n) rows}``
+    probes: dict = field(default_factory=dict)
 
     def explain(self) -> str:
         """What was built and why, as text (``femrub run SCENE --explain``)."""
@@ -257,13 +261,15 @@ def _build(scene, log, modes, stages, with_stepper=True) -> Simulation:
     blade = load_blade(scene, log)
     size = length_scale(blade)
     _check_scale(scene, size)
+    probe_at = probe_points(scene, blade)  # node numbers checked before any assembly
     report["geometry"] = blade.summary()
     report["blade_size"] = size
     clock.done("mesh", f"{blade.n_vertices} vertices")
     built = _full_model(scene, blade, stages, log, report)
     clock.done("assembly", f"{built.model.n_dofs} state dofs")
     _report_full(scene, built, report)
-    full = _Full(built.model, built.fields, size)
+    probes = _probes(scene, built, probe_at, report, log)
+    full = _Full(built.model, built.fields, size, probes)
     return _runnable(scene, full, stages, log, modes, report, clock, with_stepper)
 
 
@@ -274,12 +280,14 @@ class _Full:
     model: object
     fields: object
     size: float
+    #: the probes' observation rows on the full model (:mod:`femrub.app.probes`)
+    probes: dict
 
 
 def _runnable(scene, full: _Full, stages, log, modes, report, clock, with_stepper) -> Simulation:
     """The :class:`Simulation` of a full model: its signals and limits, natural frequencies,
     reduction (checked) and stepper."""
-    model, limits = _select_signals(scene, full.model, report, full.size)
+    model, limits = _select_signals(scene, full.model, report, full.size, full.probes)
     if modes and len(report.get("natural_frequencies_hz", ())) != modes:
         report["natural_frequencies_hz"] = stages.frequencies(model, modes).tolist()
     reduced, reductor, ran = _reduce(scene, model, full.model, stages, log, limits, report, clock)
@@ -302,6 +310,7 @@ def _runnable(scene, full: _Full, stages, log, modes, report, clock, with_steppe
         report,
         clock.timings,
         ran,
+        full.probes,
     )
 
 
@@ -342,7 +351,7 @@ def _at_speed(last: Simulation, scene, stages, log, modes) -> Simulation | None:
     before = last.full.parameters["rotation_speed"]
     report["parametric"] = {"from_rotation_speed": before, "rotation_speed": omega}
     clock.done("assembly", f"the model at {before:g} rad/s taken at {omega:g} rad/s")
-    full = _Full(model, last.fields, report["blade_size"])
+    full = _Full(model, last.fields, report["blade_size"], last.probes)
     return _runnable(scene, full, stages, log, modes, report, clock, True)
 
 
@@ -458,7 +467,15 @@ def _centrifugal_report(scene, prestress, growth, reach) -> dict:
     }
 
 
-def _select_signals(scene, model, report, size):
+def _probes(scene, built, points, report, log) -> dict:
+    """The probes' rows on the full model (:mod:`femrub.app.probes`), reported and warned."""
+    obs, report["probes"], warnings = probe_observations(scene, built, points)
+    for msg in warnings:
+        warn(msg, report, log)
+    return obs
+
+
+def _select_signals(scene, model, report, size, probes):
     outputs, limits = scene["outputs"], scene["limits"]
     wanted = set(model.observations) if outputs["signals"] == "all" else set(outputs["signals"])
     wanted |= {k for k in limits if k != "contact_force"}
@@ -479,7 +496,9 @@ def _select_signals(scene, model, report, size):
     kept_limits.update(defaults)
     report["limits"], report["ignored"] = kept_limits, ignored
     report["limits_default"] = sorted(defaults)
-    return model.with_(observations=obs), kept_limits
+    units = {PROBE_PREFIX + p["name"]: p["unit"] for p in report["probes"]}
+    info = {**model.info, "signal_units": units} if units else model.info
+    return model.with_(observations={**obs, **probes}, info=info), kept_limits
 
 
 def _contacts_report(points, reach) -> dict:

@@ -31,6 +31,7 @@ import numpy as np
 
 from ..output.folder import FINISHED, FolderError, claim, folder_status
 from ..output.jsonfile import write_json
+from ..output.results import PROBE_PREFIX
 from ..output.safe_write import atomic_file, write_atomic
 from ..scene import SceneError, parse_value, resolve_key
 from ..scene.run_checks import check_run
@@ -126,7 +127,26 @@ def point_metrics(folder) -> dict:
         "t_reached": s.get("t_reached"),
         "wall_seconds": s.get("wall_seconds"),
         "natural_frequencies_hz": build.get("natural_frequencies_hz", []),
+        "probes": _probe_metrics(folder / "history.npz", s.get("units", {})),
     }
+
+
+def _probe_metrics(path, units: dict) -> dict:
+    """``rms_probe_<name>_<unit>`` and ``max_probe_<name>_<unit>`` (largest magnitude) of
+    each probe in a ``history.npz`` (``outputs.probes``; SI units, ``m_s`` for m/s)."""
+    out = {}
+    try:
+        with np.load(path) as h:
+            probes = {
+                k: np.asarray(h[k], dtype=float) for k in h.files if k.startswith(PROBE_PREFIX)
+            }
+    except (OSError, ValueError):
+        return out
+    for key, x in probes.items():
+        unit = units.get(key, "-").replace("/", "_")
+        out[f"rms_{key}_{unit}"] = float(np.sqrt(np.mean(x**2))) if x.size else None
+        out[f"max_{key}_{unit}"] = float(np.abs(x).max()) if x.size else None
+    return out
 
 
 def _rms(path, key):
@@ -379,6 +399,7 @@ def _x(scene, key) -> float:
 
 def _write_csv(rows, keys, path) -> None:
     n_f = max((len(r.get("natural_frequencies_hz") or []) for r in rows), default=0)
+    probes = list(dict.fromkeys(k for r in rows for k in r.get("probes") or {}))
     cols = [
         "point",
         *keys,
@@ -394,6 +415,7 @@ def _write_csv(rows, keys, path) -> None:
         "message",
         "rms_tip_displacement_m",
         "max_wear_depth_m",
+        *probes,
     ]
     with atomic_file(path, "w") as fh:
         w = csv.writer(fh)
@@ -416,5 +438,6 @@ def _write_csv(rows, keys, path) -> None:
                     r.get("message", ""),
                     r.get("rms_tip_displacement"),
                     r.get("max_wear_depth"),
+                    *[(r.get("probes") or {}).get(k) for k in probes],
                 ]
             )

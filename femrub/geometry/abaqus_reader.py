@@ -216,7 +216,9 @@ def read_abaqus(
     BladeMesh
         Node sets ``root``, ``tip``, every NSET (restricted to vertices) and
         ``contact`` when all contact nodes are vertices; ``info["material"]``: the deck's
-        ``*MATERIAL`` in SI (:func:`deck_material`).
+        ``*MATERIAL`` in SI (:func:`deck_material`); ``info["node_points"]``: every node
+        number of the deck (``"ids"``) and its coordinates in metres (``"points"``, 3 × n),
+        mid-side nodes included.
 
     Raises
     ------
@@ -288,6 +290,7 @@ def read_abaqus(
             "n_source_nodes": int(model.node_ids.size),
             "files": model.files,
             "contact_map": contact_map,
+            "node_points": {"ids": model.node_ids, "points": points},
             "material": deck_material(model, length_unit, elset),
             "edge_midpoints": curved,
             "read_time_s": time.perf_counter() - start,

@@ -32,7 +32,8 @@ _IMPULSE, _FORCE = "contact_impulse", "contact_force"
 
 
 class HistoryCSV:
-    """Append blocks of per-step arrays to ``path``, one row in ``every`` (module docstring).
+    """Append blocks of per-step arrays to ``path``, one row in ``every`` (module docstring);
+    ``units``: units of signals :data:`~femrub.output.results.UNITS` does not know (probes).
 
     Attributes
     ----------
@@ -40,8 +41,9 @@ class HistoryCSV:
     received : steps received (rows of the run's history so far).
     """
 
-    def __init__(self, path, every: int = 1):
+    def __init__(self, path, every: int = 1, units: dict | None = None):
         self.path = Path(path)
+        self.units = {**UNITS, **(units or {})}  # probes' units by signal name
         self.every = int(every)
         if self.every < 1:
             raise ValueError(f"HistoryCSV: every must be >= 1, got {every!r}")
@@ -85,7 +87,7 @@ class HistoryCSV:
         if self._fh is None:
             self._fh = open_nofollow(self.path, "w", newline="")
             self._columns = list(cols)
-            csv.writer(self._fh).writerow(csv_header(self._columns, UNITS))
+            csv.writer(self._fh).writerow(csv_header(self._columns, self.units))
             self._fh.flush()
             self._good = self._fh.tell()
             self._imp = [j for j, k in enumerate(cols) if k.startswith(_IMPULSE)]

@@ -26,7 +26,7 @@ import numpy as np
 
 from ..contact.friction import coulomb_check_rows, merge_coulomb_checks
 from .balance import BALANCE_TERMS, balance_maxima, energy_error_of, heat_error_of
-from .results import Results
+from .results import Results, signal_units
 
 __all__ = ["AllRows", "LeanRows"]
 
@@ -41,7 +41,9 @@ def _signals(rec, obs) -> dict[str, np.ndarray]:
 
 
 def _info(rec) -> dict:
-    return {"label": rec.label, "stability_limit": rec.h_lim, "n_dofs": rec.model.n_dofs}
+    info = {"label": rec.label, "stability_limit": rec.h_lim, "n_dofs": rec.model.n_dofs}
+    units = signal_units(rec.model)
+    return {**info, "signal_units": units} if units else info
 
 
 class AllRows:

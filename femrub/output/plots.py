@@ -22,6 +22,8 @@ _PANELS = {
     "contact_force": ("force = impulse/h (N)", 1.0),
     "phase_impulse": ("impulse/phase (mN s)", 1e3),
 }
+#: axis label unit and scale of a probe's SI unit (``outputs.probes``)
+_PROBE_AXES = {"m": ("µm", 1e6), "m/s": ("m/s", 1.0), "K": ("K", 1.0)}
 #: thin lines for per-step force traces (impulse / h flips between steps while closed)
 _THIN = {"lw": 0.5, "alpha": 0.75}
 
@@ -52,8 +54,17 @@ def phase_impulses(res, merge: float) -> tuple[np.ndarray, np.ndarray]:
     return np.array(mids), np.array(total)
 
 
+def _axis(key: str, runs) -> tuple[str, float]:
+    """Label and scale of a panel: a known signal, or a probe ``probe_<name>`` in its unit."""
+    if key in _PANELS:
+        return _PANELS[key]
+    unit = next((r.info.get("signal_units", {}).get(key) for _, r, _ in runs), None) or "-"
+    label, scale = _PROBE_AXES.get(unit, (unit, 1.0))
+    return f"probe {key.removeprefix('probe_')} ({label})", scale
+
+
 def _draw(ax, key, runs, *, tlim, scale_t, gap, merge, log, titles):
-    ylabel, scale = _PANELS[key]
+    ylabel, scale = _axis(key, runs)
     if titles and key in titles:
         ax.set_title(titles[key], fontsize=8.5, loc="left")
     for label, res, style in runs:

@@ -37,10 +37,13 @@ from .jsonfile import jsonable
 
 __all__ = [
     "ENERGY_KEYS",
+    "PROBE_PREFIX",
     "UNITS",
     "Results",
     "csv_header",
     "flatten_columns",
+    "npz_key",
+    "signal_units",
     "unit_of",
 ]
 
@@ -88,6 +91,22 @@ UNITS = {
 
 #: the per-contact friction arrays of ``history.npz`` (friction_limit: μ per contact)
 _FRICTION_ARRAYS = ("friction_force", "slip_velocity", "contact_state", "friction_limit")
+
+
+#: signals saved under their own name in ``history.npz`` (a probe ``probe_<name>``)
+PROBE_PREFIX = "probe_"
+
+
+def npz_key(signal: str) -> str:
+    """The ``history.npz`` key of a signal: ``signal_<name>``, a probe under its own name."""
+    return signal if signal.startswith(PROBE_PREFIX) else f"signal_{signal}"
+
+
+def signal_units(model) -> dict[str, str]:
+    """Units of ``model``'s signals that :data:`UNITS` does not know (probes, by signal
+    name): ``model.info["signal_units"]``, or its full model's for a reduced model."""
+    info = getattr(model, "info", None) or {}
+    return dict(info.get("signal_units") or info.get("full_info", {}).get("signal_units") or {})
 
 
 def unit_of(name: str) -> str:
@@ -178,11 +197,28 @@ class Results:
         """Mean contact force over each step, ``impulse / h`` (N)."""
         return self.impulse / self.h
 
-    def signal(self, name: str, component: int = 0) -> np.ndarray:
-        """One component of an observed signal, e.g. ``signal("tip_displacement")``."""
+    def signal(self, name: str, component: int | None = None) -> np.ndarray:
+        """An observed signal, e.g. ``signal("tip_displacement")``: ``(rows,)`` for a signal
+        of one component, ``(rows, k)`` for one of ``k`` (``contact_displacement``: one
+        column per contact), or its column ``component``."""
         if name not in self.signals:
             raise KeyError(f"no signal {name!r}; available: {', '.join(self.signals)}")
-        return self.signals[name][:, component]
+        values = self.signals[name]
+        k = values.shape[1]
+        if component is None:
+            return values[:, 0] if k == 1 else values
+        if not -k <= component < k:
+            raise IndexError(f"signal {name!r} has {k} components; component {component} asked")
+        return values[:, component]
+
+    def probe(self, name: str) -> np.ndarray:
+        """The history ``(rows,)`` of the probe ``name`` (``outputs.probes``; SI units:
+        ``info["signal_units"]``)."""
+        key = PROBE_PREFIX + name
+        if key not in self.signals:
+            names = [k[len(PROBE_PREFIX) :] for k in self.signals if k.startswith(PROBE_PREFIX)]
+            raise KeyError(f"no probe {name!r}; probes of this run: {', '.join(names) or 'none'}")
+        return self.signals[key][:, 0]
 
     def contact_phases(self, threshold: float = 0.0) -> list[tuple[float, float]]:
         """Intervals ``(start, end)`` during which any contact carries an impulse."""
@@ -226,11 +262,12 @@ class Results:
 
     def units(self) -> dict[str, str]:
         """SI unit of every ``history.npz`` array, by key."""
-        names = ["t", "gap", "impulse", "normal_force", *[f"signal_{k}" for k in self.signals]]
+        names = ["t", "gap", "impulse", "normal_force", *map(npz_key, self.signals)]
         names += list(self.extra)
         names += [k for k in _FRICTION_ARRAYS if getattr(self, k) is not None]
         names += [f"energy_{k}" for k in self.energy]
-        return {k: unit_of(k) for k in names}
+        own = self.info.get("signal_units", {})
+        return {k: own.get(k, unit_of(k)) for k in names}
 
     def save_csv(self, path, every: int = 1, digits: int | None = None) -> Path:
         """Write :meth:`columns` as CSV, every step or one row in ``every``; ``digits``:
@@ -250,7 +287,7 @@ class Results:
         tmp = path.with_name(path.name + ".tmp")
         with tmp.open("w", newline="") as fh:
             w = csv.writer(fh)
-            w.writerow(csv_header(cols, UNITS))
+            w.writerow(csv_header(cols, {**UNITS, **self.info.get("signal_units", {})}))
             if digits is None:
                 write_csv_rows(fh, table)
             else:
@@ -331,7 +368,7 @@ class Results:
             "checks": self.checks,
             "units": self.units(),
         }
-        arrays = {f"signal_{k}": v for k, v in self.signals.items()}
+        arrays = {npz_key(k): v for k, v in self.signals.items()}
         arrays.update(self.extra)
         arrays.update({f"energy_{k}": v for k, v in self.energy.items()})
         if self.states is not None:
@@ -359,6 +396,7 @@ class Results:
         with np.load(path) as d:
             meta = json.loads(str(d["meta"]))
             signals = {k[7:]: d[k] for k in d.files if k.startswith("signal_")}
+            signals.update({k: d[k] for k in d.files if k.startswith(PROBE_PREFIX)})
             energy = {k[7:]: d[k] for k in d.files if k.startswith("energy_")}
             states = d["states"] if "states" in d.files else None
             stimes = d["state_times"] if "state_times" in d.files else None
@@ -369,7 +407,7 @@ class Results:
                 for k in d.files
                 if k not in known
                 and k not in _FRICTION_ARRAYS
-                and not k.startswith(("signal_", "energy_"))
+                and not k.startswith(("signal_", "energy_", PROBE_PREFIX))
             }
             return cls(
                 scheme=meta["scheme"],

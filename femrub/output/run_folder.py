@@ -32,6 +32,7 @@ from .history_file import HistoryCSV
 from .interrupts import deferred, interruptible
 from .jsonfile import write_json as _write_json
 from .plots import savefig, tip_panels
+from .results import PROBE_PREFIX, signal_units
 from .safe_write import describe_os_error, naming
 from .verdict import assess
 
@@ -211,7 +212,7 @@ def _run(  # noqa: PLR0913 (run_to_folder's options passed on)
         series = VTKSeries(out / "vtk", model, fields, h=stepper.h, stride=vtk_stride)
     for stale in ("history.csv", "history.npz", "signals.png", "snapshot.png"):
         (out / stale).unlink(missing_ok=True)  # results of an earlier, unfinished run
-    history = HistoryCSV(out / "history.csv", every=csv_stride)
+    history = HistoryCSV(out / "history.csv", every=csv_stride, units=signal_units(model))
     t0 = time.perf_counter()
     tolerances = {"reduction": reduction_error, "time_step": step_error}
     try:
@@ -322,6 +323,7 @@ def _finish(  # noqa: PLR0913 (run_to_folder's options passed on)
     with naming(out / "history.npz"):
         res.save_npz(out / "history.npz")
     panels = [k for k in ("tip_displacement", "tip_temperature") if k in res.signals]
+    panels += [k for k in res.signals if k.startswith(PROBE_PREFIX)]
     if plots:
         savefig(
             tip_panels(

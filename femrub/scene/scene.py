@@ -244,7 +244,7 @@ def resolve_key(key: str) -> str:
     """Full dotted key of ``key``, which may be a unique suffix (``rotation_speed``)."""
     global _KEYS
     if _KEYS is None:
-        _KEYS = sorted({k for k, _, _ in schema_rows()})
+        _KEYS = sorted({k for k, _, _ in schema_rows() if "[]" not in k})  # not in a table array
     if key in _KEYS:
         return key
     matches = [k for k in _KEYS if k.endswith("." + key)]

@@ -346,3 +346,5 @@ def schema_rows(table=None, prefix: str = ""):
             yield from schema_rows(spec, f"{dotted}.")
         else:
             yield dotted, spec, None
+            if spec.items:  # an array of tables: each table's keys
+                yield from schema_rows(spec.items, f"{dotted}[].")

@@ -10,7 +10,16 @@ from ..contact.activation import DEFAULT_FRICTIONAL_RULE, DEFAULT_RULE, FRICTION
 from .spec import NONNEG, POS, REQUIRED, Spec, Variant
 from .spec import float_spec as _f
 
-__all__ = ["LIMITS", "OUTPUTS", "REDUCTION", "SCHEME", "SIGNALS"]
+__all__ = [
+    "LIMITS",
+    "OUTPUTS",
+    "PROBE",
+    "PROBE_COMPONENTS",
+    "PROBE_QUANTITIES",
+    "REDUCTION",
+    "SCHEME",
+    "SIGNALS",
+]
 
 I, B, C = "int", "bool", "choice"
 
@@ -121,6 +130,45 @@ SIGNALS = {
     "contact_force": "force",
 }
 
+#: what a probe reads, with its dimension (docs/probes.md)
+PROBE_QUANTITIES = {"displacement": "length", "velocity": "velocity", "temperature": "temperature"}
+#: directions of a probe: global axes, and the machine's axes at the probed node
+PROBE_COMPONENTS = ("x", "y", "z", "radial", "axial", "circumferential")
+
+PROBE = {
+    "name": Spec(
+        "str",
+        REQUIRED,
+        doc="probe name (letters, digits, '-', '_'): history.npz key probe_<name>, CSV column",
+    ),
+    "node": Spec(
+        I,
+        None,
+        lo=0,
+        doc="the mesh's own node number (a deck's node id, a .msh node tag; box, naca, "
+        "sections: the gmsh node tag, as femrub mesh writes it; the bar: the vertex index "
+        "from 0 at the root); or give point",
+    ),
+    "point": Spec(
+        "vec3",
+        None,
+        "length",
+        doc="coordinates of the point (the nearest mesh node is probed, its distance reported); "
+        "or give node",
+    ),
+    "quantity": Spec(
+        C, "displacement", choices=tuple(PROBE_QUANTITIES), doc="the field read at the node"
+    ),
+    "component": Spec(
+        C,
+        None,
+        choices=PROBE_COMPONENTS,
+        doc="direction of a displacement or velocity: global x, y, z, or radial, axial, "
+        "circumferential (axis × radial) about the machine axis at the node; none for "
+        "temperature",
+    ),
+}
+
 OUTPUTS = {
     "signals": Spec("strs", "all", choices=("all",), doc="history signals kept"),
     "vtk_stride": Spec(I, 0, lo=0, doc="3D: write a VTK frame every that many steps (0: none)"),
@@ -136,6 +184,13 @@ OUTPUTS = {
         True,
         doc="the PNG plots of the run (signals, response, spectrum, contact forces, "
         "snapshot of the last VTK frame)",
+    ),
+    "probes": Spec(
+        "tables",
+        [],
+        doc="one field component at one mesh node, recorded at every step "
+        "(history.npz probe_<name>, a CSV column, signals.png); keys below",
+        items=PROBE,
     ),
 }
 

@@ -69,7 +69,8 @@ class Spec:
     Parameters
     ----------
     kind : ``"float"``, ``"int"``, ``"bool"``, ``"str"``, ``"choice"``, ``"vec3"``,
-        ``"pair"`` (two floats), ``"ints"`` (list of int), ``"strs"`` (list of str).
+        ``"pair"`` (two floats), ``"ints"`` (list of int), ``"strs"`` (list of str),
+        ``"tables"`` (an array of tables, each checked against ``items``).
     default : value used when the key is absent (``REQUIRED``: must be given; ``None``:
         left to the builder).
     dim : unit dimension of a float (:mod:`femrub.scene.units`).
@@ -77,6 +78,7 @@ class Spec:
     choices : allowed strings of a ``choice``, or words accepted besides a number
         (``reach = "auto"``) or a list (``signals = "all"``).
     doc : one-line description (docs/scenes.md).
+    items : the keys of each table of a ``"tables"`` key (name -> :class:`Spec`).
     """
 
     kind: str
@@ -88,6 +90,7 @@ class Spec:
     hi_open: bool = False
     choices: tuple = ()
     doc: str = ""
+    items: dict | None = None
 
     @property
     def unit(self) -> str:
@@ -176,6 +179,26 @@ class Spec:
         if not ok or any(isinstance(v, bool) or not isinstance(v, int) for v in value):
             fail(key, value, "must be a non-empty list of integers")
         return [int(v) for v in value]
+
+    def _check_tables(self, key, value) -> list:
+        """Each table's keys checked (unknown, required, defaults); absent keys left out."""
+        if not isinstance(value, list) or not all(isinstance(v, dict) for v in value):
+            fail(key, value, "must be an array of tables, e.g. [{ name = ... }, ...]")
+        return [self._table(f"{key}[{i}]", table) for i, table in enumerate(value)]
+
+    def _table(self, key: str, table: dict) -> dict:
+        for k in table:
+            if k not in self.items:
+                raise unknown_key(f"{key}.{k}", self.items)
+        out = {}
+        for k, spec in self.items.items():
+            if k in table:
+                out[k] = spec.check(f"{key}.{k}", table[k])
+            elif spec.default is REQUIRED:
+                raise SceneError(f"{key}.{k} is required: {spec.doc}")
+            elif spec.default is not None:
+                out[k] = spec.default
+        return out
 
     def _check_strs(self, key, value) -> list:
         if not isinstance(value, list) or not value or not all(isinstance(v, str) for v in value):

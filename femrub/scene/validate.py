@@ -10,14 +10,19 @@ from __future__ import annotations
 
 import copy
 import os
+import re
 from pathlib import Path
 
 from .activation import check_activation
 from .bounds import check_physical
 from .schema import SCHEMA, TOP
+from .schema_run import PROBE_COMPONENTS
 from .spec import REQUIRED, SceneError, Variant, fail, unknown_key
 
 __all__ = ["normalize", "check_files", "signals_for", "MAX_STEPS"]
+
+#: the characters of a probe name (a history.npz key and a CSV column)
+_PROBE_NAME = re.compile(r"[A-Za-z0-9_-]+")
 
 #: Largest number of time steps a scene may ask for (memory of the histories).
 MAX_STEPS = 20_000_000
@@ -236,6 +241,47 @@ def _check_signals(d: dict) -> None:
             )
 
 
+def _check_probe(key: str, probe: dict, d: dict) -> None:
+    """One ``outputs.probes`` table: a safe name, a node or a point, a component as its
+    quantity needs, temperature dofs that can exist, a direction the geometry has."""
+    name, quantity, component = probe["name"], probe["quantity"], probe.get("component")
+    if not _PROBE_NAME.fullmatch(name):
+        fail(f"{key}.name", name, "use letters, digits, '-' and '_' only (e.g. 'le_tip')")
+    if "node" in probe and "point" in probe:
+        fail(f"{key}.point", probe["point"], f"{key}.node is given too; give node or point")
+    if "node" not in probe and "point" not in probe:
+        raise SceneError(f"{key} ({name!r}) needs node (a mesh node number) or point (coordinates)")
+    if quantity == "temperature":
+        if component is not None:
+            fail(f"{key}.component", component, "a temperature has no component; remove the key")
+        if d["physics"]["thermal"] == "off":
+            fail(
+                f"{key}.quantity",
+                quantity,
+                "physics.thermal = 'off' leaves the model no temperature dofs; "
+                "probe a displacement or turn physics.thermal on",
+            )
+        return
+    if component is None:
+        raise SceneError(
+            f"{key}.component is required for a {quantity} probe: "
+            f"one of {', '.join(PROBE_COMPONENTS)}"
+        )
+    if d["geometry"]["kind"] == "bar" and component not in ("x", "radial"):
+        fail(f"{key}.component", component, "the 1D bar moves along x only; use 'x' or 'radial'")
+
+
+def _check_probes(d: dict) -> None:
+    """``outputs.probes``: each table (:func:`_check_probe`), names used once."""
+    seen = set()
+    for i, probe in enumerate(d["outputs"]["probes"]):
+        key = f"outputs.probes[{i}]"
+        _check_probe(key, probe, d)
+        if probe["name"] in seen:
+            fail(f"{key}.name", probe["name"], "another probe has this name; name each once")
+        seen.add(probe["name"])
+
+
 def _check_scheme(d: dict) -> None:
     """The scheme against the contact law, its number of steps and the forcing."""
     scheme, contact, loads = d["scheme"], d["contact"], d["loads"]
@@ -275,6 +321,7 @@ def _cross_check(d: dict) -> None:
         _check_blade_physics(d)
         _check_blade_geometry(d["geometry"])
     _check_signals(d)
+    _check_probes(d)
     _check_damping(d["physics"])
     _check_scheme(d)
 
