@@ -34,3 +34,22 @@ def test_a_run_draws_its_force_map():
     (ax, *_) = fig.axes
     mesh = ax.collections[0]
     assert mesh.get_array().max() == pytest.approx(res.force.sum(axis=1).max())
+
+
+def test_the_response_drawn_is_the_first_displacement_probe():
+    from types import SimpleNamespace
+
+    from femrub.output.rub_plots import response_of
+
+    rows = np.arange(6.0).reshape(3, 2)
+    res = SimpleNamespace(
+        signals={"contact_displacement": rows, "probe_T": rows[:, :1] + 7, "probe_y": rows[:, 1:]},
+        info={"signal_units": {"probe_T": "K", "probe_y": "m"}},
+    )
+    y, label = response_of(res)
+    np.testing.assert_array_equal(y, [1.0, 3.0, 5.0])
+    assert label == "probe y"  # a displacement probe, not the temperature one
+    res.signals.pop("probe_y")
+    y, label = response_of(res, node=1)
+    np.testing.assert_array_equal(y, [1.0, 3.0, 5.0])
+    assert label == "contact 1 (normal)"

@@ -1,7 +1,7 @@
 """Figures of a rub run on a rotating blade, against revolutions of the rotor.
 
-* :func:`response_panels`: the response of one contact node over the whole run and over its
-  first and last ``window`` revolutions;
+* :func:`response_panels`: the response (the first displacement probe, else one contact
+  node) over the whole run and over its first and last ``window`` revolutions;
 * :func:`spectrum_panel`: the amplitude spectrum of that response with the engine-order
   lines ``k Ω / 2π``;
 * :func:`contact_force_panel`: the summed normal (and friction) force of the contacts as a
@@ -15,6 +15,7 @@ from __future__ import annotations
 import numpy as np
 
 from .plots import plt
+from .results import PROBE_PREFIX
 
 __all__ = [
     "contact_force_panel",
@@ -26,11 +27,17 @@ __all__ = [
 
 
 def response_of(res, node: int = 0) -> tuple[np.ndarray, str]:
-    """Normal displacement (m) of contact ``node`` (or the mean tip displacement) and a label."""
+    """The response engineers read (m) and its label: the first displacement probe
+    (``outputs.probes``, e.g. Rotor 37's node 1353 along y), else the normal displacement of
+    contact ``node``, else the mean tip displacement."""
+    units = res.info.get("signal_units", {}) if isinstance(res.info, dict) else {}
+    probes = [k for k in res.signals if k.startswith(PROBE_PREFIX) and units.get(k) == "m"]
+    if probes:
+        return res.signals[probes[0]][:, 0], f"probe {probes[0][len(PROBE_PREFIX) :]}"
     if "contact_displacement" in res.signals:
         n = res.signals["contact_displacement"].shape[1]
         node = int(np.clip(node, 0, n - 1))
-        return res.signals["contact_displacement"][:, node], f"contact {node}"
+        return res.signals["contact_displacement"][:, node], f"contact {node} (normal)"
     return res.signal("tip_displacement"), "tip (mean over the contacts)"
 
 
@@ -45,7 +52,7 @@ def response_panels(res, omega: float, *, node: int = 0, window: float = 5.0):
         sel = (rev >= lo) & (rev <= hi)
         a.plot(rev[sel], y[sel] * 1e6, lw=0.6)
         a.set_title(f"{label}: {title}", fontsize=9)
-        a.set_ylabel("radial displ. (µm)")
+        a.set_ylabel("displacement (µm)")
         a.grid(True, lw=0.3, alpha=0.6)
     ax[-1].set_xlabel("revolutions")
     fig.tight_layout()
@@ -67,7 +74,7 @@ def spectrum_panel(res, omega: float, *, node: int = 0, max_order: int = 20):
         ax.axvline(k * f_rot, color="0.6", lw=0.5, ls=":")
     ax.set_xlabel(f"frequency (Hz); dotted: engine orders k Ω/2π, Ω/2π = {f_rot:.1f} Hz")
     ax.set_ylabel("amplitude (µm)")
-    ax.set_title(f"spectrum of the radial displacement, {label}", fontsize=9)
+    ax.set_title(f"spectrum of the displacement, {label}", fontsize=9)
     ax.grid(True, lw=0.3, alpha=0.6)
     fig.tight_layout()
     return fig
