@@ -211,20 +211,25 @@ class _Solve:
 
 
 class _Solver:
-    """``omega -> _Solve``: prestress at Ω and the lowest ``k`` modes of its tangent."""
+    """``omega -> _Solve``: prestress at Ω and the lowest ``k`` modes of its tangent. Each
+    prestress is warm-started from the solved one nearest in Ω²
+    (:func:`~femrub.fem.prestress.centrifugal_prestress` ``start``)."""
 
     def __init__(self, disc, material, mats, method: str, k: int, log):
         self.disc, self.material, self.mats = disc, material, mats
         self.method, self.k, self.log = method, k, log
+        self.solved = []
 
     def __call__(self, omega: float) -> _Solve:
         state, K = None, self.mats.K
         if self.method != "off":
+            start = min(self.solved, key=lambda p: abs(p.omega**2 - omega**2), default=None)
             if self.log:
                 self.log(f"prestress ({self.method}) at {omega:g} rad/s ...")
             state = centrifugal_prestress(
-                self.disc, self.material, omega, self.method, log=self.log
+                self.disc, self.material, omega, self.method, start=start, log=self.log
             )
+            self.solved.append(state)
             K = state.K
         lam, shapes = lowest_modes(K, self.mats.M, self.k, _solver(K))
         return _Solve(omega, state, K, shapes, np.sqrt(np.clip(lam, 0.0, None)) / (2 * np.pi))
