@@ -146,3 +146,24 @@ def test_the_self_check_refines_the_samples_to_its_tolerance(tmp_path):
     growth = top.growth(locate_contacts(disc, spread="node"))
     assert info["tip_growth_max_m"][-1] == pytest.approx(growth.max(), rel=1e-9)
     assert info["tip_growth_mean_m"][-1] == pytest.approx(growth.mean(), rel=1e-9)
+
+
+def test_exact_diagram_is_the_full_solve_at_every_speed(tmp_path):
+    """--exact: each speed's frequencies are its own full prestress and eigen-solve (the
+    prestress warm-started along the list), status exact, tip growth per speed."""
+    from femrub.app import translate as tr
+
+    _scene(tmp_path, "nonlinear")
+    out = tmp_path / "cb"
+    assert _cli(tmp_path, out, "--speeds", "0:1200:400", "--exact") == 0
+    doc = json.loads((out / "campbell.json").read_text())
+    assert doc["status"] == "exact" and doc["sample_speeds"] == [0.0, 400.0, 800.0, 1200.0]
+    assert len(doc["tip_growth_max_m"]) == 4 and doc["tip_growth_max_m"][0] == 0.0
+    table = np.loadtxt(out / "campbell.csv", delimiter=",", skiprows=1)
+    scene = _scene(tmp_path, "nonlinear")
+    disc = discretise(scene_blade(scene), 2)
+    mats = assemble(disc, tr.material_of(scene))
+    ps = centrifugal_prestress(disc, tr.material_of(scene), 800.0, "nonlinear")
+    f = np.sqrt(lowest_modes(ps.K, mats.M, 3, vectors=False)) / (2 * np.pi)
+    np.testing.assert_allclose(np.sort(table[2, 2:]), f, rtol=1e-7)  # CSV: 8 digits
+    np.testing.assert_allclose(table[0, 2:], doc["rest_frequencies_hz"], rtol=1e-7)

@@ -111,9 +111,13 @@ def _m_orthonormal(V, M, tol=1e-10):
     return V @ (W[:, keep] / np.sqrt(lam[keep]))
 
 
-def _track(Q_prev, Q, n):
-    """Columns of ``Q`` following the ``n`` columns of ``Q_prev`` (largest MAC)."""
-    mac = (Q_prev.T @ Q) ** 2 / np.outer(np.sum(Q_prev**2, axis=0), np.sum(Q**2, axis=0))
+def _track(Q_prev, Q, n, gram=None):
+    """Columns of ``Q`` following the ``n`` columns of ``Q_prev`` (largest MAC; in the inner
+    product of ``gram`` when given)."""
+    GQ = Q if gram is None else gram @ Q
+    GP = Q_prev if gram is None else gram @ Q_prev
+    norms = np.outer(np.sum(Q_prev * GP, axis=0), np.sum(Q * GQ, axis=0))
+    mac = (Q_prev.T @ GQ) ** 2 / norms
     rows, cols = linear_sum_assignment(-mac[:n])
     return cols[np.argsort(rows)], mac[rows, cols].min()
 
@@ -127,6 +131,7 @@ def campbell(
     check: bool = True,
     tolerance: float = TOLERANCE,
     max_samples: int = MAX_SAMPLES,
+    exact: bool = False,
     log=None,
 ) -> CampbellResult:
     """Campbell diagram of ``scene`` at ``speeds`` (rad/s; module docstring).
@@ -134,7 +139,8 @@ def campbell(
     ``samples``: the first prestress samples (>= 2, equally spaced in Ω²); ``check``: run
     the self-check, refining the samples up to ``max_samples`` until every checked
     frequency is within ``tolerance`` (relative); the result's ``status`` says whether it
-    is (``info["status"]``, ``info["message"]``).
+    is (``info["status"]``, ``info["message"]``). ``exact``: the full prestress (warm-started
+    along the list) and eigen-solve at every speed instead, no interpolation.
     """
     speeds = _checked_speeds(speeds)
     if tr.is_bar(scene):
@@ -147,37 +153,81 @@ def campbell(
     material = tr.material_of(scene)
     mats = assemble(disc, material, lumping=scene["physics"]["lumping"]).mechanical()
     method = _method(scene, log)
-    top = float(speeds.max())
-    k = min(modes + EXTRA_MODES, mats.n_u - 1)
-    if top == 0.0:
+    if float(speeds.max()) == 0.0:
         method, check = "off", False
-    solve = _Solver(disc, material, mats, "off" if top == 0.0 else method, k, log)
-    first = [0.0] if top == 0.0 else sample_speeds(top, 2 if method == "linear" else samples)
+    k = min(modes + EXTRA_MODES, mats.n_u - 1)
+    solve = _Solver(disc, material, mats, method, k, log)
+    growth = _Growth(disc, scene)
+    if exact and method != "off":
+        freqs, info = _exact_diagram(solve, speeds, modes, growth)
+        method_samples = speeds
+    else:
+        first = [0.0] if method == "off" else sample_speeds(speeds.max(), samples)
+        if method == "linear":  # K_T affine in Ω²: two samples
+            first = sample_speeds(speeds.max(), 2)
+        freqs, info = _interpolated_diagram(
+            solve, first, speeds, modes, check, float(tolerance), max_samples, growth
+        )
+        method_samples = np.asarray(info["sample_speeds"])
+    info["n_free_dofs"] = int(mats.n_u)
+    info["seconds"] = time.perf_counter() - t0
+    return CampbellResult(speeds, freqs, method, method_samples, info)
+
+
+def _interpolated_diagram(solve, first, speeds, modes, check, tolerance, max_samples, growth):
+    """The diagram from the interpolation and its self-check (module docstring)."""
+    M = solve.mats.M
     taken = [solve(float(w)) for w in first]
     if check:
         interp, checks, errors = _self_check(
-            taken, solve, mats.M, modes, float(tolerance), max(int(max_samples), len(taken)), log
+            taken, solve, M, modes, tolerance, max(int(max_samples), len(taken)), solve.log
         )
     else:
-        interp, checks, errors = _Interpolation(taken, mats.M), [], []
-    t_pre = time.perf_counter()
+        interp, checks, errors = _Interpolation(taken, M), [], []
     freqs, worst = _lines(interp, speeds, modes)
     V = interp.V
-    Kr0 = V.T @ (mats.K @ V)
+    Kr0 = V.T @ (solve.mats.K @ V)
+    rest = np.sqrt(lowest_modes(Kr0, np.eye(V.shape[1]), modes, vectors=False)) / (2 * np.pi)
     info = {
-        "n_free_dofs": int(mats.n_u),
         "basis_size": int(V.shape[1]),
         "sample_speeds": interp.speeds.tolist(),
         "worst_tracking_mac": worst,
-        "rest_frequencies_hz": (
-            np.sqrt(lowest_modes(Kr0, np.eye(V.shape[1]), modes, vectors=False)) / (2 * np.pi)
-        ).tolist(),
-        "seconds_prestress": t_pre - t0,
-        **_verdict(method, check, checks, errors, interp, modes, float(tolerance)),
-        **_tip_growth(disc, scene, interp.samples),
+        "rest_frequencies_hz": rest.tolist(),
+        **_verdict(solve.method, check, checks, errors, interp, modes, tolerance),
+        **growth.of([x.state for x in interp.samples], interp.speeds),
     }
-    info["seconds"] = time.perf_counter() - t0
-    return CampbellResult(speeds, freqs, method, interp.speeds, info)
+    return freqs, info
+
+
+def _exact_diagram(solve, speeds, modes, growth):
+    """Every speed solved in full (``--exact``): the prestress warm-started from the
+    previous speed's, the lowest modes of its tangent; lines tracked by the MAC in the mass
+    inner product. Only the last prestress is kept."""
+    M = solve.mats.M
+    freqs, states, prev, worst = [], [], None, 1.0
+    for omega in speeds:
+        x = solve(float(omega))
+        solve.solved[:] = [x.state]
+        order = np.arange(modes)
+        if prev is not None:
+            order, mac = _track(prev, x.shapes, modes, gram=M)
+            worst = min(worst, float(mac))
+        prev = x.shapes[:, order]
+        freqs.append(x.hz[order])
+        states.append(growth.at(x.state))
+    rest = lowest_modes(solve.mats.K, M, modes, _solver(solve.mats.K), vectors=False)
+    info = {
+        "status": "exact",
+        "message": (
+            f"full prestress (warm-started along the list) and eigen-solve at each of the "
+            f"{len(speeds)} speeds"
+        ),
+        "sample_speeds": np.asarray(speeds, dtype=float).tolist(),
+        "worst_tracking_mac": worst,
+        "rest_frequencies_hz": (np.sqrt(rest) / (2 * np.pi)).tolist(),
+        **growth.table(np.array(states), speeds),
+    }
+    return np.array(freqs), info
 
 
 def _checked_speeds(speeds) -> np.ndarray:
@@ -345,19 +395,27 @@ def _verdict(method, check, checks, errors, interp, modes, tolerance) -> dict:
     return {"status": "failed", "message": msg, **out}
 
 
-def _tip_growth(disc, scene, samples: list) -> dict:
-    """Radial tip growth at the scene's contacts per sample speed (m), as a run measures it
-    (module docstring)."""
-    states = [x.state for x in samples]
-    if any(s is None for s in states):
-        return {}
-    pts = locate_contacts(disc, spread=scene["contact"]["spread"])
-    g = np.array([s.growth(pts) for s in states])
-    return {
-        "tip_growth_min_m": g.min(axis=1).tolist(),
-        "tip_growth_max_m": g.max(axis=1).tolist(),
-        "tip_growth_mean_m": g.mean(axis=1).tolist(),
-    }
+class _Growth:
+    """Radial tip growth at the scene's contacts (m), as a run measures it (module
+    docstring): ``at(state)`` per contact, ``table`` over speeds."""
+
+    def __init__(self, disc, scene):
+        self.points = locate_contacts(disc, spread=scene["contact"]["spread"])
+
+    def at(self, state) -> np.ndarray:
+        return np.zeros(self.points.n) if state is None else state.growth(self.points)
+
+    def of(self, states: list, speeds) -> dict:
+        return self.table(np.array([self.at(s) for s in states]), speeds)
+
+    @staticmethod
+    def table(g: np.ndarray, speeds) -> dict:
+        return {
+            "tip_growth_speeds_rad_s": np.asarray(speeds, dtype=float).tolist(),
+            "tip_growth_min_m": g.min(axis=1).tolist(),
+            "tip_growth_max_m": g.max(axis=1).tolist(),
+            "tip_growth_mean_m": g.mean(axis=1).tolist(),
+        }
 
 
 def write_campbell(res: CampbellResult, out, *, engine_orders: int | None = None) -> dict:

@@ -276,6 +276,7 @@ def _campbell(args) -> int:
         samples=args.samples,
         check=not args.no_check,
         log=_log(args),
+        exact=args.exact,
         **{k: v for k, v in vars(args).items() if k in ("tolerance", "max_samples") and v},
     )
     doc = write_campbell(res, out)
@@ -360,6 +361,11 @@ def build_parser() -> argparse.ArgumentParser:
     )
     cb.add_argument(
         "--no-check", action="store_true", help="skip the full solves checking the interpolation"
+    )
+    cb.add_argument(
+        "--exact",
+        action="store_true",
+        help="full prestress (warm-started) and eigen-solve at every speed, no interpolation",
     )
     cb.add_argument(
         "--tolerance",
