@@ -22,12 +22,18 @@ material, lumping; no contact), then:
    checked in turn, until every check is within the tolerance or ``max_samples`` samples
    are spent; every check is measured again on the final basis and interpolation.
 
+``--exact`` (``exact=True``) skips the interpolation: the full prestress, warm-started from
+the previous speed's, and the full eigen-solve at every requested speed (status
+``"exact"``; one prestress and one factorisation per speed).
+
 The diagram's ``status`` (``campbell.json``): ``"ok"`` when every check is within the
 tolerance, ``"failed"`` otherwise (``femrub campbell`` then exits 1 with a one-line error
 and writes ``campbell-failed.csv`` and ``campbell-failed.png``, never the files of a
-diagram that passed), ``"unchecked"`` with ``--no-check``, ``"exact"`` at rest only.
+diagram that passed), ``"unchecked"`` with ``--no-check``, ``"exact"`` with ``--exact`` or
+at rest only.
 
-The tip growth (``tip_growth_*_m``, per sample speed) is measured as a run measures it:
+The tip growth (``tip_growth_*_m``, at ``tip_growth_speeds_rad_s``: the samples, or every
+speed with ``--exact``) is measured as a run measures it:
 the outward radial static displacement at the scene's contacts, at each node or as the
 mean over its patch of tip face as ``contact.spread`` says
 (:meth:`~femrub.fem.prestress.Prestress.growth`).
