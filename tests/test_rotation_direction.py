@@ -172,23 +172,13 @@ def test_a_clockwise_coated_casing_is_cut_behind_the_contacts(tmp_path):
     force, and every worn cell lies on the arc the contacts swept, ψ = φ_i − Ω t."""
     import json
 
+    from test_abradable import COATED_BLADE
+
     from femrub.app.run import run_scene
     from femrub.scene import load_scene
 
-    t_end, omega = 1.5e-3, 1500.0
-    changes = {
-        "geometry.h": 0.03,
-        "geometry.n_sections": 2,
-        "contact.reach": "all",
-        "contact.friction": 0.15,
-        "contact.abradable.thickness": "30 um",
-        "contact.abradable.yield": 5.0,
-        "loads.centrifugal": "off",
-        "loads.rotation_direction": "clockwise",
-        "reduction.method": "none",
-        "scheme.t_end": t_end,
-        "outputs.vtk_stride": 0,
-    }
+    t_end, omega = COATED_BLADE["scheme.t_end"], 1500.0  # twisted-naca's speed
+    changes = {**COATED_BLADE, "loads.rotation_direction": "clockwise"}
     _, built = run_scene(load_scene("twisted-naca", changes), tmp_path / "out")
     s = json.loads((tmp_path / "out" / "summary.json").read_text())
     assert s["status"] == "ok", s.get("message")
