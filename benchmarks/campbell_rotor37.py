@@ -134,9 +134,13 @@ def _rest_table(data: dict) -> str:
 
 
 def _check(run: dict) -> str:
+    """The self-check's status, samples and worst check (``campbell.json``)."""
     if run.get("check_max_relative_error") is None:
-        return "not checked"
-    return f"{100 * run['check_max_relative_error']:.2g} % at {run['check_speed']:.0f} rad/s"
+        return run.get("status", "not checked")
+    worst = f"{100 * run['check_max_relative_error']:.2g} % at {run['check_speed']:.0f} rad/s"
+    if "status" not in run:  # collected from a diagram written before the status existed
+        return worst
+    return f"{run['status']} ({len(run.get('sample_speeds', []))} samples; worst {worst})"
 
 
 def _prestress_table(data: dict) -> str:

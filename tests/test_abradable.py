@@ -182,22 +182,26 @@ def test_frictional_solve_caps_the_normal_impulse_and_its_cone():
         np.testing.assert_allclose(nt[slip], mu[slip] * P[slip, 0], rtol=1e-10)
 
 
+#: the twisted NACA blade with friction cutting a 30 µm coating that yields at 5 N, full model
+COATED_BLADE = {
+    "geometry.h": 0.03,
+    "geometry.n_sections": 2,
+    "contact.reach": "all",
+    "contact.friction": 0.15,
+    "contact.abradable.thickness": "30 um",
+    "contact.abradable.yield": 5.0,
+    "loads.centrifugal": "off",
+    "reduction.method": "none",
+    "scheme.t_end": 1.5e-3,
+    "outputs.vtk_stride": 0,
+}
+
+
 def test_frictional_blade_cuts_the_coating_at_the_yield_force(tmp_path):
     """3D blade, Coulomb friction and frictional heat (θ-method, frictional solve with the
     bound): the normal force never exceeds the coating's yield, Coulomb's law holds with the
     capped normal force, coating is removed, the balances close."""
-    changes = {
-        "geometry.h": 0.03,
-        "geometry.n_sections": 2,
-        "contact.reach": "all",
-        "contact.friction": 0.15,
-        "contact.abradable.thickness": "30 um",
-        "contact.abradable.yield": 5.0,
-        "loads.centrifugal": "off",
-        "reduction.method": "none",
-        "scheme.t_end": 1.5e-3,
-        "outputs.vtk_stride": 0,
-    }
+    changes = COATED_BLADE
     res, _ = run_scene(load_scene("twisted-naca", changes), tmp_path / "out")
     s = json.loads((tmp_path / "out" / "summary.json").read_text())
     assert s["status"] == "ok", s.get("message")

@@ -99,3 +99,71 @@ def test_campbell_cli_linear(tmp_path):
     table = np.loadtxt(out / "campbell.csv", delimiter=",", skiprows=1)
     assert table.shape == (5, 5) and np.allclose(table[:, 0], [0, 250, 500, 750, 1000])
     assert (out / "campbell.png").stat().st_size > 10_000
+
+
+def _cli(tmp_path, out, *extra):
+    return main(
+        ["campbell", str(tmp_path / "box-nonlinear.toml"), "--modes", "3", "-o", str(out), "-q"]
+        + list(extra)
+    )
+
+
+def test_a_failed_self_check_exits_nonzero_and_marks_its_files(tmp_path, capsys):
+    """Two samples up to 4000 rad/s: the interpolation in Ω² of the nonlinear prestress is
+    0.7 % off at the midpoint; refinement forbidden (--max-samples 2): exit 1, one line,
+    the files say failed and no campbell.csv / campbell.png is written."""
+    _scene(tmp_path, "nonlinear")
+    out = tmp_path / "cb"
+    code = _cli(tmp_path, out, "--speeds", "0:4000:1000", "--samples", "2", "--max-samples", "2")
+    assert code == 1
+    err = capsys.readouterr().err.strip()
+    assert "\n" not in err and "self-check failed" in err and "--max-samples" in err
+    doc = json.loads((out / "campbell.json").read_text())
+    assert doc["status"] == "failed" and doc["check_max_relative_error"] > doc["tolerance"]
+    assert doc["files"] == ["campbell-failed.csv", "campbell-failed.png"]
+    assert (out / "campbell-failed.csv").exists() and (out / "campbell-failed.png").exists()
+    assert not (out / "campbell.csv").exists() and not (out / "campbell.png").exists()
+
+
+def test_the_self_check_refines_the_samples_to_its_tolerance(tmp_path):
+    """The same start refines until every midpoint check is within 0.5 %; an independent
+    full solve at a requested speed agrees within 0.5 %; the tip growth is the runs'."""
+    from femrub.app import translate as tr
+    from femrub.contact.points import locate_contacts
+
+    scene = _scene(tmp_path, "nonlinear").with_changes({"contact.spread": "node"})
+    res = campbell(scene, parse_speeds("0:4000:500"), modes=3, samples=2)
+    info = res.info
+    assert info["status"] == "ok" and len(info["sample_speeds"]) > 2
+    assert max(info["check_errors"]) <= 0.005 == info["tolerance"]
+    disc = discretise(scene_blade(scene), 2)
+    mats = assemble(disc, tr.material_of(scene))
+    ps = centrifugal_prestress(disc, tr.material_of(scene), 3500.0, "nonlinear")
+    f = np.sqrt(lowest_modes(ps.K, mats.M, 3, vectors=False)) / (2 * np.pi)
+    i = int(np.flatnonzero(res.speeds == 3500.0)[0])
+    np.testing.assert_allclose(np.sort(res.frequencies[i]), f, rtol=0.005)
+    top = centrifugal_prestress(disc, tr.material_of(scene), 4000.0, "nonlinear")
+    growth = top.growth(locate_contacts(disc, spread="node"))
+    assert info["tip_growth_max_m"][-1] == pytest.approx(growth.max(), rel=1e-9)
+    assert info["tip_growth_mean_m"][-1] == pytest.approx(growth.mean(), rel=1e-9)
+
+
+def test_exact_diagram_is_the_full_solve_at_every_speed(tmp_path):
+    """--exact: each speed's frequencies are its own full prestress and eigen-solve (the
+    prestress warm-started along the list), status exact, tip growth per speed."""
+    from femrub.app import translate as tr
+
+    _scene(tmp_path, "nonlinear")
+    out = tmp_path / "cb"
+    assert _cli(tmp_path, out, "--speeds", "0:1200:400", "--exact") == 0
+    doc = json.loads((out / "campbell.json").read_text())
+    assert doc["status"] == "exact" and doc["sample_speeds"] == [0.0, 400.0, 800.0, 1200.0]
+    assert len(doc["tip_growth_max_m"]) == 4 and doc["tip_growth_max_m"][0] == 0.0
+    table = np.loadtxt(out / "campbell.csv", delimiter=",", skiprows=1)
+    scene = _scene(tmp_path, "nonlinear")
+    disc = discretise(scene_blade(scene), 2)
+    mats = assemble(disc, tr.material_of(scene))
+    ps = centrifugal_prestress(disc, tr.material_of(scene), 800.0, "nonlinear")
+    f = np.sqrt(lowest_modes(ps.K, mats.M, 3, vectors=False)) / (2 * np.pi)
+    np.testing.assert_allclose(np.sort(table[2, 2:]), f, rtol=1e-7)  # CSV: 8 digits
+    np.testing.assert_allclose(table[0, 2:], doc["rest_frequencies_hz"], rtol=1e-7)

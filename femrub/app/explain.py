@@ -189,10 +189,33 @@ def _casing_rows(report: dict) -> list[tuple[str, str]]:
     return rows
 
 
+def _rotation_rows(r: dict | None) -> list[tuple[str, str]]:
+    """The direction of rotation, where it comes from, and a reversed sliding."""
+    if not r:
+        return []
+    rows = [
+        (
+            "rotation",
+            f"{r['reason']}: casing phase θ = σ Ω t + φ and sliding velocity −σ Ω r, "
+            f"σ = {'+1' if r['direction'] == 'counterclockwise' else '-1'}",
+        )
+    ]
+    if r["slip"] == "reversed":
+        rows.append(
+            (
+                "warning",
+                "contact.slip_direction = 'reversed': the casing slides against the lobe "
+                "phase (a verification device, not a physical set-up)",
+            )
+        )
+    return rows
+
+
 def _contact_rows(report: dict, reach_key) -> list[tuple[str, str]]:
     """The contacts kept, the friction law and the build's warnings."""
     reach_key = reach_key or report.get("reach_key", "auto")
     rows = [("contacts", x) for x in _contacts(report["contacts"], reach_key)]
+    rows += _rotation_rows(report.get("rotation"))
     f = report.get("friction")
     if f and f["mu"] > 0:
         rows.append(

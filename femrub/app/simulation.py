@@ -373,6 +373,7 @@ def _full_model(scene, blade, stages, log, report) -> RubBuild:
     heat = built.heat
     report["thermal"] = built.thermal[1]
     report["friction"] = {"mu": heat.mu, "heat_law": heat.law, "heat_partition": heat.eta}
+    report["rotation"] = {**vars(built.rotation), "slip": config.contact.slip_direction}
     warn(initial_penetration(built.model), report, log)
     warn(footprint_warning(scene, built.grid), report, log)
     return built

@@ -195,6 +195,7 @@ def contact_config(scene) -> ContactConfig:
         clearance=c["clearance"],
         abradable=_coating(scene),
         casing_heat=_casing_heat(scene),
+        slip_direction=c["slip_direction"],
     )
 
 
@@ -207,6 +208,7 @@ def rub_config(scene, deck: dict | None = None, notes: list | None = None) -> Ru
         material_of(scene, deck, notes),
         contact_config(scene),
         rotation_speed=scene["loads"]["rotation_speed"],
+        rotation_direction=scene["loads"]["rotation_direction"],
         order=p["order"],
         clamped=scene["boundary"]["clamped"],
         area=area_of(scene),

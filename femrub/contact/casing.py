@@ -1,9 +1,15 @@
 """Rigid casing profiles: the radial gap seen by a blade node as the rotor turns.
 
 A contact node at angular position ``φ`` (rad, around the machine axis) of a blade turning
-at ``Ω`` (rad/s) sees the casing at angle ``ψ = Ω t + φ``; its undeformed radial gap is the
-profile ``g(ψ)`` (m). The deformed gap is ``g(ψ) − n · u`` with ``n`` the outward radial
-direction at the node (see :mod:`femrub.model.rub`).
+at ``Ω`` (rad/s) in the direction ``σ`` (+1 counterclockwise about the axis, −1 clockwise;
+``loads.rotation_direction``) sees the casing at angle ``ψ = σ Ω t + φ``; its undeformed
+radial gap is the profile ``g(ψ)`` (m). The deformed gap is ``g(ψ) − n · u`` with ``n`` the
+outward radial direction at the node (see :mod:`femrub.model.rub`). In the blade's frame the
+casing surface slides past the node at ``−σ Ω r`` along the circumferential tangent
+``e_φ = a × n`` (:func:`sliding_velocity`): the phase and the sliding follow the rotation
+together. ``contact.slip_direction = "reversed"`` turns the sliding alone (``+σ Ω r``), a
+verification device for codes that prescribe the sliding velocity independently of the
+lobe phase; it is not a physical set-up.
 
 * :class:`Concentric`: ``g(ψ) = c``.
 * :class:`Lobed`: ``g(ψ) = c − δ cos(k (ψ − ψ0))``, an ovalised casing with ``k`` lobes;
@@ -31,6 +37,8 @@ __all__ = [
     "lobe_count",
     "lobe_passing_frequency",
     "PROFILES",
+    "SLIP_DIRECTIONS",
+    "sliding_velocity",
     "swept_gap",
     "SweptGap",
     "SweptGapRate",
@@ -152,24 +160,43 @@ def lobe_passing_frequency(casing, rotation_speed: float) -> float:
     return float(lobe_count(casing)) * abs(float(rotation_speed))
 
 
-def swept_gap(profile: CasingProfile, angles, rotation_speed: float, offset=0.0):
-    """Gap ``g_i(t) = g(Ω t + φ_i) + offset_i`` of contacts at ``angles`` and its rate.
+#: the casing's sliding velocity relative to the rotation: ``"rotation"`` (``−σ Ω r``, the
+#: physical one) or ``"reversed"`` (``+σ Ω r``, a verification device; module docstring)
+SLIP_DIRECTIONS = {"rotation": 1.0, "reversed": -1.0}
+
+
+def sliding_velocity(radii, rotation_speed: float, direction: float = 1.0, slip: float = 1.0):
+    """Velocity (m/s, (n_c, 2): axial, circumferential) of the casing surface past contacts
+    at ``radii`` (m) in the blade's frame: ``(0, −slip σ Ω r_i)``, ``σ = direction``
+    (module docstring)."""
+    radii = np.asarray(radii, dtype=float)
+    vc = np.zeros((radii.size, 2))
+    vc[:, 1] = -float(slip) * float(direction) * float(rotation_speed) * radii
+    return vc
+
+
+def swept_gap(
+    profile: CasingProfile, angles, rotation_speed: float, offset=0.0, direction: float = 1.0
+):
+    """Gap ``g_i(t) = g(σ Ω t + φ_i) + offset_i`` of contacts at ``angles`` and its rate
+    (``σ = direction``: +1 counterclockwise, −1 clockwise; module docstring).
 
     Returns ``(gap, gap_rate)``: constant arrays and ``None`` when the gap does not move
     (concentric casing or ``Ω = 0``), else callables ``t -> (n_c,)`` (m and m/s).
     """
     angles = np.asarray(angles, dtype=float)
     offset = np.broadcast_to(np.asarray(offset, dtype=float), angles.shape).copy()
-    omega = float(rotation_speed)
+    omega = float(direction) * float(rotation_speed)
     if isinstance(profile, Concentric) or omega == 0.0:
         return np.asarray(profile.gap(angles), dtype=float) + offset, None
     return SweptGap(profile, omega, angles, offset), SweptGapRate(profile, omega, angles)
 
 
 class SweptGap:
-    """``t -> g(Ω t + φ_i) + offset_i`` (m, (n_c,)); :meth:`over_times`: rows at an array
-    of times (m,) in one call, (m, n_c). A small class rather than a closure, so that a
-    contact holding it can be pickled (a model sent to a worker or stored)."""
+    """``t -> g(ω t + φ_i) + offset_i`` (m, (n_c,); ``ω = σ Ω`` signed); :meth:`over_times`:
+    rows at an array of times (m,) in one call, (m, n_c). A small class rather than a
+    closure, so that a contact holding it can be pickled (a model sent to a worker or
+    stored)."""
 
     def __init__(self, profile: CasingProfile, omega: float, angles, offset):
         self.profile, self.omega, self.angles, self.offset = profile, omega, angles, offset

@@ -109,6 +109,7 @@ def centrifugal_prestress(
     tol: float = 1e-10,
     max_iter: int = 25,
     max_increments: int = 16,
+    start: Prestress | None = None,
     log=None,
 ) -> Prestress:
     """Static prestress of ``disc`` spinning at ``omega`` about its blade's axis.
@@ -122,6 +123,9 @@ def centrifugal_prestress(
     tol : Newton tolerance on ``‖r‖ / ‖f_Ω(0)‖``.
     max_iter : Newton iterations per load increment.
     max_increments : most load increments the continuation may use.
+    start : a nonlinear prestress of the same ``disc`` at another speed Ω₀: the continuation
+        in Ω² starts from its state (a warm start along a list of speeds) instead of from
+        rest; the equilibrium reached is the same to ``tol``.
     log : optional callable for progress messages.
 
     Raises
@@ -150,19 +154,22 @@ def centrifugal_prestress(
         u[free] = sparse_lu(K0, symmetric=True, what="K − Ω² M_P").solve(forms.force(u, w2)[free])
         res = _residual(forms, u, w2, free) / scale
         return Prestress(omega, method, u, _sub(forms.tangent(u, MP, w2), free), free, 1, res)
+    w2_0 = 0.0
+    if start is not None and start.method == method and start.u.shape == u.shape:
+        w2_0, u = float(start.omega) ** 2, start.u.copy()
     done, step, iters, n_inc = 0.0, 1.0, 0, 0
     rate = np.zeros_like(u)  # du / d(load fraction) of the last increment: the predictor
     while done < 1.0:
         step = min(step, 1.0 - done)
-        trial, k, ok = _newton(
-            forms, u + step * rate, MP, w2 * (done + step), free, scale, tol, max_iter, log
-        )
+        load = w2_0 + (w2 - w2_0) * (done + step)
+        trial, k, ok = _newton(forms, u + step * rate, MP, load, free, scale, tol, max_iter, log)
         iters += k
         if ok:
             rate = (trial - u) / step
             u, done, n_inc = trial, done + step, n_inc + 1
             if log:
-                log(f"prestress: {100 * done:.0f} % of Ω² in {k} Newton iterations")
+                since = f" from {math.sqrt(w2_0):g} rad/s" if w2_0 else ""
+                log(f"prestress: {100 * done:.0f} % of Ω²{since} in {k} Newton iterations")
             step *= 2.0
         else:
             step *= 0.5

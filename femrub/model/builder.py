@@ -3,8 +3,8 @@
 ::
 
     BladeMesh + RubConfig -> Discretisation -> (centrifugal prestress) -> Eq. 2 blocks
-        -> contact candidates -> reach filter -> heat law -> casing cells (coating, heat)
-        -> FirstOrderModel (:func:`~femrub.model.rub.rub_model`)
+        -> contact candidates -> reach filter -> heat law -> rotation direction
+        -> casing cells (coating, heat) -> FirstOrderModel (:func:`~femrub.model.rub.rub_model`)
 
 :func:`build_rub` is what :meth:`femrub.app.simulation.Simulation.from_scene`,
 :func:`femrub.model.rub.solid_model` and :func:`femrub.cases.bar.bar_model` call; they only
@@ -22,6 +22,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from ..contact.abradable import Abradable, CasingGrid
+from ..contact.casing import SLIP_DIRECTIONS
 from ..contact.casing_heat import CasingHeat
 from ..contact.heat import heat_coefficients
 from ..contact.points import ContactPoints, locate_contacts
@@ -30,10 +31,18 @@ from ..fem.damping import rayleigh_coefficients
 from ..fem.discretisation import assemble, discretise
 from ..fem.eigen import angular_frequencies
 from ..fem.prestress import centrifugal_prestress
+from ..geometry.rotation_direction import RotationDirection, derive_rotation_direction
 from .config import RubConfig
 from .rub import FieldMap, rub_model, tip_load
 
-__all__ = ["DirectStages", "HeatChoice", "RubBuild", "build_rub", "length_scale"]
+__all__ = [
+    "DirectStages",
+    "HeatChoice",
+    "RubBuild",
+    "build_rub",
+    "length_scale",
+    "rotation_direction",
+]
 
 
 class DirectStages:
@@ -92,6 +101,7 @@ class RubBuild:
     grid: CasingGrid | None
     heat: HeatChoice
     thermal: tuple[bool, str]
+    rotation: RotationDirection
 
 
 def length_scale(blade) -> float:
@@ -200,8 +210,19 @@ def _no_heat(config: RubConfig, reachable: bool, dim: int) -> str:
     return "loads.rotation_speed = 0 (no sliding)"
 
 
-def casing_grid(config: RubConfig, blade, points, growth) -> CasingGrid | None:
-    """Casing cells swept by the kept contacts (wear map, casing heat), or ``None``."""
+def rotation_direction(config: RubConfig, blade) -> RotationDirection:
+    """The direction the blade turns in: the configuration's, or with ``"auto"`` the one its
+    tip section implies (:func:`~femrub.geometry.rotation_direction.derive_rotation_direction`)."""
+    if config.rotation_direction == "auto":
+        return derive_rotation_direction(blade)
+    return RotationDirection(
+        config.rotation_direction, "scene", f"{config.rotation_direction} (given)"
+    )
+
+
+def casing_grid(config: RubConfig, blade, points, growth, sign=1.0) -> CasingGrid | None:
+    """Casing cells swept by the kept contacts (wear map, casing heat) at the casing angle
+    ``σ Ω t + φ`` (``sign`` σ: the rotation direction), or ``None``."""
     a, h = config.contact.abradable, config.contact.casing_heat
     if points.n == 0 or (a is None and h is None):
         return None
@@ -211,7 +232,7 @@ def casing_grid(config: RubConfig, blade, points, growth) -> CasingGrid | None:
         points.angles,
         axial,
         float(np.max(points.radii + growth)),
-        config.rotation_speed,
+        sign * config.rotation_speed,
         n_angle=cells.n_angle,
         n_axial=cells.n_axial,
         footprint=a.footprint if a is not None else 0.0,
@@ -305,7 +326,8 @@ def build_rub(blade, config: RubConfig, *, stages=None, log=None) -> RubBuild:
     points = candidates.restrict(reach.keep)
     heat = heat_choice(config, points, blade.dim)
     thermal = thermal_choice(config, heat.heated, points.n > 0, blade.dim)
-    grid = casing_grid(config, blade, points, growth[reach.keep])
+    rotation = rotation_direction(config, blade)
+    grid = casing_grid(config, blade, points, growth[reach.keep], rotation.sign)
     model, fields = rub_model(
         disc,
         mats,
@@ -326,6 +348,10 @@ def build_rub(blade, config: RubConfig, *, stages=None, log=None) -> RubBuild:
         casing_heat=_casing_heat(config, grid, heat),
         damping=damping,
         length_scale=length_scale(blade),
+        direction=rotation.sign,
+        slip=SLIP_DIRECTIONS[config.contact.slip_direction],
     )
     model = _initial_velocity(_thermal_note(model, thermal), config.initial_velocity)
-    return RubBuild(model, fields, mats, candidates, reach, prestress, growth, grid, heat, thermal)
+    return RubBuild(
+        model, fields, mats, candidates, reach, prestress, growth, grid, heat, thermal, rotation
+    )

@@ -17,8 +17,9 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from ..contact.casing import CasingProfile, Concentric
+from ..contact.casing import SLIP_DIRECTIONS, CasingProfile, Concentric
 from ..fem.material import Material
+from ..geometry.rotation_direction import ROTATION_DIRECTIONS
 
 __all__ = [
     "CasingHeatConfig",
@@ -128,6 +129,9 @@ class ContactConfig:
         (:func:`~femrub.contact.reach.contact_reach`), with ``reach_margin`` (m),
         ``gap_reference`` and ``clearance`` (``"running"`` or ``"cold"``).
     abradable, casing_heat : :class:`CoatingConfig`, :class:`CasingHeatConfig` or ``None``.
+    slip_direction : ``"rotation"`` (the casing slides past the blade against its motion)
+        or ``"reversed"`` (against the lobe phase: a verification device,
+        :mod:`femrub.contact.casing`).
     """
 
     casing: CasingProfile = field(default_factory=lambda: Concentric(1e-4))
@@ -143,8 +147,14 @@ class ContactConfig:
     clearance: str = "running"
     abradable: CoatingConfig | None = None
     casing_heat: CasingHeatConfig | None = None
+    slip_direction: str = "rotation"
 
     def __post_init__(self):
+        if self.slip_direction not in SLIP_DIRECTIONS:
+            raise ValueError(
+                f"slip_direction must be one of {tuple(SLIP_DIRECTIONS)}, got "
+                f"{self.slip_direction!r}"
+            )
         if self.heat_law not in HEAT_LAWS:
             raise ValueError(f"heat_law must be one of {HEAT_LAWS}, got {self.heat_law!r}")
         eta = float(self.heat_partition)
@@ -165,6 +175,9 @@ class RubConfig:
     material : the blade's :class:`~femrub.fem.material.Material`.
     contact : :class:`ContactConfig`.
     rotation_speed : Ω (rad/s).
+    rotation_direction : ``"counterclockwise"`` or ``"clockwise"`` about the machine axis, or
+        ``"auto"``: derived from the blade's tip section where it can be
+        (:mod:`femrub.geometry.rotation_direction`), counterclockwise otherwise.
     order : displacement element order of a 3D blade (the bar is linear).
     clamped : clamp the root (the bar may be free).
     area : cross-section of the bar (m²); 1 for a solid.
@@ -183,6 +196,7 @@ class RubConfig:
     material: Material
     contact: ContactConfig = field(default_factory=ContactConfig)
     rotation_speed: float = 0.0
+    rotation_direction: str = "auto"
     order: int = 2
     clamped: bool = True
     area: float = 1.0
@@ -202,6 +216,11 @@ class RubConfig:
     def __post_init__(self):
         if not math.isfinite(float(self.rotation_speed)):
             raise ValueError(f"rotation_speed must be finite (rad/s), got {self.rotation_speed!r}")
+        if self.rotation_direction not in ("auto", *ROTATION_DIRECTIONS):
+            raise ValueError(
+                "rotation_direction must be 'auto', 'counterclockwise' or 'clockwise', got "
+                f"{self.rotation_direction!r}"
+            )
         if self.order not in (1, 2):
             raise ValueError(f"order must be 1 or 2, got {self.order!r}")
         if self.centrifugal not in (None, "linear", "nonlinear"):

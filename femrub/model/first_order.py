@@ -152,10 +152,12 @@ class CasingSweep:
     """What the rotation speed Ω changes in a rub model, and nothing else.
 
     ``casing`` (a :class:`~femrub.contact.casing.CasingProfile`), the contacts' ``angles``
-    (rad), ``offsets`` (m, added clearance) and ``radii`` (m): the swept gap ``g(Ω t + φ_i)
-    + offset_i`` and the casing's sliding velocity ``−Ω r_i`` (the model's contact, full or
-    reduced); ``prestress_speed``: Ω of a centrifugal prestress in the stiffness, or
-    ``None``.
+    (rad), ``offsets`` (m, added clearance) and ``radii`` (m): the swept gap ``g(σ Ω t +
+    φ_i) + offset_i`` and the casing's sliding velocity ``−s σ Ω r_i`` (the model's contact,
+    full or reduced; :mod:`femrub.contact.casing`); ``direction`` σ: +1 counterclockwise,
+    −1 clockwise about the machine axis; ``slip`` s: +1, or −1 for the reversed sliding of
+    ``contact.slip_direction``; both are kept at every speed. ``prestress_speed``: Ω of a
+    centrifugal prestress in the stiffness, or ``None``.
     """
 
     casing: object
@@ -163,22 +165,24 @@ class CasingSweep:
     offsets: np.ndarray
     radii: np.ndarray
     prestress_speed: float | None = None
+    direction: float = 1.0
+    slip: float = 1.0
 
     def contact_at(self, contact, omega: float):
         """``contact`` with its gap functions and casing velocity at ``omega`` (rad/s)."""
-        from ..contact.casing import swept_gap
+        from ..contact.casing import sliding_velocity, swept_gap
 
         if contact.wear is not None or contact.casing_heat is not None:
             raise ValueError(
                 "rotation_speed: an abradable coating or a casing heat model is swept at the "
                 "speed it was built for; build the model again at the new speed"
             )
-        gap, rate = swept_gap(self.casing, self.angles, omega, self.offsets)
+        gap, rate = swept_gap(self.casing, self.angles, omega, self.offsets, self.direction)
         changes = {"gap0": gap, "gap_rate": rate}
         if contact.casing_velocity is not None:
-            vc = np.zeros_like(np.asarray(contact.casing_velocity, dtype=float))
-            vc[:, 1] = -float(omega) * self.radii
-            changes["casing_velocity"] = vc
+            changes["casing_velocity"] = sliding_velocity(
+                self.radii, omega, self.direction, self.slip
+            )
         return replace(contact, **changes)
 
 

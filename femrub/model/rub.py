@@ -22,7 +22,7 @@ import numpy as np
 import scipy.sparse as sp
 import skfem as fem
 
-from ..contact.casing import CasingProfile, Concentric, swept_gap
+from ..contact.casing import CasingProfile, Concentric, sliding_velocity, swept_gap
 from ..contact.points import ContactPoints
 from ..fem.discretisation import Discretisation
 from ..fem.forms import lame_parameters
@@ -89,18 +89,16 @@ def _observations(normal_rows, heat_rows) -> dict:
     return observe
 
 
-def _friction_spec(points: ContactPoints, mats, friction: float, rotation_speed: float) -> dict:
-    """Tangent rows, μ, casing surface velocity ``(0, −Ω r)`` and frames of the contacts."""
+def _friction_spec(points: ContactPoints, mats, friction: float, velocity) -> dict:
+    """Tangent rows, μ, casing surface ``velocity`` (n_c, 2) and frames of the contacts."""
     if not friction > 0.0:
         return {}
     if points.tangents is None:
         raise ValueError("Coulomb friction needs a 3D blade (the bar has no tangent plane)")
-    vc = np.zeros((points.n, 2))
-    vc[:, 1] = -float(rotation_speed) * points.radii
     return {
         "tangents": points.tangent_rows(mats),
         "friction": float(friction),
-        "casing_velocity": vc,
+        "casing_velocity": velocity,
         "frames": points.frames(),
     }
 
@@ -126,6 +124,8 @@ def rub_model(  # noqa: PLR0913 (the parts of a rub model, all keyword-only but 
     casing_heat=None,
     damping=None,
     length_scale: float = float("nan"),
+    direction: float = 1.0,
+    slip: float = 1.0,
 ) -> tuple[FirstOrderModel, FieldMap]:
     """First-order model of ``disc`` rubbing ``casing`` at ``points`` (module docstring).
 
@@ -141,7 +141,7 @@ def rub_model(  # noqa: PLR0913 (the parts of a rub model, all keyword-only but 
         reach, the candidate points still show the tip's response).
     friction : Coulomb μ. With μ > 0 on a 3D blade each contact gets the axial and
         circumferential tangents of ``points``, and the casing surface slides past it at
-        ``−Ω r_i`` along the circumferential one (the blade frame turns at Ω).
+        ``−σ Ω r_i`` along the circumferential one (the blade frame turns at σ Ω).
     heat_law : ``"alpha"`` (heat ``α_i λ_i``) or ``"power"`` (heat ``η`` × friction power,
         ``η = heat_partition``).
     wear : :class:`~femrub.contact.abradable.Abradable` coating over ``points``, or None.
@@ -151,13 +151,18 @@ def rub_model(  # noqa: PLR0913 (the parts of a rub model, all keyword-only but 
         known and before the model is built (the pipeline's modal damping, which takes the
         frequencies through the reduction's interior factorisation), or None.
     length_scale : the blade's characteristic size (m; the model's ``length_scale``).
+    direction : σ, +1 counterclockwise or −1 clockwise about the machine axis: the casing
+        phase ``σ Ω t + φ_i`` and the sliding velocity (:mod:`femrub.contact.casing`).
+    slip : +1, or −1 for the casing sliding reversed against the phase
+        (``contact.slip_direction = "reversed"``, a verification device).
     """
     N, Q = points.normal_rows(mats), points.heat_rows(mats)
     if observe_at is None or observe_at is points:
         observe = _observations(N, Q)
     else:
         observe = _observations(observe_at.normal_rows(mats), observe_at.heat_rows(mats))
-    gap, gap_rate = swept_gap(casing, points.angles, rotation_speed, offset)
+    gap, gap_rate = swept_gap(casing, points.angles, rotation_speed, offset, direction)
+    velocity = sliding_velocity(points.radii, rotation_speed, direction, slip)
     spec = (
         None
         if points.n == 0
@@ -171,7 +176,7 @@ def rub_model(  # noqa: PLR0913 (the parts of a rub model, all keyword-only but 
             names=list(points.names),
             heat_law=heat_law,
             heat_partition=heat_partition,
-            **_friction_spec(points, mats, friction, rotation_speed),
+            **_friction_spec(points, mats, friction, velocity),
             wear=wear,
             casing_heat=casing_heat,
             patches=None if points.patch is None else points.mean_rows(mats),
@@ -186,11 +191,19 @@ def rub_model(  # noqa: PLR0913 (the parts of a rub model, all keyword-only but 
         fe_dofs=mats.n_u + mats.n_t,
         casing=casing.as_dict(),
         rotation_speed=float(rotation_speed),
+        rotation_direction=float(direction),
+        slip_direction=float(slip),
         rayleigh=mats.info.get("rayleigh", (0.0, 0.0)),
     )
     offsets = np.broadcast_to(np.asarray(offset, dtype=float), (points.n,)).copy()
     sweep = CasingSweep(
-        casing, points.angles, offsets, points.radii, mats.info.get("prestress_speed")
+        casing,
+        points.angles,
+        offsets,
+        points.radii,
+        mats.info.get("prestress_speed"),
+        float(direction),
+        float(slip),
     )
     model = first_order_model(
         mats,
@@ -230,6 +243,8 @@ def solid_model(  # noqa: PLR0913 (the Python preset: keyword-only options, one 
     gap_reference: str = "per-node",
     spread: str = "patch",
     centrifugal: str | None = None,
+    rotation_direction: str = "auto",
+    slip_direction: str = "rotation",
 ) -> tuple[FirstOrderModel, FieldMap]:
     """A blade rubbing a casing in one call: the scene's builder with Python arguments.
 
@@ -247,7 +262,9 @@ def solid_model(  # noqa: PLR0913 (the Python preset: keyword-only options, one 
     its frequency, as a scene's ``sin`` law); ``centrifugal``: prestress method at Ω
     (``"linear"``, ``"nonlinear"``; default ``None``: none, unlike a scene's
     ``loads.centrifugal = "auto"``); ``conduction``: ``"galerkin"`` or ``"monotone"`` (the
-    scene's ``physics.conduction``). Returns ``(model, fields)``.
+    scene's ``physics.conduction``); ``rotation_direction``, ``slip_direction``: as the
+    scene's ``loads.rotation_direction`` and ``contact.slip_direction``. Returns
+    ``(model, fields)``.
     """
     from .builder import build_rub  # the builder composes this module's rub_model
     from .config import ContactConfig, ForceConfig, ForceLaw, RubConfig
@@ -275,8 +292,10 @@ def solid_model(  # noqa: PLR0913 (the Python preset: keyword-only options, one 
             spread=spread,
             reach=reach,
             gap_reference=gap_reference,
+            slip_direction=slip_direction,
         ),
         rotation_speed=float(rotation_speed),
+        rotation_direction=rotation_direction,
         order=order,
         lumping=lumping,
         conduction=conduction,

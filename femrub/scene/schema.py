@@ -179,6 +179,14 @@ CONTACT = {
         "spread like its heat; femrub.contact.patches) or on its node alone",
     ),
     "restitution": _f(0.0, "none", "Newton's restitution coefficient e", lo=0.0, hi=1.0),
+    "slip_direction": Spec(
+        C,
+        "rotation",
+        choices=("rotation", "reversed"),
+        doc="expert, a verification device: the casing slides past the blade against its "
+        "rotation (rotation), or the other way while the lobe phase stays (reversed: to "
+        "cross-check codes that prescribe the sliding velocity apart from the phase)",
+    ),
     "friction": _f(
         0.0, "none", "3D: Coulomb coefficient μ (tangential force |λ_t| <= μ λ)", **NONNEG
     ),
@@ -260,6 +268,15 @@ TIP_FORCE = Variant(
 
 LOADS = {
     "rotation_speed": _f(0.0, "angular_speed", "rotation speed Ω", **NONNEG),
+    "rotation_direction": Spec(
+        C,
+        "auto",
+        choices=("auto", "counterclockwise", "clockwise"),
+        doc="direction of rotation about the machine axis (right-hand rule); the casing "
+        "phase σ Ω t + φ and the casing's sliding velocity −σ Ω r follow it (auto: the "
+        "blade moves towards its pressure side, read from the tip section's camber; "
+        "counterclockwise where that cannot be derived, e.g. the bar or a symmetric section)",
+    ),
     "centrifugal": Spec(
         C,
         "auto",
