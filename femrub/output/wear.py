@@ -50,9 +50,10 @@ def write_wear(wear, out) -> dict:
     edges = np.degrees(np.linspace(0, 2 * np.pi, wear.n_angle + 1))
     im = ax.pcolormesh(edges, wear.z_edges * 1e3, surface.T * 1e6, shading="flat", cmap="magma_r")
     fig.colorbar(im, ax=ax, label="wear depth (µm)")
-    for i, z_i in enumerate(np.unique(np.round(wear.axial, 12))):  # where the contacts cut
+    axial = wear.grid.axial  # where the contacts cut
+    for i, z_i in enumerate(np.unique(np.round(axial, 12))):
         ax.axhline(z_i * 1e3, color="c", lw=0.5, ls="--", label="contacts" if i == 0 else None)
-    if wear.axial.size:
+    if axial.size:
         ax.legend(loc="upper right", fontsize=7)
     ax.set_xlabel("casing angle (deg)")
     ax.set_ylabel("axial position (mm)")
