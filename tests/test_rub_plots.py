@@ -53,3 +53,11 @@ def test_the_response_drawn_is_the_first_displacement_probe():
     y, label = response_of(res, node=1)
     np.testing.assert_array_equal(y, [1.0, 3.0, 5.0])
     assert label == "contact 1 (normal)"
+
+
+def test_a_run_ending_on_a_whole_revolution_has_no_row_for_its_last_time():
+    omega = 2 * np.pi  # one revolution per second
+    t = np.linspace(0.0, 2.0, 201)  # ends at 2 revolutions exactly
+    edges, grid = force_map(t, np.ones_like(t), omega, 10)
+    assert grid.shape == (2, 10) and np.allclose(edges, [0, 1, 2])
+    assert not np.isnan(grid).any()

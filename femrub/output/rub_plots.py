@@ -95,6 +95,8 @@ def force_map(t, force, omega: float, n_angle: int) -> tuple[np.ndarray, np.ndar
     grid = np.full((int(rev.max(initial=0)) + 1, n_angle), -np.inf)
     np.maximum.at(grid, (rev, cell), np.asarray(force, dtype=float))
     grid[np.isneginf(grid)] = np.nan
+    if grid.shape[0] > 1 and np.count_nonzero(rev == rev[-1]) == 1:
+        grid = grid[:-1]  # a run ending on a whole revolution: its last time opens no new one
     first = np.floor(turns[0]) if turns.size else 0.0
     return first + np.arange(grid.shape[0] + 1), grid
 
