@@ -8,8 +8,9 @@ ROOT = Path(__file__).resolve().parents[1]
 HEAVY = ("skfem", "matplotlib", "scipy.sparse", "gmsh", "pyvista", "dask")
 
 
-def _loaded(code: str) -> list[str]:
-    probe = f"{code}; import sys; print(','.join(m for m in {HEAVY!r} if m in sys.modules))"
+def _loaded(code: str, heavy=HEAVY) -> list[str]:
+    """Which of the modules ``heavy`` a fresh interpreter has loaded after ``code``."""
+    probe = f"{code}; import sys; print(','.join(m for m in {heavy!r} if m in sys.modules))"
     out = subprocess.run(
         [sys.executable, "-c", probe],
         cwd=ROOT,

@@ -4,8 +4,6 @@ package stays light (every name is imported on first use)."""
 
 import inspect
 import re
-import subprocess
-import sys
 from pathlib import Path
 
 import pytest
@@ -92,16 +90,10 @@ def test_readme_snippet_names_resolve():
 
 
 def test_import_femrub_loads_nothing_heavy():
-    probe = f"import femrub, sys; print(','.join(m for m in {HEAVY!r} if m in sys.modules))"
-    out = subprocess.run(
-        [sys.executable, "-c", probe],
-        cwd=ROOT,
-        capture_output=True,
-        text=True,
-        check=True,
-        env={"PYTHONPATH": str(ROOT), "PATH": ""},
-    )
-    assert out.stdout.strip() == "", f"import femrub loads {out.stdout.strip()}"
+    from test_lazy_imports import _loaded
+
+    loaded = _loaded("import femrub", HEAVY)
+    assert loaded == [], f"import femrub loads {','.join(loaded)}"
 
 
 def test_load_results_reads_a_folder_or_a_file_and_names_a_missing_one(tmp_path):
