@@ -269,17 +269,17 @@ def _build(scene, log, modes, stages, with_stepper=True) -> Simulation:
     clock.done("assembly", f"{built.model.n_dofs} state dofs")
     _report_full(scene, built, report)
     probes = _probes(scene, built, probe_at, report, log)
-    full = _Full(built.model, built.fields, size, probes)
+    full = _Full(built.model, built.fields, probes)
     return _runnable(scene, full, stages, log, modes, report, clock, with_stepper)
 
 
 @dataclass(frozen=True)
 class _Full:
-    """The full model of a build, its fields on the mesh and the blade's size (m)."""
+    """The full model of a build (its ``length_scale``: the blade's size, m) and its fields
+    on the mesh."""
 
     model: object
     fields: object
-    size: float
     #: the probes' observation rows on the full model (:mod:`femrub.app.probes`)
     probes: dict
 
@@ -287,7 +287,7 @@ class _Full:
 def _runnable(scene, full: _Full, stages, log, modes, report, clock, with_stepper) -> Simulation:
     """The :class:`Simulation` of a full model: its signals and limits, natural frequencies,
     reduction (checked) and stepper."""
-    model, limits = _select_signals(scene, full.model, report, full.size, full.probes)
+    model, limits = _select_signals(scene, full.model, report, full.model.length_scale, full.probes)
     if modes and len(report.get("natural_frequencies_hz", ())) != modes:
         report["natural_frequencies_hz"] = stages.frequencies(model, modes).tolist()
     reduced, reductor, ran = _reduce(scene, model, full.model, stages, log, limits, report, clock)
@@ -351,7 +351,7 @@ def _at_speed(last: Simulation, scene, stages, log, modes) -> Simulation | None:
     before = last.full.parameters["rotation_speed"]
     report["parametric"] = {"from_rotation_speed": before, "rotation_speed": omega}
     clock.done("assembly", f"the model at {before:g} rad/s taken at {omega:g} rad/s")
-    full = _Full(model, last.fields, report["blade_size"], last.probes)
+    full = _Full(model, last.fields, last.probes)
     return _runnable(scene, full, stages, log, modes, report, clock, True)
 
 

@@ -375,7 +375,10 @@ def _batches(todo: list, cache, workers: int) -> list[list[list]]:
     size, extra = divmod(len(rest), n)
     cuts = np.cumsum([0] + [size + (i < extra) for i in range(n)])
     chunks = [rest[a:b] for a, b in zip(cuts[:-1], cuts[1:]) if b > a]
-    return [[first]] * bool(first) + [chunks] * bool(chunks)
+    batches = [[first]] if first else []
+    if chunks:
+        batches.append(chunks)
+    return batches
 
 
 def _collect(futures, bar) -> None:
