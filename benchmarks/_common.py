@@ -197,6 +197,57 @@ def machine() -> dict:
     }
 
 
+def stamp(command: str, machine: dict | None) -> str:
+    """Where a table's numbers come from, as an italic sentence: the command that measured
+    them, its date, commit, Python, cores and the load average at its start."""
+    m = machine or {}
+    when = m.get("date") or "date not recorded"
+    commit = f"commit {m['commit']}" if m.get("commit") else "commit not recorded"
+    return (
+        f"*Measured by `{command}` ({when}, {commit}; Python {m.get('python', '?')}, "
+        f"{m.get('cores', '?')} cores, load average {m.get('load_average', '?')} at its start).*"
+    )
+
+
+def render_sections(doc: Path, sections: dict[str, str]) -> None:
+    """Put each ``sections[name]`` between the ``name`` markers of ``doc`` (write_between)."""
+    for name, text in sections.items():
+        write_between(doc, name, text)
+
+
+def marked(doc: Path, name: str) -> str:
+    """The text between the ``name`` markers of ``doc`` (stripped), or ``""`` without them."""
+    page = doc.read_text()
+    begin, end = f"<!-- {name}:begin -->", f"<!-- {name}:end -->"
+    if begin not in page:
+        return ""
+    return page[page.index(begin) + len(begin) : page.index(end)].strip()
+
+
+def stamped_sections(data: dict, prefix: str) -> dict[str, str]:
+    """``marker name -> text`` of stored sections ``{key: {command, machine, text}}``: each
+    section's :func:`stamp` (under the text's heading if it has one), then the text its
+    benchmark generated."""
+    return {f"{prefix}_{key}": _stamped(e) for key, e in data.items()}
+
+
+def _stamped(entry: dict) -> str:
+    """A stored section's text with its stamp under its heading (first, without one)."""
+    text = entry["text"].strip()
+    heading, body = text.split("\n", 1) if text.startswith("#") else ("", text)
+    stamped = stamp(entry["command"], entry["machine"]) + "\n\n" + body.strip()
+    return f"{heading}\n\n{stamped}" if heading else stamped
+
+
+def store_section(store: Path, page: Path, prefix: str, key: str, entry: dict) -> None:
+    """Keep ``entry`` (``command``, ``machine``, ``text``) under ``key`` in the JSON ``store``
+    and render every stored section into ``page`` (:func:`stamped_sections`)."""
+    data = read_json(store) if store.exists() else {}
+    data[key] = entry
+    write_json(store, data)
+    render_sections(page, stamped_sections(read_json(store), prefix))
+
+
 def fmt(x, digits: int = 3) -> str:
     """Number for a Markdown table: ``—`` for NaN/None, scientific for small or large."""
     if x is None or (isinstance(x, float) and not math.isfinite(x)):

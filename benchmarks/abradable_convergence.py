@@ -10,19 +10,21 @@ stepped as a control.
 
 ``python benchmarks/abradable_convergence.py`` (twisted NACA blade with a 100 µm coating,
 yield 20 N, 3600 cells, 1.5 ms) and ``--rotor37`` (the ``rotor37-thermal`` scene over one
-lobe passage; run it under ``flock /tmp/femrub-heavy.lock``) write their tables into the
-section "Time-step convergence of the coated rub" of ``docs/abradable.md``.
+lobe passage; run it under ``flock /tmp/femrub-heavy.lock``) store their rows with where
+they were measured in ``docs/performance/abradable_convergence.json`` and render the tables
+between the ``abradable_convergence_<study>`` markers of ``docs/abradable.md``
+(``--render-only``: render the page from the JSON without running anything).
 """
 
 from __future__ import annotations
 
 import argparse
-import os
 import sys
 import time
 from pathlib import Path
 
 import numpy as np
+from _common import machine, read_json, render_sections, stamp, write_json
 
 from femrub.analysis import make_stepper
 from femrub.app.cache import DEFAULT_LIMIT, ModelCache
@@ -30,8 +32,9 @@ from femrub.app.scheme import scheme_options
 from femrub.app.simulation import build
 from femrub.scene.scene import load_scene
 
-DOC = Path(__file__).resolve().parents[1] / "docs" / "abradable.md"
-HEADING = "\n## Time-step convergence of the coated rub"
+DOCS = Path(__file__).resolve().parents[1] / "docs"
+DOC = DOCS / "abradable.md"
+JSON = DOCS / "performance" / "abradable_convergence.json"
 
 NACA = {
     "contact.abradable.thickness": 1e-4,
@@ -94,7 +97,7 @@ def table(rows, rigid) -> str:
             f"| h/{r['f']} = {r['h']:.3g} s | {r['steps_per_cell']:.2g} | {r['impulse']:.4g} | "
             f"{r['impulse'] / ref['impulse'] - 1:+.1%} | {r['held']:.0%} | {r['episodes']} | "
             f"{r['volume']:.4g} | {r['volume'] / ref['volume'] - 1:+.1%} | "
-            f"{1e6 * r['depth']:.4g} | {r['T_max']:.4g} | {r['cpu']:.1f} |"
+            f"{1e6 * r['depth']:.4g} | {r['T_max']:.4g} | {r['cpu']:.2g} |"
         )
     if not rigid:
         return "\n".join(out)
@@ -111,19 +114,14 @@ def table(rows, rigid) -> str:
     return "\n".join(out)
 
 
-def write(name: str, text: str, load: str) -> None:
-    doc = DOC.read_text() if DOC.exists() else "# Abradable coating\n"
-    if HEADING not in doc:
-        doc = doc.rstrip() + "\n" + HEADING + "\n"
-    head, tail = doc.split(HEADING, 1)
-    sub = f"\n### {name}\n"
-    flag = " --rotor37" if name.startswith("rotor37") else ""
-    cmd = f"`python benchmarks/abradable_convergence.py{flag}`"
-    body = f"{sub}\n{cmd}, load average {load}.\n\n{text}\n"
-    parts = tail.split("\n### ")
-    kept = [p for p in parts[1:] if not p.startswith(name)]
-    tail = parts[0].rstrip() + "\n" + "".join("\n### " + p.rstrip() + "\n" for p in kept) + body
-    DOC.write_text(head + HEADING + tail)
+def section(entry: dict) -> str:
+    """One study's stamp and tables."""
+    return stamp(entry["command"], entry["machine"]) + "\n\n" + table(entry["rows"], entry["rigid"])
+
+
+def render(data: dict) -> dict[str, str]:
+    """``marker name -> text`` of every study in ``data`` (the JSON document)."""
+    return {f"abradable_convergence_{k}": section(v) for k, v in data.items()}
 
 
 def main(argv=None) -> int:
@@ -131,21 +129,31 @@ def main(argv=None) -> int:
     p.add_argument("--rotor37", action="store_true", help="rotor37-thermal, one lobe passage")
     p.add_argument("--factors", default=None, help="comma-separated step divisors")
     p.add_argument("--no-rigid", action="store_true", help="skip the rigid-casing control")
+    p.add_argument("--render-only", action="store_true", help="render docs from the JSON")
     a = p.parse_args(argv)
+    command = " ".join(
+        ["python benchmarks/abradable_convergence.py", *(sys.argv[1:] if argv is None else argv)]
+    )
+    data = read_json(JSON) if JSON.exists() else {}
+    if a.render_only:
+        render_sections(DOC, render(data))
+        return 0
     if a.rotor37:
-        name, scene = "rotor37-thermal, one lobe passage", load_scene("rotor37-thermal", ROTOR37)
+        name, scene = "rotor37-thermal", load_scene("rotor37-thermal", ROTOR37)
         t_end, factors = 2.3375e-3, [1, 2, 4, 8, 16]
     else:
-        name, scene = "twisted NACA, 100 µm coating", load_scene("twisted-naca", NACA)
+        name, scene = "twisted-naca", load_scene("twisted-naca", NACA)
         t_end, factors = 1.5e-3, [1, 2, 4, 8, 16, 32]
     if a.factors:
         factors = [int(x) for x in a.factors.split(",")]
+    where = machine()
     rows = study(scene, t_end, factors)
     rigid = []
     if not a.no_rigid:
         rigid = study(scene.with_changes({"contact.abradable.thickness": 0.0}), t_end, factors[::2])
-    load = ", ".join(f"{x:.1f}" for x in os.getloadavg())
-    write(name, table(rows, rigid), load)
+    data[name] = {"command": command, "machine": where, "rows": rows, "rigid": rigid}
+    write_json(JSON, data)
+    render_sections(DOC, render(read_json(JSON)))
     return 0
 
 

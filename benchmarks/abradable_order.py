@@ -11,25 +11,39 @@ map's centres played no part), the hottest contact, the deepest wear, the worn v
 row after the first of a resolution gives the observed order ``log2(d_prev / d)`` of the
 differences between consecutive steps.
 
-Writes the table between ``<!-- abradable_order:begin -->`` and ``<!-- abradable_order:end -->``
-of ``docs/abradable.md`` with the load (``--no-write``: print it).
+Stores the rows under ``--name`` with where they were measured in
+``docs/performance/abradable_order.json`` and renders them between the
+``abradable_order_<name>`` markers of ``docs/abradable.md``: every row (``--layout full``) or
+one row per map, the steps side by side (``--layout ladder``). ``--no-write``: print only;
+``--render-only``: render the page from the JSON without running anything.
 
-Run: ``flock /tmp/femrub-heavy.lock python benchmarks/abradable_order.py [--scene rotor37-thermal]
-[--factors 1,2,4] [--revolutions 10] [--n-angle 0,1440] [--set KEY=VALUE ...] [--no-write]``.
+Run: ``flock /tmp/femrub-heavy.lock python benchmarks/abradable_order.py --name NAME
+[--scene rotor37-thermal] [--factors 1,2,4] [--revolutions 10] [--n-angle 0,1440]
+[--set KEY=VALUE ...] [--layout full|ladder] [--no-write]``.
 """
 
 from __future__ import annotations
 
 import math
 import os
+import sys
 import time
 from pathlib import Path
 
 import numpy as np
-from _common import cli_scene, ladder_arguments, write_between
+from _common import (
+    cli_scene,
+    ladder_arguments,
+    machine,
+    read_json,
+    render_sections,
+    stamp,
+    write_json,
+)
 
 ROOT = Path(__file__).resolve().parents[1]
 DOC = ROOT / "docs" / "abradable.md"
+JSON = ROOT / "docs" / "performance" / "abradable_order.json"
 
 
 def with_map(model, n_angle: int):
@@ -97,6 +111,7 @@ def study(scene, factors, revolutions: float, n_angles, log=print) -> list[dict]
             row = {"n_angle": wear.n_angle, "f": f, "h": s["h"] / f, "status": res.status}
             row["cpu"] = time.process_time() - c0
             row.update(measure(res, st.model.contact.wear, s["h"] / f, revolution))
+            row["steps_per_cell"] = revolution / (s["h"] / f * wear.n_angle)
             row["balances"] = (res.energy_error(), res.heat_error())
             row["load"] = (load0, os.getloadavg()[0])
             rows.append(row)
@@ -151,27 +166,81 @@ def table(rows) -> str:
     return "\n".join(out)
 
 
+def _by_map(rows) -> list[list[dict]]:
+    """The rows grouped by map resolution, each group in the order of its steps."""
+    cells = list(dict.fromkeys(r["n_angle"] for r in rows))
+    return [[r for r in rows if r["n_angle"] == n] for n in cells]
+
+
+def _series(group, key: str, scale: float = 1.0, digits: int = 3) -> str:
+    return ", ".join(f"{scale * r[key]:.{digits}g}" for r in group)
+
+
+def ladder(rows) -> str:
+    """One row per map: impulses of the first and later revolutions and the hottest contact
+    at every step, the hottest contact extrapolated to h → 0 at first order
+    (``T(h_n) − (T(h_{n−1}) − T(h_n))`` on the two finest steps), the finest step's episodes."""
+    steps = ", ".join(f"h/{r['f']}" for r in _by_map(rows)[0])
+    out = [
+        f"| cells | steps per cell at h | first revolution: {steps} (N s) | later revolutions: "
+        f"{steps} (N s) | hottest contact: {steps} (K) | hottest contact extrapolated in h (K) | "
+        "episodes at the finest step | deepest wear (mm) | largest energy / heat balance |",
+        "|---|---|---|---|---|---|---|---|---|",
+    ]
+    for g in _by_map(rows):
+        fine = g[-1]
+        extrapolated = 2 * fine["t_max"] - g[-2]["t_max"] if len(g) > 1 else math.nan
+        balance = max(r["balances"][0] for r in g), max(r["balances"][1] for r in g)
+        out.append(
+            f"| {g[0]['n_angle']} | {g[0]['steps_per_cell']:.3g} | {_series(g, 'first')} | "
+            f"{_series(g, 'later')} | {_series(g, 't_max', digits=4)} | {extrapolated:.4g} | "
+            f"{fine['episodes']} | {_series(g, 'wear', 1e3, 4)} | {balance[0]:.1e} / "
+            f"{balance[1]:.1e} |"
+        )
+    return "\n".join(out)
+
+
+LAYOUTS = {"full": table, "ladder": ladder}
+
+
+def render(data: dict) -> dict[str, str]:
+    """``marker name -> text`` of every stored ladder: its stamp, then its table."""
+    return {
+        f"abradable_order_{name}": stamp(e["command"], e["machine"])
+        + f" h = {e['h']:.4g} s.\n\n"
+        + LAYOUTS[e["layout"]](e["rows"])
+        for name, e in data.items()
+    }
+
+
 def main(argv=None) -> int:
     ap = ladder_arguments(__doc__)
+    ap.add_argument("--name", default="order", help="where the ladder goes in the JSON and page")
     ap.add_argument("--revolutions", type=float, default=10.0)
     ap.add_argument("--n-angle", default="0", help="comma-separated map resolutions (0: scene)")
+    ap.add_argument("--layout", choices=sorted(LAYOUTS), default="full")
+    ap.add_argument("--render-only", action="store_true")
     a = ap.parse_args(argv)
+    data = read_json(JSON) if JSON.exists() else {}
+    if a.render_only:
+        render_sections(DOC, render(data))
+        return 0
     scene = cli_scene(a.scene, a.set)
     if scene is None:
         return 0
+    where = machine()
     factors = [int(x) for x in a.factors.split(",")]
     rows = study(scene, factors, a.revolutions, [int(x) for x in a.n_angle.split(",")])
-    text = (
-        f"`python benchmarks/abradable_order.py --scene {a.scene} --factors {a.factors} "
-        f"--revolutions {a.revolutions:g} --n-angle {a.n_angle}"
-        + "".join(f" --set {s}" for s in a.set)
-        + f"` ({time.strftime('%Y-%m-%d')}):\n\n"
-        + table(rows)
+    command = " ".join(
+        ["python benchmarks/abradable_order.py", *(sys.argv[1:] if argv is None else argv)]
     )
-    print(text)
+    entry = {"command": command, "machine": where, "layout": a.layout, "rows": rows}
+    entry["h"] = scene["scheme"]["h"]
+    print(LAYOUTS[a.layout](rows))
     if not a.no_write:
-        heading = "## Where the step error of a coated rub comes from\n\n"
-        write_between(DOC, "abradable_order", text, heading)
+        data[a.name] = entry
+        write_json(JSON, data)
+        render_sections(DOC, render(read_json(JSON)))
     return 0
 
 

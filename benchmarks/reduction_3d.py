@@ -13,7 +13,9 @@ and peak resident memory of the process (``getrusage``, which also counts SuperL
 ARPACK). With ``--simulate`` (default for the smallest size) the full and reduced models are
 also run with the θ-method (h = 1e-6 s, 2 ms) and compared.
 
-Run ``python benchmarks/reduction_3d.py [--quick]``; writes ``docs/reduction_3d.md``.
+Run ``python benchmarks/reduction_3d.py [--quick]``; keeps the table with where it was
+measured in ``docs/performance/reduction_3d.json`` (key ``cost``) and renders it between the
+``reduction_3d_cost`` markers of ``docs/reduction_3d.md`` (``--quick``: print only).
 """
 
 from __future__ import annotations
@@ -31,6 +33,10 @@ import numpy as np
 import skfem as fem
 
 import femrub as fr
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from _common import machine, store_section  # noqa: E402
+
 from femrub.model.build import ContactSpec, Load, first_order_model
 from femrub.reduction import ThermoelasticCraigBampton
 
@@ -38,8 +44,9 @@ L, W, H = 0.1, 0.02, 0.004  # m
 SIZES = {"1e4": (20, 6, 3), "3e4": (28, 9, 4), "1e5": (54, 16, 4)}
 QUICK = {"3e3": (10, 4, 2)}
 N_UV, N_THETA = 6, 12
-#: Heading of the section benchmarks/reduction_convergence_3d.py writes (kept on rewrite).
-CONVERGENCE = "\n## Reduced vs full model in 3D"
+ROOT = Path(__file__).resolve().parents[1]
+PAGE = ROOT / "docs" / "reduction_3d.md"
+STORE = ROOT / "docs" / "performance" / "reduction_3d.json"
 F0, OMEGA, GAP, ALPHA = 100.0, 5000.0, 0.8e-6, 3.0  # N, rad/s, m, m/s
 
 
@@ -173,7 +180,6 @@ def main(argv=None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--quick", action="store_true", help="one small box (~3e3 dofs)")
     ap.add_argument("--simulate", choices=("smallest", "all", "none"), default="smallest")
-    ap.add_argument("--out", type=Path, default=Path("docs/reduction_3d.md"))
     ap.add_argument("--worker", nargs=3, type=int, help=argparse.SUPPRESS)
     ap.add_argument("--sim", action="store_true", help=argparse.SUPPRESS)
     args = ap.parse_args(argv)
@@ -181,7 +187,7 @@ def main(argv=None) -> None:
         print(json.dumps(worker(*args.worker, args.sim)))
         return
     sizes = QUICK if args.quick else SIZES
-    results = []
+    where, results = machine(), []
     for k, (label, mesh) in enumerate(sizes.items()):
         sim = args.simulate == "all" or (args.simulate == "smallest" and k == 0)
         cmd = [sys.executable, __file__, "--worker", *map(str, mesh)] + (["--sim"] if sim else [])
@@ -193,12 +199,12 @@ def main(argv=None) -> None:
             f"{label}: {r['n_fe']} FE dofs, reduction {r['reduction_s']:.1f} s, "
             f"peak RSS {r['rss_peak_mib']:.0f} MiB (process {time.perf_counter() - t0:.0f} s)"
         )
-    args.out.parent.mkdir(parents=True, exist_ok=True)
-    old = args.out.read_text(encoding="utf-8") if args.out.exists() else ""
-    keep = old[old.index(CONVERGENCE) :] if CONVERGENCE in old else ""  # the convergence studies
-    args.out.write_text("# 3D reduction cost\n\n" + _table(results) + keep, encoding="utf-8")
-    args.out.with_suffix(".json").write_text(json.dumps(results, indent=1), encoding="utf-8")
-    print(f"wrote {args.out}")
+    print(_table(results))
+    if not args.quick:
+        command = "python benchmarks/reduction_3d.py" + "".join(f" {a}" for a in (argv or []))
+        entry = {"command": command, "machine": where, "text": _table(results), "data": results}
+        store_section(STORE, PAGE, "reduction_3d", "cost", entry)
+        print(f"wrote {PAGE}")
 
 
 if __name__ == "__main__":

@@ -9,9 +9,11 @@ largest over the checkpoints, and at the final time), the energy and heat balanc
 the lowest temperature reached, the hierarchical estimate of
 :mod:`femrub.reduction.estimate` (against the largest model) and the CPU times.
 
-``python benchmarks/reduction_convergence_3d.py [--quick]`` writes its table
-into the section "Reduced vs full model in 3D" of ``docs/reduction_3d.md`` (one
-subsection per scene) and a plot ``docs/reduction_3d_<scene>.png``.
+``python benchmarks/reduction_convergence_3d.py [--quick]`` keeps its table with where it was
+measured in ``docs/performance/reduction_3d.json`` and renders it between the
+``reduction_3d_<study>`` markers of ``docs/reduction_3d.md`` (one study per scene and kind),
+with a plot ``docs/reduction_3d_<scene>.png``; ``--render-only`` renders the page from the
+JSON without running anything.
 
 ``--default`` instead runs the scene as ``femrub run`` does (default reduction: ``auto``
 sizes, its estimate and verdict) and the same scene with ``reduction.method = "none"``,
@@ -31,11 +33,13 @@ machine, so the scene's reduced model is compared over one lobe passage with red
 from __future__ import annotations
 
 import argparse
+import re
 import sys
 import time
 from pathlib import Path
 
 import numpy as np
+from _common import machine, read_json, render_sections, stamped_sections, store_section
 
 from femrub.analysis.reduction_check import lobe_passage
 from femrub.app.simulation import build
@@ -44,19 +48,8 @@ from femrub.reduction.estimate import compare, field_norms
 from femrub.scene.scene import load_scene
 
 DOCS = Path(__file__).resolve().parents[1] / "docs"
-HEADING = "\n## Reduced vs full model in 3D"
-INTRO = (
-    "`python benchmarks/reduction_convergence_3d.py [--rotor37] [--projection P]`: "
-    "one full run, one reductor at the largest sizes, its sub-basis models stepped with "
-    "the same scheme and step (`--default`: the scene reduced as `femrub run` does, against "
-    "the same scene unreduced). Errors relative to the full model: contact impulse per "
-    "lobe passage, "
-    "contact temperature history, displacement and temperature fields (mass / heat-capacity "
-    "weighted L2 over the blade; largest over 1 ms checkpoints relative to the largest "
-    "norm, and at the final time relative to the final norm); balances relative to the "
-    "energy / heat scale; the hierarchical estimate against the largest model "
-    "(`docs/reduction.md` section 9). CPU on a shared 2-core machine."
-)
+PAGE = DOCS / "reduction_3d.md"
+STORE = DOCS / "performance" / "reduction_3d.json"
 
 
 def study(name, changes, sizes, thermal, every, projection="static-mass"):
@@ -203,7 +196,15 @@ def main(argv=None):
     ap.add_argument("--default", action="store_true", help="default reduction vs full model")
     ap.add_argument("--scene", default="twisted-naca")
     ap.add_argument("--set", action="append", default=[], metavar="KEY=VALUE")
+    ap.add_argument("--render-only", action="store_true", help="render the page from the JSON")
     a = ap.parse_args(argv)
+    if a.render_only:
+        render_sections(PAGE, stamped_sections(read_json(STORE), "reduction_3d"))
+        return 0
+    args = sys.argv[1:] if argv is None else list(argv)
+    write_section = section_writer(
+        " ".join(["python benchmarks/reduction_convergence_3d.py", *args])
+    )
     if a.default:
         from default_vs_full import run_default
 
@@ -230,17 +231,20 @@ def main(argv=None):
     return st
 
 
-def write_section(path: Path, st, text: str) -> None:
-    """Put ``text`` as the subsection of ``st`` under :data:`HEADING` of ``path``."""
-    doc = path.read_text(encoding="utf-8") if path.exists() else "# 3D reduction cost\n"
-    if HEADING not in doc:
-        doc = doc.rstrip("\n") + "\n" + HEADING + "\n\n" + INTRO + "\n"
-    sub = st.get("heading") or _heading(st)
-    head, _, rest = doc.partition(HEADING)
-    parts = rest.split("\n### ")
-    kept = [p for p in parts[1:] if not ("### " + p).startswith(sub)]
-    body = parts[0].rstrip("\n") + "\n" + "".join("\n### " + p.rstrip("\n") + "\n" for p in kept)
-    path.write_text(head + HEADING + body + "\n" + text, encoding="utf-8")
+def section_writer(command: str):
+    """``write_section(path, st, text)`` that keeps ``text`` in :data:`STORE` under the key
+    of ``st`` (its ``key``, or the slug of its heading) with ``command`` and the machine as it
+    was when the writer was made, and renders the page."""
+    where = machine()
+
+    def write_section(path: Path, st, text: str) -> None:
+        key = st.get("key") or re.sub(
+            r"[^a-z0-9]+", "-", (st.get("heading") or _heading(st)).lower()
+        )
+        entry = {"command": command, "machine": where, "text": text}
+        store_section(STORE, path, "reduction_3d", key.strip("-"), entry)
+
+    return write_section
 
 
 if __name__ == "__main__":

@@ -37,7 +37,9 @@ __all__ = [
     "DEFAULT_DIRECTION",
     "ROTATION_DIRECTIONS",
     "RotationDirection",
+    "TipSection",
     "derive_rotation_direction",
+    "tip_section",
 ]
 
 #: the two directions, as the sign of the rotation about the machine axis (right-hand rule)
@@ -106,20 +108,48 @@ def _chord(points: np.ndarray):
     return hull[i], (hull[j] - hull[i]) / length, length
 
 
+@dataclass(frozen=True)
+class TipSection:
+    """The blade's tip face unrolled on the plane ``(z, s) = (a · p, e_φ · p)`` (m).
+
+    ``points`` (n, 2): the corners of its triangles; ``start``, ``tangent``, ``chord``: the
+    chord's first end, unit vector and length (m); ``offsets`` (n,): the signed distances of
+    ``points`` from the chord along ``n = (−t_s, t_z)`` (m); ``centroid_offset``: that of the
+    face's area centroid (m).
+    """
+
+    points: np.ndarray
+    start: np.ndarray
+    tangent: np.ndarray
+    chord: float
+    offsets: np.ndarray
+    centroid_offset: float
+
+
+def tip_section(blade) -> TipSection | None:
+    """The tip section of a 3D ``blade`` (:class:`TipSection`), ``None`` without a tip face."""
+    faces = _tip_faces(blade) if blade.dim == 3 else np.zeros((3, 0), dtype=int)
+    if faces.shape[1] == 0:
+        return None
+    corners, areas = _section(blade, faces)
+    points = corners.reshape(-1, 2)
+    start, t, chord = _chord(points)
+    centroid = (areas @ corners.mean(axis=0)) / areas.sum()
+    normal = np.array([-t[1], t[0]])
+    offsets = (points - start) @ normal
+    return TipSection(points, start, t, chord, offsets, float(normal @ (centroid - start)))
+
+
 def derive_rotation_direction(blade) -> RotationDirection:
     """The direction ``blade`` (a :class:`~femrub.geometry.BladeMesh`) turns in by the
     pressure-side rule (module docstring), or the default with the reason it was not derived.
     """
     if blade.dim != 3:
         return _default("the 1D bar has no airfoil section")
-    faces = _tip_faces(blade)
-    if faces.shape[1] == 0:
+    section = tip_section(blade)
+    if section is None:
         return _default("the blade has no tip face")
-    corners, areas = _section(blade, faces)
-    start, t, chord = _chord(corners.reshape(-1, 2))
-    centroid = (areas @ corners.mean(axis=0)) / areas.sum()
-    normal = np.array([-t[1], t[0]])
-    offset = float(normal @ (centroid - start))
+    offset, chord, t = section.centroid_offset, section.chord, section.tangent
     if abs(offset) < CAMBER_MIN * chord:
         return _default(
             f"the tip section has no camber: centroid {100 * abs(offset) / chord:.2g} % of "
