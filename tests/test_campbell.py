@@ -167,3 +167,16 @@ def test_exact_diagram_is_the_full_solve_at_every_speed(tmp_path):
     f = np.sqrt(lowest_modes(ps.K, mats.M, 3, vectors=False)) / (2 * np.pi)
     np.testing.assert_allclose(np.sort(table[2, 2:]), f, rtol=1e-7)  # CSV: 8 digits
     np.testing.assert_allclose(table[0, 2:], doc["rest_frequencies_hz"], rtol=1e-7)
+
+
+def test_few_speeds_are_solved_exactly(tmp_path):
+    """A nonlinear diagram at no more speeds than the interpolation's samples and checks
+    (2 samples − 1) is the exact diagram: as many full solves, no interpolation error."""
+    scene = _scene(tmp_path, "nonlinear")
+    speeds = parse_speeds("0:1200:600")
+    few = campbell(scene, speeds, modes=3, samples=2)
+    exact = campbell(scene, speeds, modes=3, exact=True)
+    assert few.info["status"] == "exact" and few.info["sample_speeds"] == [0.0, 600.0, 1200.0]
+    assert np.allclose(few.frequencies, exact.frequencies, rtol=1e-10)
+    more = campbell(scene, parse_speeds("0:1200:300"), modes=3, samples=2, check=False)
+    assert more.info["status"] == "unchecked"

@@ -132,3 +132,27 @@ def test_the_first_point_fills_the_cache_alone():
     assert _batches(todo, None, 2) == [[todo[:2], todo[2:]]]
     assert _batches(todo, None, 8) == [[[r] for r in todo]]
     assert _batches(todo[:1], cache, 2) == [[todo[:1]]]
+
+
+def test_sweep_with_no_worker_runs_here_and_gives_the_cluster_rows(tmp_path, monkeypatch):
+    """`--workers 0` runs the points in this process, one after the other (no dask
+    cluster: a script without a `__main__` guard can sweep) with the same results."""
+    import femrub.app.sweep as sweep
+
+    scene = tmp_path / "tiny.toml"
+    scene.write_text(TINY)
+    args = ["sweep", str(scene), "--param", "rotation_speed=100:200:100", "-q"]
+    assert main([*args, "-o", str(tmp_path / "cluster"), "--workers", "1"]) == 0
+
+    def no_cluster(*_):
+        raise AssertionError("--workers 0 started a dask cluster")
+
+    monkeypatch.setattr(sweep, "_client", no_cluster)
+    assert main([*args, "-o", str(tmp_path / "here"), "--workers", "0"]) == 0
+    cluster, here = (
+        _csv(tmp_path / "cluster" / "interaction.csv"),
+        _csv(tmp_path / "here" / "interaction.csv"),
+    )
+    keys = ("loads.rotation_speed", "status", "max_contact_force_N", "f1_hz")
+    assert [[r[k] for k in keys] for r in here] == [[r[k] for k in keys] for r in cluster]
+    assert main([*args, "-o", str(tmp_path / "bad"), "--workers", "-1"]) == 2

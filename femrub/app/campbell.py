@@ -24,7 +24,9 @@ material, lumping; no contact), then:
 
 ``--exact`` (``exact=True``) skips the interpolation: the full prestress, warm-started from
 the previous speed's, and the full eigen-solve at every requested speed (status
-``"exact"``; one prestress and one factorisation per speed).
+``"exact"``; one prestress and one factorisation per speed). A nonlinear prestress asked at
+no more speeds than the interpolation's fewest full solves (``2 samples − 1``: the samples
+and their midpoint checks) is solved that way too: it costs no more, and needs no check.
 
 The diagram's ``status`` (``campbell.json``): ``"ok"`` when every check is within the
 tolerance, ``"failed"`` otherwise (``femrub campbell`` then exits 1 with a one-line error
@@ -163,6 +165,10 @@ def campbell(
         method, check = "off", False
     k = min(modes + EXTRA_MODES, mats.n_u - 1)
     solve = _Solver(disc, material, mats, method, k, log)
+    if method == "nonlinear" and check and speeds.size <= 2 * samples - 1 and not exact:
+        exact = True  # no more full solves than the samples and their checks
+        if log:
+            log(f"{speeds.size} speeds: each solved in full (the interpolation needs as many)")
     growth = _Growth(disc, scene)
     if exact and method != "off":
         freqs, info = _exact_diagram(solve, speeds, modes, growth)

@@ -349,7 +349,12 @@ def build_parser() -> argparse.ArgumentParser:
         metavar="KEY=SPEC",
         help="swept key: START:STOP:STEP (stop included) or A,B,C (repeatable)",
     )
-    sp.add_argument("--workers", type=int, default=2, help="local worker processes (default 2)")
+    sp.add_argument(
+        "--workers",
+        type=int,
+        default=2,
+        help="local worker processes (default 2; 0: the points one after the other here)",
+    )
     sp.add_argument("--scheduler", help="address of a dask scheduler (default: LocalCluster)")
     sp.set_defaults(func=_sweep)
     cb = sub.add_parser("campbell", help="Campbell diagram of a scene's blade (PNG + CSV)")

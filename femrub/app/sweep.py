@@ -241,6 +241,9 @@ def run_sweep(
     params : list of ``(dotted key, values)`` (:func:`parse_param`).
     out : sweep folder.
     scheduler : address of a dask scheduler; ``None``: a ``LocalCluster`` of ``workers``.
+    workers : worker processes of the ``LocalCluster``; 0: the points run one after the
+        other in this process, without dask (a small map, a debugger, a script that is
+        not guarded by ``if __name__ == "__main__"``).
     overwrite : rerun points that already have a finished result.
     cache : a :class:`~femrub.app.cache.ModelCache` (its folder must be shared with the
         workers): the first point runs alone and stores its models (assembly, damping,
@@ -250,9 +253,11 @@ def run_sweep(
     """
     out = Path(out)
     if scheduler is None and (
-        isinstance(workers, bool) or not isinstance(workers, int) or workers < 1
+        isinstance(workers, bool) or not isinstance(workers, int) or workers < 0
     ):
-        raise FolderError(f"--workers {workers!r}: give at least 1 worker process")
+        raise FolderError(
+            f"--workers {workers!r}: give a number of worker processes, or 0 to run here"
+        )
     keys = [k for k, _ in params]
     twice = sorted({k for k in keys if keys.count(k) > 1})
     if twice:
@@ -330,6 +335,13 @@ def _sweep(
 def _compute(scene, todo, scheduler, workers, progress, cache=None) -> None:
     from tqdm.auto import tqdm
 
+    if scheduler is None and workers == 0:  # in this process, the points in a row
+        bar, builds = tqdm(total=len(todo), disable=not progress, desc="sweep"), SceneBuilds(cache)
+        for r in todo:
+            r.update(_run_one(scene.with_changes(r["params"]), r["folder"], builds))
+            bar.update(1)
+        bar.close()
+        return
     client, cluster = _client(scheduler, workers)
     n_workers = len(client.scheduler_info().get("workers", {})) or workers
 
