@@ -118,8 +118,9 @@ def worker(nx: int, ny: int, nz: int, simulate: bool) -> dict:
         h, t_end = 1e-6, 2e-3
         full_res = fr.ThetaMethod(model, h).run(t_end, energy=False)
         red_res = fr.ThetaMethod(rom, h).run(t_end, energy=False)
-        T, Tr = full_res.signal("tip_temperature"), red_res.signal("tip_temperature")
-        u, ur = full_res.signal("tip_displacement"), red_res.signal("tip_displacement")
+        first = lambda res, name: res.signal(name).reshape(len(res.t), -1)[:, 0]  # noqa: E731
+        T, Tr = first(full_res, "tip_temperature"), first(red_res, "tip_temperature")
+        u, ur = first(full_res, "tip_displacement"), first(red_res, "tip_displacement")
         out["simulation"] = {
             "full_cpu_s": full_res.cpu_seconds,
             "reduced_cpu_s": red_res.cpu_seconds,
