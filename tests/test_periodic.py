@@ -25,6 +25,7 @@ import scipy.sparse as sp
 from femrub.model.config import ForceLaw
 from femrub.model.first_order import Contact, FirstOrderModel, Layout, LoadTerm
 from femrub.periodic import PeriodMap, Shooting, continue_branch, forcing_frequency
+from femrub.periodic.output import write_branch
 
 
 def oscillator(omega, F=0.36, d=0.5, e=0.5, c=0.0, wall=True):
@@ -131,20 +132,26 @@ def test_impact_oscillator_grazing(ratio):
         assert orbit.X[:, 0].max() == pytest.approx(Xp, rel=1e-5)
 
 
-def test_continuation_passes_a_fold():
-    """The impacting orbits continued in the wall's gap ``d`` turn back at a fold, where the
-    two roots of the closed form meet: ``R = |q| (1 − e) d``."""
-    omega, F, e = 1.4, 0.5, 0.6
-    T = 2 * np.pi / omega
-    Xp, q = F / (1 - omega**2), np.tan(T / 2)
-    d_fold = abs(Xp) * np.hypot((1 + e) * omega, q * (1 - e)) / (abs(q) * (1 - e))
+def test_branch_of_linear_orbits_and_its_folder(tmp_path):
+    """Continuation in the forcing frequency of the damped linear oscillator follows the FRF
+    through the resonance (no fold: the linear branch is a graph over ω), every point
+    stable (``max |μ| = e^{−c T / 2}``), and the folder holds its files."""
+    F, c = 0.1, 0.1
 
-    def family(d):
-        return oscillator(omega, F=F, d=d, e=e, c=0.02)
+    def family(w):
+        return oscillator(w, F=F, c=c, wall=False)
 
-    branch = continue_branch(
-        family, 0.5 * d_fold, 1.2 * d_fold, h=T / 2000, key="gap", warmup=200, max_points=200
-    )
-    folds = [p for p in branch.points if p.special == "fold"]
-    assert folds, [(p.parameter, p.special) for p in branch.points]
-    assert folds[0].parameter == pytest.approx(d_fold, rel=0.05)
+    branch = continue_branch(family, 0.8, 1.2, h=2.5e-2, key="omega", warmup=0, max_points=200)
+    w = branch.parameter
+    frf = F / np.abs(1 - w**2 + 1j * c * w)
+    assert branch.status == "ok" and len(w) > 10
+    assert np.allclose(branch.column("max_tip_displacement"), frf, rtol=2e-3)
+    assert all(p.stable and not p.special for p in branch.points)
+    mods = np.array([p.max_floquet_modulus for p in branch.points])
+    assert np.allclose(mods, np.exp(-c * 2 * np.pi / w / 2), rtol=1e-3)
+    doc = write_branch(branch, tmp_path, model_of=family)
+    head = (tmp_path / "branch.csv").read_text().splitlines()[0].split(",")
+    assert head[0] == "omega" and "max_tip_displacement" in head and "special" in head
+    assert doc["status"] == "ok" and (tmp_path / "branch.png").stat().st_size > 0
+    with np.load(tmp_path / doc["orbits"][0]["folder"] / "history.npz") as h:
+        assert {"t", "signal_tip_displacement", "impulse"} <= set(h.files)
