@@ -14,7 +14,9 @@ from the predictor ``z_k + Δs τ_k`` along the unit tangent ``τ_k``, the null 
 scaled Jacobian ``[R_X diag(s), R_p s_p]`` oriented as the step before (the first one
 towards ``stop``). ``R_X = M − I`` is the monodromy of Eq. (2) there; ``R_p`` is a finite
 difference in ``p`` at the same number of steps per period. Newton's method on Eq. (1)
-passes folds, where ``R_X`` is singular but the bordered matrix is not. Each point keeps
+passes folds, where ``R_X`` is singular but the bordered matrix is not; a correction that
+moves farther than ``2 Δs`` from its predictor is refused (it jumped to another part of the
+branch) and the step shortened. Each point keeps
 the number of steps per period ``N = ceil(T(p) / h)`` of its predictor (the step
 ``T(p) / N`` follows ``p`` inside it), so the residual is smooth in ``p`` through its
 corrections. The step ``Δs`` grows by 1.3 after a quick correction (at most 3 Newton
@@ -277,6 +279,8 @@ class _Continuation:
             F = np.append(R, tau @ (z - zp))
             dz = np.linalg.solve(np.vstack([J, tau]), -F)
             z = z + dz
+            if np.linalg.norm(z - zp) > 2.0 * abs(ds):  # left for another branch
+                return None
             Xn, pn = z[:-1] * s, z[-1] * self.sp
             try:
                 r = _norm(self.pb.map(pn, steps)(Xn) - Xn, s)
