@@ -155,3 +155,22 @@ def test_branch_of_linear_orbits_and_its_folder(tmp_path):
     assert doc["status"] == "ok" and (tmp_path / "branch.png").stat().st_size > 0
     with np.load(tmp_path / doc["orbits"][0]["folder"] / "history.npz") as h:
         assert {"t", "signal_tip_displacement", "impulse"} <= set(h.files)
+
+
+def test_restart_equals_a_fresh_stepper_from_that_state():
+    """``Stepper.restart(X, t)`` then steps = a new θ-method on ``model.with_(x0=X)`` at ``t``,
+    bit for bit, with the wall hit in between; a state that is not finite is refused."""
+    from femrub.steppers.theta import ThetaMethod
+
+    model = oscillator(0.8)
+    st = ThetaMethod(model, 1e-3)
+    for _ in range(500):
+        st.step()
+    X, t = np.array([0.3, 0.9]), 0.37
+    st.restart(X, t)
+    fresh = ThetaMethod(model.with_(x0=X), 1e-3, t0=t)
+    for _ in range(800):
+        a, b = st.step(), fresh.step()
+    assert a.t == b.t and np.array_equal(a.X, b.X)
+    with pytest.raises(ValueError, match="finite vector"):
+        st.restart(np.array([np.nan, 0.0]))
