@@ -174,3 +174,16 @@ def test_restart_equals_a_fresh_stepper_from_that_state():
     assert a.t == b.t and np.array_equal(a.X, b.X)
     with pytest.raises(ValueError, match="finite vector"):
         st.restart(np.array([np.nan, 0.0]))
+
+
+@pytest.mark.parametrize("rule", ["position", "capped", "paper"])
+def test_step_monodromy_equals_finite_differences(rule):
+    """On an impacting orbit the product of the step Jacobians is the finite-difference
+    monodromy (no impact moves a step under the perturbations)."""
+    omega = 0.8
+    pm = PeriodMap(oscillator(omega), 2 * np.pi / omega / 1000, activation=rule)
+    X0 = impact_orbit(omega)[2]
+    assert pm.orbit(X0).P.any()
+    exact = Shooting(pm).monodromy(X0, np.ones(2))
+    fd = Shooting(pm, derivatives="fd", eps=1e-8).monodromy(X0, np.ones(2))
+    assert np.allclose(exact, fd, rtol=1e-5, atol=1e-5 * np.abs(exact).max())

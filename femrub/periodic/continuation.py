@@ -39,7 +39,7 @@ import numpy as np
 
 from .floquet import multipliers, special_point, stable
 from .period import Orbit, PeriodMap
-from .shooting import FD_STEP, TOLERANCE, Shooting, _norm, state_scale
+from .shooting import FD_STEP, STALL_TOLERANCE, TOLERANCE, Shooting, _norm, stalled, state_scale
 
 __all__ = ["Branch", "BranchPoint", "check_model", "continue_branch", "measures"]
 
@@ -176,7 +176,7 @@ class _Problem:
         """``R``, ``M`` and ``R_p`` at ``(X, p)`` with ``N = steps``."""
         pm = self.map(p, steps)
         orbit = pm.orbit(X)
-        M = Shooting(pm).monodromy(X, s, orbit.X[-1])
+        M = Shooting(pm).monodromy(X, s, orbit)
         dp = FD_STEP * max(abs(p), dp_scale)
         Rp = (self.map(p + dp, steps)(X) - orbit.X[-1]) / dp
         self._maps.pop((float(p + dp), steps), None)
@@ -202,6 +202,7 @@ class _Settings:
     max_points: int = 400
     max_corrections: int = 10
     tolerance: float = TOLERANCE
+    stall_tolerance: float = STALL_TOLERANCE
 
 
 class _Continuation:
@@ -215,13 +216,16 @@ class _Continuation:
         self._orbits = {}
         self.direction = 1.0 if self.stop >= self.start else -1.0
 
+    def _shooting(self, pm) -> Shooting:
+        return Shooting(pm, tolerance=self.set.tolerance, stall_tolerance=self.set.stall_tolerance)
+
     def first(self, x0, warmup: int) -> tuple:
         """The orbit at ``start`` by natural-parameter shooting after ``warmup`` periods."""
         pm = self.pb.map(self.start)
         X = pm.model.x0.copy() if x0 is None else np.asarray(x0, dtype=float)
         for _ in range(warmup):
             X = pm(X)
-        res = Shooting(pm, tolerance=self.set.tolerance).solve(X)
+        res = self._shooting(pm).solve(X)
         if not res.converged:
             raise RuntimeError(
                 f"no periodic orbit at {self.branch.key} = {self.start:g} (scaled residual "
@@ -250,7 +254,7 @@ class _Continuation:
             X.copy(),
             r,
             iterations,
-            r <= self.set.tolerance * 10,
+            r <= max(self.set.tolerance, self.set.stall_tolerance),
             mu,
             pm.steps,
             pm.h,
@@ -267,7 +271,7 @@ class _Continuation:
         z0 = np.append(X / s, p / self.sp)
         zp = z0 + ds * tau
         steps = self.pb.map(zp[-1] * self.sp).steps
-        z = zp.copy()
+        z, history = zp.copy(), []
         for k in range(1, self.set.max_corrections + 1):
             Xk, pk = z[:-1] * s, z[-1] * self.sp
             try:
@@ -286,7 +290,8 @@ class _Continuation:
                 r = _norm(self.pb.map(pn, steps)(Xn) - Xn, s)
             except (ValueError, FloatingPointError):
                 return None
-            if r <= self.set.tolerance:
+            history.append(r)
+            if r <= self.set.tolerance or stalled(history, self.set.stall_tolerance):
                 return Xn, pn, steps, k
         return None
 
@@ -299,7 +304,7 @@ class _Continuation:
         end = self.stop if abs(pn - self.stop) < abs(pn - self.start) else self.start
         w = (end - p) / (pn - p)
         pm = self.pb.map(end)
-        res = Shooting(pm, tolerance=self.set.tolerance).solve((1 - w) * X + w * Xn, previous["s"])
+        res = self._shooting(pm).solve((1 - w) * X + w * Xn, previous["s"])
         if not res.converged:
             return None
         return self._point(res.X0, end, pm.steps, res.iterations, previous)
@@ -386,6 +391,7 @@ def continue_branch(  # noqa: PLR0913 (keyword-only options of a public entry po
     ds_max: float = 0.05,
     max_points: int = 400,
     tolerance: float = TOLERANCE,
+    stall_tolerance: float = STALL_TOLERANCE,
     keep_orbits: int = 3,
     log=None,
 ) -> Branch:
@@ -406,6 +412,8 @@ def continue_branch(  # noqa: PLR0913 (keyword-only options of a public entry po
     ds, ds_max : first and largest pseudo-arclength step (scaled: the parameter range is 1).
     max_points : most points of the branch.
     tolerance : scaled shooting residual of a converged orbit.
+    stall_tolerance : scaled residual accepted where Newton stalls (the period map is only
+        piecewise continuous; :data:`~femrub.periodic.shooting.STALL_TOLERANCE`).
     keep_orbits : orbits of largest tip displacement kept (beside the ends and special
         points) in ``Branch.orbits``.
     log : callable receiving one line per point.
@@ -417,7 +425,8 @@ def continue_branch(  # noqa: PLR0913 (keyword-only options of a public entry po
         the end) and the selected orbits. A Ctrl-C returns the points found, ``interrupted``.
     """
     family = _family(source, key)
-    settings = _Settings(ds=ds, ds_max=ds_max, max_points=max_points, tolerance=tolerance)
+    settings = _Settings(ds, ds_max=ds_max, max_points=max_points, tolerance=tolerance)
+    settings.stall_tolerance = stall_tolerance
     options = {"multiple": multiple, "gamma": gamma, "activation": activation}
     cont = _Continuation(_Problem(family, h, options), key, start, stop, settings, log)
     try:
@@ -431,6 +440,12 @@ def continue_branch(  # noqa: PLR0913 (keyword-only options of a public entry po
     if branch.status == "ok" and not all(p.converged for p in branch.points):
         branch.status, branch.message = "failed", "a point did not converge"
     if branch.status == "ok":
-        branch.message = f"{len(branch.points)} periodic orbits, every one converged"
+        loose = sum(p.residual > tolerance for p in branch.points)
+        branch.message = f"{len(branch.points)} periodic orbits, every one converged" + (
+            f" ({loose} closed to a scaled residual between {tolerance:g} and "
+            f"{stall_tolerance:g}, where Newton stalls)"
+            if loose
+            else ""
+        )
     branch.orbits = _selected(branch, cont._orbits, keep_orbits)
     return branch

@@ -30,13 +30,18 @@ from dataclasses import dataclass
 import numpy as np
 
 from .period import PeriodMap
+from .sensitivity import step_monodromy
 
-__all__ = ["Shooting", "ShootingResult", "state_scale"]
+__all__ = ["Shooting", "ShootingResult", "stalled", "state_scale"]
 
 #: relative finite-difference step ε of Eq. (2)
 FD_STEP = 1e-6
 #: scaled residual ``max |R_j| / s_j`` below which an orbit is periodic
 TOLERANCE = 1e-8
+#: scaled residual accepted when Newton stalls: the period map is only piecewise continuous
+#: (an impact moved by one step jumps it by ``O(h |ġ|)``), so an exact fixed point may not
+#: exist; the orbit then closes to this fraction of its size
+STALL_TOLERANCE = 1e-3
 
 
 def state_scale(layout, X: np.ndarray) -> np.ndarray:
@@ -63,7 +68,8 @@ class ShootingResult:
     X0 : the orbit's state at ``t0`` (N,).
     residual : scaled residual ``max_j |R_j| / s_j`` of Eq. (1) at ``X0``.
     iterations : Newton iterations.
-    converged : ``residual <= tolerance``.
+    converged : ``residual <= tolerance``, or Newton stalled (no 10 % decrease in three
+        iterations) below ``stall_tolerance``.
     monodromy : ``M = ∂Φ_T/∂X0`` (N, N) at ``X0``.
     scale : the scale ``s`` (N,) of the orbit.
     """
@@ -85,6 +91,10 @@ class Shooting:
     eps : ε of Eq. (2).
     tolerance : scaled residual of a converged orbit.
     max_iterations : Newton iterations before giving up.
+    stall_tolerance : scaled residual accepted when Newton stalls (:data:`STALL_TOLERANCE`).
+    derivatives : ``"auto"``: the step Jacobians' product where the step has them (one
+        frictionless contact on a dense model), finite differences otherwise; ``"fd"``:
+        finite differences always.
     """
 
     def __init__(
@@ -94,18 +104,31 @@ class Shooting:
         eps: float = FD_STEP,
         tolerance: float = TOLERANCE,
         max_iterations: int = 40,
+        derivatives: str = "auto",
+        stall_tolerance: float = STALL_TOLERANCE,
     ):
+        if derivatives not in ("auto", "fd"):
+            raise ValueError(f"derivatives must be 'auto' or 'fd', got {derivatives!r}")
+        self.derivatives = derivatives
         self.map, self.eps = period_map, float(eps)
         self.tolerance, self.max_iterations = float(tolerance), int(max_iterations)
+        self.stall_tolerance = max(float(stall_tolerance), self.tolerance)
         self.layout = period_map.model.layout
 
     def residual(self, X0) -> np.ndarray:
         """``R(X0) = Φ_T(X0) − X0`` (N,), Eq. (1)."""
         return self.map(X0) - X0
 
-    def monodromy(self, X0, scale, phi=None) -> np.ndarray:
-        """``M`` (N, N) at ``X0`` by Eq. (2); ``phi``: ``Φ_T(X0)`` when known."""
-        phi = self.map(X0) if phi is None else phi
+    def monodromy(self, X0, scale, orbit=None) -> np.ndarray:
+        """``M`` (N, N) at ``X0``: the product of the step Jacobians on the orbit's contact set
+        where the step has them (:func:`~femrub.periodic.sensitivity.step_monodromy`, with
+        ``derivatives="auto"``), else Eq. (2); ``orbit``: the orbit from ``X0`` when known."""
+        orbit = self.map.orbit(X0) if orbit is None else orbit
+        if self.derivatives == "auto":
+            M = step_monodromy(self.map.stepper, orbit)
+            if M is not None:
+                return M
+        phi = orbit.X[-1]
         delta = self.eps * (scale + np.abs(X0))
         M = np.empty((X0.size, X0.size))
         for j in range(X0.size):  # the columns of Eq. (2), one period each
@@ -121,16 +144,24 @@ class Shooting:
         s = state_scale(self.layout, orbit.X) if scale is None else scale
         R = orbit.X[-1] - X
         r = _norm(R, s)
-        k = 0
+        k, history = 0, [r]
         while r > self.tolerance and k < self.max_iterations:
-            M = self.monodromy(X, s, orbit.X[-1])
+            if self.stalled(history):
+                break
+            M = self.monodromy(X, s, orbit)
             dX = np.linalg.lstsq(M - np.eye(X.size), -R, rcond=None)[0]
             X, R, r = self._damped(X, dX, r, s)
             k += 1
+            history.append(r)
             if scale is None:
                 s = state_scale(self.layout, np.vstack([s, self.map.orbit(X).X]))
             orbit = self.map.orbit(X)
-        return ShootingResult(X, r, k, r <= self.tolerance, self.monodromy(X, s), s)
+        ok = r <= self.tolerance or self.stalled(history)
+        return ShootingResult(X, r, k, ok, self.monodromy(X, s), s)
+
+    def stalled(self, history: list) -> bool:
+        """:func:`stalled` below ``stall_tolerance``."""
+        return stalled(history, self.stall_tolerance)
 
     def _damped(self, X, dX, r, s):
         """The Newton step ``dX`` halved until the scaled residual decreases (Armijo); else
@@ -151,6 +182,12 @@ class Shooting:
         if best is None:
             raise FloatingPointError("every damped Newton step left the model's domain")
         return best
+
+
+def stalled(history: list, limit: float) -> bool:
+    """Newton, below ``limit``, has not decreased the residual by 10 % in three iterations
+    (``history``: the scaled residuals so far)."""
+    return len(history) > 3 and history[-1] <= limit and history[-1] > 0.9 * min(history[-4:-1])
 
 
 def _norm(R, s) -> float:
