@@ -187,3 +187,23 @@ def test_step_monodromy_equals_finite_differences(rule):
     exact = Shooting(pm).monodromy(X0, np.ones(2))
     fd = Shooting(pm, derivatives="fd", eps=1e-8).monodromy(X0, np.ones(2))
     assert np.allclose(exact, fd, rtol=1e-5, atol=1e-5 * np.abs(exact).max())
+
+
+@pytest.mark.parametrize(
+    ("args", "message"),
+    [
+        (["--set", "physics.thermal=on", "--param", "rotation_speed=1:2"], "physics.thermal"),
+        (["--param", "loads.rotation_speed=1"], "KEY=START:STOP"),
+        (["--param", "loads.rotation_speed=2000rpm:2000rpm"], "equal"),
+        (["--param", "loads.nothing=1:2"], "unknown key"),
+        (["--set", "scheme.name=carpenter", "--param", "rotation_speed=1:2"], "theta"),
+    ],
+)
+def test_cli_refuses_bad_input_in_one_line_before_any_folder(tmp_path, capsys, args, message):
+    from femrub.app.cli import main
+
+    out = tmp_path / "branch"
+    assert main(["periodic", "paper", *args, "-o", str(out), "--quiet"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert message in err and len(err.splitlines()) == 1
+    assert not out.exists()

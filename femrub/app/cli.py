@@ -274,6 +274,11 @@ def _periodic(args) -> int:
             f"scheme.name = {scene['scheme']['name']!r}: periodic orbits are found by "
             "shooting on the theta-method; use --set scheme.name=theta"
         )
+    if scene["physics"]["thermal"] == "on":  # "auto" is refused once built (check_model)
+        raise ValueError(
+            "physics.thermal = 'on': periodic orbits are computed on mechanical models only; "
+            "use --set physics.thermal=off"
+        )
     key, start, stop = parse_range(args.param, scene)
     out = Path(args.out or f"{safe_name(scene.name)}-periodic")
     t0 = time.perf_counter()
