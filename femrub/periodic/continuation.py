@@ -16,7 +16,8 @@ towards ``stop``). ``R_X = M − I`` is the monodromy of Eq. (2) there; ``R_p`` 
 difference in ``p`` at the same number of steps per period. Newton's method on Eq. (1)
 passes folds, where ``R_X`` is singular but the bordered matrix is not; a correction that
 moves farther than ``2 Δs`` from its predictor is refused (it jumped to another part of the
-branch) and the step shortened. Each point keeps
+branch), each Newton step is halved until the residual decreases, and the step shortened
+after a failed correction. Each point keeps
 the number of steps per period ``N = ceil(T(p) / h)`` of its predictor (the step
 ``T(p) / N`` follows ``p`` inside it), so the residual is smooth in ``p`` through its
 corrections. The step ``Δs`` grows by 1.3 after a quick correction (at most 3 Newton
@@ -265,35 +266,51 @@ class _Continuation:
         return point, info, orbit
 
     def correct(self, X, p, info, ds):
-        """Newton on Eq. (1) from the predictor ``z_k + Δs τ_k``; ``(X, p, iterations)`` or
-        ``None``."""
+        """Damped Newton on Eq. (1) from the predictor ``z_k + Δs τ_k`` (each step halved
+        until the residual decreases, within ``2 Δs`` of the predictor); ``(X, p, steps,
+        iterations)`` once converged or stalled below the stall tolerance, else ``None``."""
         s, tau = info["s"], info["tau"]
-        z0 = np.append(X / s, p / self.sp)
-        zp = z0 + ds * tau
+        zp = np.append(X / s, p / self.sp) + ds * tau
         steps = self.pb.map(zp[-1] * self.sp).steps
         z, history = zp.copy(), []
-        for k in range(1, self.set.max_corrections + 1):
+        for k in range(self.set.max_corrections + 1):
             Xk, pk = z[:-1] * s, z[-1] * self.sp
             try:
                 orbit, M, Rp = self.pb.derivatives(Xk, pk, steps, s, self.sp)
             except (ValueError, FloatingPointError):
                 return None
             R = (orbit.X[-1] - Xk) / s
+            history.append(float(np.abs(R).max()))
+            if history[-1] <= self.set.tolerance or stalled(history, self.set.stall_tolerance):
+                return Xk, pk, steps, k
             _, J, _ = _tangent(M, Rp, s, self.sp)
-            F = np.append(R, tau @ (z - zp))
-            dz = np.linalg.solve(np.vstack([J, tau]), -F)
-            z = z + dz
-            if np.linalg.norm(z - zp) > 2.0 * abs(ds):  # left for another branch
+            dz = np.linalg.solve(np.vstack([J, tau]), -np.append(R, tau @ (z - zp)))
+            z = self._damped(z, dz, history[-1], (zp, ds, s, steps))
+            if z is None:
                 return None
-            Xn, pn = z[:-1] * s, z[-1] * self.sp
-            try:
-                r = _norm(self.pb.map(pn, steps)(Xn) - Xn, s)
-            except (ValueError, FloatingPointError):
-                return None
-            history.append(r)
-            if r <= self.set.tolerance or stalled(history, self.set.stall_tolerance):
-                return Xn, pn, steps, k
         return None
+
+    def _damped(self, z, dz, r, frame):
+        """``z + α dz`` for the first ``α = 1, 1/2, …`` that lowers the residual ``r``, else
+        the best of the tries; ``None`` when every try leaves ``2 Δs`` of the predictor or
+        the model's domain."""
+        zp, ds, s, steps = frame
+        best, alpha = None, 1.0
+        for _ in range(6):
+            zt = z + alpha * dz
+            alpha *= 0.5
+            if np.linalg.norm(zt - zp) > 2.0 * abs(ds):  # left for another branch
+                continue
+            Xt, pt = zt[:-1] * s, zt[-1] * self.sp
+            try:
+                rt = _norm(self.pb.map(pt, steps)(Xt) - Xt, s)
+            except (ValueError, FloatingPointError):
+                continue
+            if rt < r:
+                return zt
+            if best is None or rt < best[0]:
+                best = (rt, zt)
+        return None if best is None else best[1]
 
     def inside(self, p: float) -> bool:
         lo, hi = sorted((self.start, self.stop))
