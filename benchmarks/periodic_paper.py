@@ -11,6 +11,7 @@ stable point differs by more than 2 % or the branch is not ``ok``.
 Usage::
 
     python benchmarks/periodic_paper.py -o periodic-paper [--points 3] [--revolutions 400]
+        [--set KEY=VALUE ...]   (more changes, to the branch and the runs alike)
 """
 
 from __future__ import annotations
@@ -34,15 +35,15 @@ def _femrub(*args: str) -> int:
     return subprocess.call([sys.executable, "-m", "femrub.app.cli", *args])
 
 
-def branch_rows(out: Path) -> list[dict]:
+def branch_rows(out: Path, sets: list) -> list[dict]:
     """The branch's rows, running ``femrub periodic`` when its folder has no summary."""
     if not (out / "summary.json").exists():
-        _femrub("periodic", "paper", *SETS, "--param", PARAM, "-o", str(out))
+        _femrub("periodic", "paper", *SETS, *sets, "--param", PARAM, "-o", str(out))
     with open(out / "branch.csv") as fh:
         return list(csv.DictReader(fh))
 
 
-def run_peak(out: Path, speed: float, periods: int, last: int) -> float:
+def run_peak(out: Path, speed: float, periods: int, last: int, sets: list) -> float:
     """Largest |tip displacement| (m) of the last ``last`` of ``periods`` forcing periods of
     a ``femrub run`` at ``speed`` (rad/s)."""
     period = 2.0 * math.pi / speed
@@ -50,7 +51,7 @@ def run_peak(out: Path, speed: float, periods: int, last: int) -> float:
     h = period / math.ceil(period / 2e-6)  # a whole number of steps per period
     folder = out / f"run_{speed:.6g}"
     changes = ["--set", f"loads.rotation_speed={speed!r}", "--set", f"scheme.t_end={t_end!r}"]
-    changes += ["--set", f"scheme.h={h!r}", "--set", "physics.thermal=off"]
+    changes += ["--set", f"scheme.h={h!r}", "--set", "physics.thermal=off", *sets]
     _femrub("run", "paper", *changes, "-o", str(folder), "--overwrite", "--quiet")
     with np.load(folder / "history.npz") as hist:
         t, x = hist["t"], hist["signal_tip_displacement"]
@@ -63,9 +64,11 @@ def main(argv=None) -> int:
     p.add_argument("--points", type=int, default=3, help="stable points compared")
     p.add_argument("--revolutions", type=int, default=400, help="forcing periods per run")
     p.add_argument("--last", type=int, default=20, help="periods of the run compared")
+    p.add_argument("--set", action="append", default=[], help="more scene changes (both)")
     args = p.parse_args(argv)
     out = Path(args.out)
-    rows = branch_rows(out)
+    sets = [a for kv in args.set for a in ("--set", kv)]
+    rows = branch_rows(out, sets)
     summary = json.loads((out / "summary.json").read_text())
     stable = [r for r in rows if r["stable"] == "1"]
     pick = (
@@ -77,7 +80,7 @@ def main(argv=None) -> int:
     for r in pick:
         speed = float(r["loads.rotation_speed"])
         orbit = float(r["max_tip_displacement"])
-        run = run_peak(out, speed, args.revolutions, args.last)
+        run = run_peak(out, speed, args.revolutions, args.last, sets)
         err = abs(orbit - run) / run
         result.append({"rotation_speed": speed, "orbit": orbit, "run": run, "relative": err})
         print(f"{speed:.6g} rad/s: orbit {orbit:.6g} m, run {run:.6g} m, {100 * err:.2f} %")
