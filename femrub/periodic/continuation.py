@@ -357,7 +357,8 @@ class _Continuation:
         self.log(
             f"{self.branch.key} = {point.parameter:.6g}: max |tip| "
             f"{point.measures.get('max_tip_displacement', math.nan):.4g}, max |mu| "
-            f"{point.max_floquet_modulus:.4f}, {point.iterations} it"
+            f"{point.max_floquet_modulus:.4f}, {point.iterations} it, "
+            f"{point.steps} steps of h = {point.h:.6g} s per period"
             + (f", {point.special}" if point.special else "")
         )
 
