@@ -6,7 +6,8 @@ objects of each stage of the pipeline (``docs/architecture.md``):
 * scenes: :func:`load_scene`, :func:`loads_scene`, :class:`Scene`, :class:`SceneError`,
   :func:`builtin_scenes`;
 * simulations and run folders: :class:`Simulation`, :func:`build`, :func:`run_scene`,
-  :func:`run_to_folder`, :func:`folder_status`, :func:`run_sweep`;
+  :func:`run_to_folder`, :func:`folder_status`, :func:`run_sweep`,
+  :func:`continue_branch` (periodic orbits);
 * blades, meshes and casings: :class:`BladeMesh`, :class:`MeshSize`, :func:`box_blade`,
   :func:`naca_blade`, :func:`sections_blade`, :func:`read_mesh`, :func:`read_rotor37_mesh`,
   :func:`casing_profile`, :class:`Concentric`, :class:`Lobed`, :class:`TwoLobePiollet`;
@@ -41,6 +42,7 @@ _LAZY = {
     "build": ".app.simulation",
     "run_scene": ".app.run",
     "run_sweep": ".app.sweep",
+    "continue_branch": ".periodic.continuation",
     "folder_status": ".output.folder",
     "run_to_folder": ".output.run_folder",
     # blades, meshes and casings

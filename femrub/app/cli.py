@@ -1,5 +1,5 @@
-"""Command line: ``femrub run | check | sweep | campbell | scenes | scene show | paper | mesh |
-cache``.
+"""Command line: ``femrub run | check | sweep | periodic | campbell | scenes | scene show |
+paper | mesh | cache``.
 
 ``run``, ``check`` and ``sweep`` keep the assembled and reduced models in a cache folder
 (:mod:`femrub.app.cache`): ``--cache-dir`` or ``$FEMRUB_CACHE_DIR`` (default: the user's
@@ -262,6 +262,56 @@ def _sweep(args) -> int:
     return 1 if failed else 0
 
 
+def _periodic(args) -> int:
+    from ..output.folder import claim, safe_name
+    from ..periodic.continuation import check_model, continue_branch
+    from ..periodic.output import write_branch
+    from ..periodic.scene_family import parse_range, scene_family
+
+    scene = _load(args)
+    if scene["scheme"]["name"] != "theta":
+        raise ValueError(
+            f"scheme.name = {scene['scheme']['name']!r}: periodic orbits are found by "
+            "shooting on the theta-method; use --set scheme.name=theta"
+        )
+    if scene["physics"]["thermal"] == "on":  # "auto" is refused once built (check_model)
+        raise ValueError(
+            "physics.thermal = 'on': periodic orbits are computed on mechanical models only; "
+            "use --set physics.thermal=off"
+        )
+    key, start, stop = parse_range(args.param, scene)
+    out = Path(args.out or f"{safe_name(scene.name)}-periodic")
+    t0 = time.perf_counter()
+    with claim(out, "periodic", overwrite=args.overwrite):
+        family = scene_family(scene.with_changes({key: start}), key, log=_log(args))
+        check_model(family(start))
+        s = scene["scheme"]
+        branch = continue_branch(
+            family,
+            start,
+            stop,
+            h=s["h"],
+            key=key,
+            gamma=s["gamma"],
+            activation=s.get("activation"),
+            multiple=args.multiple,
+            max_points=args.max_points,
+            log=_log(args),
+        )
+        doc = write_branch(
+            branch, out, model_of=family, extra={"wall_seconds": time.perf_counter() - t0}
+        )
+    if not args.quiet:
+        print(
+            f"done in {time.perf_counter() - t0:.1f} s: {doc['points']} points, "
+            f"{len(doc['special'])} special; {out / 'branch.csv'}, {out / 'branch.png'}"
+        )
+    if doc["status"] != "ok":
+        print(f"femrub: periodic {scene.name}: {doc['status']}: {doc['message']}", file=sys.stderr)
+        return 1
+    return 0
+
+
 def _campbell(args) -> int:
     from .campbell import campbell, parse_speeds, write_campbell
 
@@ -357,6 +407,19 @@ def build_parser() -> argparse.ArgumentParser:
     )
     sp.add_argument("--scheduler", help="address of a dask scheduler (default: LocalCluster)")
     sp.set_defaults(func=_sweep)
+    pe = sub.add_parser("periodic", help="a branch of periodic orbits and their stability")
+    _scene_args(pe)
+    pe.add_argument(
+        "--param",
+        required=True,
+        metavar="KEY=A:B",
+        help="continued key and range, e.g. loads.rotation_speed=20000rpm:40000rpm",
+    )
+    pe.add_argument(
+        "--multiple", type=int, default=1, help="orbit period in excitation periods (default 1)"
+    )
+    pe.add_argument("--max-points", type=int, default=400, help="most branch points (400)")
+    pe.set_defaults(func=_periodic)
     cb = sub.add_parser("campbell", help="Campbell diagram of a scene's blade (PNG + CSV)")
     _scene_args(cb)
     cb.add_argument("--speeds", required=True, help="START:STOP:STEP (rad/s, stop included)")

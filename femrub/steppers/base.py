@@ -13,7 +13,9 @@ methods:
 * :meth:`Stepper.block_writer`: a compiled writer of whole blocks of steps into given rows
   (the fast path of the θ-method), or ``None``;
 * :meth:`Stepper.measure_works`: ask for the exact works of each step in its record (steppers
-  that can integrate them).
+  that can integrate them);
+* :meth:`Stepper.restart`: start again from a given state and time, the factorised operators
+  kept (steppers whose ``restartable`` is true: the period map of :mod:`femrub.periodic`).
 
 Recording, stop limits and the verdict live in the analysis layer above
 (:mod:`femrub.analysis`, whose runnable subclasses add ``run()``). Every stepper refuses a
@@ -67,6 +69,8 @@ class Stepper:
     locates_events = False
     #: bounds its impulses by ``Contact.impulse_cap`` (abradable coatings)
     supports_wear = False
+    #: :meth:`restart` resets every state the step carries (``_restart``)
+    restartable = False
 
     def __init__(self, model: FirstOrderModel, h: float, *, t0: float = 0.0):
         if not isinstance(model, FirstOrderModel):
@@ -157,6 +161,43 @@ class Stepper:
     def measure_works(self, on: bool) -> None:
         """Fill the records' ``works`` with the exact energy-balance integrals of each step
         when the stepper can integrate them (``on``); the others ignore it."""
+
+    def restart(self, X, t: float = 0.0) -> None:
+        """Start again from the state ``X`` (N,) at the time ``t`` (s): step ``k = 0``, no
+        impulse, the warm starts and carried load signals of the last run dropped, the
+        factorised operators kept.
+
+        Raises
+        ------
+        TypeError
+            The stepper does not say how to reset what its step carries (``restartable``).
+        ValueError
+            ``X`` is not a finite state of the model, or the contact has a history outside
+            ``X`` (an abradable coating, casing heat: not a function of ``X``).
+
+        Notes
+        -----
+        A state within ``h |ġ|`` inside the casing is a state the θ-method reaches (it
+        does not prevent penetration at the position level), so it is not refused here.
+        """
+        if not self.restartable:
+            raise TypeError(f"the {self.name} stepper cannot restart from a given state")
+        c = self.model.contact
+        if c is not None and c.carried_state:
+            raise ValueError(
+                "a contact with a history outside the state (abradable coating, casing heat) "
+                "cannot restart from a state alone"
+            )
+        X = np.array(X, dtype=float)
+        if X.shape != (self.model.n_dofs,) or not np.all(np.isfinite(X)):
+            raise ValueError(f"restart state must be a finite vector of length {self.model.n_dofs}")
+        self.k, self.t0, self.t, self.X = 0, float(t), float(t), X
+        self.impulse = np.zeros(self.model.n_contacts)
+        self.friction = None
+        self._restart()
+
+    def _restart(self) -> None:
+        """Reset what the step carries from step to step (warm starts, signals)."""
 
     @property
     def state(self) -> State:

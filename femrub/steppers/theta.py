@@ -95,6 +95,7 @@ class ThetaMethod(Stepper):
 
     name = "theta"
     supports_wear = True
+    restartable = True
     #: ``run()`` advances dense models in compiled blocks of steps where
     #: :func:`~femrub.steppers.theta_blocks.block_kind` allows (``False``: step by step,
     #: same results)
@@ -191,6 +192,13 @@ class ThetaMethod(Stepper):
             self._memo = (None, 0.0, None)
             self._n3 = c.n
         prepare(self)
+
+    def _restart(self):
+        self._sk = self._signal_values(self.t)
+        self._warm = None
+        if self._friction:
+            self._warm3 = None
+            self._memo = (None, 0.0, None)
 
     def block_writer(self):
         if not (self.block_steps and self._block_kind):

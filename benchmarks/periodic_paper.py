@@ -1,0 +1,104 @@
+"""Periodic orbits of the paper's bar against long time integrations (docs/periodic.md).
+
+Runs ``femrub periodic paper --set physics.thermal=off --set scheme.h=2e-6
+--param loads.rotation_speed=20000rpm:40000rpm`` (or reads its finished folder), takes up to
+``--points`` stable points of the branch, runs ``femrub run`` at each of their speeds for
+``--revolutions`` periods of the forcing, and compares the branch's ``max_tip_displacement``
+with the largest tip displacement of the run's last ``--last`` periods (the transient left
+out). Writes ``DIR/comparison.json`` and prints one line per point; exit status 1 when a
+stable point differs by more than 2 % or the branch is not ``ok``.
+
+Usage::
+
+    python benchmarks/periodic_paper.py -o periodic-paper [--points 3] [--revolutions 400]
+        [--set KEY=VALUE ...]   (more changes, to the branch and the runs alike)
+"""
+
+from __future__ import annotations
+
+import argparse
+import csv
+import json
+import math
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+
+SETS = ["--set", "physics.thermal=off", "--set", "scheme.h=2e-6"]
+PARAM = "loads.rotation_speed=20000rpm:40000rpm"
+TOLERANCE = 0.02
+
+
+def _femrub(*args: str) -> int:
+    return subprocess.call([sys.executable, "-m", "femrub.app.cli", *args])
+
+
+def branch_rows(out: Path, sets: list) -> list[dict]:
+    """The branch's rows, running ``femrub periodic`` when its folder has no summary."""
+    if not (out / "summary.json").exists():
+        _femrub("periodic", "paper", *SETS, *sets, "--param", PARAM, "-o", str(out))
+    with open(out / "branch.csv") as fh:
+        return list(csv.DictReader(fh))
+
+
+def run_peak(out: Path, speed: float, periods: int, last: int, sets: list) -> float:
+    """Largest |tip displacement| (m) of the last ``last`` of ``periods`` forcing periods of
+    a ``femrub run`` at ``speed`` (rad/s)."""
+    period = 2.0 * math.pi / speed
+    t_end = periods * period
+    h = period / math.ceil(period / 2e-6)  # a whole number of steps per period
+    folder = out / f"run_{speed:.6g}"
+    changes = ["--set", f"loads.rotation_speed={speed!r}", "--set", f"scheme.t_end={t_end!r}"]
+    changes += ["--set", f"scheme.h={h!r}", "--set", "physics.thermal=off", *sets]
+    _femrub("run", "paper", *changes, "-o", str(folder), "--overwrite", "--quiet")
+    with np.load(folder / "history.npz") as hist:
+        t, x = hist["t"], hist["signal_tip_displacement"]
+    return float(np.abs(x[t >= t_end - last * period]).max())
+
+
+def main(argv=None) -> int:
+    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    p.add_argument("-o", "--out", default="periodic-paper", help="branch folder")
+    p.add_argument("--points", type=int, default=3, help="stable points compared")
+    p.add_argument("--revolutions", type=int, default=400, help="forcing periods per run")
+    p.add_argument("--last", type=int, default=20, help="periods of the run compared")
+    p.add_argument("--set", action="append", default=[], help="more scene changes (both)")
+    args = p.parse_args(argv)
+    out = Path(args.out)
+    sets = [a for kv in args.set for a in ("--set", kv)]
+    rows = branch_rows(out, sets)
+    summary = json.loads((out / "summary.json").read_text())
+    stable = [r for r in rows if r["stable"] == "1"]
+    pick = (
+        [stable[i] for i in np.linspace(0, len(stable) - 1, args.points).astype(int)]
+        if stable
+        else []
+    )
+    result = []
+    for r in pick:
+        speed = float(r["loads.rotation_speed"])
+        orbit = float(r["max_tip_displacement"])
+        run = run_peak(out, speed, args.revolutions, args.last, sets)
+        err = abs(orbit - run) / run
+        result.append({"rotation_speed": speed, "orbit": orbit, "run": run, "relative": err})
+        print(f"{speed:.6g} rad/s: orbit {orbit:.6g} m, run {run:.6g} m, {100 * err:.2f} %")
+    doc = {
+        "branch_status": summary.get("status"),
+        "branch_message": summary.get("message"),
+        "points": len(rows),
+        "stable": len(stable),
+        "special": summary.get("special", []),
+        "comparisons": result,
+    }
+    (out / "comparison.json").write_text(json.dumps(doc, indent=2) + "\n")
+    print(json.dumps({k: v for k, v in doc.items() if k != "comparisons"}))
+    ok = (
+        summary.get("status") == "ok" and result and all(c["relative"] <= TOLERANCE for c in result)
+    )
+    return 0 if ok else 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())
