@@ -1,5 +1,5 @@
-"""Command line: ``femrub run | check | sweep | campbell | scenes | scene show | paper | mesh |
-cache``.
+"""Command line: ``femrub run | check | sweep | campbell | modes | scenes | scene show | paper |
+mesh | cache``.
 
 ``run``, ``check`` and ``sweep`` keep the assembled and reduced models in a cache folder
 (:mod:`femrub.app.cache`): ``--cache-dir`` or ``$FEMRUB_CACHE_DIR`` (default: the user's
@@ -297,6 +297,21 @@ def _campbell(args) -> int:
     return 0
 
 
+def _modes(args) -> int:
+    from ..output.folder import claim, safe_name
+    from ..scene import load_scene
+    from .modes import compute_modes, write_modes_folder
+
+    scene = load_scene(args.scene, _changes(args))  # no run checks: a bladed disk is welcome
+    out = Path(args.out or f"{safe_name(scene.name)}-modes")
+    t0 = time.perf_counter()
+    with claim(out, "modes", overwrite=args.overwrite):
+        doc = write_modes_folder(compute_modes(scene, _log(args)), out, scene)
+    if not args.quiet:
+        print(f"done in {time.perf_counter() - t0:.1f} s: {doc['message']}; {out / 'modes.csv'}")
+    return 0
+
+
 def _scene_args(p: argparse.ArgumentParser, out: bool = True) -> None:
     p.add_argument("scene", help="scene file (.toml) or built-in scene name (femrub scenes)")
     p.add_argument(
@@ -378,6 +393,11 @@ def build_parser() -> argparse.ArgumentParser:
         help="most prestress samples the self-check refines to (default 12)",
     )
     cb.set_defaults(func=_campbell)
+    mp = sub.add_parser(
+        "modes", help="modes of a bladed disk and its casing ring by nodal diameter (CSV + PNG)"
+    )
+    _scene_args(mp)
+    mp.set_defaults(func=_modes)
     lp = sub.add_parser("scenes", help="list the built-in scenes")
     lp.set_defaults(func=_scenes)
     shp = sub.add_parser("scene", help="show a built-in scene")
