@@ -1,15 +1,17 @@
 """Cyclic-symmetry modes of a bladed disk sector and a casing ring against the whole structure.
 
 The whole structure is the sector's mesh turned N times with its shared face nodes merged, so
-both problems discretise the same structure with the same elements: the frequencies agree to
-the eigen-solvers' round-off, and every whole-structure mode's nodal diameter (its spatial DFT
-over the sectors) is the one the cyclic solve gave it.
+both problems discretise the same structure with the same elements: every cyclic mode, turned
+out over the N copies, is a mode of the whole structure to round-off (a double one, its real
+and imaginary parts, for 0 < k < N/2), and the whole structure's lowest frequencies (ARPACK)
+are cyclic ones, of the nodal diameter of their spatial DFT over the sectors.
 """
 
 from __future__ import annotations
 
 import numpy as np
 import pytest
+from scipy.spatial import cKDTree
 
 from femrub.fem.discretisation import assemble, discretise
 from femrub.fem.eigen import lowest_modes
@@ -17,7 +19,7 @@ from femrub.fem.material import Material
 from femrub.fem.prestress import centrifugal_prestress
 from femrub.geometry.bladed_disk import bladed_disk_sector
 from femrub.geometry.casing_ring import RingDistortion, casing_ring_sector
-from femrub.geometry.cyclic_sector import face_pairs, full_wheel
+from femrub.geometry.cyclic_sector import axis_rotation, face_pairs, full_wheel
 from femrub.model.cyclic import (
     cyclic_projection,
     cyclic_structure,
@@ -34,7 +36,12 @@ BLADE = dict(code="0012", span=0.03, root_chord=0.015, tip_chord=0.012, twist=20
 
 @pytest.fixture(scope="module")
 def disk():
-    return bladed_disk_sector(N, 0.02, 0.045, 0.015, BLADE, h=0.015)
+    return bladed_disk_sector(N, 0.02, 0.045, 0.015, BLADE, h=0.015, h_min=0.01)
+
+
+@pytest.fixture(scope="module")
+def rest(disk):
+    return cyclic_structure(disk, TITANIUM)
 
 
 @pytest.fixture(scope="module")
@@ -42,29 +49,85 @@ def ring():
     return casing_ring_sector(N, 0.08, 0.004, 0.03, distortion=RingDistortion(3, 1e-5), h=0.01)
 
 
-def _whole_modes(sector, material, n_modes, omega=0.0, method="linear"):
-    """Frequencies (Hz) and nodal diameters of the whole structure's lowest modes."""
-    mesh, copies = full_wheel(sector)
-    disc = discretise(mesh, 2)
-    pre = centrifugal_prestress(disc, material, omega, method) if omega else None
-    mats = assemble(disc, material, prestress=pre)
-    lam, V = lowest_modes(mats.K, mats.M, n_modes)
-    u = np.zeros((disc.basis_u.N, n_modes))
-    u[mats.free_u] = V
-    nodal = disc.basis_u.nodal_dofs
-    content = [nodal_diameter_content(u[nodal, j], copies, sector.angle) for j in range(n_modes)]
-    return np.sqrt(lam) / (2 * np.pi), np.array(content)
+def _located(basis):
+    """``(n_locations, 3)`` dofs of the three components at each dof location."""
+    comp = np.empty(basis.N, dtype=np.int64)
+    comp[basis.element_dofs] = (np.arange(basis.Nbfun) % 3)[:, None]
+    first = np.flatnonzero(comp == 0)
+    cols = [first]
+    for c in (1, 2):
+        dofs = np.flatnonzero(comp == c)
+        dist, idx = cKDTree(basis.doflocs[:, dofs].T).query(basis.doflocs[:, first].T)
+        assert dist.max() < 1e-12
+        cols.append(dofs[idx])
+    return np.column_stack(cols)
 
 
-def _cyclic_spectrum(structure, n_families):
-    """The whole structure's spectrum from the cyclic one: (frequency, k), doubles twice."""
-    table = mode_table(structure, n_families)
-    k = table.nodal_diameter
-    count = np.where((k == 0) | (2 * k == N), 1, 2)
-    freq = np.repeat(table.frequency_hz, count)
-    nd = np.repeat(k, count)
-    order = np.argsort(freq, kind="stable")
-    return freq[order], nd[order]
+class Whole:
+    """The whole structure meshed from the turned sectors: its matrices and lowest modes."""
+
+    def __init__(self, sector, material, n_modes, omega=0.0):
+        self.sector = sector
+        mesh, self.copies = full_wheel(sector)
+        self.disc = discretise(mesh, 2)
+        pre = centrifugal_prestress(self.disc, material, omega, "linear") if omega else None
+        self.mats = assemble(self.disc, material, prestress=pre)
+        lam, V = lowest_modes(self.mats.K, self.mats.M, n_modes)
+        self.frequency = np.sqrt(lam) / (2 * np.pi)
+        u = np.zeros((self.disc.basis_u.N, n_modes))
+        u[self.mats.free_u] = V
+        nodal = self.disc.basis_u.nodal_dofs
+        self.content = np.array(
+            [nodal_diameter_content(u[nodal, j], self.copies, sector.angle) for j in range(n_modes)]
+        )
+
+    def expand(self, structure, k, shape):
+        """The whole structure's free dofs of a sector shape of nodal diameter ``k``:
+        copy ``s`` is ``e^{i k s α} R(s α) u``."""
+        sector_dofs = _located(structure.basis)
+        whole = self.disc.basis_u
+        whole_dofs = _located(whole)
+        tree = cKDTree(whole.doflocs[:, whole_dofs[:, 0]].T)
+        u = np.zeros(structure.basis.N, dtype=complex)
+        u[structure.free] = shape
+        out = np.zeros(whole.N, dtype=complex)
+        for s in range(N):
+            turn = axis_rotation(s * self.sector.angle)
+            where = turn @ structure.basis.doflocs[:, sector_dofs[:, 0]]
+            dist, idx = tree.query(where.T)
+            assert dist.max() < 1e-9
+            values = np.exp(1j * k * s * self.sector.angle) * (u[sector_dofs] @ turn.T)
+            out[whole_dofs[idx]] = values
+        return out[self.mats.free_u]
+
+    def residual(self, x, frequency):
+        """``‖K x − ω² M x‖ / ‖K x‖``."""
+        w2 = (2 * np.pi * frequency) ** 2
+        Kx = self.mats.K @ x
+        return np.linalg.norm(Kx - w2 * (self.mats.M @ x)) / np.linalg.norm(Kx)
+
+
+def _check_against_whole(structure, whole, n_families, n_whole):
+    """Every cyclic mode is a whole mode (twice for 0 < k < N/2: its real and imaginary
+    parts); the whole structure's lowest frequencies are cyclic ones, of the nodal diameter
+    of their spatial DFT."""
+    found = []
+    for k in structure.nodal_diameters:
+        freq, shapes = harmonic_modes(structure, int(k), n_families)
+        for f, q in zip(freq, shapes.T, strict=True):
+            x = whole.expand(structure, int(k), q)
+            parts = np.column_stack([x.real, x.imag])
+            assert max(whole.residual(p, f) for p in parts.T if np.any(p)) < 1e-8
+            double = 0 < k < N / 2
+            assert np.linalg.matrix_rank(parts, tol=1e-6 * np.abs(x).max()) == (2 if double else 1)
+            found += [(f, int(k))] * (2 if double else 1)
+    found.sort()
+    cyclic = np.array([f for f, _ in found])
+    for f, content in zip(whole.frequency[:n_whole], whole.content[:n_whole], strict=True):
+        j = int(np.argmin(np.abs(cyclic - f)))
+        assert abs(cyclic[j] - f) < 1e-8 * f
+        assert found[j][1] == int(np.argmax(content)) and content.max() > 0.999
+    return cyclic
 
 
 def test_sector_faces_are_periodic_and_the_blade_is_fused(disk):
@@ -81,8 +144,8 @@ def test_sector_faces_are_periodic_and_the_blade_is_fused(disk):
     assert np.isclose(whole.volume(), N * disk.mesh.volume(), rtol=1e-12)
 
 
-def test_cyclic_constraint_turns_the_left_face_onto_the_right(disk):
-    structure = cyclic_structure(disk, TITANIUM)
+def test_cyclic_constraint_turns_the_left_face_onto_the_right(disk, rest):
+    structure = rest
     q = np.random.default_rng(0).standard_normal(cyclic_projection(structure, 1).shape[1])
     u = cyclic_projection(structure, 1) @ q
     phase = np.exp(2j * np.pi / N)
@@ -92,31 +155,26 @@ def test_cyclic_constraint_turns_the_left_face_onto_the_right(disk):
 
 
 @pytest.mark.parametrize("omega", [0.0, 3000.0])
-def test_bladed_disk_cyclic_modes_match_the_whole_wheel(disk, omega):
+def test_bladed_disk_cyclic_modes_match_the_whole_wheel(disk, rest, omega):
     method = "linear" if omega else "off"
-    structure = cyclic_structure(disk, TITANIUM, omega=omega, prestress=method)
-    freq, nd = _cyclic_spectrum(structure, 2)
-    n = 8  # the first family (1 + 2 + 2 + 1 modes) and two of the second
-    whole, content = _whole_modes(disk, TITANIUM, n, omega)
-    np.testing.assert_allclose(freq[:n], whole, rtol=1e-8)
-    np.testing.assert_array_equal(np.argmax(content, axis=1)[:6], np.sort(nd[:6]))
-    assert np.all(content.max(axis=1) > 0.999)
+    structure = cyclic_structure(disk, TITANIUM, omega=omega, prestress=method) if omega else rest
+    whole = Whole(disk, TITANIUM, 8, omega)
+    cyclic = _check_against_whole(structure, whole, 2, 8)
     if omega:  # the prestress stiffens the blades
-        rest = _cyclic_spectrum(cyclic_structure(disk, TITANIUM), 1)[0]
-        assert np.all(freq[:6] > 1.05 * rest[:6])
+        at_rest = mode_table(rest, 1).frequency_hz
+        spinning = mode_table(structure, 1).frequency_hz
+        assert np.all(spinning > 1.05 * at_rest)
+        assert cyclic[0] == pytest.approx(spinning.min())
 
 
 def test_casing_ring_cyclic_modes_match_the_whole_ring(ring):
     structure = cyclic_structure(ring, STEEL)
-    freq, nd = _cyclic_spectrum(structure, 1)
-    whole, content = _whole_modes(ring, STEEL, freq.size)
-    np.testing.assert_allclose(freq, whole, rtol=1e-8)
-    np.testing.assert_array_equal(np.argmax(content, axis=1), nd)
+    _check_against_whole(structure, Whole(ring, STEEL, 6), 2, 6)
     assert ring.info["distortion"].lobes == 3
 
 
-def test_harmonic_modes_are_hermitian_and_refuse_a_foreign_nodal_diameter(disk):
-    structure = cyclic_structure(disk, TITANIUM)
+def test_harmonic_modes_are_hermitian_and_refuse_a_foreign_nodal_diameter(rest):
+    structure = rest
     f, shapes = harmonic_modes(structure, 1, 2)
     assert f.shape == (2,) and np.iscomplexobj(shapes) and np.all(np.diff(f) > 0)
     with pytest.raises(ValueError, match="nodal diameter 4 outside 0..3"):

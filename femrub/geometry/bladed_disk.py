@@ -195,6 +195,11 @@ def bladed_disk_sector(  # noqa: PLR0913 (keyword options, one per scene key)
             gmsh.model.addPhysicalGroup(2, tags, name=name)
         size.apply(session)
         gmsh.model.mesh.generate(3)
+        if not any(len(t) for t in gmsh.model.mesh.getElements(3)[1]):
+            raise GeometryError(
+                f"gmsh could not mesh the bladed disk sector with h = {h:g} m, h_min ="
+                f" {size.h_min:g} m; use a smaller element size (rotor.h, geometry.h_min)"
+            )
         mesh = to_blade_mesh(
             "x",
             f"bladed_disk_sector(N={n_sectors}, hub={hub_radius}, rim={rim_radius},"
