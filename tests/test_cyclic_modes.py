@@ -179,3 +179,26 @@ def test_harmonic_modes_are_hermitian_and_refuse_a_foreign_nodal_diameter(rest):
     assert f.shape == (2,) and np.iscomplexobj(shapes) and np.all(np.diff(f) > 0)
     with pytest.raises(ValueError, match="nodal diameter 4 outside 0..3"):
         harmonic_modes(structure, 4, 1)
+
+
+@pytest.mark.parametrize("method", ["linear", "nonlinear"])
+def test_the_sector_prestress_is_the_whole_wheels_equilibrium(disk, method):
+    """The sector's static state at Ω (k = 0), turned out over the copies, zeroes the whole
+    wheel's residual ``f_int(u) − f_Ω(u)``; the nonlinear state differs from the linear one."""
+    from femrub.fem import centrifugal as cf
+    from femrub.fem.forms import lame_parameters
+
+    omega = 6000.0
+    structure = cyclic_structure(disk, TITANIUM, omega=omega, prestress=method)
+    whole = Whole(disk, TITANIUM, 0)
+    u = np.zeros(whole.disc.basis_u.N)
+    u[whole.mats.free_u] = whole.expand(structure, 0, structure.static[structure.free]).real
+    basis, lam, mu = whole.disc.basis_u, *lame_parameters(110e9, 0.3, 3)
+    linear = method == "linear"
+    load = cf.centrifugal_force(basis, u, 4500.0 * omega**2, (1.0, 0.0, 0.0))
+    r = cf.internal_force(basis, u, lam, mu, linear) - load
+    free = whole.mats.free_u
+    assert np.linalg.norm(r[free]) < 1e-8 * np.linalg.norm(load[free])
+    if not linear:
+        other = cyclic_structure(disk, TITANIUM, omega=omega, prestress="linear").static
+        assert not np.allclose(structure.static, other, rtol=1e-6, atol=0)
