@@ -143,3 +143,22 @@ def test_a_single_blade_scene_gets_its_blade_modes(tmp_path):
     assert np.all(f > 0) and f[1] > f[0]
     assert {float(r["rotation_speed"]) for r in rows} == {1500.0}
     assert not (out / "coincidences.csv").exists()
+
+
+def test_a_failed_computation_keeps_the_disk_modes_marked_failed(tmp_path, monkeypatch, capsys):
+    import femrub.app.modes as modes
+
+    def no_ring(scene, tip_radius):
+        raise modes.SceneError("casing.ring: gmsh could not mesh the ring")
+
+    monkeypatch.setattr(modes, "casing_sector", no_ring)
+    scene = tmp_path / "wheel.toml"
+    scene.write_text(SCENE.replace("families = 2", "families = 1"))
+    out = tmp_path / "out"
+    assert main(["modes", str(scene), "-o", str(out), "-q"]) == 2
+    assert "casing.ring: gmsh could not mesh the ring" in capsys.readouterr().err
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["status"] == "failed" and "gmsh could not mesh" in summary["message"]
+    rows = _rows(out / "modes.csv")
+    assert {r["structure"] for r in rows} == {"disk"} and len(rows) == 4
+    assert not (out / "coincidences.csv").exists()

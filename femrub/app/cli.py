@@ -298,15 +298,14 @@ def _campbell(args) -> int:
 
 
 def _modes(args) -> int:
-    from ..output.folder import claim, safe_name
+    from ..output.folder import safe_name
     from ..scene import load_scene
-    from .modes import compute_modes, write_modes_folder
+    from .modes import modes_to_folder
 
     scene = load_scene(args.scene, _changes(args))  # no run checks: a bladed disk is welcome
     out = Path(args.out or f"{safe_name(scene.name)}-modes")
     t0 = time.perf_counter()
-    with claim(out, "modes", overwrite=args.overwrite):
-        doc = write_modes_folder(compute_modes(scene, _log(args)), out, scene)
+    doc = modes_to_folder(scene, out, overwrite=args.overwrite, log=_log(args))
     if not args.quiet:
         print(f"done in {time.perf_counter() - t0:.1f} s: {doc['message']}; {out / 'modes.csv'}")
     return 0

@@ -15,7 +15,8 @@ modes at the scene's speed with the same prestress (``structure = blade``, no no
 diameter): the blade clamped at its root is the bladed disk of a rigid disk.
 
 Files (:mod:`femrub.output.modes`): ``modes.csv``, ``modes.png``, ``coincidences.csv``
-(with a casing ring) and ``summary.json`` (``status`` ``ok`` or ``failed``, ``message``,
+(with a casing ring) and ``summary.json`` (``status`` ``ok``, or ``failed`` / ``interrupted``
+with the stages finished kept, ``message``,
 ``timings`` per stage, sizes, the sector's geometry).
 """
 
@@ -33,7 +34,14 @@ from ..model.cyclic import ModeTable, cyclic_structure, mode_table
 from ..scene.spec import SceneError
 from . import translate as tr
 
-__all__ = ["ModesResult", "casing_sector", "compute_modes", "rotor_sector", "write_modes_folder"]
+__all__ = [
+    "ModesResult",
+    "casing_sector",
+    "compute_modes",
+    "modes_to_folder",
+    "rotor_sector",
+    "write_modes_folder",
+]
 
 
 @dataclass
@@ -111,10 +119,10 @@ def _solve(sector, material, omega, prestress, families, timings, stage, log):
     return structure, table
 
 
-def _bladed_disk(scene, log) -> ModesResult:
+def _bladed_disk(scene, log, result: ModesResult) -> ModesResult:
     from ..model.coincidence import coincidences
 
-    timings, info = {}, {}
+    timings, info = result.info.setdefault("timings", {}), result.info
     omega = float(scene["loads"]["rotation_speed"])
     method = tr.centrifugal_of(scene) or "off"
     t0 = time.perf_counter()
@@ -125,7 +133,8 @@ def _bladed_disk(scene, log) -> ModesResult:
     structure, table = _solve(
         disk, tr.material_of(scene), omega, method, scene["rotor"]["families"], timings, "disk", log
     )
-    tables = {"disk": table}
+    tables = result.tables
+    tables["disk"] = table
     info["disk"] = {
         "sectors": disk.n_sectors,
         "tets": disk.mesh.n_tets,
@@ -133,7 +142,6 @@ def _bladed_disk(scene, log) -> ModesResult:
         "prestress": method,
         **{k: v for k, v in disk.info.items()},
     }
-    found = []
     if scene["casing"]["ring"].get("thickness") is not None:
         t0 = time.perf_counter()
         ring = casing_sector(scene, disk.info["tip_radius"])
@@ -151,11 +159,11 @@ def _bladed_disk(scene, log) -> ModesResult:
             "lobes": d.lobes,
             "distortion": d.amplitude,
         }
-        found = coincidences(table, tables["casing"])
-    return ModesResult(tables, found, {"timings": timings, **info})
+        result.coincidences = coincidences(table, tables["casing"])
+    return result
 
 
-def _single_blade(scene, log) -> ModesResult:
+def _single_blade(scene, log, result: ModesResult) -> ModesResult:
     from .campbell import campbell
 
     if tr.is_bar(scene):
@@ -168,19 +176,39 @@ def _single_blade(scene, log) -> ModesResult:
     res = campbell(scene, np.array([omega]), modes=families, exact=True, log=log)
     f = np.asarray(res.frequencies[0], dtype=float)
     table = ModeTable(None, np.arange(1, f.size + 1), f, omega)
-    info = {
-        "timings": {"blade": time.perf_counter() - t0},
-        "blade": {"prestress": res.method, "free_dofs": res.info.get("n_free_dofs")},
-    }
-    return ModesResult({"blade": table}, [], info)
+    result.tables["blade"] = table
+    result.info["timings"] = {"blade": time.perf_counter() - t0}
+    result.info["blade"] = {"prestress": res.method, "free_dofs": res.info.get("n_free_dofs")}
+    return result
 
 
-def compute_modes(scene, log=None) -> ModesResult:
+def compute_modes(scene, log=None, into: ModesResult | None = None) -> ModesResult:
     """The modes of ``scene`` (module docstring): a bladed disk and its casing ring, or the
-    single blade."""
+    single blade. ``into``: the result filled stage by stage (what a failed or interrupted
+    computation has finished stays in it)."""
+    result = ModesResult({}) if into is None else into
     if scene["rotor"].get("sectors") is None:
-        return _single_blade(scene, log)
-    return _bladed_disk(scene, log)
+        return _single_blade(scene, log, result)
+    return _bladed_disk(scene, log, result)
+
+
+def modes_to_folder(scene, out, *, overwrite: bool = False, log=None) -> dict:
+    """Claim ``out`` (kind ``modes``), compute the modes and write the folder; return the
+    summary. A computation that fails or is interrupted writes what it finished with
+    ``status`` ``failed`` or ``interrupted`` and its one-line ``message``, then raises."""
+    from ..output.folder import claim
+
+    result = ModesResult({})
+    with claim(out, "modes", overwrite=overwrite):
+        try:
+            compute_modes(scene, log, into=result)
+        except BaseException as exc:
+            status = "interrupted" if isinstance(exc, KeyboardInterrupt) else "failed"
+            text = str(exc).strip().splitlines()
+            message = text[0] if text else type(exc).__name__
+            write_modes_folder(result, out, scene, status=status, message=message)
+            raise
+        return write_modes_folder(result, out, scene)
 
 
 def _message(result: ModesResult) -> str:
@@ -190,9 +218,11 @@ def _message(result: ModesResult) -> str:
     return ", ".join(parts)
 
 
-def write_modes_folder(result: ModesResult, out, scene) -> dict:
+def write_modes_folder(
+    result: ModesResult, out, scene, *, status: str = "ok", message: str | None = None
+) -> dict:
     """Write the files of the module docstring into ``out`` (already claimed); return the
-    summary."""
+    summary (``status``, ``message``: those of a computation that did not finish)."""
     from ..output.jsonfile import write_json
     from ..output.modes import plot_modes, write_coincidences, write_modes
 
@@ -200,7 +230,7 @@ def write_modes_folder(result: ModesResult, out, scene) -> dict:
     t0 = time.perf_counter()
     files = ["modes.csv", "modes.png", "summary.json"]
     write_modes(out / "modes.csv", result.tables)
-    if "casing" in result.tables:
+    if "casing" in result.tables and "disk" in result.tables:
         write_coincidences(out / "coincidences.csv", result.coincidences)
         files.insert(2, "coincidences.csv")
     omega = float(scene["loads"]["rotation_speed"])
@@ -210,8 +240,8 @@ def write_modes_folder(result: ModesResult, out, scene) -> dict:
     )
     timings = dict(result.info.get("timings", {}), output=time.perf_counter() - t0)
     summary = {
-        "status": "ok",
-        "message": _message(result),
+        "status": status,
+        "message": message or _message(result),
         "scene": scene.name,
         "structures": list(result.tables),
         "rotation_speed": omega,
