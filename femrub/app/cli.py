@@ -395,7 +395,11 @@ def build_parser() -> argparse.ArgumentParser:
     mp = sub.add_parser(
         "modes", help="modes of a bladed disk and its casing ring by nodal diameter (CSV + PNG)"
     )
-    _scene_args(mp)
+    mp.add_argument("scene", help="scene file (.toml) or built-in scene name (femrub scenes)")
+    mp.add_argument("--set", action="append", metavar="KEY=VALUE", help="change a key (repeatable)")
+    mp.add_argument("-o", "--out", help="results folder (default NAME-modes)")
+    mp.add_argument("--overwrite", action="store_true", help="replace a finished result")
+    mp.add_argument("--quiet", "-q", action="store_true", help="no progress output")
     mp.set_defaults(func=_modes)
     lp = sub.add_parser("scenes", help="list the built-in scenes")
     lp.set_defaults(func=_scenes)
