@@ -59,7 +59,7 @@ class Coincidence:
 
 
 def coincidences(disk: ModeTable, casing: ModeTable) -> list[Coincidence]:
-    """Every speed of Eq. (1) for the nodal diameters ``k >= 1`` the two tables share.
+    """Every speed of ``k Ω = ω_d + ω_c`` for the nodal diameters ``k >= 1`` of both tables.
 
     The disk's frequencies are those at its table's ``rotation_speed``: the speeds are
     exact where they equal it and first estimates elsewhere (the disk's frequencies change

@@ -101,7 +101,7 @@ class CyclicStructure:
 
     @property
     def nodal_diameters(self) -> np.ndarray:
-        """``0 .. ⌊N/2⌋``."""
+        """The nodal diameters k from 0 to ⌊N/2⌋."""
         return np.arange(self.n_sectors // 2 + 1)
 
 
@@ -216,7 +216,7 @@ def _prestress_state(basis, material, free, T0, omega, method):
 def cyclic_structure(
     sector: SectorMesh, material, *, omega: float = 0.0, prestress: str = "off"
 ) -> CyclicStructure:
-    """Assemble a sector (P2 tetrahedra, HRZ mass, ``root`` clamped) for Eq. (2).
+    """Assemble a sector (P2 tetrahedra, HRZ mass, ``root`` clamped) for the eigenproblem (2).
 
     Parameters
     ----------
@@ -250,7 +250,7 @@ def cyclic_structure(
 
 
 def harmonic_modes(structure: CyclicStructure, k: int, n_modes: int):
-    """The ``n_modes`` lowest modes of nodal diameter ``k`` (Eq. 2).
+    """The ``n_modes`` lowest modes of nodal diameter ``k`` (eigenproblem 2).
 
     Returns
     -------
@@ -295,7 +295,7 @@ class ModeTable:
 
 
 def mode_table(structure: CyclicStructure, n_families: int) -> ModeTable:
-    """The ``n_families`` lowest modes of every nodal diameter ``0 .. ⌊N/2⌋``."""
+    """The ``n_families`` lowest modes of every nodal diameter k from 0 to ⌊N/2⌋."""
     nd, fam, freq = [], [], []
     for k in structure.nodal_diameters:
         f, _ = harmonic_modes(structure, int(k), n_families)
