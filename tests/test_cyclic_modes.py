@@ -202,3 +202,24 @@ def test_the_sector_prestress_is_the_whole_wheels_equilibrium(disk, method):
     if not linear:
         other = cyclic_structure(disk, TITANIUM, omega=omega, prestress="linear").static
         assert not np.allclose(structure.static, other, rtol=1e-6, atol=0)
+
+
+def test_coincidences_lock_the_disks_backward_wave_on_the_casings_forward_wave():
+    """k Ω = ω_d + ω_c: the disk's backward wave seen from the casing, cos(k θ − (k Ω − ω_d) t),
+    has the casing's forward wave's frequency ω_c; k = 0 has no travelling wave."""
+    from femrub.model.coincidence import coincidences
+    from femrub.model.cyclic import ModeTable
+
+    k = np.array([0, 1, 2, 0, 1, 2])
+    family = np.array([1, 1, 1, 2, 2, 2])
+    disk = ModeTable(k, family, np.array([100.0, 110.0, 130.0, 400.0, 420.0, 450.0]), 500.0)
+    casing = ModeTable(k[:3], family[:3], np.array([900.0, 700.0, 300.0]), 0.0)
+    found = coincidences(disk, casing)
+    assert len(found) == 4 and all(c.nodal_diameter >= 1 for c in found)
+    for c in found:
+        wd, wc = 2 * np.pi * c.disk_frequency_hz, 2 * np.pi * c.casing_frequency_hz
+        assert c.nodal_diameter * c.rotation_speed - wd == pytest.approx(wc)
+    assert [c.rotation_speed for c in found] == sorted(c.rotation_speed for c in found)
+    first = found[0]
+    assert (first.nodal_diameter, first.disk_family, first.casing_family) == (2, 1, 1)
+    assert first.rotation_speed == pytest.approx(2 * np.pi * (130.0 + 300.0) / 2)
