@@ -11,6 +11,9 @@ objects of each stage of the pipeline (``docs/architecture.md``):
 * blades, meshes and casings: :class:`BladeMesh`, :class:`MeshSize`, :func:`box_blade`,
   :func:`naca_blade`, :func:`sections_blade`, :func:`read_mesh`, :func:`read_rotor37_mesh`,
   :func:`casing_profile`, :class:`Concentric`, :class:`Lobed`, :class:`TwoLobePiollet`;
+* bladed disks and casing rings: :func:`bladed_disk_sector`, :func:`casing_ring_sector`,
+  :func:`full_wheel`, :func:`cyclic_structure`, :func:`mode_table` (modes by nodal
+  diameter), :func:`coincidences` (``k Ω = ω_disk + ω_casing``);
 * models: :func:`bar_model`, :func:`solid_model`, :func:`build_rub` with :class:`RubConfig`,
   :func:`first_order_model`, :class:`FirstOrderModel` (Eqs. 8-9) and their parts;
 * reduction: :class:`ThermoelasticCraigBampton` (``reduce(n_uv, n_theta)``, Eqs. 10-15),
@@ -57,6 +60,13 @@ _LAZY = {
     "Concentric": ".contact.casing",
     "Lobed": ".contact.casing",
     "TwoLobePiollet": ".contact.casing",
+    # bladed disks and casing rings: cyclic sectors, modes by nodal diameter
+    "bladed_disk_sector": ".geometry.bladed_disk",
+    "casing_ring_sector": ".geometry.casing_ring",
+    "full_wheel": ".geometry.cyclic_sector",
+    "cyclic_structure": ".model.cyclic",
+    "mode_table": ".model.cyclic",
+    "coincidences": ".model.coincidence",
     # models
     "PAPER": ".cases.bar",
     "BarCase": ".cases.bar",

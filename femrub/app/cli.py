@@ -1,5 +1,5 @@
-"""Command line: ``femrub run | check | sweep | periodic | campbell | scenes | scene show |
-paper | mesh | cache``.
+"""Command line: ``femrub run | check | sweep | periodic | campbell | modes | scenes |
+scene show | paper | mesh | cache``.
 
 ``run``, ``check`` and ``sweep`` keep the assembled and reduced models in a cache folder
 (:mod:`femrub.app.cache`): ``--cache-dir`` or ``$FEMRUB_CACHE_DIR`` (default: the user's
@@ -347,6 +347,20 @@ def _campbell(args) -> int:
     return 0
 
 
+def _modes(args) -> int:
+    from ..output.folder import safe_name
+    from ..scene import load_scene
+    from .modes import modes_to_folder
+
+    scene = load_scene(args.scene, _changes(args))  # no run checks: a bladed disk is welcome
+    out = Path(args.out or f"{safe_name(scene.name)}-modes")
+    t0 = time.perf_counter()
+    doc = modes_to_folder(scene, out, overwrite=args.overwrite, log=_log(args))
+    if not args.quiet:
+        print(f"done in {time.perf_counter() - t0:.1f} s: {doc['message']}; {out / 'modes.csv'}")
+    return 0
+
+
 def _scene_args(p: argparse.ArgumentParser, out: bool = True) -> None:
     p.add_argument("scene", help="scene file (.toml) or built-in scene name (femrub scenes)")
     p.add_argument(
@@ -446,6 +460,15 @@ def build_parser() -> argparse.ArgumentParser:
         help="most prestress samples the self-check refines to (default 12)",
     )
     cb.set_defaults(func=_campbell)
+    mp = sub.add_parser(
+        "modes", help="modes of a bladed disk and its casing ring by nodal diameter (CSV + PNG)"
+    )
+    mp.add_argument("scene", help="scene file (.toml) or built-in scene name (femrub scenes)")
+    mp.add_argument("--set", action="append", metavar="KEY=VALUE", help="change a key (repeatable)")
+    mp.add_argument("-o", "--out", help="results folder (default NAME-modes)")
+    mp.add_argument("--overwrite", action="store_true", help="replace a finished result")
+    mp.add_argument("--quiet", "-q", action="store_true", help="no progress output")
+    mp.set_defaults(func=_modes)
     lp = sub.add_parser("scenes", help="list the built-in scenes")
     lp.set_defaults(func=_scenes)
     shp = sub.add_parser("scene", help="show a built-in scene")

@@ -32,6 +32,7 @@ __all__ = [
     "DENSE_EIGEN_BELOW",
     "angular_frequencies",
     "largest_modulus",
+    "lowest_hermitian_modes",
     "lowest_modes",
     "natural_frequencies",
     "normalise_columns",
@@ -171,3 +172,38 @@ def largest_modulus(A, B) -> float:
     op = spla.LinearOperator((n, n), matvec=lambda x: lu.solve(Bc @ x), dtype=float)
     ev = spla.eigs(op, k=2, which="LM", return_eigenvectors=False, tol=1e-6, maxiter=5000)
     return float(np.max(np.abs(ev)))
+
+
+def lowest_hermitian_modes(K, M, k: int, *, tol: float = 1e-12):
+    """The ``k`` lowest eigenpairs of ``K x = λ M x`` with ``K``, ``M`` complex Hermitian
+    (``M`` positive definite), as the cyclic-symmetry problems of one nodal diameter.
+
+    Dense LAPACK ``eigh`` below :data:`DENSE_EIGEN_BELOW` unknowns, else ARPACK in complex
+    arithmetic, shift-invert about σ = 0; ``K`` is factorised as its real symmetric form
+    ``[[Re K, −Im K], [Im K, Re K]]`` (:func:`~femrub.fem.linalg.sparse_lu`).
+
+    Returns
+    -------
+    lam : (k,) real eigenvalues in increasing order (ω² in rad²/s²).
+    V : (n, k) complex shapes, ``M``-normalised.
+    """
+    n = K.shape[0]
+    if not 0 < k <= n:
+        raise ValueError(f"asked for {k} modes of a {n}-dof problem")
+    if n < DENSE_EIGEN_BELOW or k >= n - 1:
+        with one_blas_thread:
+            return sla.eigh(_dense(K), _dense(M), subset_by_index=[0, k - 1])
+    Kc, Mc = sp.csc_matrix(K, dtype=complex), sp.csc_matrix(M, dtype=complex)
+    # K = A + iB (A symmetric, B antisymmetric) solved as the real symmetric [[A, −B], [B, A]]
+    real = sp.bmat([[Kc.real, -Kc.imag], [Kc.imag, Kc.real]]).tocsc()
+    lu = sparse_lu(real, symmetric=True, what="cyclic stiffness")
+
+    def solve(rhs):
+        z = lu.solve(np.concatenate([rhs.real, rhs.imag]))
+        return z[:n] + 1j * z[n:]
+
+    opinv = spla.LinearOperator((n, n), matvec=solve, dtype=complex)
+    with progress.phase(f"eigen-solve: {k} lowest modes of {n} complex unknowns (ARPACK)"):
+        lam, V = spla.eigsh(Kc, k=k, M=Mc, sigma=0.0, OPinv=opinv, which="LM", tol=tol)
+    order = np.argsort(lam.real)
+    return lam.real[order], V[:, order]

@@ -1,8 +1,8 @@
 """Ownership of a results folder: its kind, its status, a lock, and safe default names.
 
-Three commands write results folders: ``femrub run`` (kind ``run``), ``femrub sweep``
-(``sweep``) and ``femrub paper`` (``paper``). :func:`claim` is called before any expensive
-work and guarantees, for the duration of the ``with`` block:
+Four commands write results folders: ``femrub run`` (kind ``run``), ``femrub sweep``
+(``sweep``), ``femrub paper`` (``paper``) and ``femrub modes`` (``modes``). :func:`claim`
+is called before any expensive work and guarantees, for the duration of the ``with`` block:
 
 * the folder is writable (else a one-line :class:`FolderError`);
 * it is not a folder of another kind (the marker file ``.femrub`` says which command owns
@@ -72,6 +72,7 @@ OUTPUTS = {
     "sweep": ("sweep.json", "scene.toml", "interaction.csv", "interaction.png", "runs"),
     "paper": ("summary.json", "runs", "fig*.png", "fig*.csv", "energy_*.png"),
     "periodic": ("summary.json", "branch.csv", "branch.png", "orbits"),
+    "modes": ("summary.json", "modes.csv", "modes.png", "coincidences.csv"),
 }
 #: the files of a run's VTK series (in ``vtk/``)
 VTK_FILES = ("rub_*.vtu", "rub.pvd", "*.tmp")

@@ -6,7 +6,10 @@
 * :func:`check_friction`: the Coulomb coefficient μ (``contact.friction``) is at most
   :data:`MAX_FRICTION` (a percentage or a typing slip, not a material pair).
 
-:func:`check_run` applies both; ``femrub run``, ``check`` and ``sweep`` call it on every
+* :func:`check_bladed_disk`: a bladed disk (``rotor.sectors``) has modes
+  (``femrub modes``) but no time integration yet.
+
+:func:`check_run` applies them all; ``femrub run``, ``check`` and ``sweep`` call it on every
 scene (every point of a sweep) before building anything.
 """
 
@@ -16,7 +19,14 @@ import math
 
 from .spec import fail
 
-__all__ = ["MAX_FRICTION", "check_friction", "check_run", "check_steps", "fractional_steps"]
+__all__ = [
+    "MAX_FRICTION",
+    "check_bladed_disk",
+    "check_friction",
+    "check_run",
+    "check_steps",
+    "fractional_steps",
+]
 
 #: the largest Coulomb coefficient taken (metals on abradable coatings: about 0.1 to 1)
 MAX_FRICTION = 2.0
@@ -70,7 +80,21 @@ def check_friction(scene) -> None:
         )
 
 
+def check_bladed_disk(scene) -> None:
+    """Refuse to time-integrate a bladed disk (``rotor.sectors``): only its modes exist."""
+    sectors = scene.get("rotor.sectors")
+    if sectors is not None:
+        fail(
+            "rotor.sectors",
+            sectors,
+            "time integration of a bladed disk is not available yet; `femrub modes SCENE` "
+            "writes its modes by nodal diameter, its casing ring's and their coincidence "
+            "speeds (remove rotor.sectors to run the single blade)",
+        )
+
+
 def check_run(scene) -> None:
     """Every check of this module."""
+    check_bladed_disk(scene)
     check_steps(scene)
     check_friction(scene)

@@ -7,6 +7,7 @@ documents the same table; :func:`schema_rows` lists it for the docs and the test
 
 from __future__ import annotations
 
+from .schema_rotor import CASING_SECTION, ROTOR
 from .schema_run import LIMITS, OUTPUTS, REDUCTION, SCHEME, SIGNALS
 from .spec import NONNEG, POS, REQUIRED, Spec, Variant
 from .spec import float_spec as _f
@@ -346,6 +347,8 @@ SCHEMA: dict = {
     "reduction": REDUCTION,
     "outputs": OUTPUTS,
     "limits": LIMITS,
+    "rotor": ROTOR,
+    "casing": CASING_SECTION,
 }
 
 

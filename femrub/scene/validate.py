@@ -16,6 +16,7 @@ from pathlib import Path
 from .activation import check_activation
 from .bounds import check_physical
 from .schema import SCHEMA, TOP
+from .schema_rotor import check_rotor
 from .schema_run import PROBE_COMPONENTS
 from .spec import REQUIRED, SceneError, Variant, fail, unknown_key
 
@@ -59,6 +60,7 @@ def normalize(doc) -> dict:
     for section, spec in SCHEMA.items():
         out[section] = _table(section, doc.get(section, {}), spec)
     _cross_check(out)
+    check_rotor(out)
     check_activation(out)
     return out
 

@@ -1,0 +1,94 @@
+"""The scene schema of a bladed disk (``rotor``) and a flexible casing ring (``casing.ring``).
+
+Part of :data:`femrub.scene.schema.SCHEMA`. A scene with ``rotor.sectors = N`` is a bladed
+disk of ``N`` blades: the blade is the scene's ``geometry`` (``kind = "naca"``; its
+``hub_radius`` is replaced by the disk's rim), the disk an annulus clamped at its bore.
+``casing.ring.thickness`` adds a flexible casing ring around the blades' tips. Both feed
+``femrub modes`` (:mod:`femrub.app.modes`); ``femrub run`` refuses them
+(:func:`femrub.scene.run_checks.check_run`). :func:`check_rotor` is the cross-key check,
+made when the scene is loaded.
+"""
+
+from __future__ import annotations
+
+from .spec import NONNEG, POS, Spec, fail
+from .spec import float_spec as _f
+
+__all__ = ["CASING_SECTION", "ROTOR", "check_rotor"]
+
+I = "int"  # noqa: E741 (the schema's one-letter type names)
+
+ROTOR = {
+    "sectors": Spec(
+        I, None, lo=3, hi=360, doc="number of blades N of a bladed disk (unset: a single blade)"
+    ),
+    "hub_radius": _f(0.05, "length", "radius of the disk's bore (clamped)", **POS),
+    "rim_radius": _f(0.15, "length", "radius of the disk's rim, where the blades stand", **POS),
+    "thickness": _f(0.04, "length", "axial thickness of the disk", **POS),
+    "h": _f(
+        None,
+        "length",
+        "element size of the sector mesh (default: geometry.h, else a third of the disk's "
+        "thickness)",
+        **POS,
+    ),
+    "families": Spec(I, 3, lo=1, hi=30, doc="mode families computed per nodal diameter"),
+}
+
+CASING_RING = {
+    "thickness": _f(
+        None, "length", "radial wall thickness of a flexible casing ring (unset: no ring)", **POS
+    ),
+    "axial_length": _f(0.1, "length", "axial length between the clamped flanges", **POS),
+    "clearance": _f(
+        5e-4, "length", "radial gap from the blades' tip radius to the ring's bore", **NONNEG
+    ),
+    "lobes": Spec(
+        I, 0, lo=0, hi=100, doc="order k of the ring's initial out-of-roundness (0: round)"
+    ),
+    "distortion": _f(0.0, "length", "radial amplitude of the k-lobed out-of-roundness", **NONNEG),
+    "young": _f(200e9, "pressure", "Young's modulus of the ring", **POS),
+    "poisson": _f(
+        0.3, "none", "Poisson's ratio of the ring", lo=-1.0, hi=0.5, lo_open=True, hi_open=True
+    ),
+    "density": _f(7800.0, "density", "mass density of the ring", **POS),
+    "h": _f(
+        None, "length", "element size (default: the larger of thickness and axial_length/6)", **POS
+    ),
+    "families": Spec(I, 3, lo=1, hi=30, doc="mode families computed per nodal diameter"),
+}
+
+CASING_SECTION = {"ring": CASING_RING}
+
+
+def check_rotor(d: dict) -> None:
+    """Refuse a bladed disk or casing ring whose keys contradict each other (one line)."""
+    rotor, ring = d["rotor"], d["casing"]["ring"]
+    if rotor.get("sectors") is None:
+        if ring.get("thickness") is not None:
+            fail(
+                "casing.ring.thickness",
+                ring["thickness"],
+                "a casing ring surrounds a bladed disk; set rotor.sectors (the number of "
+                "blades) or remove casing.ring",
+            )
+        return
+    if d["geometry"]["kind"] != "naca":
+        fail(
+            "geometry.kind",
+            d["geometry"]["kind"],
+            "the blades of a bladed disk (rotor.sectors) are NACA blades; use geometry.kind = "
+            "'naca'",
+        )
+    if not rotor["rim_radius"] > rotor["hub_radius"]:
+        fail(
+            "rotor.rim_radius",
+            rotor["rim_radius"],
+            f"must exceed rotor.hub_radius = {rotor['hub_radius']:g} m",
+        )
+    if ring.get("thickness") is not None and ring["distortion"] > 0 and ring["lobes"] == 0:
+        fail(
+            "casing.ring.distortion",
+            ring["distortion"],
+            "an out-of-roundness needs its order: set casing.ring.lobes >= 1",
+        )
