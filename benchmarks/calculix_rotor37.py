@@ -18,8 +18,11 @@ A minute of ``ccx`` and a few minutes of femrub (about 3 GB). It writes the Calc
 frequencies with where they were measured into ``docs/validation/rotor37_calculix.json``
 (key ``calculix``, read by ``benchmarks/campbell_rotor37.py``, whose page it renders again),
 the flexibilities into ``docs/validation/rotor37_tip_flexibility.json`` and renders
-``docs/validation/rotor37-tip-flexibility.md`` from it. ``--render-only`` renders both pages
-from the JSON. Without ``ccx`` or the shared data it prints why and writes nothing.
+``docs/validation/rotor37-tip-flexibility.md`` from it. It also measures, on a small
+cantilever in femrub's P2 tetrahedra, how a point force's flexibility and a uniform
+traction's change as the mesh is refined (``--refinement``: only that, in seconds, into the
+JSON). ``--render-only`` renders both pages from the JSON. Without ``ccx`` or the shared
+data it prints why and writes nothing.
 """
 
 from __future__ import annotations
@@ -276,6 +279,86 @@ def plain(x):
     return x.tolist() if isinstance(x, np.ndarray) else x
 
 
+#: divisions per 10 mm of the refinement study's cantilever (40 × 10 × 10 mm, P2 tetrahedra)
+LEVELS = (1, 2, 4, 8)
+
+
+def _beam(divisions: int):
+    """A steel-like cantilever, 40 × 10 × 10 mm in metres, clamped at x = 0, as a blade."""
+    import skfem
+
+    from femrub.geometry.blade_mesh import BladeMesh
+
+    n = int(divisions)
+    axes = (np.linspace(0, 0.04, 4 * n + 1), *(np.linspace(0, 0.01, n + 1),) * 2)
+    mesh = skfem.MeshTet.init_tensor(*axes)
+    corner = int(np.flatnonzero(np.all(np.abs(mesh.p - [[0.04], [0.01], [0.01]]) < 1e-12, 0))[0])
+    return BladeMesh(
+        mesh=mesh,
+        node_sets={"root": np.flatnonzero(mesh.p[0] < 1e-12), "tip": np.array([corner])},
+        contact_points=mesh.p[:, [corner]],
+        radial_axis="z",
+        source=f"cantilever, {n} divisions per 10 mm",
+        info={"contact_map": {"vertex": np.array([corner])}},
+    ), corner
+
+
+def refinement_study(levels=LEVELS) -> dict:
+    """Flexibility (m/N) of a clamped cantilever's free end as femrub's P2 mesh is refined:
+    under a point force on its corner node (z), and under a uniform z traction on its end
+    face (the end's mean displacement per newton, ``fᵀ K⁻¹ f`` with ``f`` the consistent
+    load of 1 N spread over the face). Seconds; no reference data."""
+    import skfem
+
+    from femrub.fem.discretisation import assemble, discretise
+    from femrub.fem.linalg import sparse_lu
+    from femrub.fem.material import Material
+
+    material = Material(young=DECK["material.young"], rho=DECK["material.density"], poisson=0.3)
+    point, face, dofs = [], [], []
+    for n in levels:
+        blade, corner = _beam(n)
+        disc = discretise(blade, 2)
+        mats = assemble(disc, material, lumping="consistent").mechanical()
+        end = blade.mesh.facets_satisfying(lambda x: x[0] > 0.04 - 1e-12)
+        fb = skfem.FacetBasis(blade.mesh, disc.basis_u.elem, facets=end)
+        f = skfem.LinearForm(lambda v, w: v[2] / 1e-4).assemble(fb)[mats.free_u]
+        rows = mats.u_index(disc.basis_u.nodal_dofs[2, [corner]])
+        unit = np.zeros(mats.n_u)
+        unit[rows] = 1.0
+        lu = sparse_lu(mats.K.tocsc(), symmetric=True, what="stiffness")
+        point.append(float(lu.solve(unit)[rows][0]))
+        face.append(float(f @ lu.solve(f)))
+        dofs.append(int(mats.n_u))
+    return {"divisions_per_10mm": list(levels), "n_free_dofs": dofs, "point": point, "face": face}
+
+
+def _refinement(doc: dict) -> str:
+    """The refinement study's table (``doc["refinement"]``), or nothing."""
+    ref = doc.get("refinement")
+    if not ref:
+        return ""
+    rows = [
+        "A cantilever, 40 × 10 × 10 mm, clamped at one end, in femrub's P2 tetrahedra refined "
+        "uniformly (`python benchmarks/calculix_rotor37.py --refinement`; "
+        f"{ref['machine']['date']}, commit {ref['machine']['commit']}): the flexibility of its "
+        "free end under a point force on a corner node grows with every refinement, under the "
+        "same force spread uniformly over the end face it settles.",
+        "| divisions per 10 mm | free dofs | corner node, point force (µm/N) | change "
+        "| end face, uniform traction (µm/N) | change |",
+        "|---|---|---|---|---|---|",
+    ]
+    for k, n in enumerate(ref["divisions_per_10mm"]):
+        grow = [
+            "—" if k == 0 else _percent(ref[key][k] / ref[key][k - 1]) for key in ("point", "face")
+        ]
+        rows.append(
+            f"| {n} | {ref['n_free_dofs'][k]} | {ref['point'][k] * 1e6:.4f} | {grow[0]} "
+            f"| {ref['face'][k] * 1e6:.4f} | {grow[1]} |"
+        )
+    return "\n".join(rows[:1]) + "\n\n" + "\n".join(rows[1:])
+
+
 def _percent(ratio: float) -> str:
     return f"{100 * (ratio - 1):+.1f} %"
 
@@ -457,12 +540,13 @@ def render(doc: dict) -> str:
         f"of their mean displacement, CalculiX over femrub: {together}.",
         "## Why the gap, and why refining does not close it",
         _why(doc),
+        _refinement(doc),
         "## Effect on the contact forces",
         _force_effect(doc),
         "## Per contact dof",
         _dof_table(doc),
     ]
-    return "\n\n".join(lines) + "\n"
+    return "\n\n".join(line for line in lines if line) + "\n"
 
 
 def _render_modes_page() -> None:
@@ -475,12 +559,22 @@ def _render_modes_page() -> None:
 def main(argv=None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--render-only", action="store_true", help="render the pages from the JSON")
+    ap.add_argument(
+        "--refinement",
+        action="store_true",
+        help="only the refinement study (seconds), into the JSON",
+    )
     args = ap.parse_args(argv)
-    if not args.render_only:
+    if args.refinement:
+        doc = json.loads(DATA.read_text())
+        doc["refinement"] = {**refinement_study(), "machine": machine()}
+        write_json(DATA, doc)
+    elif not args.render_only:
         out = run()
         if out is None:
             return
         doc, modes = out
+        doc["refinement"] = {**refinement_study(), "machine": machine()}
         write_json(DATA, doc)
         data = json.loads(MODES_DATA.read_text())
         data["calculix"] = modes

@@ -127,3 +127,21 @@ def test_femrub_tetrahedra_in_calculix_have_femrub_flexibility(bench, load_bench
     ccx = bench.tet10_side(disc)
     np.testing.assert_allclose(ccx["static"], fem["static"], rtol=1e-6)
     np.testing.assert_allclose(ccx["frequency_hz"][:3], fem["frequency_hz"][:3], rtol=1e-3)
+
+
+def test_refinement_study_measures_point_and_face_flexibility(bench):
+    """Two coarse levels: a point force's flexibility is above the uniform traction's and
+    both grow as the mesh resolves more deformation (the committed study goes further)."""
+    study = bench.refinement_study((1, 2))
+    point, face = np.array(study["point"]), np.array(study["face"])
+    assert study["n_free_dofs"][1] > study["n_free_dofs"][0]
+    assert (point > face).all() and (np.diff(point) > 0).all() and (np.diff(face) > 0).all()
+    # Euler-Bernoulli end deflection P L^3 / (3 E I) of the 40 x 10 x 10 mm beam, 1 N
+    beam = 0.04**3 / (3 * 210e9 * 0.01**4 / 12)
+    assert 0.9 * beam < face[-1] < 1.3 * beam
+
+
+def test_page_shows_the_refinement_study_from_the_json(bench, doc):
+    ref = doc["refinement"]
+    page = bench.PAGE.read_text()
+    assert f"| {ref['point'][-1] * 1e6:.4f} |" in page and ref["machine"]["commit"] in page
