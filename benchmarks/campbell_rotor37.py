@@ -23,9 +23,6 @@ from pathlib import Path
 
 from _common import DOCS, OUT, machine, write_json
 
-#: the first three natural frequencies (Hz) of the CalculiX C3D15 model of the deck
-#: (its frequency step, E = 210 GPa, ν = 0.3, ρ = 9000 kg/m³, root clamped)
-CALCULIX_HZ = (312.12, 922.81, 1165.62)
 DECK = {
     "material.young": 210e9,
     "material.poisson": 0.3,
@@ -69,7 +66,9 @@ def run(methods) -> dict | None:
 
 
 def _empty() -> dict:
-    return {"calculix_hz": list(CALCULIX_HZ), "deck": DECK, "speeds": SPEEDS, "runs": {}}
+    """A document without runs; the CalculiX entry (``benchmarks/calculix_rotor37.py``) kept."""
+    calculix = _read(DATA).get("calculix") if DATA.exists() else None
+    return {"calculix": calculix, "deck": DECK, "speeds": SPEEDS, "runs": {}}
 
 
 def _git(*args: str) -> str | None:
@@ -117,20 +116,37 @@ def _percent(value: float, reference: float) -> str:
 
 
 def _rest_table(data: dict) -> str:
-    runs = data["runs"]
+    """Rest frequencies of each run and of today's model against CalculiX's frequency step."""
+    ccx = data["calculix"]
+    columns = {f"{method} run": run["rest_frequencies_hz"] for method, run in data["runs"].items()}
+    columns[f"commit {ccx['machine']['commit']}"] = ccx["femrub_frequencies_hz"]
+    n = min(len(ccx["frequencies_hz"]), *(len(f) for f in columns.values()))
     head = "| mode | CalculiX C3D15 (Hz) |"
     rule = "|---|---|"
-    for method in runs:
-        head += f" femrub, {method} run (Hz) | difference |"
+    for name in columns:
+        head += f" femrub, {name} (Hz) | difference |"
         rule += "---|---|"
     rows = [head, rule]
-    for k, ref in enumerate(data["calculix_hz"]):
+    for k, ref in enumerate(ccx["frequencies_hz"][:n]):
         row = f"| {k + 1} | {ref:.2f} |"
-        for run in runs.values():
-            f = run["rest_frequencies_hz"][k]
-            row += f" {f:.2f} | {_percent(f, ref)} |"
+        for freqs in columns.values():
+            row += f" {freqs[k]:.2f} | {_percent(freqs[k], ref)} |"
         rows.append(row)
     return "\n".join(rows)
+
+
+def _calculix_stamp(data: dict) -> str:
+    """Where the CalculiX frequencies (and today's femrub ones beside them) were measured."""
+    ccx = data.get("calculix")
+    if not ccx:
+        return "* CalculiX: not run (`python benchmarks/calculix_rotor37.py`)."
+    m = ccx["machine"]
+    return (
+        f"* CalculiX {ccx['ccx_version']} frequency step, and femrub's model at commit "
+        f"{m.get('commit') or 'not recorded'}: measured {m['date']} by "
+        f"`python benchmarks/calculix_rotor37.py`; {m['platform']}, Python {m['python']}, "
+        f"{m['cores']} cores, load average {m['load_average']} at its start."
+    )
 
 
 def _check(run: dict) -> str:
@@ -190,12 +206,19 @@ def render(data: dict) -> str:
         "--set material.density=9000 --set physics.lumping=consistent --set "
         "loads.centrifugal=METHOD`.",
         "## Where the numbers come from",
-        "\n".join(f"* {method} run: {_stamp(run)}." for method, run in runs.items()) or "Not run.",
+        "\n".join(
+            [
+                _calculix_stamp(data),
+                *(f"* {method} run: {_stamp(run)}." for method, run in runs.items()),
+            ]
+        ),
         "## Natural frequencies at rest",
-        "Against the frequency step of the CalculiX C3D15 model of the same deck. At rest the "
+        "Against the frequency step of the CalculiX C3D15 model of the same deck, run by "
+        "`benchmarks/calculix_rotor37.py` (its first twenty modes and the contact "
+        "flexibility: [Rotor 37 contact flexibility](rotor37-tip-flexibility.md)). At rest the "
         "prestress method plays no part: a difference between the runs comes from the code "
         "each was measured with.",
-        _rest_table(data) if runs else "Not run.",
+        _rest_table(data) if data.get("calculix") else "CalculiX not run.",
         "## Centrifugal prestress",
         f"The blade spun to {top:.0f} rad/s, its stiffness with the stress of the spin "
         "(`loads.centrifugal`: `linear`, exact to first order in Ω², or the geometrically "

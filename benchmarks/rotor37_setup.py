@@ -70,7 +70,13 @@ def _casing(s) -> str:
 def _contacts(s) -> str:
     c = s["contact"]
     nodes = " ".join(map(str, c["nodes"]))
-    return f'deck nodes {nodes} (`spread = "{c["spread"]}"`)'
+    text = f'deck nodes {nodes} (`spread = "{c["spread"]}"`'
+    if c["spread"] == "node":  # point contacts: their stiffness against the deck's element
+        text += (
+            "; point contacts, stiffer at these nodes than the deck's own C3D15 element: "
+            "[contact flexibility against CalculiX](validation/rotor37-tip-flexibility.md)"
+        )
+    return text + ")"
 
 
 def _law(s) -> str:

@@ -65,6 +65,8 @@ def test_api_reference_documents_the_user_objects(site):
 def test_validation_has_the_rotor37_calculix_page(site):
     text = _text(site / "validation" / "rotor37-calculix.html")
     assert "CalculiX C3D15" in text and "commit" in text
+    text = _text(site / "validation" / "rotor37-tip-flexibility.html")
+    assert "C3D10" in text and "residual flexibility" in text
 
 
 def test_scene_key_reference_lists_every_key(site):
