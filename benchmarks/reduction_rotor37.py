@@ -54,7 +54,8 @@ def measure(name: str, sets: list[str], factors=FACTORS, log=print) -> dict:
     scene = load_scene(name, changes)
     if scene["reduction"]["method"] != "craig-bampton":
         raise SystemExit(f"{name}: reduction.method must be 'craig-bampton' (fixed sizes)")
-    window = lobe_passage(scene)
+    h = scene["scheme"]["h"]
+    window = max(1, round(lobe_passage(scene) / h)) * h  # a whole number of steps
     if "scheme.t_end" not in changes:
         scene = load_scene(name, {**changes, "scheme.t_end": window})
     t_end, opts = scene["scheme"]["t_end"], scene["reduction"]
