@@ -65,7 +65,10 @@ def measure(name: str, sets: list[str], factors=FACTORS, log=print) -> dict:
     t0 = time.perf_counter()
     bare = {k: v for k, v in changes.items() if not k.startswith("reduction.")}
     fsim = build(
-        load_scene(name, {**bare, "scheme.t_end": t_end, "reduction.method": "none"}),
+        load_scene(  # the full model only assembled: no time-step check, no stepper
+            name,
+            {**bare, "scheme.t_end": t_end, "reduction.method": "none", "scheme.step_check": False},
+        ),
         cache=ModelCache(),
         stepper=False,
         log=log,
