@@ -20,9 +20,6 @@ import math
 import gmsh
 import numpy as np
 
-# the package's function `naca_blade` first: importing the submodule of the same name before
-# would leave the package's `naca_blade` name on the module
-from . import naca_blade as _naca_blade  # noqa: F401
 from .cyclic_sector import (
     SectorMesh,
     classify_faces,
