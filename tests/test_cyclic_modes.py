@@ -223,3 +223,79 @@ def test_coincidences_lock_the_disks_backward_wave_on_the_casings_forward_wave()
     first = found[0]
     assert (first.nodal_diameter, first.disk_family, first.casing_family) == (2, 1, 1)
     assert first.rotation_speed == pytest.approx(2 * np.pi * (130.0 + 300.0) / 2)
+
+
+def test_the_disks_modes_over_speeds_equal_single_speed_solves(disk):
+    """One assembly, the nonlinear prestress solved speed after speed from the previous
+    state: the same frequencies as independent solves at each speed."""
+    from femrub.model.cyclic import mode_tables_over_speeds
+
+    speeds = [3000.0, 6000.0]
+    rest = cyclic_structure(disk, TITANIUM, prestress="nonlinear")
+    tables = mode_tables_over_speeds(rest, TITANIUM, speeds, 1)
+    assert [t.rotation_speed for t in tables] == speeds
+    for omega, table in zip(speeds, tables, strict=True):
+        alone = cyclic_structure(disk, TITANIUM, omega=omega, prestress="nonlinear")
+        assert np.allclose(table.frequency_hz, mode_table(alone, 1).frequency_hz, rtol=1e-8)
+    assert np.all(tables[1].frequency_hz > tables[0].frequency_hz)
+
+
+def _southwell_tables(speeds, rest_hz, slope):
+    """Disk tables (k = 0..3, one family) with ``ω² = ω_0² + S Ω²`` exactly."""
+    from femrub.model.cyclic import ModeTable
+
+    k = np.arange(4)
+    return [
+        ModeTable(k, np.ones(4, int), np.sqrt(rest_hz**2 + slope * (w / (2 * np.pi)) ** 2), w)
+        for w in speeds
+    ]
+
+
+def test_coincidences_over_speeds_are_exact_for_southwells_law():
+    """Interpolating ω_d² linearly in Ω² is exact when ω_d² = ω_0² + S Ω²: each root found
+    between listed speeds solves k Ω = ω_d(Ω) + ω_c to round-off; a pair whose equation keeps
+    its sign over the list gets the estimate from the nearest end; bad lists are refused."""
+    from femrub.model.coincidence import coincidences_over_speeds
+    from femrub.model.cyclic import ModeTable
+
+    rest_hz, slope = np.array([500.0, 800.0, 900.0, 950.0]), 1.0
+    speeds = 2 * np.pi * np.linspace(0.0, 1000.0, 4)
+    casing = ModeTable(np.arange(4), np.ones(4, int), np.array([900.0, 700.0, 300.0, 200.0]), 0.0)
+    found = coincidences_over_speeds(_southwell_tables(speeds, rest_hz, slope), casing)
+    assert [c.nodal_diameter for c in found] == [3, 2, 1]
+    assert [c.method for c in found] == ["interpolated", "interpolated", "outside-range"]
+    for c in found[:2]:
+        k, w = c.nodal_diameter, c.rotation_speed
+        wd = 2 * np.pi * np.sqrt(rest_hz[k] ** 2 + slope * (w / (2 * np.pi)) ** 2)
+        assert c.disk_frequency_hz == pytest.approx(wd / (2 * np.pi), rel=1e-12)
+        assert speeds[0] < w < speeds[-1]
+        assert k * w - wd == pytest.approx(2 * np.pi * c.casing_frequency_hz, rel=1e-10)
+    top = found[-1]  # k = 1: k Ω < ω_d + ω_c up to the top speed: ω_d taken there
+    assert top.rotation_speed == pytest.approx(2 * np.pi * (np.hypot(800.0, 1000.0) + 700.0))
+    with pytest.raises(ValueError, match="two or more increasing speeds"):
+        coincidences_over_speeds(_southwell_tables(speeds[::-1], rest_hz, slope), casing)
+
+
+def test_a_coincidence_found_between_two_speeds_solves_the_equation_there(disk, ring):
+    """The 3-diameter coincidence of the small wheel and a soft ring, found between 10 000 and
+    20 000 rad/s, checked by a solve at the speed found: |k Ω − ω_d(Ω) − ω_c| is within the
+    interpolation's error, far below the first estimate's from the lower speed."""
+    from femrub.model.coincidence import coincidences, coincidences_over_speeds
+    from femrub.model.cyclic import mode_tables_over_speeds, spinning
+
+    soft = Material(young=5e9, rho=7800.0, poisson=0.3)
+    casing = mode_table(cyclic_structure(ring, soft), 1)
+    rest = cyclic_structure(disk, TITANIUM, prestress="linear")
+    tables = mode_tables_over_speeds(rest, TITANIUM, [10000.0, 20000.0], 1)
+    found = coincidences_over_speeds(tables, casing)
+    hit = [c for c in found if c.method == "interpolated"]
+    assert [c.nodal_diameter for c in hit] == [3] and 10000.0 < hit[0].rotation_speed < 20000.0
+    wc = 2 * np.pi * casing.frequency(3, 1)
+
+    def mismatch(speed):
+        wd = 2 * np.pi * mode_table(spinning(rest, TITANIUM, speed), 1).frequency(3, 1)
+        return abs(3 * speed - wd - wc) / wc
+
+    first = next(c for c in coincidences(tables[0], casing) if c.nodal_diameter == 3)
+    assert mismatch(hit[0].rotation_speed) < 2e-3
+    assert mismatch(hit[0].rotation_speed) < 0.02 * mismatch(first.rotation_speed)

@@ -99,6 +99,8 @@ def test_coincidence_speeds_follow_from_the_modes(modes_folder):
         assert float(r["rotation_speed"]) == pytest.approx(2 * math.pi * (fd + fc) / k, rel=1e-9)
     speeds = [float(r["rotation_speed"]) for r in rows]
     assert speeds == sorted(speeds)
+    assert {r["method"] for r in rows} == {"scene-speed"}
+    assert not (out / "campbell.png").exists()
 
 
 def test_modes_keeps_a_finished_folder_and_run_refuses_a_bladed_disk(modes_folder, capsys):
@@ -162,3 +164,93 @@ def test_a_failed_computation_keeps_the_disk_modes_marked_failed(tmp_path, monke
     rows = _rows(out / "modes.csv")
     assert {r["structure"] for r in rows} == {"disk"} and len(rows) == 4
     assert not (out / "coincidences.csv").exists()
+
+
+@pytest.fixture(scope="module")
+def speeds_folder(tmp_path_factory):
+    """The small wheel at 10 000 and 15 000 rad/s with a soft ring (5 GPa): the 3-diameter
+    coincidences lie between the two speeds."""
+    root = tmp_path_factory.mktemp("modes-speeds")
+    scene = root / "wheel.toml"
+    scene.write_text(SCENE)
+    out = root / "out"
+    args = ["modes", str(scene), "-o", str(out), "-q", "--speeds", "10000:15000:5000"]
+    assert main(args + ["--set", "casing.ring.young=5e9"]) == 0
+    return out
+
+
+def test_modes_over_speeds_write_a_block_per_speed_and_the_campbell_diagram(speeds_folder):
+    out = speeds_folder
+    rows = _rows(out / "modes.csv")
+    disk = [r for r in rows if r["structure"] == "disk"]
+    assert [float(r["rotation_speed"]) for r in disk] == [10000.0] * 8 + [15000.0] * 8
+    assert [(r["nodal_diameter"], r["family"]) for r in disk[:8]] == [
+        (r["nodal_diameter"], r["family"]) for r in disk[8:]
+    ]
+    assert all(
+        float(b["frequency_hz"]) > float(a["frequency_hz"]) for a, b in zip(disk[:8], disk[8:])
+    )
+    casing = [r for r in rows if r["structure"] == "casing"]
+    assert len(casing) == 8 and {float(r["rotation_speed"]) for r in casing} == {0.0}
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["status"] == "ok" and summary["speeds"] == [10000.0, 15000.0]
+    assert "campbell.png" in summary["files"]
+    assert (out / "campbell.png").stat().st_size > 10_000
+    assert (out / "modes.png").stat().st_size > 10_000
+
+
+def test_coincidences_between_speeds_solve_the_interpolated_equation(speeds_folder):
+    """Each interpolated row solves k Ω = ω_d(Ω) + ω_c with ω_d² linear in Ω² between the
+    two blocks of modes.csv; the others keep their sign and take the top speed's ω_d."""
+    out = speeds_folder
+    hz = {}
+    for r in _rows(out / "modes.csv"):
+        key = (r["structure"], int(r["nodal_diameter"]), int(r["family"]))
+        hz.setdefault(key, []).append(float(r["frequency_hz"]))
+    rows = _rows(out / "coincidences.csv")
+    assert list(rows[0])[-1] == "method" and len(rows) == 12
+    interpolated = [r for r in rows if r["method"] == "interpolated"]
+    assert {int(r["nodal_diameter"]) for r in interpolated} == {3}
+    for r in rows:
+        k, speed = int(r["nodal_diameter"]), float(r["rotation_speed"])
+        (fa, fb), (fc,) = (
+            hz["disk", k, int(r["disk_family"])],
+            hz["casing", k, int(r["casing_family"])],
+        )
+        if r["method"] == "interpolated":
+            assert 10000.0 < speed < 15000.0
+            t = (speed**2 - 10000.0**2) / (15000.0**2 - 10000.0**2)
+            fd = math.sqrt(fa**2 + (fb**2 - fa**2) * t)
+            assert float(r["disk_frequency_hz"]) == pytest.approx(fd, rel=1e-9)
+        else:
+            assert r["method"] == "outside-range" and speed > 15000.0
+            fd = fb
+        assert k * speed == pytest.approx(2 * math.pi * (fd + fc), rel=1e-9)
+
+
+@pytest.mark.parametrize(
+    ("speeds", "words"),
+    [
+        ("15000:10000:1000", "--speeds '15000:10000:1000': use START:STOP:STEP"),
+        ("fast", "--speeds 'fast': use START:STOP:STEP"),
+        ("5000", "--speeds '5000': give two or more increasing speeds"),
+        ("-100,2000", "--speeds '-100,2000': give two or more increasing speeds >= 0"),
+        ("3000,1000", "--speeds '3000,1000': give two or more increasing speeds"),
+    ],
+)
+def test_bad_speeds_are_refused_in_one_line_before_any_mesh(tmp_path, capsys, speeds, words):
+    scene = tmp_path / "wheel.toml"
+    scene.write_text(SCENE)
+    out = tmp_path / "out"
+    assert main(["modes", str(scene), "--speeds", speeds, "-o", str(out), "-q"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and words in err
+    assert not out.exists()
+
+
+def test_speeds_on_a_single_blade_point_to_femrub_campbell(tmp_path, capsys):
+    out = tmp_path / "out"
+    assert main(["modes", "twisted-naca", "--speeds", "0:1000:500", "-o", str(out), "-q"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "femrub campbell twisted-naca --speeds 0:1000:500" in err
+    assert not out.exists()

@@ -350,12 +350,14 @@ def _campbell(args) -> int:
 def _modes(args) -> int:
     from ..output.folder import safe_name
     from ..scene import load_scene
-    from .modes import modes_to_folder
+    from .modes import modes_speeds, modes_to_folder
 
     scene = load_scene(args.scene, _changes(args))  # no run checks: a bladed disk is welcome
+    speeds = None if args.speeds is None else modes_speeds(args.speeds, scene)
     out = Path(args.out or f"{safe_name(scene.name)}-modes")
     t0 = time.perf_counter()
-    doc = modes_to_folder(scene, out, overwrite=args.overwrite, log=_log(args))
+    log = _log(args)
+    doc = modes_to_folder(scene, out, overwrite=args.overwrite, log=log, speeds=speeds)
     if not args.quiet:
         print(f"done in {time.perf_counter() - t0:.1f} s: {doc['message']}; {out / 'modes.csv'}")
     return 0
@@ -466,6 +468,11 @@ def build_parser() -> argparse.ArgumentParser:
     mp.add_argument("scene", help="scene file (.toml) or built-in scene name (femrub scenes)")
     mp.add_argument("--set", action="append", metavar="KEY=VALUE", help="change a key (repeatable)")
     mp.add_argument("-o", "--out", help="results folder (default NAME-modes)")
+    mp.add_argument(
+        "--speeds",
+        help="the disk's modes at these speeds, rad/s: START:STOP:STEP or A,B,C "
+        "(adds campbell.png; coincidences solved between speeds)",
+    )
     mp.add_argument("--overwrite", action="store_true", help="replace a finished result")
     mp.add_argument("--quiet", "-q", action="store_true", help="no progress output")
     mp.set_defaults(func=_modes)

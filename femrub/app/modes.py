@@ -10,13 +10,20 @@ tips (bore radius: the blades' largest tip radius + ``casing.ring.clearance``) i
 a sector of the same ``N`` and solved likewise, at rest; the rotation speeds of
 ``k Ω = ω_disk + ω_casing`` follow (:mod:`femrub.model.coincidence`).
 
+With ``speeds`` (``femrub modes --speeds A:B:STEP``, rad/s) the disk's modes are solved at
+every listed speed, the sector assembled once and its prestress solved speed after speed
+from the previous state (:func:`~femrub.model.cyclic.mode_tables_over_speeds`), the casing's
+once; the coincidence speeds are then the roots of ``k Ω − ω_disk,k(Ω) − ω_casing,k``
+between listed speeds (:func:`~femrub.model.coincidence.coincidences_over_speeds`) and the
+folder gains ``campbell.png``.
+
 A single-blade scene (no ``rotor.sectors``) gets its blade's ``rotor.families`` lowest
 modes at the scene's speed with the same prestress (``structure = blade``, no nodal
 diameter): the blade clamped at its root is the bladed disk of a rigid disk.
 
 Files (:mod:`femrub.output.modes`): ``modes.csv``, ``modes.png``, ``coincidences.csv``
-(with a casing ring) and ``summary.json`` (``status`` ``ok``, or ``failed`` / ``interrupted``
-with the stages finished kept, ``message``,
+(with a casing ring), ``campbell.png`` (with ``speeds``) and ``summary.json`` (``status``
+``ok``, or ``failed`` / ``interrupted`` with the stages finished kept, ``message``,
 ``timings`` per stage, sizes, the sector's geometry).
 """
 
@@ -30,7 +37,7 @@ from pathlib import Path
 import numpy as np
 
 from ..fem.material import Material
-from ..model.cyclic import ModeTable, cyclic_structure, mode_table
+from ..model.cyclic import ModeTable, cyclic_structure, mode_table, mode_tables_over_speeds
 from ..scene.spec import SceneError
 from . import translate as tr
 
@@ -38,6 +45,7 @@ __all__ = [
     "ModesResult",
     "casing_sector",
     "compute_modes",
+    "modes_speeds",
     "modes_to_folder",
     "rotor_sector",
     "write_modes_folder",
@@ -46,12 +54,34 @@ __all__ = [
 
 @dataclass
 class ModesResult:
-    """The mode tables of a scene (``{"disk" | "casing" | "blade": ModeTable}``), the
-    coincidence speeds, and what the computation reports (``info``: sizes, timings)."""
+    """The mode tables of a scene (``{"disk" | "casing" | "blade": ModeTable}``; the disk's
+    at the top speed of a sweep), the disk's tables at every speed of a sweep (``sweep``,
+    empty without one), the coincidence speeds, and what the computation reports (``info``:
+    sizes, timings)."""
 
     tables: dict
     coincidences: list = field(default_factory=list)
     info: dict = field(default_factory=dict)
+    sweep: list = field(default_factory=list)
+
+
+def modes_speeds(text: str, scene) -> np.ndarray:
+    """The speeds (rad/s) of ``femrub modes --speeds TEXT`` for ``scene``, refused in one line
+    unless two or more, increasing, not negative, and the scene a bladed disk."""
+    from .campbell import parse_speeds
+
+    speeds = parse_speeds(text)
+    if speeds.size < 2 or np.any(np.diff(speeds) <= 0.0) or speeds[0] < 0.0:
+        raise SceneError(
+            f"--speeds {text!r}: give two or more increasing speeds >= 0 (rad/s), "
+            "e.g. --speeds 0:3000:500"
+        )
+    if scene["rotor"].get("sectors") is None:
+        raise SceneError(
+            f"--speeds {text!r}: speeds are for a bladed disk (rotor.sectors); "
+            f"for a single blade use femrub campbell {scene.name} --speeds {text}"
+        )
+    return speeds
 
 
 def _blade_of(scene) -> dict:
@@ -119,22 +149,31 @@ def _solve(sector, material, omega, prestress, families, timings, stage, log):
     return structure, table
 
 
-def _bladed_disk(scene, log, result: ModesResult) -> ModesResult:
-    from ..model.coincidence import coincidences
-
+def _disk(scene, log, result: ModesResult, speeds):
+    """The disk's sector and its modes, at the scene's speed or at every one of ``speeds``."""
     timings, info = result.info.setdefault("timings", {}), result.info
     omega = float(scene["loads"]["rotation_speed"])
     method = tr.centrifugal_of(scene) or "off"
+    material, families = tr.material_of(scene), scene["rotor"]["families"]
     t0 = time.perf_counter()
     if log:
         log(f"mesh: bladed disk sector of {scene['rotor']['sectors']} ...")
     disk = rotor_sector(scene)
     timings["disk_mesh"] = time.perf_counter() - t0
-    structure, table = _solve(
-        disk, tr.material_of(scene), omega, method, scene["rotor"]["families"], timings, "disk", log
-    )
-    tables = result.tables
-    tables["disk"] = table
+    if speeds is None:
+        structure, table = _solve(disk, material, omega, method, families, timings, "disk", log)
+    else:
+        info["speeds"] = [float(w) for w in speeds]
+        t1 = time.perf_counter()
+        structure = cyclic_structure(disk, material, prestress=method)
+        t2 = time.perf_counter()
+        if log:
+            log(f"disk: {structure.free.size} free dofs per sector; modes at {speeds.size} speeds")
+        mode_tables_over_speeds(structure, material, speeds, families, done=result.sweep)
+        timings["disk_assembly"] = t2 - t1
+        timings["disk_speeds"] = time.perf_counter() - t2
+        table = result.sweep[-1]
+    result.tables["disk"] = table
     info["disk"] = {
         "sectors": disk.n_sectors,
         "tets": disk.mesh.n_tets,
@@ -142,24 +181,41 @@ def _bladed_disk(scene, log, result: ModesResult) -> ModesResult:
         "prestress": method,
         **{k: v for k, v in disk.info.items()},
     }
+    return disk
+
+
+def _casing(scene, log, result: ModesResult, tip_radius: float) -> None:
+    """The casing ring's sector and its modes at rest."""
+    timings, tables = result.info["timings"], result.tables
+    t0 = time.perf_counter()
+    ring = casing_sector(scene, tip_radius)
+    timings["casing_mesh"] = time.perf_counter() - t0
+    families = scene["casing"]["ring"]["families"]
+    rs, tables["casing"] = _solve(
+        ring, ring_material(scene), 0.0, "off", families, timings, "casing", log
+    )
+    d = ring.info["distortion"]
+    result.info["casing"] = {
+        "sectors": ring.n_sectors,
+        "tets": ring.mesh.n_tets,
+        "free_dofs": int(rs.free.size),
+        **{k: v for k, v in ring.info.items() if k != "distortion"},
+        "lobes": d.lobes,
+        "distortion": d.amplitude,
+    }
+
+
+def _bladed_disk(scene, log, result: ModesResult, speeds) -> ModesResult:
+    from ..model.coincidence import coincidences, coincidences_over_speeds
+
+    disk = _disk(scene, log, result, speeds)
     if scene["casing"]["ring"].get("thickness") is not None:
-        t0 = time.perf_counter()
-        ring = casing_sector(scene, disk.info["tip_radius"])
-        timings["casing_mesh"] = time.perf_counter() - t0
-        families = scene["casing"]["ring"]["families"]
-        rs, tables["casing"] = _solve(
-            ring, ring_material(scene), 0.0, "off", families, timings, "casing", log
-        )
-        d = ring.info["distortion"]
-        info["casing"] = {
-            "sectors": ring.n_sectors,
-            "tets": ring.mesh.n_tets,
-            "free_dofs": int(rs.free.size),
-            **{k: v for k, v in ring.info.items() if k != "distortion"},
-            "lobes": d.lobes,
-            "distortion": d.amplitude,
-        }
-        result.coincidences = coincidences(table, tables["casing"])
+        _casing(scene, log, result, disk.info["tip_radius"])
+        casing = result.tables["casing"]
+        if speeds is None:
+            result.coincidences = coincidences(result.tables["disk"], casing)
+        else:
+            result.coincidences = coincidences_over_speeds(result.sweep, casing)
     return result
 
 
@@ -182,26 +238,30 @@ def _single_blade(scene, log, result: ModesResult) -> ModesResult:
     return result
 
 
-def compute_modes(scene, log=None, into: ModesResult | None = None) -> ModesResult:
+def compute_modes(scene, log=None, into: ModesResult | None = None, speeds=None) -> ModesResult:
     """The modes of ``scene`` (module docstring): a bladed disk and its casing ring, or the
     single blade. ``into``: the result filled stage by stage (what a failed or interrupted
-    computation has finished stays in it)."""
+    computation has finished stays in it). ``speeds``: the disk's rotation speeds (rad/s,
+    increasing; :func:`modes_speeds`), ``None`` for the scene's speed only."""
     result = ModesResult({}) if into is None else into
     if scene["rotor"].get("sectors") is None:
+        if speeds is not None:
+            raise SceneError("speeds are for a bladed disk (rotor.sectors); use femrub campbell")
         return _single_blade(scene, log, result)
-    return _bladed_disk(scene, log, result)
+    return _bladed_disk(scene, log, result, None if speeds is None else np.asarray(speeds))
 
 
-def modes_to_folder(scene, out, *, overwrite: bool = False, log=None) -> dict:
-    """Claim ``out`` (kind ``modes``), compute the modes and write the folder; return the
-    summary. A computation that fails or is interrupted writes what it finished with
-    ``status`` ``failed`` or ``interrupted`` and its one-line ``message``, then raises."""
+def modes_to_folder(scene, out, *, overwrite: bool = False, log=None, speeds=None) -> dict:
+    """Claim ``out`` (kind ``modes``), compute the modes (at ``speeds``, rad/s, when given)
+    and write the folder; return the summary. A computation that fails or is interrupted
+    writes what it finished with ``status`` ``failed`` or ``interrupted`` and its one-line
+    ``message``, then raises."""
     from ..output.folder import claim
 
     result = ModesResult({})
     with claim(out, "modes", overwrite=overwrite):
         try:
-            compute_modes(scene, log, into=result)
+            compute_modes(scene, log, into=result, speeds=speeds)
         except BaseException as exc:
             status = "interrupted" if isinstance(exc, KeyboardInterrupt) else "failed"
             text = str(exc).strip().splitlines()
@@ -213,6 +273,8 @@ def modes_to_folder(scene, out, *, overwrite: bool = False, log=None) -> dict:
 
 def _message(result: ModesResult) -> str:
     parts = [f"{t.frequency_hz.size} {name} modes" for name, t in result.tables.items()]
+    if result.sweep:
+        parts[0] += f" at each of {len(result.sweep)} speeds"
     if "casing" in result.tables:
         parts.append(f"{len(result.coincidences)} coincidence speeds")
     return ", ".join(parts)
@@ -224,20 +286,33 @@ def write_modes_folder(
     """Write the files of the module docstring into ``out`` (already claimed); return the
     summary (``status``, ``message``: those of a computation that did not finish)."""
     from ..output.jsonfile import write_json
-    from ..output.modes import plot_modes, write_coincidences, write_modes
+    from ..output.modes import plot_campbell, plot_modes, write_coincidences, write_modes
 
     out = Path(out)
     t0 = time.perf_counter()
     files = ["modes.csv", "modes.png", "summary.json"]
-    write_modes(out / "modes.csv", result.tables)
+    blocks = [("disk", t) for t in result.sweep]
+    blocks += [(name, t) for name, t in result.tables.items() if not (blocks and name == "disk")]
+    write_modes(out / "modes.csv", blocks)
     if "casing" in result.tables and "disk" in result.tables:
         write_coincidences(out / "coincidences.csv", result.coincidences)
         files.insert(2, "coincidences.csv")
     omega = float(scene["loads"]["rotation_speed"])
+    speeds = [t.rotation_speed for t in result.sweep]
     title = f"{scene.name}: modes by nodal diameter"
     plot_modes(
-        out / "modes.png", result.tables, result.coincidences, rotation_speed=omega, title=title
+        out / "modes.png",
+        result.tables,
+        result.coincidences,
+        rotation_speed=speeds[-1] if speeds else omega,
+        speed_range=(speeds[0], speeds[-1]) if speeds else None,
+        title=title,
     )
+    if speeds:
+        title = f"{scene.name}: Campbell diagram by nodal diameter (rotating frame)"
+        casing = result.tables.get("casing")
+        plot_campbell(out / "campbell.png", result.sweep, casing, result.coincidences, title)
+        files.insert(-1, "campbell.png")
     timings = dict(result.info.get("timings", {}), output=time.perf_counter() - t0)
     summary = {
         "status": status,

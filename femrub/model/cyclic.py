@@ -25,13 +25,15 @@ The centrifugal load is cyclic-symmetric, so the static displacement is the ``k 
 solution of the sector: ``T_0ᵀ r(T_0 q) = 0``, solved once (``"linear"``: one solve;
 ``"nonlinear"``: Newton from the linear solution); its stress field, and hence the
 geometric stiffness assembled on the sector, repeats in every sector. Coriolis terms are
-left out, as for the single blade.
+left out, as for the single blade. Over a list of speeds (:func:`mode_tables_over_speeds`)
+the sector is assembled once and the static state at each speed is solved from the previous
+speed's, scaled by ``(Ω_i / Ω_{i−1})²`` (the centrifugal load grows as ``Ω²``).
 """
 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 import scipy.sparse as sp
@@ -51,7 +53,9 @@ __all__ = [
     "cyclic_structure",
     "harmonic_modes",
     "mode_table",
+    "mode_tables_over_speeds",
     "nodal_diameter_content",
+    "spinning",
 ]
 
 AXIS = (1.0, 0.0, 0.0)  # the machine axis x
@@ -178,13 +182,16 @@ def cyclic_projection(structure: CyclicStructure, k: int) -> sp.csr_matrix:
     return T
 
 
-def _prestress_state(basis, material, free, T0, omega, method):
-    """Static displacement at Ω (k = 0 on the sector) and the tangent on the free dofs."""
+def _prestress_state(basis, material, free, T0, omega, method, start=None):
+    """Static displacement at Ω (k = 0 on the sector) and the tangent on the free dofs.
+
+    Newton from ``start`` (m, every dof; zeros when ``None``); ``"linear"`` takes one step,
+    exact from any start since its residual is affine in ``u``."""
     lam, mu = lame_parameters(material.young, material.poisson, 3)
     linear = method == "linear"
     rho, w2 = float(material.rho), omega * omega
     MP = sp.csr_matrix(cf.spin_mass(basis, rho, AXIS))[free][:, free]
-    u = np.zeros(basis.N)
+    u = np.zeros(basis.N) if start is None else np.array(start, dtype=float)
 
     def tangent(u):
         return (
@@ -197,7 +204,8 @@ def _prestress_state(basis, material, free, T0, omega, method):
         )
         return T0.T @ r[free]
 
-    scale = float(np.linalg.norm(T0.T @ cf.centrifugal_force(basis, u, rho * w2, AXIS)[free]))
+    zero = np.zeros(basis.N)
+    scale = float(np.linalg.norm(T0.T @ cf.centrifugal_force(basis, zero, rho * w2, AXIS)[free]))
     for _ in range(1 if linear else 30):
         r = residual(u)
         if np.linalg.norm(r) <= 1e-10 * scale:
@@ -231,22 +239,41 @@ def cyclic_structure(
     """
     if prestress not in PRESTRESS_METHODS:
         raise ValueError(f"unknown prestress {prestress!r}; use one of {PRESTRESS_METHODS}")
-    omega = float(omega) if prestress != "off" else 0.0
     disc = discretise(sector.mesh, order=2)
     mats = assemble(disc, material)
     free = np.asarray(mats.free_u)
     left, right = _face_map(disc.basis_u, sector, free)
     static = np.zeros(disc.basis_u.N)
-    structure = CyclicStructure(
-        sector, mats.K, mats.M, free, left, right, omega, prestress, static, disc.basis_u
+    rest = CyclicStructure(
+        sector, mats.K, mats.M, free, left, right, 0.0, prestress, static, disc.basis_u
     )
+    return spinning(rest, material, omega)
+
+
+def spinning(rest: CyclicStructure, material, omega: float, start=None) -> CyclicStructure:
+    """The sector ``rest`` (assembled at rest) about its spinning equilibrium at Ω.
+
+    Solves ``T_0ᵀ r(T_0 q) = 0`` for the static state (module docstring) with the method
+    ``rest.prestress`` and replaces the stiffness by the tangent
+    ``K_T = K(u) + K_σ − Ω² M_P`` (N/m).
+
+    Parameters
+    ----------
+    rest : CyclicStructure
+        The sector at Ω = 0 (from :func:`cyclic_structure`).
+    material : Material
+        Its material.
+    omega : float
+        Ω (rad/s); ``rest`` itself when 0 or when ``rest.prestress`` is ``"off"``.
+    start : numpy.ndarray, optional
+        Static displacement (m, every dof) Newton starts from; zeros when ``None``.
+    """
+    omega = float(omega) if rest.prestress != "off" else 0.0
     if omega == 0.0:
-        return structure
-    T0 = cyclic_projection(structure, 0)
-    static, K = _prestress_state(disc.basis_u, material, free, T0, omega, prestress)
-    return CyclicStructure(
-        sector, K, mats.M, free, left, right, omega, prestress, static, disc.basis_u
-    )
+        return rest
+    T0 = cyclic_projection(rest, 0)
+    static, K = _prestress_state(rest.basis, material, rest.free, T0, omega, rest.prestress, start)
+    return replace(rest, K=K, omega=omega, static=static)
 
 
 def harmonic_modes(structure: CyclicStructure, k: int, n_modes: int):
@@ -303,6 +330,44 @@ def mode_table(structure: CyclicStructure, n_families: int) -> ModeTable:
         fam.append(np.arange(1, f.size + 1))
         freq.append(f)
     return ModeTable(np.concatenate(nd), np.concatenate(fam), np.concatenate(freq), structure.omega)
+
+
+def mode_tables_over_speeds(
+    rest: CyclicStructure, material, speeds, n_families: int, *, done=None
+) -> list[ModeTable]:
+    """:func:`mode_table` of the sector ``rest`` at every speed of ``speeds`` (rad/s).
+
+    The sector is assembled once (``rest``); the static state at ``Ω_i`` is solved by
+    :func:`spinning` from ``(Ω_i / Ω_{i−1})² u_{i−1}``, the previous speed's state scaled as
+    the centrifugal load ``∝ Ω²``.
+
+    Parameters
+    ----------
+    rest : CyclicStructure
+        The sector at rest, with its prestress method.
+    material : Material
+        Its material.
+    speeds : array_like
+        Rotation speeds Ω (rad/s), in the order solved.
+    n_families : int
+        Modes per nodal diameter.
+    done : list, optional
+        Each table is appended to it as soon as it is computed (what an interrupted sweep
+        finished stays there); the returned list is ``done`` when given.
+
+    Returns
+    -------
+    list of ModeTable
+        One per speed, its ``rotation_speed`` the listed Ω (also without prestress).
+    """
+    tables = [] if done is None else done
+    state, previous = None, 0.0
+    for omega in np.asarray(speeds, dtype=float):
+        start = None if state is None or previous == 0.0 else (omega / previous) ** 2 * state
+        structure = spinning(rest, material, omega, start)
+        tables.append(replace(mode_table(structure, n_families), rotation_speed=float(omega)))
+        state, previous = structure.static, structure.omega
+    return tables
 
 
 def nodal_diameter_content(vertex_displacement: np.ndarray, copies: np.ndarray, angle: float):

@@ -72,7 +72,7 @@ OUTPUTS = {
     "sweep": ("sweep.json", "scene.toml", "interaction.csv", "interaction.png", "runs"),
     "paper": ("summary.json", "runs", "fig*.png", "fig*.csv", "energy_*.png"),
     "periodic": ("summary.json", "branch.csv", "branch.png", "orbits"),
-    "modes": ("summary.json", "modes.csv", "modes.png", "coincidences.csv"),
+    "modes": ("summary.json", "modes.csv", "modes.png", "coincidences.csv", "campbell.png"),
 }
 #: the files of a run's VTK series (in ``vtk/``)
 VTK_FILES = ("rub_*.vtu", "rub.pvd", "*.tmp")
