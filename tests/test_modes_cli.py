@@ -242,7 +242,7 @@ def test_bad_speeds_are_refused_in_one_line_before_any_mesh(tmp_path, capsys, sp
     scene = tmp_path / "wheel.toml"
     scene.write_text(SCENE)
     out = tmp_path / "out"
-    assert main(["modes", str(scene), "--speeds", speeds, "-o", str(out), "-q"]) == 2
+    assert main(["modes", str(scene), f"--speeds={speeds}", "-o", str(out), "-q"]) == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and words in err
     assert not out.exists()

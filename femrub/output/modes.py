@@ -186,10 +186,10 @@ def plot_campbell(path, sweep, casing, found, title: str = "") -> None:
 
     speeds = np.array([t.rotation_speed for t in sweep])
     ks = np.unique(sweep[0].nodal_diameter)
-    cmap = plt.get_cmap("viridis")
+    cmap = plt.get_cmap("tab10")
 
     def colour(k):
-        return cmap(float(k) / max(1.0, float(ks.max())))
+        return cmap(int(k) % 10)
 
     fig, ax = plt.subplots(figsize=(9, 6))
     _disk_lines(ax, sweep, colour)
