@@ -13,7 +13,8 @@ objects of each stage of the pipeline (``docs/architecture.md``):
   :func:`casing_profile`, :class:`Concentric`, :class:`Lobed`, :class:`TwoLobePiollet`;
 * bladed disks and casing rings: :func:`bladed_disk_sector`, :func:`casing_ring_sector`,
   :func:`full_wheel`, :func:`cyclic_structure`, :func:`mode_table` (modes by nodal
-  diameter), :func:`coincidences` (``k Ω = ω_disk + ω_casing``);
+  diameter), :func:`mode_tables_over_speeds`, :func:`coincidences` (``k Ω = ω_disk +
+  ω_casing``), :func:`coincidences_over_speeds`;
 * models: :func:`bar_model`, :func:`solid_model`, :func:`build_rub` with :class:`RubConfig`,
   :func:`first_order_model`, :class:`FirstOrderModel` (Eqs. 8-9) and their parts;
 * reduction: :class:`ThermoelasticCraigBampton` (``reduce(n_uv, n_theta)``, Eqs. 10-15),
@@ -66,7 +67,9 @@ _LAZY = {
     "full_wheel": ".geometry.cyclic_sector",
     "cyclic_structure": ".model.cyclic",
     "mode_table": ".model.cyclic",
+    "mode_tables_over_speeds": ".model.cyclic",
     "coincidences": ".model.coincidence",
+    "coincidences_over_speeds": ".model.coincidence",
     # models
     "PAPER": ".cases.bar",
     "BarCase": ".cases.bar",
