@@ -239,3 +239,28 @@ def test_speeds_on_a_single_blade_point_to_femrub_campbell(tmp_path, capsys):
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "femrub campbell twisted-naca --speeds 0:1000:500" in err
     assert not out.exists()
+
+
+def test_a_sweep_that_fails_keeps_the_speeds_solved_marked_failed(tmp_path, monkeypatch, capsys):
+    """The prestress fails at the second speed: the first speed's block is written, the
+    folder marked failed with the one-line reason, no coincidences."""
+    import femrub.model.cyclic as cyclic
+
+    solve = cyclic.spinning
+
+    def no_convergence_above_12000(rest, material, omega, start=None):
+        if omega > 12000.0:
+            raise ValueError(f"Newton on the rotor's centrifugal prestress at Ω = {omega:g} rad/s")
+        return solve(rest, material, omega, start)
+
+    monkeypatch.setattr(cyclic, "spinning", no_convergence_above_12000)
+    scene = tmp_path / "wheel.toml"
+    scene.write_text(SCENE.replace("families = 2", "families = 1"))
+    out = tmp_path / "out"
+    assert main(["modes", str(scene), "--speeds", "10000,15000", "-o", str(out), "-q"]) == 2
+    assert "Ω = 15000 rad/s" in capsys.readouterr().err
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["status"] == "failed" and summary["speeds"] == [10000.0, 15000.0]
+    rows = _rows(out / "modes.csv")
+    assert [float(r["rotation_speed"]) for r in rows] == [10000.0] * 4
+    assert (out / "campbell.png").exists() and not (out / "coincidences.csv").exists()

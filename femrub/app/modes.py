@@ -300,9 +300,10 @@ def write_modes_folder(
     omega = float(scene["loads"]["rotation_speed"])
     speeds = [t.rotation_speed for t in result.sweep]
     title = f"{scene.name}: modes by nodal diameter"
+    shown = {"disk": result.sweep[-1], **result.tables} if result.sweep else result.tables
     plot_modes(
         out / "modes.png",
-        result.tables,
+        shown,
         result.coincidences,
         rotation_speed=speeds[-1] if speeds else omega,
         speed_range=(speeds[0], speeds[-1]) if speeds else None,

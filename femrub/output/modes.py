@@ -129,7 +129,8 @@ def plot_modes(
     ax.set_ylabel("natural frequency (Hz)")
     ax.set_title(title)
     ax.grid(alpha=0.3)
-    ax.legend(fontsize=7, loc="best")
+    if ax.get_legend_handles_labels()[0]:
+        ax.legend(fontsize=7, loc="best")
     if two:
         ax = axes[0, 1]
         k = np.array([c.nodal_diameter for c in found])
@@ -212,7 +213,8 @@ def plot_campbell(path, sweep, casing, found, title: str = "") -> None:
         handles.append(
             Line2D([], [], color="red", marker="o", mfc="none", ls="", label="k Ω = ω_d + ω_c")
         )
-    ax.set_xlim(speeds[0], speeds[-1])
+    if speeds[-1] > speeds[0]:
+        ax.set_xlim(speeds[0], speeds[-1])
     ax.set_ylim(0.0, top)
     ax.set_xlabel("rotation speed Ω (rad/s)")
     ax.set_ylabel("frequency in the rotating frame (Hz)")
