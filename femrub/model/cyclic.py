@@ -267,6 +267,11 @@ def spinning(rest: CyclicStructure, material, omega: float, start=None) -> Cycli
         Ω (rad/s); ``rest`` itself when 0 or when ``rest.prestress`` is ``"off"``.
     start : numpy.ndarray, optional
         Static displacement (m, every dof) Newton starts from; zeros when ``None``.
+
+    Returns
+    -------
+    CyclicStructure
+        ``rest`` with ``K`` the tangent, ``omega`` Ω and ``static`` the static state (m).
     """
     omega = float(omega) if rest.prestress != "off" else 0.0
     if omega == 0.0:

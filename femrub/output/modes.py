@@ -187,10 +187,12 @@ def plot_campbell(path, sweep, casing, found, title: str = "") -> None:
 
     speeds = np.array([t.rotation_speed for t in sweep])
     ks = np.unique(sweep[0].nodal_diameter)
-    cmap = plt.get_cmap("tab10")
+    many = ks.max() >= 10  # tab10 would repeat: a continuous map, one shade per k
 
     def colour(k):
-        return cmap(int(k) % 10)
+        if many:
+            return plt.get_cmap("turbo")(0.05 + 0.9 * float(k) / float(ks.max()))
+        return plt.get_cmap("tab10")(int(k))
 
     fig, ax = plt.subplots(figsize=(9, 6))
     _disk_lines(ax, sweep, colour)
@@ -207,11 +209,11 @@ def plot_campbell(path, sweep, casing, found, title: str = "") -> None:
             [c.disk_frequency_hz for c in hits],
             "o",
             mfc="none",
-            mec="red",
+            mec="black",
             ms=9,
         )
         handles.append(
-            Line2D([], [], color="red", marker="o", mfc="none", ls="", label="k Ω = ω_d + ω_c")
+            Line2D([], [], color="black", marker="o", mfc="none", ls="", label="k Ω = ω_d + ω_c")
         )
     if speeds[-1] > speeds[0]:
         ax.set_xlim(speeds[0], speeds[-1])
