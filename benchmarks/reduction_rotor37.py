@@ -7,7 +7,8 @@ more than 13 GB and 13 min, docs/reduction_3d.md), so the scene's reduced model 
 against reduced models 2x and 4x larger, all sub-bases of one reductor built at the 4x
 sizes with the scene's projection and thermal reduction. The full model is built without a
 stepper (:func:`femrub.app.simulation.build` with ``stepper=False``), through the model
-cache. Every model is stepped over one lobe passage (``t_end = 2π / (2 Ω)``) with the
+cache. Every model is stepped over one lobe passage (``t_end = 2π / (2 Ω)``, or the
+``scheme.t_end`` given with ``--set``) with the
 scene's scheme and step; differences (:func:`femrub.reduction.estimate.compare`, fields
 reconstructed on the mesh ``y = R X̄``) of the default and 2x models to the 4x one, and of
 the default to the 2x one: convergence shows as ``‖2x − 4x‖ ≪ ‖default − 4x‖``. The
@@ -20,6 +21,7 @@ time-discretisation error of the largest model, for scale.
 
 from __future__ import annotations
 
+import math
 import os
 import resource
 import time
@@ -131,6 +133,7 @@ def measure(name: str, sets: list[str], factors=FACTORS, log=print) -> dict:
         scene=name,
         sets=sets,
         t_end=t_end,
+        revolutions=t_end * scene["loads"]["rotation_speed"] / (2 * math.pi),
         h=scene["scheme"]["h"],
         window=window,
         n_full=full.n_dofs,
@@ -184,8 +187,8 @@ def table(r: dict) -> str:
             else " --factors " + ",".join(str(x["factor"]) for x in runs)
         )
         + f"`: built-in `{r['scene']}` (projection `{r['projection']}`, thermal "
-        f"`{r['thermal']}`, conduction `{r['conduction']}`), one lobe passage t_end = "
-        f"{r['t_end']:.4g} s, h = {r['h']:g} s. The full model ({r['n_full']} state dofs, "
+        f"`{r['thermal']}`, conduction `{r['conduction']}`), t_end = {r['t_end']:.4g} s "
+        f"({r['revolutions']:.3g} revolutions), h = {r['h']:g} s. The full model ({r['n_full']} state dofs, "
         f"{r['n_contacts']} contacts) cannot be stepped on this machine, so the default sizes "
         f"{f(runs[0]['sizes'])} are compared with {others}, sub-bases of one reductor built at "
         f"the {_name(big)} sizes ({t['reductor']:.0f} s wall, {t['reductor_cpu']:.0f} s CPU; "
