@@ -188,7 +188,8 @@ def table(r: dict) -> str:
         )
         + f"`: built-in `{r['scene']}` (projection `{r['projection']}`, thermal "
         f"`{r['thermal']}`, conduction `{r['conduction']}`), t_end = {r['t_end']:.4g} s "
-        f"({r['revolutions']:.3g} revolutions), h = {r['h']:g} s. The full model ({r['n_full']} state dofs, "
+        f"({r['revolutions']:.3g} revolutions), h = {r['h']:g} s. The full model "
+        f"({r['n_full']} state dofs, "
         f"{r['n_contacts']} contacts) cannot be stepped on this machine, so the default sizes "
         f"{f(runs[0]['sizes'])} are compared with {others}, sub-bases of one reductor built at "
         f"the {_name(big)} sizes ({t['reductor']:.0f} s wall, {t['reductor_cpu']:.0f} s CPU; "
