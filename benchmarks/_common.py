@@ -215,13 +215,10 @@ def render_sections(doc: Path, sections: dict[str, str]) -> None:
         write_between(doc, name, text)
 
 
-def marked(doc: Path, name: str) -> str:
-    """The text between the ``name`` markers of ``doc`` (stripped), or ``""`` without them."""
-    page = doc.read_text()
-    begin, end = f"<!-- {name}:begin -->", f"<!-- {name}:end -->"
-    if begin not in page:
-        return ""
-    return page[page.index(begin) + len(begin) : page.index(end)].strip()
+def command_line(script: str, argv=None) -> str:
+    """The command that ran ``benchmarks/<script>``: ``argv``, or this process's arguments."""
+    args = sys.argv[1:] if argv is None else list(argv)
+    return " ".join([f"python benchmarks/{script}", *args])
 
 
 def stamped_sections(data: dict, prefix: str) -> dict[str, str]:

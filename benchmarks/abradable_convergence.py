@@ -24,7 +24,7 @@ import time
 from pathlib import Path
 
 import numpy as np
-from _common import machine, read_json, render_sections, stamp, write_json
+from _common import command_line, machine, read_json, render_sections, stamp, write_json
 
 from femrub.analysis import make_stepper
 from femrub.app.cache import DEFAULT_LIMIT, ModelCache
@@ -131,9 +131,7 @@ def main(argv=None) -> int:
     p.add_argument("--no-rigid", action="store_true", help="skip the rigid-casing control")
     p.add_argument("--render-only", action="store_true", help="render docs from the JSON")
     a = p.parse_args(argv)
-    command = " ".join(
-        ["python benchmarks/abradable_convergence.py", *(sys.argv[1:] if argv is None else argv)]
-    )
+    command = command_line("abradable_convergence.py", argv)
     data = read_json(JSON) if JSON.exists() else {}
     if a.render_only:
         render_sections(DOC, render(data))

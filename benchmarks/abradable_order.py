@@ -26,13 +26,13 @@ from __future__ import annotations
 
 import math
 import os
-import sys
 import time
 from pathlib import Path
 
 import numpy as np
 from _common import (
     cli_scene,
+    command_line,
     ladder_arguments,
     machine,
     read_json,
@@ -231,9 +231,7 @@ def main(argv=None) -> int:
     where = machine()
     factors = [int(x) for x in a.factors.split(",")]
     rows = study(scene, factors, a.revolutions, [int(x) for x in a.n_angle.split(",")])
-    command = " ".join(
-        ["python benchmarks/abradable_order.py", *(sys.argv[1:] if argv is None else argv)]
-    )
+    command = command_line("abradable_order.py", argv)
     entry = {"command": command, "machine": where, "layout": a.layout, "rows": rows}
     entry["h"] = scene["scheme"]["h"]
     print(LAYOUTS[a.layout](rows))

@@ -39,7 +39,14 @@ import time
 from pathlib import Path
 
 import numpy as np
-from _common import machine, read_json, render_sections, stamped_sections, store_section
+from _common import (
+    command_line,
+    machine,
+    read_json,
+    render_sections,
+    stamped_sections,
+    store_section,
+)
 
 from femrub.analysis.reduction_check import lobe_passage
 from femrub.app.simulation import build
@@ -201,10 +208,7 @@ def main(argv=None):
     if a.render_only:
         render_sections(PAGE, stamped_sections(read_json(STORE), "reduction_3d"))
         return 0
-    args = sys.argv[1:] if argv is None else list(argv)
-    write_section = section_writer(
-        " ".join(["python benchmarks/reduction_convergence_3d.py", *args])
-    )
+    write_section = section_writer(command_line("reduction_convergence_3d.py", argv))
     if a.default:
         from default_vs_full import run_default
 

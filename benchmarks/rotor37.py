@@ -25,6 +25,7 @@ import sys
 from pathlib import Path
 
 import numpy as np
+from _common import stamp
 
 ROOT = Path(__file__).resolve().parents[1]
 PAGE = ROOT / "docs" / "rotor37.md"
@@ -91,17 +92,6 @@ def table(row: dict) -> str:
     return "\n".join(lines)
 
 
-def _stamp(machine: dict | None) -> str:
-    m = machine or {}
-    when = m.get("date") or "date not recorded"
-    commit = f"commit {m['commit']}" if m.get("commit") else "commit not recorded"
-    return (
-        f"*Measured by `python benchmarks/rotor37.py --docs` ({when}, {commit}; Python "
-        f"{m.get('python', '?')}, {m.get('cores', '?')} cores, load average "
-        f"{m.get('load_average', '?')} at its start).*"
-    )
-
-
 def _estimate(doc) -> str:
     if not isinstance(doc, dict) or doc.get("estimate") is None:
         return "—"
@@ -148,7 +138,7 @@ def render(data: dict[str, dict]) -> str:
         row = doc["results"]
         parts += [
             f"### `femrub run {scene}`",
-            _stamp(doc.get("machine")),
+            stamp("python benchmarks/rotor37.py --docs", doc.get("machine")),
             summary_table(row),
             "Radial (normal) displacement of each contact node (negative: pushed inwards by "
             "the casing), largest normal and friction force per node and fraction of the "
