@@ -159,7 +159,9 @@ def _rms(path, key):
     return float(np.sqrt(np.mean(x**2))) if x.size else None
 
 
-def run_points(scene_data: dict, source: str, base_dir: str, points: list, cache=None) -> list:
+def run_points(
+    scene_data: dict, source: str, base_dir: str, points: list, cache=None, done=None
+) -> list:
     """Run ``points`` (``[(changes, folder), ...]``) in order in one worker and return their
     rows; never raises: a failed point comes back as its row.
 
@@ -167,11 +169,17 @@ def run_points(scene_data: dict, source: str, base_dir: str, points: list, cache
     another rotation speed than the one before takes the previous point's model at its own
     speed (its parameter) instead of building one; any other point shares the mesh's bases,
     the assembled blocks and the reductor the points before it built. ``cache``: a
-    :class:`~femrub.app.cache.ModelCache` shared by the workers.
+    :class:`~femrub.app.cache.ModelCache` shared by the workers; ``done``: called after
+    each point (a progress bar).
     """
     base = Scene(scene_data, source, Path(base_dir))
     builds = SceneBuilds(cache)
-    return [_run_one(base.with_changes(changes), out, builds) for changes, out in points]
+    rows = []
+    for changes, out in points:
+        rows.append(_run_one(base.with_changes(changes), out, builds))
+        if done is not None:
+            done()
+    return rows
 
 
 def run_point(
@@ -336,10 +344,11 @@ def _compute(scene, todo, scheduler, workers, progress, cache=None) -> None:
     from tqdm.auto import tqdm
 
     if scheduler is None and workers == 0:  # in this process, the points in a row
-        bar, builds = tqdm(total=len(todo), disable=not progress, desc="sweep"), SceneBuilds(cache)
-        for r in todo:
-            r.update(_run_one(scene.with_changes(r["params"]), r["folder"], builds))
-            bar.update(1)
+        bar = tqdm(total=len(todo), disable=not progress, unit="point", desc="sweep")
+        points = [(r["params"], r["folder"]) for r in todo]
+        rows = run_points(*_here(scene), points, cache, done=lambda: bar.update(1))
+        for r, row in zip(todo, rows, strict=True):
+            r.update(row)
         bar.close()
         return
     client, cluster = _client(scheduler, workers)
@@ -349,9 +358,7 @@ def _compute(scene, todo, scheduler, workers, progress, cache=None) -> None:
         return {
             client.submit(
                 run_points,
-                scene.data,
-                scene.source,
-                str(scene.base_dir),
+                *_here(scene),
                 [(r["params"], r["folder"]) for r in chunk],
                 cache,
                 pure=False,
@@ -369,6 +376,11 @@ def _compute(scene, todo, scheduler, workers, progress, cache=None) -> None:
         client.close()
         if cluster is not None:
             cluster.close()
+
+
+def _here(scene) -> tuple:
+    """The scene as :func:`run_points` takes it (what a worker receives)."""
+    return scene.data, scene.source, str(scene.base_dir)
 
 
 def _batches(todo: list, cache, workers: int) -> list[list[list]]:
