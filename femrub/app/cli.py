@@ -441,25 +441,28 @@ def build_parser() -> argparse.ArgumentParser:
     cb.add_argument("--speeds", required=True, help="START:STOP:STEP (rad/s, stop included)")
     cb.add_argument("--modes", type=int, default=6, help="mode lines (default 6)")
     cb.add_argument(
-        "--samples", type=int, default=3, help="prestress solves, equally spaced in Ω² (default 3)"
+        "--samples",
+        type=int,
+        default=2,
+        help="first full modal samples, equally spaced in Ω² (default 2: at rest and the top)",
     )
     cb.add_argument(
-        "--no-check", action="store_true", help="skip the full solves checking the interpolation"
+        "--no-check", action="store_true", help="skip the residual bounds of the frequencies"
     )
     cb.add_argument(
         "--exact",
         action="store_true",
-        help="full prestress (warm-started) and eigen-solve at every speed, no interpolation",
+        help="full prestress (warm-started) and eigen-solve at every speed, no reduced basis",
     )
     cb.add_argument(
         "--tolerance",
         type=float,
-        help="largest relative frequency error of the self-check (default 0.005: 0.5 %%)",
+        help="largest relative frequency error bound accepted (default 0.005: 0.5 %%)",
     )
     cb.add_argument(
         "--max-samples",
         type=int,
-        help="most prestress samples the self-check refines to (default 12)",
+        help="most full modal samples the self-check adds up to (default 12)",
     )
     cb.set_defaults(func=_campbell)
     mp = sub.add_parser(

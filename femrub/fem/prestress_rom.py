@@ -1,0 +1,403 @@
+"""The centrifugal prestress along a list of speeds, on a reduced basis certified by residuals.
+
+The static equilibrium of :mod:`femrub.fem.prestress` at ``s = Ω²``::
+
+    r(u; s) = f_int(u) − s (f_0 + M_P u) = 0          (f_0: ∫ ρ P X · v dX per unit Ω²)
+
+is solved by Galerkin projection on a basis ``V`` (``u = V q``). For the Saint
+Venant–Kirchhoff material the strain is a polynomial of degree two in ``q``::
+
+    E(q) = Σ_i q_i L_i + Σ_{i≤j} q_i q_j Q_ij,   L_i = sym(∇V_i),
+    Q_ij = sym(∇V_iᵀ ∇V_j) (i < j),  Q_ii = ½ ∇V_iᵀ ∇V_i
+
+so the strain energy ``W(q) = ½ ∫ λ tr(E)² + 2 μ E : E`` is ``½ e(q)ᵀ Γ e(q)`` with the
+features ``e = (q_i, q_i q_j)`` and their Gram matrix ``Γ`` in the elasticity inner product
+(:class:`EnergyPolynomial`, computed once per basis on the quadrature points of
+:mod:`femrub.fem.quadrature`). The reduced force ``Jᵀ Γ e`` and tangent are then exact and
+cost microseconds, whatever the mesh.
+
+The basis is built greedily (:func:`prestress_path`): it starts from the linear static
+solution ``K⁻¹ f_0``; at a training speed the reduced solution's full residual ``r`` is
+measured by its correction ``d = K⁻¹ r`` in the energy norm, relative to the solution,
+``η = √|d · r| / √(u · K u)`` (``K`` the stiffness at rest: one factorisation, reused); while
+``η`` exceeds the tolerance the correction joins the basis (a Newton–Krylov step whose
+Krylov space is kept). Every requested speed is certified the same way at the end: one
+internal-force evaluation and one back-substitution per speed.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+try:  # numba is a dependency; the fallback keeps a broken install importable
+    import numba
+except ImportError:  # pragma: no cover
+    numba = None
+
+from ..blas import one_blas_thread
+from . import centrifugal as cf
+from .forms import lame_parameters
+from .quadrature import CHUNK, gradient_operator
+
+__all__ = [
+    "EnergyPolynomial",
+    "PrestressProblem",
+    "Reduced",
+    "energy_polynomial",
+    "enrich",
+    "initial_reduced",
+    "prestress_problem",
+]
+
+#: relative energy-norm correction ``η`` below which a reduced prestress is accepted
+TOLERANCE = 1e-8
+#: most basis vectors the greedy enrichment may use
+MAX_BASIS = 40
+
+
+def _layout(r: int, linear: bool):
+    """Feature indices, stable as the basis grows: vector ``k`` adds ``L_k`` then
+    ``Q_0k … Q_kk``. Returns ``(linear_index (r,), pair_i, pair_j, pair_index)``."""
+    lin, pi, pj, pidx, n = [], [], [], [], 0
+    for k in range(r):
+        lin.append(n)
+        n += 1
+        if not linear:
+            for i in range(k + 1):
+                pi.append(i), pj.append(k), pidx.append(n)
+                n += 1
+    return (
+        np.array(lin, dtype=int),
+        np.array(pi, dtype=int),
+        np.array(pj, dtype=int),
+        np.array(pidx, dtype=int),
+    )
+
+
+@dataclass(frozen=True)
+class EnergyPolynomial:
+    """``W(q) = ½ e(q)ᵀ Γ e(q)`` (J) on a basis of ``r`` vectors (module docstring)."""
+
+    gamma: np.ndarray
+    r: int
+    linear: bool
+
+    def _idx(self):
+        return _layout(self.r, self.linear)
+
+    def features(self, q: np.ndarray) -> np.ndarray:
+        lin, i, j, pair = self._idx()
+        e = np.empty(self.gamma.shape[0])
+        e[lin] = q
+        e[pair] = q[i] * q[j]
+        return e
+
+    def jacobian(self, q: np.ndarray) -> np.ndarray:
+        """``∂e/∂q`` (n_features × r)."""
+        lin, i, j, pair = self._idx()
+        eye = np.eye(self.r)
+        J = np.empty((self.gamma.shape[0], self.r))
+        J[lin] = eye
+        J[pair] = eye[i] * q[j][:, None] + eye[j] * q[i][:, None]
+        return J
+
+    def force(self, q: np.ndarray) -> np.ndarray:
+        """``∂W/∂q = Vᵀ f_int(V q)`` (N·m per unit coordinate)."""
+        return self.jacobian(q).T @ (self.gamma @ self.features(q))
+
+    def tangent(self, q: np.ndarray) -> np.ndarray:
+        """``∂²W/∂q² = Vᵀ K_T(V q) V`` without spin softening."""
+        J = self.jacobian(q)
+        K = J.T @ self.gamma @ J
+        if not self.linear:
+            _, i, j, pair = self._idx()
+            stress = (self.gamma @ self.features(q))[pair]
+            H = np.zeros((self.r, self.r))
+            np.add.at(H, (i, j), stress)
+            K += H + H.T
+        return K
+
+
+def _strain_features(Gt, lin, pi, pj, pair, phi):  # pragma: no cover (compiled)
+    """Fill ``phi`` (c, 6, n_features) with the Voigt components (shear × √2) of ``L_k``
+    and ``Q_ij`` from the gradients ``Gt`` (c, r, 3, 3); compiled by numba."""
+    r2 = np.sqrt(2.0)
+    for q in range(Gt.shape[0]):
+        for k in range(lin.size):
+            g = Gt[q, k]
+            f = lin[k]
+            phi[q, 0, f] = g[0, 0]
+            phi[q, 1, f] = g[1, 1]
+            phi[q, 2, f] = g[2, 2]
+            phi[q, 3, f] = r2 * 0.5 * (g[1, 2] + g[2, 1])
+            phi[q, 4, f] = r2 * 0.5 * (g[0, 2] + g[2, 0])
+            phi[q, 5, f] = r2 * 0.5 * (g[0, 1] + g[1, 0])
+        for p in range(pi.size):
+            a = Gt[q, pi[p]]
+            b = Gt[q, pj[p]]
+            scale = 0.5 if pi[p] == pj[p] else 1.0
+            f = pair[p]
+            for c in range(6):
+                x = (0, 1, 2, 1, 0, 0)[c]
+                y = (0, 1, 2, 2, 2, 1)[c]
+                v = 0.0
+                for m in range(3):
+                    v += a[m, x] * b[m, y] + a[m, y] * b[m, x]
+                phi[q, c, f] = scale * 0.5 * v * (1.0 if c < 3 else r2)
+
+
+if numba is not None:
+    _strain_features = numba.njit(cache=True, nogil=True)(_strain_features)
+
+
+def _features(G: np.ndarray, r: int, linear: bool) -> np.ndarray:
+    """Voigt strain features ``(c, 6, n_features)`` in the :func:`_layout` order from the
+    gradients ``G`` (c, 3, 3, r) of the basis vectors."""
+    lin, pi, pj, pair = _layout(r, linear)
+    phi = np.empty((G.shape[0], 6, lin.size + pair.size))
+    _strain_features(np.ascontiguousarray(np.moveaxis(G, 3, 1)), lin, pi, pj, pair, phi)
+    return phi
+
+
+def _gamma_rows(op, BV, lo, r, n_old, rows) -> None:
+    """Add the quadrature points ``lo … lo + CHUNK`` to the new rows of ``Γ``."""
+    n_feat = rows.shape[1]
+    hi = min(lo + CHUNK, op.n_points)
+    G = BV[9 * lo : 9 * hi].reshape(hi - lo, 3, 3, r)
+    phi = _features(G, r, op.linear)  # (c, 6, n_feat)
+    new = phi[..., n_old:] * op.w[lo:hi, None, None]
+    trace = phi[:, :3].sum(axis=1)
+    rows += 2.0 * op.mu * (new.reshape(-1, n_feat - n_old).T @ phi.reshape(-1, n_feat))
+    rows += op.lam * (new[:, :3].sum(axis=1).T @ trace)
+
+
+def energy_polynomial(op, BV: np.ndarray, previous: EnergyPolynomial | None = None):
+    """:class:`EnergyPolynomial` of the basis whose gradients at the quadrature points are
+    ``BV = B V`` (``op``: a :class:`~femrub.fem.quadrature.GradientOperator`); given the
+    ``previous`` polynomial of the first columns, only the new rows of ``Γ`` are computed."""
+    r = BV.shape[1]
+    n_feat = _layout(r, op.linear)[0].size + _layout(r, op.linear)[3].size
+    n_old = 0 if previous is None else previous.gamma.shape[0]
+    rows = np.zeros((n_feat - n_old, n_feat))
+    with one_blas_thread:  # tall-skinny products: threads only contend
+        for lo in range(0, op.n_points, CHUNK):
+            _gamma_rows(op, BV, lo, r, n_old, rows)
+    gamma = np.zeros((n_feat, n_feat))
+    if n_old:
+        gamma[:n_old, :n_old] = previous.gamma
+    gamma[n_old:] = rows
+    gamma[:, n_old:] = rows.T
+    return EnergyPolynomial(gamma, r, op.linear)
+
+
+class PrestressProblem:
+    """The full problem's pieces: ``B`` (:mod:`femrub.fem.quadrature`), ``f_0``, ``M_P``
+    and the stiffness at rest ``K0`` on the free dofs ``free``, with the factorisations
+    that precondition the corrections: ``(s, solve)`` pairs, the first at rest."""
+
+    def __init__(self, op, f0, MP, free, K0, solve):
+        self.op, self.f0, self.MP, self.free = op, f0, MP, free
+        self.K0 = K0
+        self.factors = [(0.0, solve)]
+
+    def add_factor(self, s: float, solve) -> None:
+        """A factorisation of the tangent at ``s = Ω²`` (preconditions nearby speeds)."""
+        self.factors.append((float(s), solve))
+
+    def nearest_solve(self, s: float):
+        return min(self.factors, key=lambda f: abs(f[0] - s))[1]
+
+    def residual(self, u: np.ndarray, s: float) -> np.ndarray:
+        """``r(u; s)`` on the free dofs (N)."""
+        r = self.op.internal_force(u) - s * (self.f0 + self.MP @ u)
+        return r[self.free]
+
+    def tangent(self, u: np.ndarray, s: float):
+        """``x ↦ K_T(u) x − s M_P x`` on the free dofs (one evaluation of the moduli)."""
+        op, free, n = self.op, self.free, self.op.B.shape[1]
+        D = op.moduli(op.gradients(u))
+        MP = self.MP[free][:, free]
+
+        def apply(x):
+            full = np.zeros(n)
+            full[free] = x
+            gx = (op.B @ full).reshape(-1, 9, 1)
+            return (op.B.T @ np.matmul(D, gx).reshape(-1))[free] - s * (MP @ x)
+
+        return apply
+
+    def correction(self, u: np.ndarray, s: float, *, newton: bool):
+        """``(η, d)``: the correction ``d ≈ K_T⁻¹ r`` (``newton``: preconditioned conjugate
+        gradients on the tangent to 1e-3, else the nearest factorisation alone) and its
+        relative energy norm ``η = √|d · r| / √(u · K0 u)``."""
+        r = self.residual(u, s)
+        solve = self.nearest_solve(s)
+        d = _pcg(self.tangent(u, s), r, solve) if newton else solve(r)
+        uf = u[self.free]
+        energy = float(uf @ (self.K0 @ uf))
+        return (math.sqrt(abs(float(d @ r)) / energy) if energy > 0 else 0.0), d
+
+
+def _pcg(apply, b, precondition, rtol: float = 1e-3, max_iter: int = 30) -> np.ndarray:
+    """Preconditioned conjugate gradients for ``A x = b`` (``A`` symmetric positive)."""
+    x = np.zeros_like(b)
+    r = b.copy()
+    z = precondition(r)
+    p = z.copy()
+    rz = float(r @ z)
+    rz0 = rz
+    for _ in range(max_iter):
+        Ap = apply(p)
+        curvature = float(p @ Ap)
+        if curvature <= 0.0:
+            break
+        alpha = rz / curvature
+        x += alpha * p
+        r -= alpha * Ap
+        z = precondition(r)
+        rz_new = float(r @ z)
+        if rz_new <= rtol**2 * rz0:
+            break
+        p = z + (rz_new / rz) * p
+        rz = rz_new
+    return x
+
+
+def prestress_problem(disc, material, method: str, K0, solve) -> PrestressProblem:
+    """The :class:`PrestressProblem` of ``disc`` (3D, clamped) for ``method`` = ``"linear"``
+    or ``"nonlinear"``; ``K0`` the stiffness at rest on its free dofs, ``solve`` its
+    factorisation's solve."""
+    basis = disc.basis_u
+    lam, mu = lame_parameters(material.young, material.poisson, 3)
+    op = gradient_operator(basis, lam, mu, linear=method == "linear")
+    rho, axis = float(material.rho), disc.blade.axis
+    f0 = cf.centrifugal_force(basis, np.zeros(basis.N), rho, axis)
+    MP = cf.spin_mass(basis, rho, axis).tocsr()
+    free = np.setdiff1d(np.arange(basis.N), np.asarray(disc.fixed_u, dtype=int))
+    return PrestressProblem(op, f0, MP, free, K0, solve)
+
+
+class Reduced:
+    """The Galerkin problem on a ``K0``-orthonormal basis ``V`` (free dofs); built from
+    ``previous`` (a basis of its first columns) only the new rows of ``Γ`` are computed."""
+
+    def __init__(self, problem: PrestressProblem, V: np.ndarray, previous=None):
+        self.problem, self.V = problem, V
+        full = np.zeros((problem.op.B.shape[1], V.shape[1]))
+        full[problem.free] = V
+        self.full = full
+        r0 = 0 if previous is None else previous.V.shape[1]
+        BV = problem.op.B @ full[:, r0:]
+        self.BV = BV if previous is None else np.hstack([previous.BV, BV])
+        prior = None if previous is None else previous.energy
+        self.energy = energy_polynomial(problem.op, self.BV, prior)
+        self.b = full.T @ problem.f0
+        self.Mr = full.T @ (problem.MP @ full)
+
+    def solve(self, s: float, q0: np.ndarray, max_iter: int = 40):
+        """Newton on ``Vᵀ r(V q; s) = 0`` from ``q0``: ``(q, converged)``."""
+        q = q0.copy()
+        for _ in range(max_iter):
+            R = self.energy.force(q) - s * (self.b + self.Mr @ q)
+            T = self.energy.tangent(q) - s * self.Mr
+            try:
+                dq = np.linalg.solve(T, R)
+            except np.linalg.LinAlgError:
+                return q, False
+            q -= dq
+            if not np.all(np.isfinite(q)):
+                return q, False
+            if np.linalg.norm(dq) <= 1e-13 * max(np.linalg.norm(q), 1e-300):
+                return q, True
+        return q, False
+
+    def path(self, s_list: np.ndarray) -> np.ndarray:
+        """``q`` at every ``s`` (ascending), by continuation from rest with halving."""
+        q, s_done, rate, out = np.zeros(self.V.shape[1]), 0.0, None, []
+        for s in s_list:
+            while s_done < s:
+                step = s - s_done
+                for _ in range(30):
+                    guess = q if rate is None else q + step * rate
+                    trial, ok = self.solve(s_done + step, guess)
+                    if ok:
+                        break
+                    step *= 0.5
+                else:
+                    raise ValueError(
+                        f"the reduced prestress did not converge at Ω = {math.sqrt(s):g} rad/s"
+                    )
+                rate = (trial - q) / step
+                q, s_done = trial, s_done + step
+            out.append(q.copy())
+        return np.array(out)
+
+    def displacement(self, q: np.ndarray) -> np.ndarray:
+        return self.full @ q
+
+    def enriched(self, d: np.ndarray):
+        """This problem with ``d`` added to the basis (``None`` when ``d`` is in it)."""
+        V = _orthonormal_add(self.V, d, self.problem.K0)
+        return None if V is None else Reduced(self.problem, V, self)
+
+
+def _orthonormal_add(V: np.ndarray, d: np.ndarray, K0) -> np.ndarray | None:
+    """``V`` with ``d`` added, ``K0``-orthonormal (twice Gram–Schmidt); ``None`` when ``d``
+    lies in the span."""
+    norm0 = math.sqrt(abs(float(d @ (K0 @ d))))
+    for _ in range(2):
+        d = d - V @ (V.T @ (K0 @ d))
+    norm = math.sqrt(abs(float(d @ (K0 @ d))))
+    if norm <= 1e-12 * norm0:
+        return None
+    return np.column_stack([V, d / norm])
+
+
+def initial_reduced(problem: PrestressProblem) -> Reduced:
+    """The basis of the linear static solution ``K0⁻¹ f_0``."""
+    u_lin = problem.factors[0][1](problem.f0[problem.free])
+    return Reduced(problem, _orthonormal_add(np.zeros((u_lin.size, 0)), u_lin, problem.K0))
+
+
+def enrich(reduced: Reduced, s_set, tol: float, *, newton=True, max_basis=MAX_BASIS, log=None):
+    """Enrich ``reduced`` until ``η ≤ tol`` at every ``s`` of ``s_set`` (ascending):
+    ``(reduced, q, η, d)`` (``d``: each speed's correction, free dofs). ``η`` is measured
+    with the nearest factorisation; each round the corrections of every speed above
+    ``tol`` join the basis (``newton``: the Newton corrections, by preconditioned
+    conjugate gradients on the tangent). Raises ``ValueError`` when ``max_basis``
+    vectors do not suffice."""
+    s_set = np.asarray(s_set, dtype=float)
+    while True:
+        q = reduced.path(s_set)
+        measured = [
+            reduced.problem.correction(reduced.displacement(x), s, newton=False)
+            for x, s in zip(q, s_set, strict=True)
+        ]
+        eta = np.array([m[0] for m in measured])
+        worst = int(np.argmax(eta))
+        if log:
+            log(
+                f"reduced prestress: basis {reduced.V.shape[1]}, largest η = {eta[worst]:.2e} "
+                f"at {math.sqrt(s_set[worst]):.6g} rad/s"
+            )
+        if eta[worst] <= tol:
+            return reduced, q, eta, [m[1] for m in measured]
+        grown = reduced
+        for k in np.argsort(-eta)[: max(max_basis - reduced.V.shape[1], 0)]:
+            if eta[k] <= tol:
+                break
+            d = measured[k][1]
+            if newton:
+                u = reduced.displacement(q[k])
+                d = reduced.problem.correction(u, s_set[k], newton=True)[1]
+            grown = grown.enriched(d) or grown
+        if grown is reduced:
+            raise ValueError(
+                f"the reduced prestress did not reach η = {tol:g} with "
+                f"{reduced.V.shape[1]} basis vectors (η = {eta[worst]:.2e} at "
+                f"{math.sqrt(s_set[worst]):.6g} rad/s)"
+            )
+        reduced = grown

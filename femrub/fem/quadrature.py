@@ -1,0 +1,169 @@
+"""The displacement gradient at the quadrature points, as one sparse operator.
+
+:func:`gradient_operator` returns ``B`` with ``(B u)[q] = ∇u(x_q)`` (the 3 × 3 gradient
+``g_ik = ∂u_i/∂X_k`` at every quadrature point ``q`` of every element, rows ordered
+``(q, i, k)``) and the quadrature weights ``w_q`` (``|J| × weight``, m³). Every form of
+:mod:`femrub.fem.centrifugal` is then a product with ``B`` and ``Bᵀ``; for the Saint
+Venant–Kirchhoff material (``F = I + g``, ``E = ½ (Fᵀ F − I)``, ``S = λ tr(E) I + 2 μ E``)::
+
+    f_int(u) = Bᵀ (w F S)                                    (internal force, N)
+    K_T(u) x = Bᵀ (w [F S'[δ] + g_x S]),  δ = sym(Fᵀ g_x),  g_x = B x   (tangent action)
+
+(``S'[δ] = λ tr(δ) I + 2 μ δ``). This is what makes the reduced prestress of
+:mod:`femrub.fem.prestress_rom` cheap: the projection ``Wᵀ K_T(u) W`` of the tangent on a
+basis ``W`` is ``(B W)ᵀ (w K_T-stress of B W)``, evaluated quadrature point by quadrature
+point without assembling a sparse matrix, and the same product applied to a few vectors
+gives the residuals of Ritz pairs on the full mesh.
+
+``linear=True`` gives the small-displacement forms of :mod:`femrub.fem.centrifugal`
+(``F = I``, ``E = sym(g)``, the geometric term ``g_x S`` kept).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.sparse as sp
+
+try:  # numba is a dependency; the fallback keeps a broken install importable
+    import numba
+except ImportError:  # pragma: no cover
+    numba = None
+
+__all__ = ["GradientOperator", "gradient_operator"]
+
+#: quadrature points per chunk of the products with many vectors
+CHUNK = 16384
+
+
+@dataclass(frozen=True)
+class GradientOperator:
+    """``B`` (``9 n_q × N``), weights ``w`` (``n_q``) and the Lamé parameters (Pa)."""
+
+    B: sp.csr_matrix
+    w: np.ndarray
+    lam: float
+    mu: float
+    linear: bool = False
+
+    @property
+    def n_points(self) -> int:
+        return self.w.size
+
+    def gradients(self, u: np.ndarray) -> np.ndarray:
+        """``∇u`` at every quadrature point, ``(n_q, 3, 3)``; ``u`` on all dofs."""
+        return (self.B @ u).reshape(-1, 3, 3)
+
+    def internal_force(self, u: np.ndarray) -> np.ndarray:
+        """``f_int(u) = ∫ F S : ∇v dX`` on all dofs (N)."""
+        g = np.ascontiguousarray(self.gradients(u))
+        P = np.empty_like(g)
+        _stress_kernel(g, self.w, self.lam, self.mu, self.linear, P)
+        return self.B.T @ P.reshape(-1)
+
+    def moduli(self, g: np.ndarray, w=None) -> np.ndarray:
+        """``w D`` (``n_q × 9 × 9``): the tangent's integrand ``g_xᵀ D g_y`` at the state of
+        the gradients ``g`` (module docstring; ``w``: the weights of those points)."""
+        g = np.ascontiguousarray(g)
+        D = np.empty((g.shape[0], 9, 9))
+        _moduli_kernel(g, self.w if w is None else w, self.lam, self.mu, self.linear, D)
+        return D
+
+    def tangent_action(self, u: np.ndarray, X: np.ndarray) -> np.ndarray:
+        """``K_T(u) X`` (no spin softening) for the columns of ``X`` (all dofs)."""
+        X = np.asarray(X, dtype=float).reshape(self.B.shape[1], -1)
+        m = X.shape[1]
+        D = self.moduli(self.gradients(u))
+        gx = (self.B @ X).reshape(-1, 9, m)
+        return self.B.T @ np.matmul(D, gx).reshape(-1, m)
+
+    def projected_tangent(self, u: np.ndarray, BW: np.ndarray) -> np.ndarray:
+        """``Wᵀ K_T(u) W`` (no spin softening) from ``BW = B @ W`` (``9 n_q × m``)."""
+        g = self.gradients(u)
+        m = BW.shape[1]
+        out = np.zeros((m, m))
+        for lo in range(0, self.n_points, CHUNK):
+            hi = min(lo + CHUNK, self.n_points)
+            gx = BW[9 * lo : 9 * hi]
+            D = self.moduli(g[lo:hi], self.w[lo:hi])
+            out += gx.T @ np.matmul(D, gx.reshape(-1, 9, m)).reshape(-1, m)
+        return 0.5 * (out + out.T)
+
+
+def _stress_kernel(g, w, lam, mu, linear, P):  # pragma: no cover (compiled)
+    """``P = w F S`` (first Piola–Kirchhoff stress × weight) at every point of ``g``."""
+    for q in range(g.shape[0]):
+        F, S = _point_state(g[q], lam, mu, linear)
+        for i in range(3):
+            for j in range(3):
+                P[q, i, j] = w[q] * (F[i, 0] * S[0, j] + F[i, 1] * S[1, j] + F[i, 2] * S[2, j])
+
+
+def _point_state(g, lam, mu, linear):  # pragma: no cover (compiled)
+    """``F``, ``S`` of one point (module docstring)."""
+    F = np.eye(3)
+    E = np.empty((3, 3))
+    for i in range(3):
+        for j in range(3):
+            E[i, j] = 0.5 * (g[i, j] + g[j, i])
+            if not linear:
+                F[i, j] += g[i, j]
+                E[i, j] += 0.5 * (g[0, i] * g[0, j] + g[1, i] * g[1, j] + g[2, i] * g[2, j])
+    S = 2.0 * mu * E
+    trace = E[0, 0] + E[1, 1] + E[2, 2]
+    for i in range(3):
+        S[i, i] += lam * trace
+    return F, S
+
+
+def _moduli_kernel(g, w, lam, mu, linear, D):  # pragma: no cover (compiled)
+    """``w D`` at every point of ``g``: ``g_xᵀ D g_y = λ tr(Fᵀ g_x) tr(Fᵀ g_y) + 2 μ
+    sym(Fᵀ g_x) : sym(Fᵀ g_y) + g_x S : g_y``, rows ``(i, k)`` and columns ``(j, l)`` of the
+    flattened gradients."""
+    for q in range(g.shape[0]):
+        F, S = _point_state(g[q], lam, mu, linear)
+        for i in range(3):
+            for k in range(3):
+                for j in range(3):
+                    for l in range(3):
+                        # λ tr(Fᵀg) tr(Fᵀh) + 2μ sym(Fᵀg):sym(Fᵀh) + g S : h, with
+                        # (Fᵀg)_kl = Σ_i F_ik g_il: the coefficient of g_ik h_jl
+                        v = lam * F[i, k] * F[j, l]
+                        v += mu * (
+                            F[i, l] * F[j, k]
+                            + (F[i, 0] * F[j, 0] + F[i, 1] * F[j, 1] + F[i, 2] * F[j, 2])
+                            * (1.0 if k == l else 0.0)
+                        )
+                        if i == j:
+                            v += S[k, l]
+                        D[q, 3 * i + k, 3 * j + l] = w[q] * v
+
+
+if numba is not None:
+    _point_state = numba.njit(cache=True, nogil=True)(_point_state)
+    _stress_kernel = numba.njit(cache=True, nogil=True)(_stress_kernel)
+    _moduli_kernel = numba.njit(cache=True, nogil=True)(_moduli_kernel)
+
+
+def gradient_operator(basis, lam: float, mu: float, *, linear: bool = False) -> GradientOperator:
+    """:class:`GradientOperator` of a vector scikit-fem ``basis`` (3D displacement).
+
+    Each local basis function of a vector element has one non-zero component ``i``; its
+    three derivatives ``∂φ/∂X_k`` at every quadrature point fill rows ``(q, i, k)`` of ``B``.
+    """
+    n_el, n_qp = basis.dx.shape
+    rows_of_point = 9 * np.arange(n_el * n_qp).reshape(n_el, n_qp)
+    rows, cols, vals = [], [], []
+    for a in range(basis.Nbfun):
+        grad = basis.basis[a][0].grad  # (3, 3, n_el, n_qp): ∂φ_i/∂X_k
+        i = int(np.argmax(np.abs(grad[:, :, 0, :]).sum(axis=(1, 2))))
+        for k in range(3):
+            rows.append((rows_of_point + 3 * i + k).ravel())
+            cols.append(np.repeat(basis.element_dofs[a], n_qp))
+            vals.append(grad[i, k].ravel())
+    B = sp.csr_matrix(
+        (np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
+        shape=(9 * n_el * n_qp, basis.N),
+    )
+    return GradientOperator(B, np.asarray(basis.dx, dtype=float).ravel(), lam, mu, linear)

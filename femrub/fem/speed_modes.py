@@ -1,0 +1,279 @@
+"""Modes of a spinning blade at many speeds, each frequency certified by its residual.
+
+For a list of rotation speeds, :func:`speed_modes` gives the lowest natural frequencies of
+``K_T(u(Ω), Ω) x = ω² M x`` (the prestressed tangent of :mod:`femrub.fem.centrifugal`) at
+every speed, without a full prestress or a full eigen-solve per speed:
+
+1. **prestress**: the static state ``u(Ω)`` of :mod:`femrub.fem.prestress_rom` (a reduced
+   basis built greedily, its full residual certified at every speed: ``η ≤ static_tol``);
+2. **Ritz**: the modes of the full tangent at a few *sample* speeds (first at rest and at
+   the largest speed), M-orthonormalised together, span ``W``; at every speed the small
+   problem ``Wᵀ K_T(u(Ω)) W y = λ y`` (its matrix evaluated on the quadrature points,
+   :mod:`femrub.fem.quadrature`) gives Ritz values ``λ_j ≥`` the exact ``λ_j`` (min–max);
+3. **certificate**: the residual of each Ritz pair on the full mesh, ``ρ_j = K_T x_j − λ_j M
+   x_j`` with ``‖x_j‖_M = 1``, bounds the distance to an exact eigenvalue by ``ε_j =
+   ‖ρ_j‖_{M⁻¹}`` (Krylov–Bogoliubov) and, with the gap ``δ_j`` to the neighbouring Ritz
+   values (less their ``ε``), by ``ε_j² / δ_j`` (Kato–Temple). The relative error bound of
+   the frequency ``f_j = √λ_j / 2π`` is ``1 − √(1 − min(ε_j, ε_j²/δ_j) / λ_j)``.
+   Where a bound exceeds the tolerance, the modes of the full tangent at the worst speed
+   become a sample (``W`` grows) and every speed is evaluated again, up to ``max_samples``.
+
+Coriolis terms are left out, as in the rest of femrub (docs/theory.md).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.linalg as sla
+
+from ..blas import one_blas_thread
+from . import centrifugal as cf
+from .eigen import lowest_modes
+from .linalg import sparse_lu
+from .prestress_rom import enrich, initial_reduced, prestress_problem
+
+__all__ = ["SpeedModes", "frequency_bounds", "speed_modes"]
+
+#: relative residual ``η`` of the reduced prestress below which it is accepted
+STATIC_TOLERANCE = 1e-5
+#: ``η`` of the first, coarse basis (before the tangent at the largest speed is factorised)
+COARSE_TOLERANCE = 0.1
+#: training speeds of the prestress basis, equally spaced in Ω²
+TRAINING = 5
+#: extra modes per sample in the Ritz basis
+EXTRA_MODES = 4
+
+
+@dataclass(frozen=True)
+class SpeedModes:
+    """Frequencies (Hz) at ``speeds`` (rad/s) and their certificates.
+
+    Attributes
+    ----------
+    speeds : (n,) rotation speeds (rad/s), as given.
+    frequencies : (n, modes) frequencies (Hz), ascending at each speed.
+    shapes : list of (m, modes) Ritz coordinates of the modes on the final basis ``W``.
+    bounds : (n, modes) relative error bounds of the frequencies (NaN: not checked).
+    eta : (n,) certified relative residual of the prestress.
+    displacements : (n, N) static displacement (m) on every dof.
+    sample_speeds : speeds whose full modes span ``W`` (rad/s).
+    static_basis, ritz_basis : sizes of the prestress basis and of ``W``.
+    """
+
+    speeds: np.ndarray
+    frequencies: np.ndarray
+    shapes: list
+    bounds: np.ndarray
+    eta: np.ndarray
+    displacements: np.ndarray
+    sample_speeds: list
+    static_basis: int
+    ritz_basis: int
+
+
+def frequency_bounds(lam: np.ndarray, res_k: np.ndarray, modes: int) -> np.ndarray:
+    """Relative error bounds of the frequencies of the ``modes`` lowest Ritz values ``lam``
+    (ascending, ``λ = ω²``) from ``res_k = ‖ρ_j‖_{K⁻¹}`` (``‖x_j‖_M = 1``; one more entry
+    than ``modes`` gives the last mode its upper gap). Module docstring, step 3: in the
+    pencil ``M x = μ K x`` (``μ = 1/λ``, ``‖y‖_K = 1``) the residual norm is
+    ``ε_j = ‖ρ_j‖_{K⁻¹} / λ_j^{3/2}``, the bound ``δ_j = min(ε_j, ε_j² / gap_j)``, and
+    ``λ_j ≥ λ'_j ≥ 1 / (μ_j + δ_j)``."""
+    lam = np.asarray(lam, dtype=float)
+    mu = 1.0 / np.where(lam > 0, lam, np.nan)
+    eps = np.asarray(res_k, dtype=float) / lam[: len(res_k)] ** 1.5
+    out = np.empty(modes)
+    for j in range(modes):
+        below = mu[j] - mu[j + 1] - eps[j + 1] if j + 1 < eps.size else 0.0
+        above = mu[j - 1] - mu[j] if j > 0 else np.inf
+        gap = min(below, above)
+        delta = min(eps[j], eps[j] ** 2 / gap) if gap > 0 else eps[j]
+        out[j] = 1.0 - math.sqrt(mu[j] / (mu[j] + delta)) if np.isfinite(mu[j]) else np.inf
+    return out
+
+
+class _Setting:
+    """The full problem at every speed: prestress basis, mass, the tangent's pieces."""
+
+    def __init__(self, disc, material, mats, method, log):
+        self.disc, self.material, self.mats, self.method, self.log = (
+            disc,
+            material,
+            mats,
+            method,
+            log,
+        )
+        lu0 = sparse_lu(mats.K, symmetric=True, what="stiffness")
+        self.solve0 = lu0.solve
+        self.problem = prestress_problem(disc, material, method, mats.K, lu0.solve)
+        self.free = self.problem.free
+        self.MPf = self.problem.MP[self.free][:, self.free].tocsr()
+
+    def full_tangent(self, u, s):
+        """The assembled tangent ``K_T(u) − s M_P`` on the free dofs."""
+        op = self.problem.op
+        K = cf.tangent_stiffness(self.disc.basis_u, u, op.lam, op.mu, op.linear)
+        return (K[self.free][:, self.free] - s * self.MPf).tocsr()
+
+    def sample(self, u, s, k):
+        """Lowest ``k`` modes of the full tangent at ``(u, s)`` (free dofs), and its solve."""
+        if s == 0.0:
+            solve, K = self.solve0, self.mats.K
+        else:
+            K = self.full_tangent(u, s)
+            solve = sparse_lu(K, symmetric=True, what="prestressed tangent").solve
+        return lowest_modes(K, self.mats.M, k, solve)[1], solve
+
+    def nearest_solve(self, s: float):
+        """The factorised tangent nearest in ``s = Ω²`` (the ``K⁻¹`` norm of residuals)."""
+        return self.problem.nearest_solve(s)
+
+    def prestress(self, speeds, static_tol):
+        """``(u (n, N), η (n,), corrections (n, N), basis size)`` at ``speeds`` (sorted,
+        > 0); the corrections ``d ≈ u_exact − u`` feed the frequency bounds."""
+        s_all = np.asarray(speeds) ** 2
+        s_train = np.linspace(0.0, s_all[-1], TRAINING + 1)[1:]
+        reduced = initial_reduced(self.problem)
+        reduced, q, _, _ = enrich(reduced, s_train, COARSE_TOLERANCE, newton=False, log=self.log)
+        u_max = reduced.displacement(q[-1])
+        self.max_sample = self.sample(u_max, s_train[-1], self.k)
+        self.problem.add_factor(s_train[-1], self.max_sample[1])
+        reduced = enrich(reduced, s_train, static_tol, log=self.log)[0]
+        reduced, q, eta, d = enrich(reduced, s_all, static_tol, log=self.log)
+        corrections = np.zeros((len(d), self.problem.op.B.shape[1]))
+        corrections[:, self.free] = d
+        return np.array([reduced.displacement(x) for x in q]), eta, corrections, reduced.V.shape[1]
+
+
+def speed_modes(
+    disc,
+    material,
+    mats,
+    method: str,
+    speeds,
+    *,
+    modes: int = 6,
+    samples: int = 2,
+    tolerance: float = 0.005,
+    static_tol: float = STATIC_TOLERANCE,
+    max_samples: int = 12,
+    check: bool = True,
+    log=None,
+) -> SpeedModes:
+    """Certified frequencies at ``speeds`` (rad/s) of ``disc`` with prestress ``method``
+    (``"linear"`` or ``"nonlinear"``); ``mats``: its mechanical matrices on the free dofs
+    (``K`` at rest, ``M``). ``tolerance``: the largest relative frequency error bound
+    accepted before a sample is added; ``samples``: the first samples, equally spaced in
+    ``Ω²`` from rest to the largest speed (at least 2). Module docstring."""
+    speeds = np.asarray(speeds, dtype=float)
+    setting = _Setting(disc, material, mats, method, log)
+    setting.k = min(modes + EXTRA_MODES, mats.n_u - 1)
+    top = float(speeds.max())
+    between = np.sqrt(np.linspace(0.0, top**2, max(int(samples), 2)))[1:-1]
+    moving = np.unique(np.concatenate([speeds[speeds > 0], between]))
+    u_all, eta_all = np.zeros((speeds.size, disc.basis_u.N)), np.zeros(speeds.size)
+    d_all = np.zeros_like(u_all)
+    first = [(0.0, setting.sample(None, 0.0, setting.k)[0])]
+    static_basis = 0
+    if moving.size:
+        u_m, eta_m, d_m, static_basis = setting.prestress(moving, static_tol)
+        where = np.searchsorted(moving, speeds)
+        moving_mask = speeds > 0
+        u_all[moving_mask] = u_m[where[moving_mask]]
+        eta_all[moving_mask] = eta_m[where[moving_mask]]
+        d_all[moving_mask] = d_m[where[moving_mask]]
+        for omega in between:
+            shapes, solve = setting.sample(u_m[np.searchsorted(moving, omega)], omega**2, setting.k)
+            setting.problem.add_factor(omega**2, solve)
+            first.append((float(omega), shapes))
+        first.append((top, setting.max_sample[0]))
+    ritz = _Ritz(setting, first)
+    while True:
+        lam, Y, bounds = ritz.evaluate(speeds, u_all, d_all, modes, check)
+        worst = int(np.nanargmax(bounds.max(axis=1))) if check else 0
+        if not check or bounds[worst].max() <= tolerance or len(ritz.samples) >= max_samples:
+            break
+        if log:
+            log(
+                f"Ritz bound {100 * bounds[worst].max():.3g} % at {speeds[worst]:.6g} rad/s: "
+                "its full modes join the basis"
+            )
+        shapes, solve = setting.sample(u_all[worst], speeds[worst] ** 2, setting.k)
+        setting.problem.add_factor(speeds[worst] ** 2, solve)
+        ritz = _Ritz(setting, ritz.samples + [(float(speeds[worst]), shapes)])
+    return SpeedModes(
+        speeds=speeds,
+        frequencies=np.sqrt(np.clip(lam[:, :modes], 0.0, None)) / (2 * np.pi),
+        shapes=[y[:, :modes] for y in Y],
+        bounds=bounds,
+        eta=eta_all,
+        displacements=u_all,
+        sample_speeds=[w for w, _ in ritz.samples],
+        static_basis=int(static_basis),
+        ritz_basis=int(ritz.W.shape[1]),
+    )
+
+
+class _Ritz:
+    """The Ritz basis ``W`` of the samples' modes (M-orthonormal, full numbering) and
+    its products with ``B`` and ``M_P``."""
+
+    def __init__(self, setting: _Setting, samples: list):
+        self.setting, self.samples = setting, samples
+        M = setting.mats.M
+        V = np.hstack([shapes for _, shapes in samples])
+        G = V.T @ (M @ V)
+        lam, Q = sla.eigh(0.5 * (G + G.T))
+        keep = lam > 1e-10 * lam.max()
+        Wf = V @ (Q[:, keep] / np.sqrt(lam[keep]))
+        op, free = setting.problem.op, setting.free
+        self.Wf = Wf
+        self.W = np.zeros((op.B.shape[1], Wf.shape[1]))
+        self.W[free] = Wf
+        self.BW = op.B @ self.W
+        self.MPr = Wf.T @ (setting.MPf @ Wf)
+
+    def evaluate(self, speeds, u_all, d_all, modes, check):
+        """Ritz values (n, m), coordinates and frequency bounds (n, modes) at every speed
+        (``d_all``: the prestress corrections, whose effect joins the bounds)."""
+        lams, Ys, bounds = [], [], []
+        with one_blas_thread:  # tall-skinny products: threads only contend
+            for omega, u, d in zip(speeds, u_all, d_all, strict=True):
+                lam, Y, bound = self._at(float(omega) ** 2, u, d, modes, check)
+                lams.append(lam), Ys.append(Y), bounds.append(bound)
+        return np.array(lams), Ys, np.array(bounds)
+
+    def _at(self, s, u, d, modes, check):
+        op, setting = self.setting.problem.op, self.setting
+        D = op.moduli(op.gradients(u))
+        m = self.W.shape[1]
+        DBW = np.matmul(D, self.BW.reshape(-1, 9, m)).reshape(-1, m)
+        Kr = self.BW.T @ DBW
+        Kr = 0.5 * (Kr + Kr.T) - s * self.MPr
+        lam, Y = sla.eigh(Kr)
+        if not check:
+            return lam, Y, np.full(modes, np.nan)
+        n_res = min(modes + 1, m)
+        KX = (op.B.T @ (DBW @ Y[:, :n_res]))[setting.free]
+        X = self.Wf @ Y[:, :n_res]
+        R = KX - s * (setting.MPf @ X) - (setting.mats.M @ X) * lam[:n_res]
+        solve = setting.nearest_solve(s)
+        KR = np.column_stack([solve(R[:, j]) for j in range(n_res)])
+        res_k = np.sqrt(np.maximum(np.sum(R * KR, axis=0), 0.0))
+        return (
+            lam,
+            Y,
+            frequency_bounds(lam[:n_res], res_k, modes) + self._static(u, d, lam, Y, modes),
+        )
+
+    def _static(self, u, d, lam, Y, modes):
+        """Relative frequency shift of the prestress correction ``d``, to first order:
+        ``|yᵀ Wᵀ (K_T(u + d) − K_T(u)) W y| / 2λ`` per mode."""
+        if not np.any(d):
+            return np.zeros(modes)
+        op = self.setting.problem.op
+        dK = op.projected_tangent(u + d, self.BW) - op.projected_tangent(u, self.BW)
+        y = Y[:, :modes]
+        return np.abs(np.sum(y * (dK @ y), axis=0)) / (2.0 * lam[:modes])
