@@ -150,20 +150,23 @@ def gradient_operator(basis, lam: float, mu: float, *, linear: bool = False) -> 
     """:class:`GradientOperator` of a vector scikit-fem ``basis`` (3D displacement).
 
     Each local basis function of a vector element has one non-zero component ``i``; its
-    three derivatives ``∂φ/∂X_k`` at every quadrature point fill rows ``(q, i, k)`` of ``B``.
+    three derivatives ``∂φ/∂X_k`` at every quadrature point fill rows ``(q, i, k)`` of ``B``,
+    which therefore holds as many entries per row as the element has nodes: ``B`` is built
+    row-major directly (no sort).
     """
     n_el, n_qp = basis.dx.shape
-    rows_of_point = 9 * np.arange(n_el * n_qp).reshape(n_el, n_qp)
-    rows, cols, vals = [], [], []
+    comps = [[], [], []]
     for a in range(basis.Nbfun):
         grad = basis.basis[a][0].grad  # (3, 3, n_el, n_qp): ∂φ_i/∂X_k
-        i = int(np.argmax(np.abs(grad[:, :, 0, :]).sum(axis=(1, 2))))
-        for k in range(3):
-            rows.append((rows_of_point + 3 * i + k).ravel())
-            cols.append(np.repeat(basis.element_dofs[a], n_qp))
-            vals.append(grad[i, k].ravel())
-    B = sp.csr_matrix(
-        (np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
-        shape=(9 * n_el * n_qp, basis.N),
-    )
+        comps[int(np.argmax(np.abs(grad[:, :, 0, :]).sum(axis=(1, 2))))].append(a)
+    n_loc = len(comps[0])
+    data = np.empty((n_el, n_qp, 3, 3, n_loc))
+    cols = np.empty((n_el, n_qp, 3, 3, n_loc), dtype=np.int64)
+    for i, local in enumerate(comps):
+        for j, a in enumerate(local):
+            data[:, :, i, :, j] = np.moveaxis(basis.basis[a][0].grad[i], 0, -1)
+            cols[:, :, i, :, j] = basis.element_dofs[a][:, None, None]
+    n_rows = 9 * n_el * n_qp
+    indptr = np.arange(0, n_rows * n_loc + 1, n_loc, dtype=np.int64)
+    B = sp.csr_matrix((data.ravel(), cols.ravel(), indptr), shape=(n_rows, basis.N))
     return GradientOperator(B, np.asarray(basis.dx, dtype=float).ravel(), lam, mu, linear)
