@@ -33,7 +33,7 @@ def _model_cache_folder(tmp_path_factory):
 
 @pytest.fixture(scope="session")
 def model_cache(_model_cache_folder):
-    """The session's :class:`~femrub.app.cache.ModelCache` (the folder the command-line runs
+    """The test run's :class:`~femrub.app.cache.ModelCache` (the folder the command-line runs
     use): tests whose property is a model's behaviour, not how it is built, share the
     assembled blocks, prestress and damping of the blades they have in common."""
     from femrub.app.cache import ModelCache
