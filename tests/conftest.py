@@ -32,6 +32,16 @@ def _model_cache_folder(tmp_path_factory):
 
 
 @pytest.fixture(scope="session")
+def model_cache(_model_cache_folder):
+    """The test run's :class:`~femrub.app.cache.ModelCache` (the folder the command-line runs
+    use): tests whose property is a model's behaviour, not how it is built, share the
+    assembled blocks, prestress and damping of the blades they have in common."""
+    from femrub.app.cache import ModelCache
+
+    return ModelCache(os.environ["FEMRUB_CACHE_DIR"])
+
+
+@pytest.fixture(scope="session")
 def shared_data() -> Path:
     """The read-only reference data folder; tests using it skip when it is absent."""
     path = Path(os.environ.get("FEMRUB_SHARED_DATA", ROOT.parent / "shared" / "data"))

@@ -35,6 +35,8 @@ damping_modes = [1, 2]
 name = "theta"
 h = 2e-5
 t_end = 0.15
+[outputs]
+plots = false
 """
 
 
@@ -194,6 +196,7 @@ COATED_BLADE = {
     "reduction.method": "none",
     "scheme.t_end": 1.5e-3,
     "outputs.vtk_stride": 0,
+    "outputs.plots": False,
 }
 
 
@@ -421,17 +424,18 @@ def test_steppers_of_one_coated_model_each_run_their_own_coating(tmp_path):
     scene = load_scene(str(path))
     model = build(scene, stepper=False).model
     make = lambda: make_stepper("theta", model, 2e-5, **scheme_options(scene))  # noqa: E731
+    t_end = 0.07  # the cut starts at 0.055 s (F = F_y + k d): 750 steps of cutting
     early = make()
     first = make()
-    reference = first.run(0.15)
+    reference = first.run(t_end)
     assert first.model.contact.wear.max_depth > 1e-7  # the reference run wore its coating
     assert model.contact.wear.max_depth == 0.0  # the model's: untouched
-    again = early.run(0.15)
+    again = early.run(t_end)
     assert again.status == reference.status == "ok"
     np.testing.assert_array_equal(again.impulse, reference.impulse)
     np.testing.assert_array_equal(early.model.contact.wear.depth, first.model.contact.wear.depth)
     a, b = make(), make()
-    for _ in range(a.steps_to(0.15)):
+    for _ in range(a.steps_to(t_end)):
         np.testing.assert_array_equal(b.step().X, a.step().X)
     depth = first.model.contact.wear.depth  # the run's compiled blocks: equal to round-off
     assert depth.max() > 1e-7
@@ -439,7 +443,7 @@ def test_steppers_of_one_coated_model_each_run_their_own_coating(tmp_path):
     np.testing.assert_allclose(a.X, first.X, rtol=0, atol=1e-9 * np.abs(first.X).max())
 
 
-def test_contacts_reading_a_coating_at_points_are_warned_with_their_width(tmp_path):
+def test_contacts_reading_a_coating_at_points_are_warned_with_their_width(tmp_path, model_cache):
     """Several contacts with ``footprint = 0`` (point reads, whose later-revolution wear
     keeps changing with the map): a warning names the width each contact stands for (their
     span around the casing over their number less one); one contact, or a footprint, none."""
@@ -448,9 +452,9 @@ def test_contacts_reading_a_coating_at_points_are_warned_with_their_width(tmp_pa
     from femrub.app.casing import footprint_warning
     from femrub.app.simulation import build
 
-    scene = load_scene("twisted-naca", BLADE)
+    scene = load_scene("twisted-naca", {**BLADE, "outputs.plots": False})
     with pytest.warns(UserWarning, match="contact.abradable.footprint = 0"):
-        sim = build(scene, stepper=False)
+        sim = build(scene, stepper=False, cache=model_cache)
     grid = sim.full.contact.wear.grid
     phi = np.sort(np.mod(grid.angles, 2 * np.pi))
     assert grid.angles.size > 1 and phi[-1] - phi[0] < np.pi  # one blade's tip: no wrap
@@ -460,7 +464,7 @@ def test_contacts_reading_a_coating_at_points_are_warned_with_their_width(tmp_pa
     grid.footprint = width
     assert footprint_warning(scene, grid) is None
     with pytest.warns(UserWarning, match="footprint"):  # summary.json lists it first
-        run_scene(scene, tmp_path / "blade")
+        run_scene(scene, tmp_path / "blade", cache=model_cache)  # the blade built above
     summary = json.loads((tmp_path / "blade" / "summary.json").read_text())
     assert "contact.abradable.footprint = 0" in summary["warnings"][0]
     path = tmp_path / "bar.toml"

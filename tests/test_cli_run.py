@@ -23,6 +23,8 @@ tip_force = { law = "sin", amplitude = 7.0 }
 h = 1e-4
 t_end = 0.05
 """
+#: the runs whose plots no test here looks at (test_run_writes_the_results_folder does)
+NO_PLOTS = ["--set", "outputs.plots=false"]
 
 
 @pytest.fixture()
@@ -62,13 +64,13 @@ def test_run_writes_the_results_folder(tiny, tmp_path, capsys):
 
 def test_rerun_refuses_to_overwrite_a_finished_result(tiny, tmp_path, capsys):
     out = tmp_path / "out"
-    assert main(["run", str(tiny), "-o", str(out), "-q"]) == 0
+    assert main(["run", str(tiny), "-o", str(out), "-q", *NO_PLOTS]) == 0
     before = (out / "summary.json").stat().st_mtime_ns
-    assert main(["run", str(tiny), "-o", str(out), "-q"]) == 2
+    assert main(["run", str(tiny), "-o", str(out), "-q", *NO_PLOTS]) == 2
     err = capsys.readouterr().err
     assert "already holds a finished result (status ok)" in err and "--overwrite" in err
     assert err.count("\n") == 1 and (out / "summary.json").stat().st_mtime_ns == before
-    assert main(["run", str(tiny), "-o", str(out), "-q", "--overwrite"]) == 0
+    assert main(["run", str(tiny), "-o", str(out), "-q", "--overwrite", *NO_PLOTS]) == 0
 
 
 def test_interrupted_run_keeps_partial_results(tiny, tmp_path, capsys, monkeypatch):
@@ -85,7 +87,7 @@ def test_interrupted_run_keeps_partial_results(tiny, tmp_path, capsys, monkeypat
     monkeypatch.setattr(
         ThetaMethod, "block_steps", False
     )  # step by step (blocks: test_theta_blocks)
-    assert main(["run", str(tiny), "-o", str(out), "-q"]) == 130
+    assert main(["run", str(tiny), "-o", str(out), "-q", *NO_PLOTS]) == 130
     err = capsys.readouterr().err
     assert "interrupted at t = " in err and str(out) in err and "partial results kept" in err
     s = json.loads((out / "summary.json").read_text())
@@ -94,9 +96,9 @@ def test_interrupted_run_keeps_partial_results(tiny, tmp_path, capsys, monkeypat
     assert 1 < len(rows) < 501 and float(rows[-1]["t [s]"]) < 0.05
     # an interrupted result is not a finished one: the same command starts again
     monkeypatch.setattr(ThetaMethod, "_step", real_step)
-    assert main(["run", str(tiny), "-o", str(out), "-q"]) == 0
+    assert main(["run", str(tiny), "-o", str(out), "-q", *NO_PLOTS]) == 0
     assert json.loads((out / "summary.json").read_text())["status"] == "ok"
-    assert main(["run", str(tiny), "-o", str(out), "-q"]) == 2
+    assert main(["run", str(tiny), "-o", str(out), "-q", *NO_PLOTS]) == 2
     assert "--overwrite" in capsys.readouterr().err
 
 
@@ -114,7 +116,7 @@ def test_failed_run_keeps_partial_results(tiny, tmp_path, capsys, monkeypatch):
     monkeypatch.setattr(
         ThetaMethod, "block_steps", False
     )  # step by step (blocks: test_theta_blocks)
-    assert main(["run", str(tiny), "-o", str(out), "-q"]) == 1
+    assert main(["run", str(tiny), "-o", str(out), "-q", *NO_PLOTS]) == 1
     err = capsys.readouterr().err
     assert "run failed" in err and "solver exploded" in err and str(out) in err
     assert json.loads((out / "summary.json").read_text())["status"] == "failed"
@@ -123,7 +125,12 @@ def test_failed_run_keeps_partial_results(tiny, tmp_path, capsys, monkeypatch):
 
 def test_stop_limit_ends_the_run(tiny, tmp_path):
     out = tmp_path / "out"
-    assert main(["run", str(tiny), "-o", str(out), "-q", "--set", "limits.contact_force=1.0"]) == 0
+    assert (
+        main(
+            ["run", str(tiny), "-o", str(out), "-q", *NO_PLOTS, "--set", "limits.contact_force=1.0"]
+        )
+        == 0
+    )
     s = json.loads((out / "summary.json").read_text())
     assert s["status"] == "diverged-physically" and "contact_force exceeded 1" in s["message"]
     assert s["t_reached"] < 0.05

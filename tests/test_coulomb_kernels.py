@@ -130,7 +130,7 @@ def test_compiled_and_python_kernels_agree():
         np.testing.assert_allclose(a["P"], b["P"], rtol=0, atol=1e-10 * scale)
 
 
-def test_theta_run_with_several_frictional_contacts_meets_coulomb():
+def test_theta_run_with_several_frictional_contacts_meets_coulomb(model_cache):
     """A frictional θ-method run through the compiled step: Coulomb checks of the run."""
     from femrub.app import build
     from femrub.scene import load_scene
@@ -150,7 +150,7 @@ def test_theta_run_with_several_frictional_contacts_meets_coulomb():
             "contact.reach": "all",
         },
     )
-    sim = build(scene, log=lambda s: None)
+    sim = build(scene, log=lambda s: None, cache=model_cache)
     res = sim.stepper.run(scene["scheme"]["t_end"])
     assert sim.model.contact.n >= 4
     assert res.status == "ok", res.message  # includes the Coulomb check at 1e-8

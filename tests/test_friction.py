@@ -190,7 +190,7 @@ def test_history_keys(tmp_path):
     assert s["coulomb_check"]["cone"] <= 1e-8
 
 
-def test_energy_and_heat_balance_close_on_a_full_blade_model(monkeypatch):
+def test_energy_and_heat_balance_close_on_a_full_blade_model(monkeypatch, model_cache):
     """Twisted NACA blade, full model (no reduction), μ = 0.15, frictional heat on."""
     from femrub.app import build
     from femrub.scene import load_scene
@@ -204,7 +204,7 @@ def test_energy_and_heat_balance_close_on_a_full_blade_model(monkeypatch):
             "outputs.vtk_stride": 0,
         },
     )
-    res = build(scene).stepper.run(scene["scheme"]["t_end"])
+    res = build(scene, cache=model_cache).stepper.run(scene["scheme"]["t_end"])
     assert res.status == "ok" and res.force.max() > 0
     e = res.energy
     assert res.energy_error() < 1e-8 and res.heat_error() < 1e-10

@@ -16,13 +16,13 @@ from femrub.contact.friction import coulomb_check
 
 
 @pytest.fixture(scope="module")
-def blade():
+def blade(model_cache):
     from femrub.app import build
     from femrub.app.scheme import scheme_options
     from femrub.scene import load_scene
 
     scene = load_scene("twisted-naca", SCENE)
-    sim = build(scene, log=lambda s: None)
+    sim = build(scene, log=lambda s: None, cache=model_cache)
     return sim.model, scene["scheme"], scheme_options(scene)
 
 

@@ -27,9 +27,9 @@ SCENE = {
 
 
 @pytest.mark.parametrize("thermal", ["off", "on"])
-def test_reduced_damped_frictional_rub_closes_energy_balance(tmp_path, thermal):
+def test_reduced_damped_frictional_rub_closes_energy_balance(tmp_path, thermal, model_cache):
     over = dict(SCENE, **{"physics.thermal": thermal, "reduction.n_theta": 8})
-    res, built = run_scene(load_scene("twisted-naca", over), tmp_path / "run")
+    res, built = run_scene(load_scene("twisted-naca", over), tmp_path / "run", cache=model_cache)
     e = res.energy
     assert e["friction_work"][-1] > 1.0  # the casing drags the blade: joules flow through
     assert e["damping_work"][-1] < 0.0
@@ -40,7 +40,7 @@ def test_reduced_damped_frictional_rub_closes_energy_balance(tmp_path, thermal):
     assert rate < 1e-3 * res.t[-1] ** -1, rate  # the reduction creates no energy
 
 
-def test_second_order_craig_bampton_is_the_classical_galerkin_model(tmp_path):
+def test_second_order_craig_bampton_is_the_classical_galerkin_model(tmp_path, model_cache):
     """``projection = "second-order"``: M̄ = TᵀMT, K̄ = TᵀKT, C̄ = TᵀCT with T = [I 0; Ψ Φ]
     on u and v alike; the damped frictional rub closes its energy balance."""
     import scipy.sparse as sp
@@ -49,7 +49,7 @@ def test_second_order_craig_bampton_is_the_classical_galerkin_model(tmp_path):
 
     over = dict(SCENE, **{"physics.thermal": "off", "reduction.n_theta": 0})
     over["reduction.projection"] = "second-order"
-    res, built = run_scene(load_scene("twisted-naca", over), tmp_path / "run")
+    res, built = run_scene(load_scene("twisted-naca", over), tmp_path / "run", cache=model_cache)
     assert res.energy_error() < 1e-6, res.energy_error()
     full = built.full
     red = ThermoelasticCraigBampton(full, 8, 0, projection="second-order")

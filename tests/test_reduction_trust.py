@@ -79,7 +79,7 @@ def test_reduced_matches_full_box(box):
     assert X[:, full.layout.t].min() > -0.5
 
 
-def test_too_small_basis_is_inaccurate(tmp_path):
+def test_too_small_basis_is_inaccurate(tmp_path, model_cache):
     scene = load_scene(
         "twisted-naca",
         {
@@ -91,7 +91,7 @@ def test_too_small_basis_is_inaccurate(tmp_path):
             "outputs.plots": False,
         },
     )
-    res, built = run_scene(scene, tmp_path / "run")
+    res, built = run_scene(scene, tmp_path / "run", cache=model_cache)
     doc = json.loads((tmp_path / "run" / "summary.json").read_text())
     err = doc["reduction_error"]
     assert doc["status"] == res.status == "inaccurate"
@@ -103,7 +103,7 @@ def test_too_small_basis_is_inaccurate(tmp_path):
     assert "estimated error" in text and "EXCEEDS tolerance 5 %" in text
 
 
-def test_auto_picks_sizes_from_the_estimate():
+def test_auto_picks_sizes_from_the_estimate(model_cache):
     from femrub.app.simulation import build
 
     def built(tol):
@@ -117,7 +117,7 @@ def test_auto_picks_sizes_from_the_estimate():
                 "outputs.vtk_stride": 0,
             },
         )
-        return build(scene).report["reduction"]
+        return build(scene, cache=model_cache).report["reduction"]
 
     loose, tight = built(0.9), built(0.02)
     assert loose["error"]["estimate"] <= 0.45
@@ -127,7 +127,7 @@ def test_auto_picks_sizes_from_the_estimate():
     assert all(t["estimate"] > 0.01 for t in tight["error"]["tried"][:-1])
 
 
-def test_default_reduction_matches_full_twisted_naca():
+def test_default_reduction_matches_full_twisted_naca(model_cache):
     """The README's 3D path, reduced as `femrub run` does (auto sizes, default projection
     "static-mass"), against the same scene unreduced: final fields, contact temperature,
     balances (docs/reduction_3d.md; with "petrov-galerkin" the final displacement misses
@@ -135,13 +135,15 @@ def test_default_reduction_matches_full_twisted_naca():
     from femrub.app.simulation import build
 
     changes = {"scheme.t_end": 0.004, "outputs.vtk_stride": 0}
-    sim = build(load_scene("twisted-naca", changes))
+    sim = build(load_scene("twisted-naca", changes), cache=model_cache)
     rep = sim.report["reduction"]
     assert rep["projection"] == "static-mass" and rep["method"] == "auto"
     assert rep["error"]["estimate"] <= rep["error"]["tolerance"]
     res = sim.stepper.run(0.004, store_every=400)
     X = sim.reductor.reconstruct(res.states, rep["n_uv"], rep["n_theta"])
-    fsim = build(load_scene("twisted-naca", {**changes, "reduction.method": "none"}))
+    fsim = build(
+        load_scene("twisted-naca", {**changes, "reduction.method": "none"}), cache=model_cache
+    )
     ref = fsim.stepper.run(0.004, store_every=400)
     e = compare(res, ref, X, ref.states, field_norms(fsim.full), 0.0)
     for k in ("displacement_end", "temperature_end", "contact_temperature", "displacement"):

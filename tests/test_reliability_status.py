@@ -20,6 +20,8 @@ from femrub.output.verdict import assess
 from femrub.scene import SceneError, load_scene, loads_scene
 
 BAR = bar_scene("bar", 10, 0.4)
+#: the command-line runs here are judged by their summary.json: no plots drawn
+NO_PLOTS = ["--set", "outputs.plots=false"]
 
 
 def test_reduced_run_with_an_open_energy_balance_is_inaccurate():
@@ -52,7 +54,7 @@ def test_physical_limits_are_on_without_a_limits_table(tmp_path):
     (tmp_path / "bar.toml").write_text(
         BAR.replace("heat_coefficient = 3.0", "heat_coefficient = 9.0")
     )
-    assert main(["run", str(tmp_path / "bar.toml"), "-o", str(out), "-q"]) == 0
+    assert main(["run", str(tmp_path / "bar.toml"), "-o", str(out), "-q", *NO_PLOTS]) == 0
     s = json.loads((out / "summary.json").read_text())
     assert s["status"] == "diverged-physically" and "tip_temperature exceeded 1500" in s["message"]
     # a scene's own limit wins over the default
@@ -63,11 +65,11 @@ def test_physical_limits_are_on_without_a_limits_table(tmp_path):
 def test_coarse_steps_on_the_paper_scene_are_not_silently_ok(tmp_path):
     """h = 5e-3 s: 2 steps per contact episode, inaccurate; h = 1e-3 s warns."""
     out = tmp_path / "h5e-3"
-    assert main(["run", "paper", "--set", "scheme.h=5e-3", "-o", str(out), "-q"]) == 0
+    assert main(["run", "paper", "--set", "scheme.h=5e-3", "-o", str(out), "-q", *NO_PLOTS]) == 0
     s = json.loads((out / "summary.json").read_text())
     assert s["status"] == "inaccurate" and "use scheme.h <= 0.0005 s" in s["message"]
     out = tmp_path / "h1e-3"
-    assert main(["run", "paper", "--set", "scheme.h=1e-3", "-o", str(out), "-q"]) == 0
+    assert main(["run", "paper", "--set", "scheme.h=1e-3", "-o", str(out), "-q", *NO_PLOTS]) == 0
     s = json.loads((out / "summary.json").read_text())
     assert len(s["warnings"]) == 1 and "use scheme.h <= 0.0004 s" in s["warnings"][0]
 

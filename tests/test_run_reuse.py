@@ -110,7 +110,8 @@ def test_run_scene_steps_once(tmp_path, monkeypatch):
         return original(self, *a, **kw)
 
     monkeypatch.setattr(runnable.ThetaMethod, "run", counted)
-    res, built = run_scene(load_scene("twisted-naca", SMALL), tmp_path / "run")
+    scene = load_scene("twisted-naca", {**SMALL, "outputs.plots": False})
+    res, built = run_scene(scene, tmp_path / "run")
     s = json.loads((tmp_path / "run/summary.json").read_text())
     # the estimate's reference, its run at the chosen sizes (the run) and possibly a twin
     assert len(calls) in (2, 3) and all(c > 0 for c in calls)
@@ -164,15 +165,24 @@ def test_builds_in_a_row_keep_the_discretisation(tmp_path):
     assert not any("discretisation kept" in n for n in notes)  # another mesh
 
 
+PROBE = {"name": "tip", "node": 5, "quantity": "displacement", "component": "radial"}
+
+
+@pytest.fixture(scope="module")
+def fresh_faster():
+    """The probed small scene at 1650 rad/s, built from nothing (no cache, no kept model)."""
+    scene = load_scene("twisted-naca", {**SMALL, "outputs.probes": [PROBE]})
+    return build(scene.with_changes({"loads.rotation_speed": "1650 rad/s"}))
+
+
 @pytest.mark.parametrize("cached", [False, True], ids=["no-cache", "cache"])
-def test_a_point_at_another_speed_is_the_model_at_that_speed(tmp_path, cached):
+def test_a_point_at_another_speed_is_the_model_at_that_speed(tmp_path, cached, fresh_faster):
     """The next point of a speed sweep takes the previous point's model at its own speed (a
     parameter): no mesh, assembly or bases built; the same model and run as a fresh build."""
     from femrub.app.cache import ModelCache
     from femrub.app.simulation import SceneBuilds
 
-    probe = {"name": "tip", "node": 5, "quantity": "displacement", "component": "radial"}
-    scene = load_scene("twisted-naca", {**SMALL, "outputs.probes": [probe]})
+    scene = load_scene("twisted-naca", {**SMALL, "outputs.probes": [PROBE]})
     faster = scene.with_changes({"loads.rotation_speed": "1650 rad/s"})
     builds, notes = SceneBuilds(ModelCache(tmp_path / "c") if cached else None), []
     first = builds.build(scene)
@@ -183,7 +193,7 @@ def test_a_point_at_another_speed_is_the_model_at_that_speed(tmp_path, cached):
     assert not any(w in n for n in notes for w in ("assembly loaded", "assembly stored", "mesh"))
     assert sim.report["reduction"]["bases"].startswith("reused")
     assert sim.model.parameters["rotation_speed"] == 1650.0
-    fresh = build(faster)
+    fresh = fresh_faster
     assert "parametric" not in fresh.report
     assert sim.model.n_dofs == fresh.model.n_dofs
     np.testing.assert_array_equal(sim.full.B.toarray(), fresh.full.B.toarray())

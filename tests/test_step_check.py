@@ -113,7 +113,7 @@ def test_a_coated_run_is_checked_against_a_fresh_coating(tmp_path):
 
     path = tmp_path / "bar.toml"
     path.write_text(SCENE.format(e=50e-6))
-    scene = load_scene(str(path), {"scheme.step_check": True, "scheme.t_end": 0.12})
+    scene = load_scene(str(path), {"scheme.step_check": True, "scheme.t_end": 0.06})
     err = build(scene).report["time_step"]
     assert err["status_reference"] == "ok"
     assert err["estimate"] < 0.05  # a quasi-static cut: converged in h

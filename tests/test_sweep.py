@@ -23,6 +23,8 @@ tip_force = { law = "sin", amplitude = 7.0 }
 [scheme]
 h = 2e-4
 t_end = 0.02
+[outputs]
+plots = false
 """
 
 

@@ -6,7 +6,7 @@ round-off, with the energy balance, and the same code must run as Python under
 ``NUMBA_DISABLE_JIT=1``.
 """
 
-import json
+import pickle
 from pathlib import Path
 
 import numpy as np
@@ -65,12 +65,12 @@ def test_one_contact_blocks_equal_the_steps(rule):
 
 
 @pytest.fixture(scope="module")
-def naca():
+def naca(model_cache):
     from femrub.app import build
     from femrub.scene import load_scene
 
     scene = load_scene("twisted-naca", NACA)
-    return build(scene, log=lambda s: None), scene
+    return build(scene, log=lambda s: None, cache=model_cache), scene
 
 
 def test_frictional_blocks_equal_the_steps(naca):
@@ -107,27 +107,31 @@ def test_a_history_dependent_contact_keeps_the_per_step_path():
 
 
 _CHILD = """
-import json, numpy as np, femrub as fr
+import json, pickle
+import femrub as fr
 from femrub.cases.bar import bar_model
-from femrub.app import build
-from femrub.app.scheme import scheme_options
-from femrub.scene import load_scene
 from femrub.analysis import make_stepper
 from femrub.contact.jit import compiled
 r = fr.ThetaMethod(bar_model(), 1e-4, activation="paper").run(0.05)
-scene = load_scene("twisted-naca", json.loads(%r))
-sim = build(scene, log=lambda s: None)
-s = scene["scheme"]
-st = make_stepper(s["name"], sim.model, s["h"], **scheme_options(scene))
-f = st.run(s["t_end"])
+d = pickle.load(open(%r, "rb"))
+st = make_stepper(d["scheme"]["name"], d["model"], d["scheme"]["h"], **d["opts"])
+f = st.run(d["scheme"]["t_end"])
 print(json.dumps({"jit": compiled(), "kind": st._block_kind, "bar": r.impulse.tolist(),
                   "P": f.impulse.tolist(), "Pt": f.friction_force.tolist()}))
 """
 
 
 @pytest.mark.skipif(not compiled(), reason="kernels not compiled (NUMBA_DISABLE_JIT)")
-def test_blocks_run_as_python_without_jit():
-    code = _CHILD % json.dumps(NACA)
+def test_blocks_run_as_python_without_jit(naca, tmp_path):
+    """The bar and the frictional blade (the model built here, pickled) stepped in blocks by
+    two fresh interpreters, numba off and on."""
+    from femrub.app.scheme import scheme_options
+
+    sim, scene = naca
+    path = tmp_path / "model.pkl"
+    model = {"model": sim.model, "scheme": scene["scheme"], "opts": scheme_options(scene)}
+    path.write_bytes(pickle.dumps(model))
+    code = _CHILD % str(path)
     py, jit = child_json(code, False), child_json(code, True)
     assert not py["jit"] and jit["jit"] and py["kind"] == jit["kind"] == "friction"
     _close(np.array(py["bar"]), np.array(jit["bar"]), 1e-12)
