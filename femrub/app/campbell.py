@@ -9,7 +9,7 @@ material, lumping; no contact), then:
    at every requested speed on a reduced basis whose full residual is certified at each
    speed (:mod:`femrub.fem.prestress_rom`);
 2. the lowest ``modes + 4`` modes of the full prestressed tangent at ``samples`` speeds
-   (equally spaced in ``Ω²``: by default at rest and at the largest speed),
+   (equally spaced in ``Ω²``: by default at rest, halfway in ``Ω²`` and at the largest speed),
    M-orthonormalised together, span a Ritz basis ``W``; at every speed the small problem
    ``Wᵀ K_T(Ω) W y = ω² y`` (the tangent of that speed's prestress, projected exactly) gives
    the frequencies, and each line follows its mode from one speed to the next by the
@@ -131,7 +131,7 @@ def campbell(
     speeds,
     *,
     modes: int = 6,
-    samples: int = 2,
+    samples: int = 3,
     check: bool = True,
     tolerance: float = TOLERANCE,
     max_samples: int = MAX_SAMPLES,

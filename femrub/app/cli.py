@@ -443,8 +443,8 @@ def build_parser() -> argparse.ArgumentParser:
     cb.add_argument(
         "--samples",
         type=int,
-        default=2,
-        help="first full modal samples, equally spaced in Ω² (default 2: at rest and the top)",
+        default=3,
+        help="first full modal samples, equally spaced in Ω² from rest to the top (default 3)",
     )
     cb.add_argument(
         "--no-check", action="store_true", help="skip the residual bounds of the frequencies"

@@ -207,6 +207,10 @@ class PrestressProblem:
         """A factorisation of the tangent at ``s = Ω²`` (preconditions nearby speeds)."""
         self.factors.append((float(s), solve))
 
+    def replace_factor(self, s: float, solve) -> None:
+        """The factorisation at ``s`` replaced by ``solve`` (added when there is none)."""
+        self.factors = [f for f in self.factors if f[0] != float(s)] + [(float(s), solve)]
+
     def nearest_solve(self, s: float):
         return min(self.factors, key=lambda f: abs(f[0] - s))[1]
 
@@ -231,7 +235,7 @@ class PrestressProblem:
 
     def correction(self, u: np.ndarray, s: float, *, newton: bool):
         """``(η, d)``: the correction ``d ≈ K_T⁻¹ r`` (``newton``: preconditioned conjugate
-        gradients on the tangent to 1e-3, else the nearest factorisation alone) and its
+        gradients on the tangent to 1e-2, else the nearest factorisation alone) and its
         relative energy norm ``η = √|d · r| / √(u · K0 u)``."""
         r = self.residual(u, s)
         solve = self.nearest_solve(s)
@@ -241,7 +245,7 @@ class PrestressProblem:
         return (math.sqrt(abs(float(d @ r)) / energy) if energy > 0 else 0.0), d
 
 
-def _pcg(apply, b, precondition, rtol: float = 1e-3, max_iter: int = 30) -> np.ndarray:
+def _pcg(apply, b, precondition, rtol: float = 1e-2, max_iter: int = 15) -> np.ndarray:
     """Preconditioned conjugate gradients for ``A x = b`` (``A`` symmetric positive)."""
     x = np.zeros_like(b)
     r = b.copy()

@@ -37,9 +37,12 @@ from .prestress_rom import enrich, initial_reduced, prestress_problem
 
 __all__ = ["SpeedModes", "frequency_bounds", "speed_modes"]
 
-#: relative residual ``η`` of the reduced prestress below which it is accepted
-STATIC_TOLERANCE = 1e-5
-#: ``η`` of the first, coarse basis (before the tangent at the largest speed is factorised)
+#: relative residual ``η`` of the reduced prestress at its training speeds
+STATIC_TOLERANCE = 1e-4
+#: largest ``η`` accepted at a listed speed without enriching the basis again (the
+#: frequency bounds include the first-order effect of that speed's correction)
+LISTED_TOLERANCE = 1e-3
+#: ``η`` of the first, coarse basis (on which the modal samples are taken and factorised)
 COARSE_TOLERANCE = 0.1
 #: training speeds of the prestress basis, equally spaced in Ω²
 TRAINING = 5
@@ -130,21 +133,33 @@ class _Setting:
         """The factorised tangent nearest in ``s = Ω²`` (the ``K⁻¹`` norm of residuals)."""
         return self.problem.nearest_solve(s)
 
-    def prestress(self, speeds, static_tol):
-        """``(u (n, N), η (n,), corrections (n, N), basis size)`` at ``speeds`` (sorted,
-        > 0); the corrections ``d ≈ u_exact − u`` feed the frequency bounds."""
+    def prestress(self, speeds, sample_speeds, static_tol):
+        """``(u (n, N), η (n,), corrections (n, N), basis size, samples)`` at ``speeds``
+        (sorted, > 0); the corrections ``d ≈ u_exact − u`` feed the frequency bounds. The
+        tangents at ``sample_speeds`` (sorted, > 0) are factorised on the first, coarse
+        prestress to precondition the Newton corrections, then again on the final one,
+        where the modal samples are taken."""
         s_all = np.asarray(speeds) ** 2
         s_train = np.linspace(0.0, s_all[-1], TRAINING + 1)[1:]
+        s_samples = np.asarray(sample_speeds, dtype=float) ** 2
         reduced = initial_reduced(self.problem)
-        reduced, q, _, _ = enrich(reduced, s_train, COARSE_TOLERANCE, newton=False, log=self.log)
-        u_max = reduced.displacement(q[-1])
-        self.max_sample = self.sample(u_max, s_train[-1], self.k)
-        self.problem.add_factor(s_train[-1], self.max_sample[1])
+        reduced = enrich(reduced, s_train, COARSE_TOLERANCE, newton=False, log=self.log)[0]
+        for s, q in zip(s_samples, reduced.path(s_samples), strict=True):
+            K = self.full_tangent(reduced.displacement(q), s)
+            self.problem.add_factor(s, sparse_lu(K, symmetric=True, what="tangent").solve)
         reduced = enrich(reduced, s_train, static_tol, log=self.log)[0]
-        reduced, q, eta, d = enrich(reduced, s_all, static_tol, log=self.log)
+        # every listed speed: measured, and enriched only above LISTED_TOLERANCE (the
+        # frequency bounds carry the effect of each speed's correction d)
+        reduced, q, eta, d = enrich(reduced, s_all, LISTED_TOLERANCE, newton=False, log=self.log)
         corrections = np.zeros((len(d), self.problem.op.B.shape[1]))
         corrections[:, self.free] = d
-        return np.array([reduced.displacement(x) for x in q]), eta, corrections, reduced.V.shape[1]
+        u = np.array([reduced.displacement(x) for x in q])
+        samples = []
+        for s, x in zip(s_samples, reduced.path(s_samples), strict=True):
+            shapes, solve = self.sample(reduced.displacement(x), s, self.k)
+            self.problem.replace_factor(s, solve)
+            samples.append((float(np.sqrt(s)), shapes))
+        return u, eta, corrections, reduced.V.shape[1], samples
 
 
 def speed_modes(
@@ -155,7 +170,7 @@ def speed_modes(
     speeds,
     *,
     modes: int = 6,
-    samples: int = 2,
+    samples: int = 3,
     tolerance: float = 0.005,
     static_tol: float = STATIC_TOLERANCE,
     max_samples: int = 12,
@@ -171,24 +186,20 @@ def speed_modes(
     setting = _Setting(disc, material, mats, method, log)
     setting.k = min(modes + EXTRA_MODES, mats.n_u - 1)
     top = float(speeds.max())
-    between = np.sqrt(np.linspace(0.0, top**2, max(int(samples), 2)))[1:-1]
-    moving = np.unique(np.concatenate([speeds[speeds > 0], between]))
+    sampled = np.sqrt(np.linspace(0.0, top**2, max(int(samples), 2)))[1:]
+    moving = np.unique(speeds[speeds > 0])
     u_all, eta_all = np.zeros((speeds.size, disc.basis_u.N)), np.zeros(speeds.size)
     d_all = np.zeros_like(u_all)
     first = [(0.0, setting.sample(None, 0.0, setting.k)[0])]
     static_basis = 0
     if moving.size:
-        u_m, eta_m, d_m, static_basis = setting.prestress(moving, static_tol)
+        u_m, eta_m, d_m, static_basis, taken = setting.prestress(moving, sampled, static_tol)
         where = np.searchsorted(moving, speeds)
         moving_mask = speeds > 0
         u_all[moving_mask] = u_m[where[moving_mask]]
         eta_all[moving_mask] = eta_m[where[moving_mask]]
         d_all[moving_mask] = d_m[where[moving_mask]]
-        for omega in between:
-            shapes, solve = setting.sample(u_m[np.searchsorted(moving, omega)], omega**2, setting.k)
-            setting.problem.add_factor(omega**2, solve)
-            first.append((float(omega), shapes))
-        first.append((top, setting.max_sample[0]))
+        first += taken
     ritz = _Ritz(setting, first)
     while True:
         lam, Y, bounds = ritz.evaluate(speeds, u_all, d_all, modes, check)
@@ -259,21 +270,19 @@ class _Ritz:
         KX = (op.B.T @ (DBW @ Y[:, :n_res]))[setting.free]
         X = self.Wf @ Y[:, :n_res]
         R = KX - s * (setting.MPf @ X) - (setting.mats.M @ X) * lam[:n_res]
-        solve = setting.nearest_solve(s)
-        KR = np.column_stack([solve(R[:, j]) for j in range(n_res)])
+        KR = np.asarray(setting.nearest_solve(s)(R)).reshape(R.shape)
         res_k = np.sqrt(np.maximum(np.sum(R * KR, axis=0), 0.0))
-        return (
-            lam,
-            Y,
-            frequency_bounds(lam[:n_res], res_k, modes) + self._static(u, d, lam, Y, modes),
-        )
-
-    def _static(self, u, d, lam, Y, modes):
-        """Relative frequency shift of the prestress correction ``d``, to first order:
-        ``|yᵀ Wᵀ (K_T(u + d) − K_T(u)) W y| / 2λ`` per mode."""
+        bound = frequency_bounds(lam[:n_res], res_k, modes)
         if not np.any(d):
-            return np.zeros(modes)
+            return lam, Y, bound
+        return lam, Y, bound + self._static(u, d, D, Y[:, :modes], lam[:modes])
+
+    def _static(self, u, d, D, y, lam):
+        """Relative frequency shift of the prestress correction ``d``, to first order:
+        ``|xᵀ (K_T(u + d) − K_T(u)) x| / 2λ`` per Ritz vector ``x = W y`` (``D``: the
+        moduli at ``u``)."""
         op = self.setting.problem.op
-        dK = op.projected_tangent(u + d, self.BW) - op.projected_tangent(u, self.BW)
-        y = Y[:, :modes]
-        return np.abs(np.sum(y * (dK @ y), axis=0)) / (2.0 * lam[:modes])
+        dD = op.moduli(op.gradients(u + d)) - D
+        gx = (self.BW @ y).reshape(-1, 9, y.shape[1])
+        shift = np.einsum("qim,qim->m", gx, np.matmul(dD, gx))
+        return np.abs(shift) / (2.0 * lam)
