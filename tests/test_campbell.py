@@ -53,7 +53,7 @@ def test_campbell_nonlinear_matches_full_solves(tmp_path):
     start at the clamped frequencies and the lead-lag/flap lines rise (Southwell)."""
     scene = _scene(tmp_path, "nonlinear")
     res = campbell(scene, parse_speeds("0:1200:100"), modes=3, samples=3)
-    assert res.info["status"] == "ok" and res.info["max_error_bound"] < 1e-4
+    assert res.info["status"] == "ok" and res.info["max_error_bound"] < 1e-3
     assert 700.0 not in res.info["sample_speeds"]
     assert res.info["worst_tracking_mac"] > 0.9
     disc = discretise(scene_blade(scene), 2)
