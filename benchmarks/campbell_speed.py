@@ -21,7 +21,6 @@ from __future__ import annotations
 
 import argparse
 import json
-import resource
 import subprocess
 import sys
 import tempfile
@@ -44,21 +43,28 @@ RATIO_TARGET = 2.0
 ERROR_TARGET = 0.005
 
 
+#: runs ``femrub ARGS`` in this child and reports its own peak resident memory last
+_CHILD = (
+    "import resource, sys; from femrub.app.cli import main; code = main(sys.argv[1:]); "
+    "sys.stderr.write(f'\\nmaxrss_kib {resource.getrusage(resource.RUSAGE_SELF).ru_maxrss}\\n'); "
+    "sys.exit(code)"
+)
+
+
 def _femrub(*args) -> dict:
     """Wall seconds and peak memory (MiB) of ``femrub ARGS`` in its own process."""
-    before = resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss
     t0 = time.perf_counter()
-    cmd = [sys.executable, "-m", "femrub.app.cli", *args]
+    cmd = [sys.executable, "-c", _CHILD, *args]
     done = subprocess.run(cmd, cwd=C.ROOT, capture_output=True, text=True)
     wall = time.perf_counter() - t0
-    peak = resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss
     if done.returncode not in (0, 1):
-        raise RuntimeError(f"{' '.join(cmd)} failed:\n{done.stderr[-2000:]}")
+        raise RuntimeError(f"femrub {' '.join(args)} failed:\n{done.stderr[-2000:]}")
+    peak = float(done.stderr.rsplit("maxrss_kib", 1)[1].split()[0]) / 1024.0
     return {
         "command": "femrub " + " ".join(args),
         "exit": done.returncode,
         "wall_s": wall,
-        "peak_mib": max(peak, before) / 1024.0,
+        "peak_mib": peak,
     }
 
 

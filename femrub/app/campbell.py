@@ -205,16 +205,11 @@ def _reduced_diagram(blade_parts, speeds, modes, options, growth, log):
         "prestress_residual_max": float(sm.eta.max()),
         "sample_speeds": sm.sample_speeds,
         "worst_tracking_mac": worst,
-        "rest_frequencies_hz": _rest(mats, modes),
+        "rest_frequencies_hz": sm.rest_frequencies.tolist(),
         **_verdict(method, options, sm, speeds),
         **growth.table(growths, speeds),
     }
     return freqs, info
-
-
-def _rest(mats, modes) -> list:
-    lam = lowest_modes(mats.K, mats.M, modes, _solver(mats.K), vectors=False)
-    return (np.sqrt(np.clip(lam, 0.0, None)) / (2 * np.pi)).tolist()
 
 
 def _exact_diagram(solve, speeds, modes, growth):

@@ -75,6 +75,7 @@ class SpeedModes:
     eta : (n,) certified relative residual of the prestress.
     displacements : (n, N) static displacement (m) on every dof.
     sample_speeds : speeds whose full modes span ``W`` (rad/s).
+    rest_frequencies : (modes,) the full eigen-solve's frequencies at rest (Hz).
     static_basis, ritz_basis : sizes of the prestress basis and of ``W``.
     """
 
@@ -85,6 +86,7 @@ class SpeedModes:
     eta: np.ndarray
     displacements: np.ndarray
     sample_speeds: list
+    rest_frequencies: np.ndarray
     static_basis: int
     ritz_basis: int
 
@@ -205,7 +207,8 @@ def speed_modes(
     moving = np.unique(speeds[speeds > 0])
     u_all, eta_all = np.zeros((speeds.size, disc.basis_u.N)), np.zeros(speeds.size)
     d_all = np.zeros_like(u_all)
-    first = [(0.0, setting.sample(None, 0.0, setting.k)[0])]
+    lam0, shapes0 = lowest_modes(mats.K, mats.M, setting.k, setting.solve0)
+    first = [(0.0, shapes0)]
     static_basis = 0
     if moving.size:
         u_m, eta_m, d_m, static_basis, taken = setting.prestress(moving, sampled, static_tol)
@@ -237,6 +240,7 @@ def speed_modes(
         eta=eta_all,
         displacements=u_all,
         sample_speeds=[w for w, _ in ritz.samples],
+        rest_frequencies=np.sqrt(np.clip(lam0[:modes], 0.0, None)) / (2 * np.pi),
         static_basis=int(static_basis),
         ritz_basis=int(ritz.W.shape[1]),
     )
