@@ -16,13 +16,14 @@ features ``e = (q_i, q_i q_j)`` and their Gram matrix ``Γ`` in the elasticity i
 :mod:`femrub.fem.quadrature`). The reduced force ``Jᵀ Γ e`` and tangent are then exact and
 cost microseconds, whatever the mesh.
 
-The basis is built greedily (:func:`prestress_path`): it starts from the linear static
-solution ``K⁻¹ f_0``; at a training speed the reduced solution's full residual ``r`` is
-measured by its correction ``d = K⁻¹ r`` in the energy norm, relative to the solution,
-``η = √|d · r| / √(u · K u)`` (``K`` the stiffness at rest: one factorisation, reused); while
-``η`` exceeds the tolerance the correction joins the basis (a Newton–Krylov step whose
-Krylov space is kept). Every requested speed is certified the same way at the end: one
-internal-force evaluation and one back-substitution per speed.
+The basis is built greedily (:func:`enrich`, from :func:`initial_reduced`, the linear static
+solution ``K⁻¹ f_0``): at each speed of a list the reduced solution's full residual ``r`` is
+measured by its correction ``d ≈ K_T⁻¹ r`` (a back-substitution with the factorised tangent
+nearest in ``Ω²``, :class:`PrestressProblem`) in the energy norm, relative to the solution,
+``η = √|d · r| / √(u · K u)``; while ``η`` exceeds the tolerance somewhere, the corrections
+join the basis (with ``newton``, Newton corrections by conjugate gradients on the tangent,
+preconditioned by that factorisation: a Newton–Krylov step whose Krylov space is kept).
+Measuring a speed costs one internal-force evaluation and one back-substitution.
 """
 
 from __future__ import annotations
@@ -52,8 +53,6 @@ __all__ = [
     "prestress_problem",
 ]
 
-#: relative energy-norm correction ``η`` below which a reduced prestress is accepted
-TOLERANCE = 1e-8
 #: most basis vectors the greedy enrichment may use
 MAX_BASIS = 40
 

@@ -5,9 +5,10 @@ For a list of rotation speeds, :func:`speed_modes` gives the lowest natural freq
 every speed, without a full prestress or a full eigen-solve per speed:
 
 1. **prestress**: the static state ``u(Ω)`` of :mod:`femrub.fem.prestress_rom` (a reduced
-   basis built greedily, its full residual certified at every speed: ``η ≤ static_tol``);
-2. **Ritz**: the modes of the full tangent at a few *sample* speeds (first at rest and at
-   the largest speed), M-orthonormalised together, span ``W``; at every speed the small
+   basis built greedily, its full residual measured at every speed: ``η``, at most
+   :data:`LISTED_TOLERANCE`, and the correction ``d`` that estimates its error);
+2. **Ritz**: the modes of the full tangent at a few *sample* speeds (first at rest, halfway
+   in ``Ω²`` and at the largest speed), M-orthonormalised together, span ``W``; at every speed the small
    problem ``Wᵀ K_T(u(Ω)) W y = λ y`` (its matrix evaluated on the quadrature points,
    :mod:`femrub.fem.quadrature`) gives Ritz values ``λ_j ≥`` the exact ``λ_j`` (min–max);
 3. **certificate**: the residual of each Ritz pair on the full mesh, ``ρ_j = K_T x_j − λ_j M
