@@ -8,9 +8,10 @@ every speed, without a full prestress or a full eigen-solve per speed:
    basis built greedily, its full residual measured at every speed: ``η``, at most
    :data:`LISTED_TOLERANCE`, and the correction ``d`` that estimates its error);
 2. **Ritz**: the modes of the full tangent at a few *sample* speeds (first at rest, halfway
-   in ``Ω²`` and at the largest speed), M-orthonormalised together, span ``W``; at every speed the small
-   problem ``Wᵀ K_T(u(Ω)) W y = λ y`` (its matrix evaluated on the quadrature points,
-   :mod:`femrub.fem.quadrature`) gives Ritz values ``λ_j ≥`` the exact ``λ_j`` (min–max);
+   in ``Ω²`` and at the largest speed), M-orthonormalised together, span ``W``; at every
+   speed the small problem ``Wᵀ K_T(u(Ω)) W y = λ y`` (its matrix evaluated on the
+   quadrature points, :mod:`femrub.fem.quadrature`) gives Ritz values ``λ_j ≥`` the exact
+   ``λ_j`` (min–max);
 3. **certificate**: the residual of each Ritz pair on the full mesh, ``ρ_j = K_T x_j − λ_j M
    x_j`` with ``‖x_j‖_M = 1``, bounds the distance to an exact eigenvalue by ``ε_j =
    ‖ρ_j‖_{M⁻¹}`` (Krylov–Bogoliubov) and, with the gap ``δ_j`` to the neighbouring Ritz
