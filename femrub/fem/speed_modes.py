@@ -13,12 +13,13 @@ every speed, without a full prestress or a full eigen-solve per speed:
    quadrature points, :mod:`femrub.fem.quadrature`) gives Ritz values ``λ_j ≥`` the exact
    ``λ_j`` (min–max);
 3. **certificate**: the residual of each Ritz pair on the full mesh, ``ρ_j = K_T x_j − λ_j M
-   x_j`` with ``‖x_j‖_M = 1``, bounds the distance to an exact eigenvalue by ``ε_j =
-   ‖ρ_j‖_{M⁻¹}`` (Krylov–Bogoliubov) and, with the gap ``δ_j`` to the neighbouring Ritz
-   values (less their ``ε``), by ``ε_j² / δ_j`` (Kato–Temple). The relative error bound of
-   the frequency ``f_j = √λ_j / 2π`` is ``1 − √(1 − min(ε_j, ε_j²/δ_j) / λ_j)``. The
-   prestress is itself approximate: the first-order frequency shift of its correction
-   ``d`` (step 1), times :data:`STATIC_MARGIN`, is added to each bound.
+   x_j`` with ``‖x_j‖_M = 1``, in the norm of the nearest factorised tangent
+   ``‖ρ_j‖_{K⁻¹}``, bounds the distance from ``μ_j = 1/λ_j`` to an eigenvalue of the pencil
+   ``M x = μ K x`` by ``ε_j = ‖ρ_j‖_{K⁻¹} / λ_j^{3/2}`` (Krylov–Bogoliubov) and, with the gap
+   ``δ_j`` to the neighbouring Ritz values (less their ``ε``), by ``ε_j² / δ_j``
+   (Kato–Temple); the frequency's relative error bound is ``1 − √(μ_j / (μ_j + δ))``
+   (:func:`frequency_bounds`). The prestress is itself approximate: the first-order
+   frequency shift of its correction ``d`` (step 1), times :data:`STATIC_MARGIN`, is added.
    Where a bound exceeds the tolerance, the modes of the full tangent at the worst speed
    become a sample (``W`` grows) and every speed is evaluated again, up to ``max_samples``.
 
