@@ -2,6 +2,7 @@
 
 import numpy as np
 import pytest
+from test_campbell import BOX
 
 from femrub.app import translate as tr
 from femrub.app.blade import load_blade
@@ -15,29 +16,11 @@ from femrub.fem.quadrature import gradient_operator
 from femrub.fem.speed_modes import frequency_bounds
 from femrub.scene import load_scene
 
-BOX = """
-name = "box-spin"
-[geometry]
-kind = "box"
-span = 0.2
-chord = 0.012
-thickness = 0.008
-h = 0.01
-n_contact = 2
-[material]
-young = 200e9
-density = 8000.0
-poisson = 0.3
-[scheme]
-h = 1e-5
-t_end = 1e-4
-"""
-
 
 @pytest.fixture(scope="module")
 def box(tmp_path_factory):
     path = tmp_path_factory.mktemp("box") / "box.toml"
-    path.write_text(BOX)
+    path.write_text(BOX.format(method="nonlinear"))
     scene = load_scene(str(path))
     disc = discretise(load_blade(scene), 2)
     material = tr.material_of(scene)

@@ -49,7 +49,6 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
-import scipy.linalg as sla
 from scipy.optimize import linear_sum_assignment
 
 from ..contact.points import locate_contacts
@@ -57,7 +56,7 @@ from ..fem.discretisation import assemble, discretise
 from ..fem.eigen import lowest_modes
 from ..fem.linalg import sparse_lu
 from ..fem.prestress import centrifugal_prestress
-from ..fem.speed_modes import speed_modes
+from ..fem.speed_modes import EXTRA_MODES, speed_modes
 from ..scene.spec import SceneError
 from . import translate as tr
 from .blade import load_blade
@@ -71,8 +70,6 @@ __all__ = [
     "write_campbell",
 ]
 
-#: extra modes per speed of the exact diagram
-EXTRA_MODES = 4
 #: largest relative error of a checked frequency (0.5 %)
 TOLERANCE = 0.005
 #: most full modal samples the self-check adds up to
@@ -106,13 +103,6 @@ def parse_speeds(text: str) -> np.ndarray:
 def _solver(K):
     """``K⁻¹`` for the shift-invert eigen-solve (Pardiso on large problems when installed)."""
     return sparse_lu(K, symmetric=True, what="prestressed stiffness").solve
-
-
-def _m_orthonormal(V, M, tol=1e-10):
-    G = V.T @ (M @ V)
-    lam, W = sla.eigh(0.5 * (G + G.T))
-    keep = lam > tol * lam.max()
-    return V @ (W[:, keep] / np.sqrt(lam[keep]))
 
 
 def _track(Q_prev, Q, n, gram=None):

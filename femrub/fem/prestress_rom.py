@@ -28,6 +28,7 @@ Measuring a speed costs one internal-force evaluation and one back-substitution.
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 
@@ -57,6 +58,7 @@ __all__ = [
 MAX_BASIS = 40
 
 
+@functools.lru_cache(maxsize=64)
 def _layout(r: int, linear: bool):
     """Feature indices, stable as the basis grows: vector ``k`` adds ``L_k`` then
     ``Q_0k … Q_kk``. Returns ``(linear_index (r,), pair_i, pair_j, pair_index)``."""
@@ -178,7 +180,8 @@ def energy_polynomial(op, BV: np.ndarray, previous: EnergyPolynomial | None = No
     ``BV = B V`` (``op``: a :class:`~femrub.fem.quadrature.GradientOperator`); given the
     ``previous`` polynomial of the first columns, only the new rows of ``Γ`` are computed."""
     r = BV.shape[1]
-    n_feat = _layout(r, op.linear)[0].size + _layout(r, op.linear)[3].size
+    lin, _, _, pair = _layout(r, op.linear)
+    n_feat = lin.size + pair.size
     n_old = 0 if previous is None else previous.gamma.shape[0]
     rows = np.zeros((n_feat - n_old, n_feat))
     with one_blas_thread:  # tall-skinny products: threads only contend
@@ -199,6 +202,7 @@ class PrestressProblem:
 
     def __init__(self, op, f0, MP, free, K0, solve):
         self.op, self.f0, self.MP, self.free = op, f0, MP, free
+        self.MP_free = MP[free][:, free].tocsr()
         self.K0 = K0
         self.factors = [(0.0, solve)]
 
@@ -220,15 +224,13 @@ class PrestressProblem:
 
     def tangent(self, u: np.ndarray, s: float):
         """``x ↦ K_T(u) x − s M_P x`` on the free dofs (one evaluation of the moduli)."""
-        op, free, n = self.op, self.free, self.op.B.shape[1]
+        op, free = self.op, self.free
         D = op.moduli(op.gradients(u))
-        MP = self.MP[free][:, free]
 
         def apply(x):
-            full = np.zeros(n)
+            full = np.zeros(op.B.shape[1])
             full[free] = x
-            gx = (op.B @ full).reshape(-1, 9, 1)
-            return (op.B.T @ np.matmul(D, gx).reshape(-1))[free] - s * (MP @ x)
+            return op.apply(D, full)[free] - s * (self.MP_free @ x)
 
         return apply
 

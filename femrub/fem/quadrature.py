@@ -70,13 +70,17 @@ class GradientOperator:
         _moduli_kernel(g, self.w if w is None else w, self.lam, self.mu, self.linear, D)
         return D
 
+    def apply(self, D: np.ndarray, X: np.ndarray) -> np.ndarray:
+        """``Bᵀ (D (B X))``: the tangent whose moduli are ``D`` (:meth:`moduli`) applied to
+        the columns of ``X`` (all dofs; a vector gives a vector)."""
+        X = np.asarray(X, dtype=float)
+        cols = X.reshape(self.B.shape[1], -1)
+        gx = (self.B @ cols).reshape(-1, 9, cols.shape[1])
+        return (self.B.T @ np.matmul(D, gx).reshape(-1, cols.shape[1])).reshape(X.shape)
+
     def tangent_action(self, u: np.ndarray, X: np.ndarray) -> np.ndarray:
         """``K_T(u) X`` (no spin softening) for the columns of ``X`` (all dofs)."""
-        X = np.asarray(X, dtype=float).reshape(self.B.shape[1], -1)
-        m = X.shape[1]
-        D = self.moduli(self.gradients(u))
-        gx = (self.B @ X).reshape(-1, 9, m)
-        return self.B.T @ np.matmul(D, gx).reshape(-1, m)
+        return self.apply(self.moduli(self.gradients(u)), X)
 
     def projected_tangent(self, u: np.ndarray, BW: np.ndarray) -> np.ndarray:
         """``Wᵀ K_T(u) W`` (no spin softening) from ``BW = B @ W`` (``9 n_q × m``)."""

@@ -42,6 +42,7 @@ from . import centrifugal as cf
 from .eigen import lowest_modes
 from .linalg import sparse_lu
 from .prestress_rom import enrich, initial_reduced, prestress_problem
+from .speed_family import sample_speeds
 
 __all__ = ["SpeedModes", "frequency_bounds", "speed_modes"]
 
@@ -129,7 +130,7 @@ class _Setting:
         self.solve0 = lu0.solve
         self.problem = prestress_problem(disc, material, method, mats.K, lu0.solve)
         self.free = self.problem.free
-        self.MPf = self.problem.MP[self.free][:, self.free].tocsr()
+        self.MPf = self.problem.MP_free
 
     def full_tangent(self, u, s):
         """The assembled tangent ``K_T(u) − s M_P`` on the free dofs."""
@@ -204,7 +205,7 @@ def speed_modes(
     setting = _Setting(disc, material, mats, method, log)
     setting.k = min(modes + EXTRA_MODES, mats.n_u - 1)
     top = float(speeds.max())
-    sampled = np.sqrt(np.linspace(0.0, top**2, max(int(samples), 2)))[1:]
+    sampled = sample_speeds(top, max(int(samples), 2))[1:]
     moving = np.unique(speeds[speeds > 0])
     u_all, eta_all = np.zeros((speeds.size, disc.basis_u.N)), np.zeros(speeds.size)
     d_all = np.zeros_like(u_all)
