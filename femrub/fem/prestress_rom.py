@@ -344,21 +344,24 @@ class Reduced:
         return self.full @ q
 
     def enriched(self, d: np.ndarray):
-        """This problem with ``d`` added to the basis (``None`` when ``d`` is in it)."""
+        """This problem with the columns of ``d`` (or the vector ``d``) added to the basis,
+        ``Γ`` grown once for all of them (``None`` when they all lie in its span)."""
         V = _orthonormal_add(self.V, d, self.problem.K0)
         return None if V is None else Reduced(self.problem, V, self)
 
 
 def _orthonormal_add(V: np.ndarray, d: np.ndarray, K0) -> np.ndarray | None:
-    """``V`` with ``d`` added, ``K0``-orthonormal (twice Gram–Schmidt); ``None`` when ``d``
-    lies in the span."""
-    norm0 = math.sqrt(abs(float(d @ (K0 @ d))))
-    for _ in range(2):
-        d = d - V @ (V.T @ (K0 @ d))
-    norm = math.sqrt(abs(float(d @ (K0 @ d))))
-    if norm <= 1e-12 * norm0:
-        return None
-    return np.column_stack([V, d / norm])
+    """``V`` with the columns of ``d`` added in turn, ``K0``-orthonormal (twice
+    Gram–Schmidt), each skipped when it lies in the span; ``None`` when none is added."""
+    added = V
+    for x in np.asarray(d, dtype=float).reshape(V.shape[0], -1).T:
+        norm0 = math.sqrt(abs(float(x @ (K0 @ x))))
+        for _ in range(2):
+            x = x - added @ (added.T @ (K0 @ x))
+        norm = math.sqrt(abs(float(x @ (K0 @ x))))
+        if norm > 1e-12 * norm0:
+            added = np.column_stack([added, x / norm])
+    return None if added.shape[1] == V.shape[1] else added
 
 
 def initial_reduced(problem: PrestressProblem) -> Reduced:
@@ -390,7 +393,7 @@ def enrich(reduced: Reduced, s_set, tol: float, *, newton=True, max_basis=MAX_BA
             )
         if eta[worst] <= tol:
             return reduced, q, eta, [m[1] for m in measured]
-        grown = reduced
+        corrections = []
         for k in np.argsort(-eta)[: max(max_basis - reduced.V.shape[1], 0)]:
             if eta[k] <= tol:
                 break
@@ -398,8 +401,9 @@ def enrich(reduced: Reduced, s_set, tol: float, *, newton=True, max_basis=MAX_BA
             if newton:
                 u = reduced.displacement(q[k])
                 d = reduced.problem.correction(u, s_set[k], newton=True)[1]
-            grown = grown.enriched(d) or grown
-        if grown is reduced:
+            corrections.append(d)
+        grown = reduced.enriched(np.column_stack(corrections)) if corrections else None
+        if grown is None:
             raise ValueError(
                 f"the reduced prestress did not reach η = {tol:g} with "
                 f"{reduced.V.shape[1]} basis vectors (η = {eta[worst]:.2e} at "

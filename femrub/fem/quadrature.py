@@ -46,6 +46,10 @@ class GradientOperator:
     lam: float
     mu: float
     linear: bool = False
+    #: dofs of each element by component and local node (``n_el × 3 × n_loc``)
+    element_dofs: np.ndarray | None = None
+    #: shape-function gradients ``∂φ_a/∂X_k`` (``n_el × n_qp × 3 × n_loc``, 1/m)
+    shape_gradients: np.ndarray | None = None
 
     @property
     def n_points(self) -> int:
@@ -84,15 +88,48 @@ class GradientOperator:
 
     def projected_tangent(self, u: np.ndarray, BW: np.ndarray) -> np.ndarray:
         """``Wᵀ K_T(u) W`` (no spin softening) from ``BW = B @ W`` (``9 n_q × m``)."""
-        g = self.gradients(u)
+        return self.project(self.moduli(self.gradients(u)), BW)
+
+    def project(self, D: np.ndarray, BW: np.ndarray) -> np.ndarray:
+        """``Wᵀ K W = Σ_q (B W)_qᵀ D_q (B W)_q`` for the moduli ``D`` (:meth:`moduli`),
+        summed by chunks of :data:`CHUNK` points (no ``9 n_q × m`` temporary)."""
         m = BW.shape[1]
         out = np.zeros((m, m))
         for lo in range(0, self.n_points, CHUNK):
             hi = min(lo + CHUNK, self.n_points)
             gx = BW[9 * lo : 9 * hi]
-            D = self.moduli(g[lo:hi], self.w[lo:hi])
-            out += gx.T @ np.matmul(D, gx.reshape(-1, 9, m)).reshape(-1, m)
+            out += gx.T @ np.matmul(D[lo:hi], gx.reshape(-1, 9, m)).reshape(-1, m)
         return 0.5 * (out + out.T)
+
+    def assemble(self, D: np.ndarray) -> sp.csr_matrix:
+        """The sparse matrix ``Bᵀ D B`` (``N × N``) for the moduli ``D`` (:meth:`moduli`):
+        element by element, ``K_e[(i,a),(j,b)] = Σ_q Σ_kl ∂_kφ_a D_q[(i,k),(j,l)] ∂_lφ_b``
+        (compiled), then summed into CSR."""
+        n_el, _, n_loc = self.element_dofs.shape
+        Ke = np.empty((n_el, 3 * n_loc, 3 * n_loc))
+        _assembly_kernel(self.shape_gradients, np.ascontiguousarray(D), Ke)
+        idx = self.element_dofs.reshape(n_el, -1)
+        rows = np.broadcast_to(idx[:, :, None], Ke.shape).ravel()
+        cols = np.broadcast_to(idx[:, None, :], Ke.shape).ravel()
+        N = self.B.shape[1]
+        return sp.csr_matrix((Ke.ravel(), (rows, cols)), shape=(N, N))
+
+    def quadratic_forms(self, g: np.ndarray, GX: np.ndarray) -> np.ndarray:
+        """``xᵀ K_T x`` (no spin softening) for each column ``x`` whose gradients are
+        ``GX`` (``n_q × 9 × m``), at the state of the gradients ``g``: the integrand of
+        :meth:`moduli` evaluated on the columns without forming ``D`` (J per unit
+        amplitude²)."""
+        out = np.zeros(GX.shape[2])
+        _form_kernel(
+            np.ascontiguousarray(g),
+            self.w,
+            self.lam,
+            self.mu,
+            self.linear,
+            np.ascontiguousarray(GX),
+            out,
+        )
+        return out
 
 
 def _stress_kernel(g, w, lam, mu, linear, P):  # pragma: no cover (compiled)
@@ -144,10 +181,69 @@ def _moduli_kernel(g, w, lam, mu, linear, D):  # pragma: no cover (compiled)
                         D[q, 3 * i + k, 3 * j + l] = w[q] * v
 
 
+def _form_kernel(g, w, lam, mu, linear, GX, out):  # pragma: no cover (compiled)
+    """``out_c = Σ_q w_q (λ tr(A)² + 2 μ sym(A) : sym(A) + h S : h)`` with ``h`` the
+    gradient ``GX[q, :, c]`` and ``A = Fᵀ h`` (the integrand of :func:`_moduli_kernel`)."""
+    A = np.empty((3, 3))
+    for q in range(g.shape[0]):
+        F, S = _point_state(g[q], lam, mu, linear)
+        for c in range(GX.shape[2]):
+            for k in range(3):
+                for l in range(3):
+                    A[k, l] = F[0, k] * GX[q, l, c] + F[1, k] * GX[q, 3 + l, c]
+                    A[k, l] += F[2, k] * GX[q, 6 + l, c]
+            trace, sym2, geometric = 0.0, 0.0, 0.0
+            for k in range(3):
+                trace += A[k, k]
+                for l in range(3):
+                    e = 0.5 * (A[k, l] + A[l, k])
+                    sym2 += e * e
+            for i in range(3):
+                for k in range(3):
+                    hs = 0.0
+                    for l in range(3):
+                        hs += S[k, l] * GX[q, 3 * i + l, c]
+                    geometric += GX[q, 3 * i + k, c] * hs
+            out[c] += w[q] * (lam * trace * trace + 2.0 * mu * sym2 + geometric)
+
+
+def _assembly_kernel(dphi, D, Ke):  # pragma: no cover (compiled)
+    """Element matrices ``Ke`` (``n_el × 3 n_loc × 3 n_loc``, rows ``(i, a)``) from the
+    shape-function gradients ``dphi`` (``n_el × n_qp × 3 × n_loc``) and the moduli ``D``
+    (``n_el n_qp × 9 × 9``, weights included)."""
+    n_el, n_qp, _, n_loc = dphi.shape
+    T = np.empty((9, 3, n_loc))
+    for e in range(n_el):
+        Ke[e] = 0.0
+        for q in range(n_qp):
+            p = e * n_qp + q
+            g = dphi[e, q]
+            for ik in range(9):
+                for j in range(3):
+                    for b in range(n_loc):
+                        T[ik, j, b] = (
+                            D[p, ik, 3 * j] * g[0, b]
+                            + D[p, ik, 3 * j + 1] * g[1, b]
+                            + D[p, ik, 3 * j + 2] * g[2, b]
+                        )
+            for i in range(3):
+                for a in range(n_loc):
+                    row = i * n_loc + a
+                    for j in range(3):
+                        for b in range(n_loc):
+                            Ke[e, row, j * n_loc + b] += (
+                                g[0, a] * T[3 * i, j, b]
+                                + g[1, a] * T[3 * i + 1, j, b]
+                                + g[2, a] * T[3 * i + 2, j, b]
+                            )
+
+
 if numba is not None:
+    _assembly_kernel = numba.njit(cache=True, nogil=True)(_assembly_kernel)
     _point_state = numba.njit(cache=True, nogil=True)(_point_state)
     _stress_kernel = numba.njit(cache=True, nogil=True)(_stress_kernel)
     _moduli_kernel = numba.njit(cache=True, nogil=True)(_moduli_kernel)
+    _form_kernel = numba.njit(cache=True, nogil=True)(_form_kernel)
 
 
 def gradient_operator(basis, lam: float, mu: float, *, linear: bool = False) -> GradientOperator:
@@ -173,4 +269,8 @@ def gradient_operator(basis, lam: float, mu: float, *, linear: bool = False) -> 
     n_rows = 9 * n_el * n_qp
     indptr = np.arange(0, n_rows * n_loc + 1, n_loc, dtype=np.int64)
     B = sp.csr_matrix((data.ravel(), cols.ravel(), indptr), shape=(n_rows, basis.N))
-    return GradientOperator(B, np.asarray(basis.dx, dtype=float).ravel(), lam, mu, linear)
+    element_dofs = np.ascontiguousarray(cols[:, 0, :, 0, :], dtype=np.int32)
+    # every component's rows hold the same scalar shape-function gradients
+    shape_gradients = np.ascontiguousarray(data[:, :, 0])
+    w = np.asarray(basis.dx, dtype=float).ravel()
+    return GradientOperator(B, w, lam, mu, linear, element_dofs, shape_gradients)

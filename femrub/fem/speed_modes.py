@@ -38,7 +38,6 @@ import numpy as np
 import scipy.linalg as sla
 
 from ..blas import one_blas_thread
-from . import centrifugal as cf
 from .eigen import lowest_modes
 from .linalg import sparse_lu
 from .prestress_rom import enrich, initial_reduced, prestress_problem
@@ -64,6 +63,9 @@ STATIC_MARGIN = 2.0
 THREADS = max(1, min(4, len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else 1))
 #: extra modes per sample in the Ritz basis
 EXTRA_MODES = 4
+#: relative accuracy asked of the samples' eigenvalues (the samples only span ``W``: the
+#: frequencies reported are its Ritz values, certified by their residuals)
+SAMPLE_TOLERANCE = 1e-8
 
 
 @dataclass(frozen=True)
@@ -135,7 +137,7 @@ class _Setting:
     def full_tangent(self, u, s):
         """The assembled tangent ``K_T(u) − s M_P`` on the free dofs."""
         op = self.problem.op
-        K = cf.tangent_stiffness(self.disc.basis_u, u, op.lam, op.mu, op.linear)
+        K = op.assemble(op.moduli(op.gradients(u)))
         return (K[self.free][:, self.free] - s * self.MPf).tocsr()
 
     def sample(self, u, s, k):
@@ -145,7 +147,7 @@ class _Setting:
         else:
             K = self.full_tangent(u, s)
             solve = sparse_lu(K, symmetric=True, what="prestressed tangent").solve
-        return lowest_modes(K, self.mats.M, k, solve)[1], solve
+        return lowest_modes(K, self.mats.M, k, solve, tol=SAMPLE_TOLERANCE)[1], solve
 
     def nearest_solve(self, s: float):
         """The factorised tangent nearest in ``s = Ω²`` (the ``K⁻¹`` norm of residuals)."""
@@ -209,7 +211,7 @@ def speed_modes(
     moving = np.unique(speeds[speeds > 0])
     u_all, eta_all = np.zeros((speeds.size, disc.basis_u.N)), np.zeros(speeds.size)
     d_all = np.zeros_like(u_all)
-    lam0, shapes0 = lowest_modes(mats.K, mats.M, setting.k, setting.solve0)
+    lam0, shapes0 = lowest_modes(mats.K, mats.M, setting.k, setting.solve0, tol=SAMPLE_TOLERANCE)
     first = [(0.0, shapes0)]
     static_basis = 0
     if moving.size:
@@ -282,16 +284,14 @@ class _Ritz:
 
     def _at(self, s, u, d, modes, check):
         op, setting = self.setting.problem.op, self.setting
-        D = op.moduli(op.gradients(u))
-        m = self.W.shape[1]
-        DBW = np.matmul(D, self.BW.reshape(-1, 9, m)).reshape(-1, m)
-        Kr = self.BW.T @ DBW
-        Kr = 0.5 * (Kr + Kr.T) - s * self.MPr
-        lam, Y = sla.eigh(Kr)
+        g = op.gradients(u)
+        D = op.moduli(g)
+        lam, Y = sla.eigh(op.project(D, self.BW) - s * self.MPr)
         if not check:
             return lam, Y, np.full(modes, np.nan)
-        n_res = min(modes + 1, m)
-        KX = (op.B.T @ (DBW @ Y[:, :n_res]))[setting.free]
+        n_res = min(modes + 1, self.W.shape[1])
+        GX = (self.BW @ Y[:, :n_res]).reshape(-1, 9, n_res)
+        KX = (op.B.T @ np.matmul(D, GX).reshape(-1, n_res))[setting.free]
         X = self.Wf @ Y[:, :n_res]
         R = KX - s * (setting.MPf @ X) - (setting.mats.M @ X) * lam[:n_res]
         with self.lock:  # a factorisation's solve is not re-entrant
@@ -300,14 +300,12 @@ class _Ritz:
         bound = frequency_bounds(lam[:n_res], res_k, modes)
         if not np.any(d):
             return lam, Y, bound
-        return lam, Y, bound + self._static(u, d, D, Y[:, :modes], lam[:modes])
+        return lam, Y, bound + self._static(g, u + d, GX[..., :modes], lam[:modes])
 
-    def _static(self, u, d, D, y, lam):
+    def _static(self, g, corrected, GX, lam):
         """Relative frequency shift of the prestress correction ``d``, to first order:
-        ``|xᵀ (K_T(u + d) − K_T(u)) x| / 2λ`` per Ritz vector ``x = W y`` (``D``: the
-        moduli at ``u``), times :data:`STATIC_MARGIN`."""
+        ``|xᵀ (K_T(u + d) − K_T(u)) x| / 2λ`` per Ritz vector ``x`` (``GX``: its gradients,
+        ``g``: those of ``u``, ``corrected = u + d``), times :data:`STATIC_MARGIN`."""
         op = self.setting.problem.op
-        dD = op.moduli(op.gradients(u + d)) - D
-        gx = (self.BW @ y).reshape(-1, 9, y.shape[1])
-        shift = np.einsum("qim,qim->m", gx, np.matmul(dD, gx))
+        shift = op.quadratic_forms(op.gradients(corrected), GX) - op.quadratic_forms(g, GX)
         return STATIC_MARGIN * np.abs(shift) / (2.0 * lam)
