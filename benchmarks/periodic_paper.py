@@ -5,8 +5,11 @@ Runs ``femrub periodic paper --set physics.thermal=off --set scheme.h=2e-6
 ``--points`` stable points of the branch, runs ``femrub run`` at each of their speeds for
 ``--revolutions`` periods of the forcing, and compares the branch's ``max_tip_displacement``
 with the largest tip displacement of the run's last ``--last`` periods (the transient left
-out). Writes ``DIR/comparison.json`` and prints one line per point; exit status 1 when a
-stable point differs by more than 2 % or the branch is not ``ok``.
+out). A run whose per-period maxima over those periods spread by more than 2 % has not
+settled onto a periodic response (``spread`` in the output): no orbit can agree with it.
+Writes ``DIR/comparison.json`` and prints one line per point; exit status 1 when a stable
+point differs by more than 2 %, a compared run has not settled, the branch has no stable
+point, or the branch is not ``ok``.
 
 Usage::
 
@@ -43,9 +46,10 @@ def branch_rows(out: Path, sets: list) -> list[dict]:
         return list(csv.DictReader(fh))
 
 
-def run_peak(out: Path, speed: float, periods: int, last: int, sets: list) -> float:
+def run_peak(out: Path, speed: float, periods: int, last: int, sets: list) -> tuple:
     """Largest |tip displacement| (m) of the last ``last`` of ``periods`` forcing periods of
-    a ``femrub run`` at ``speed`` (rad/s)."""
+    a ``femrub run`` at ``speed`` (rad/s), and the spread ``(max − min) / max`` of the
+    per-period maxima over those periods (0 for a periodic response)."""
     period = 2.0 * math.pi / speed
     t_end = periods * period
     h = period / math.ceil(period / 2e-6)  # a whole number of steps per period
@@ -54,8 +58,10 @@ def run_peak(out: Path, speed: float, periods: int, last: int, sets: list) -> fl
     changes += ["--set", f"scheme.h={h!r}", "--set", "physics.thermal=off", *sets]
     _femrub("run", "paper", *changes, "-o", str(folder), "--overwrite", "--quiet")
     with np.load(folder / "history.npz") as hist:
-        t, x = hist["t"], hist["signal_tip_displacement"]
-    return float(np.abs(x[t >= t_end - last * period]).max())
+        t, x = hist["t"], np.abs(hist["signal_tip_displacement"])
+    which = np.floor((t_end - t) / period - 1e-9).astype(int)
+    peaks = np.array([x[which == j].max() for j in range(last) if np.any(which == j)])
+    return float(peaks.max()), float((peaks.max() - peaks.min()) / peaks.max())
 
 
 def main(argv=None) -> int:
@@ -80,10 +86,17 @@ def main(argv=None) -> int:
     for r in pick:
         speed = float(r["loads.rotation_speed"])
         orbit = float(r["max_tip_displacement"])
-        run = run_peak(out, speed, args.revolutions, args.last, sets)
+        run, spread = run_peak(out, speed, args.revolutions, args.last, sets)
         err = abs(orbit - run) / run
-        result.append({"rotation_speed": speed, "orbit": orbit, "run": run, "relative": err})
-        print(f"{speed:.6g} rad/s: orbit {orbit:.6g} m, run {run:.6g} m, {100 * err:.2f} %")
+        result.append(
+            {"rotation_speed": speed, "orbit": orbit, "run": run, "relative": err, "spread": spread}
+        )
+        print(
+            f"{speed:.6g} rad/s: orbit {orbit:.6g} m, run {run:.6g} m, {100 * err:.2f} % "
+            f"(run's per-period maxima spread {100 * spread:.2f} %)"
+        )
+    if not pick:
+        print(f"no stable point to compare ({summary.get('status')}: {summary.get('message')})")
     doc = {
         "branch_status": summary.get("status"),
         "branch_message": summary.get("message"),
@@ -95,7 +108,9 @@ def main(argv=None) -> int:
     (out / "comparison.json").write_text(json.dumps(doc, indent=2) + "\n")
     print(json.dumps({k: v for k, v in doc.items() if k != "comparisons"}))
     ok = (
-        summary.get("status") == "ok" and result and all(c["relative"] <= TOLERANCE for c in result)
+        summary.get("status") == "ok"
+        and result
+        and all(c["relative"] <= TOLERANCE and c["spread"] <= TOLERANCE for c in result)
     )
     return 0 if ok else 1
 

@@ -207,3 +207,21 @@ def test_cli_refuses_bad_input_in_one_line_before_any_folder(tmp_path, capsys, a
     err = capsys.readouterr().err.strip()
     assert message in err and len(err.splitlines()) == 1
     assert not out.exists()
+
+
+def test_paper_bar_without_damping_has_no_settled_response_to_start_from(tmp_path, capsys):
+    """The paper's bar without damping (γ = 1/2, plastic impacts) at 20000 rpm: the time
+    integration from rest does not settle (its state changes by a large fraction of its size
+    from period to period), Newton from there finds no orbit, and the branch says both and
+    keeps its folder."""
+    from femrub.app.cli import main
+
+    out = tmp_path / "branch"
+    args = ["periodic", "paper", "--set", "physics.thermal=off", "--set", "scheme.h=2e-6"]
+    args += ["--param", "loads.rotation_speed=20000rpm:40000rpm", "-o", str(out), "--quiet"]
+    assert main(args) == 1
+    err = capsys.readouterr().err
+    assert "no periodic orbit at loads.rotation_speed = 2094.4" in err
+    drift = float(err.split("still changes by ")[1].split()[0])
+    assert "has not settled" in err and drift > 0.1
+    assert (out / "branch.csv").exists() and (out / "summary.json").exists()

@@ -224,13 +224,17 @@ class _Continuation:
         """The orbit at ``start`` by natural-parameter shooting after ``warmup`` periods."""
         pm = self.pb.map(self.start)
         X = pm.model.x0.copy() if x0 is None else np.asarray(x0, dtype=float)
-        for _ in range(warmup):
-            X = pm(X)
+        drift = math.nan
+        for k in range(warmup):
+            X, before = pm(X), X
+            if k == warmup - 1:
+                drift = _norm(X - before, state_scale(pm.model.layout, np.vstack([X, before])))
         res = self._shooting(pm).solve(X)
         if not res.converged:
             raise RuntimeError(
                 f"no periodic orbit at {self.branch.key} = {self.start:g} (scaled residual "
                 f"{res.residual:.2e} after {res.iterations} Newton iterations)"
+                + _settling(warmup, drift, self.pb.options.get("multiple", 1))
             )
         return res.X0, self.start, pm.steps, res.iterations
 
@@ -365,6 +369,20 @@ class _Continuation:
     def _fail(self, message: str) -> Branch:
         self.branch.status, self.branch.message = "failed", message
         return self.branch
+
+
+def _settling(warmup: int, drift: float, multiple: int) -> str:
+    """What the time integration before the first Newton iteration says: the scaled change
+    ``max_j |Φ_T(X)_j − X_j| / s_j`` of its state over its last period (``drift``); a
+    time integration that has not settled (drift above the stall tolerance) starts Newton
+    far from any orbit of that period and suggests that none attracts it."""
+    if not warmup or not math.isfinite(drift) or drift <= STALL_TOLERANCE:
+        return ""
+    return (
+        f"; the time integration over {warmup} periods has not settled (its state still "
+        f"changes by {drift:.2g} of its size per period of {multiple} forcing period(s)): "
+        "the response there is not periodic with that period"
+    )
 
 
 def _selected(branch: Branch, orbits: dict, count: int) -> dict:
