@@ -44,6 +44,9 @@ from .shooting import FD_STEP, STALL_TOLERANCE, TOLERANCE, Shooting, _norm, stal
 
 __all__ = ["Branch", "BranchPoint", "check_model", "continue_branch", "measures"]
 
+#: smallest step ``T(p) / N``, as a fraction of ``h``, before a branch chooses ``N`` again
+FINEST = 0.75
+
 
 def check_model(model) -> None:
     """Refuse, in one line, a model whose periodic orbits this method does not compute.
@@ -163,6 +166,11 @@ class _Problem:
         self.family, self.h, self.options = family, float(h), options
         self._maps = {}
 
+    def holds(self, steps: int, p: float) -> bool:
+        """``N = steps`` still fits the orbit's period at ``p``: ``FINEST h <= T(p) / N <= h``."""
+        h = self.map(p).period / steps
+        return FINEST * self.h <= h <= self.h * (1.0 + 1e-12)
+
     def map(self, p: float, steps: int | None = None) -> PeriodMap:
         key = (float(p), steps)
         if key not in self._maps:
@@ -251,7 +259,7 @@ class _Continuation:
         else:
             tau, _, sign = _tangent(M, Rp, s, self.sp, previous["tau"])
         mu = multipliers(M)
-        info = {"mu": mu, "dp": tau[-1], "det_sign": sign, "tau": tau, "s": s}
+        info = {"mu": mu, "dp": tau[-1], "det_sign": sign, "tau": tau, "s": s, "steps": pm.steps}
         special = "" if previous is None or forced else special_point(previous, info)
         r = _norm(orbit.X[-1] - X, s)
         point = BranchPoint(
@@ -275,7 +283,7 @@ class _Continuation:
         iterations)`` once converged or stalled below the stall tolerance, else ``None``."""
         s, tau = info["s"], info["tau"]
         zp = np.append(X / s, p / self.sp) + ds * tau
-        steps = self.pb.map(zp[-1] * self.sp).steps
+        steps = info["steps"]
         z, history = zp.copy(), []
         for k in range(self.set.max_corrections + 1):
             Xk, pk = z[:-1] * s, z[-1] * self.sp
@@ -316,6 +324,21 @@ class _Continuation:
                 best = (rt, zt)
         return None if best is None else best[1]
 
+    def remesh(self, X, p, info):
+        """The orbit at ``p`` again with ``N = ceil(T(p) / h)`` steps per period (natural
+        shooting from ``X``), and its tangent, where the predictor's step left ``FINEST h``
+        to ``h``."""
+        pm = self.pb.map(p)
+        res = self._shooting(pm).solve(X, info["s"])
+        if not res.converged:
+            raise RuntimeError(
+                f"no orbit at {self.branch.key} = {p:g} with {pm.steps} steps per period "
+                f"(scaled residual {res.residual:.2e})"
+            )
+        self.log(f"{self.branch.key} = {p:.6g}: {pm.steps} steps per period from here")
+        _, new, _ = self._point(res.X0, p, pm.steps, res.iterations, info, forced=True)
+        return res.X0, new
+
     def inside(self, p: float) -> bool:
         lo, hi = sorted((self.start, self.stop))
         return lo - 1e-12 * self.sp <= p <= hi + 1e-12 * self.sp
@@ -336,6 +359,8 @@ class _Continuation:
         self._accept(point, orbit)
         ds = self.set.ds
         while len(self.branch.points) < self.set.max_points:
+            if not self.pb.holds(info["steps"], p + ds * info["tau"][-1] * self.sp):
+                X, info = self.remesh(X, p, info)
             got = self.correct(X, p, info, ds)
             if got is None:
                 ds *= 0.5
