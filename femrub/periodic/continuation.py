@@ -40,10 +40,14 @@ import numpy as np
 
 from .floquet import multipliers, special_point, stable
 from .period import Orbit, PeriodMap
+from .phase import new_start, state_later
 from .shooting import FD_STEP, STALL_TOLERANCE, TOLERANCE, Shooting, _norm, stalled, state_scale
 
 __all__ = ["Branch", "BranchPoint", "check_model", "continue_branch", "measures"]
 
+#: largest scaled distance between an orbit and the same orbit re-converged on another
+#: grid (a new start, a new number of steps): farther, Newton went to another orbit
+SAME_ORBIT = 0.05
 #: smallest step ``T(p) / N``, as a fraction of ``h``, before a branch chooses ``N`` again
 FINEST = 0.75
 
@@ -124,6 +128,7 @@ class BranchPoint:
     period: float
     measures: dict
     special: str = ""
+    t0: float = 0.0
 
     @property
     def stable(self) -> bool:
@@ -165,6 +170,7 @@ class _Problem:
     def __init__(self, family, h, options):
         self.family, self.h, self.options = family, float(h), options
         self._maps = {}
+        self.t0 = 0.0  # the orbits' start (s): :mod:`femrub.periodic.phase`
 
     def holds(self, steps: int, p: float) -> bool:
         """``N = steps`` still fits the orbit's period at ``p``: ``FINEST h <= T(p) / N <= h``."""
@@ -172,23 +178,24 @@ class _Problem:
         return FINEST * self.h <= h <= self.h * (1.0 + 1e-12)
 
     def map(self, p: float, steps: int | None = None) -> PeriodMap:
-        key = (float(p), steps)
+        key = (float(p), steps, self.t0)
         if key not in self._maps:
             if len(self._maps) > 8:
                 self._maps.pop(next(iter(self._maps)))
             model = self.family(float(p))
             check_model(model)
-            self._maps[key] = PeriodMap(model, self.h, steps=steps, **self.options)
+            self._maps[key] = PeriodMap(model, self.h, steps=steps, t0=self.t0, **self.options)
         return self._maps[key]
 
-    def derivatives(self, X, p, steps, s, dp_scale):
-        """``R``, ``M`` and ``R_p`` at ``(X, p)`` with ``N = steps``."""
+    def derivatives(self, X, p, steps, s, dp_scale, saltation=False):
+        """``R``, ``M`` and ``R_p`` at ``(X, p)`` with ``N = steps``; ``saltation``: ``M``
+        with the impact-time terms (:func:`~femrub.periodic.sensitivity.step_monodromy`)."""
         pm = self.map(p, steps)
         orbit = pm.orbit(X)
-        M = Shooting(pm).monodromy(X, s, orbit)
+        M = Shooting(pm).monodromy(X, s, orbit, saltation)
         dp = FD_STEP * max(abs(p), dp_scale)
         Rp = (self.map(p + dp, steps)(X) - orbit.X[-1]) / dp
-        self._maps.pop((float(p + dp), steps), None)
+        self._maps.pop((float(p + dp), steps, self.t0), None)
         return orbit, M, Rp
 
 
@@ -251,7 +258,7 @@ class _Continuation:
         pm = self.pb.map(p, steps)
         orbit0 = pm.orbit(X)
         s = state_scale(pm.model.layout, orbit0.X)
-        orbit, M, Rp = self.pb.derivatives(X, p, steps, s, self.sp)
+        orbit, M, Rp = self.pb.derivatives(X, p, steps, s, self.sp, saltation=True)
         if previous is None:
             tau, _, sign = _tangent(M, Rp, s, self.sp)
             tau = tau if tau[-1] * self.direction >= 0 else -tau
@@ -274,6 +281,7 @@ class _Continuation:
             pm.period,
             measures(pm.model, orbit, pm.h),
             special,
+            pm.t0,
         )
         return point, info, orbit
 
@@ -330,13 +338,33 @@ class _Continuation:
         to ``h``."""
         pm = self.pb.map(p)
         res = self._shooting(pm).solve(X, info["s"])
-        if not res.converged:
+        if not res.converged or _norm(res.X0 - X, info["s"]) > SAME_ORBIT:
             raise RuntimeError(
                 f"no orbit at {self.branch.key} = {p:g} with {pm.steps} steps per period "
                 f"(scaled residual {res.residual:.2e})"
             )
         self.log(f"{self.branch.key} = {p:.6g}: {pm.steps} steps per period from here")
         _, new, _ = self._point(res.X0, p, pm.steps, res.iterations, info, forced=True)
+        return res.X0, new
+
+    def rephase(self, X, p, info, orbit):
+        """The orbit at ``p`` from a start ``t0`` that puts its main impact mid-step
+        (:func:`~femrub.periodic.phase.new_start`), re-converged there, and its tangent;
+        ``(X, info)`` unchanged when the impact is already inside its step or Newton from
+        the new start does not converge to the same orbit (:data:`SAME_ORBIT`)."""
+        pm = self.pb.map(p, info["steps"])
+        start = new_start(pm.model, orbit, pm.h)
+        if start is None:
+            return X, info
+        j, delta = start
+        opts = self.pb.options
+        Xd = state_later(pm.model, orbit.X[j], orbit.t[j], delta, opts["gamma"], opts["activation"])
+        before, self.pb.t0 = self.pb.t0, float(orbit.t[j] + delta)
+        res = self._shooting(self.pb.map(p, info["steps"])).solve(Xd, info["s"])
+        if not res.converged or _norm(res.X0 - Xd, info["s"]) > SAME_ORBIT:
+            self.pb.t0 = before
+            return X, info
+        _, new, _ = self._point(res.X0, p, info["steps"], res.iterations, info, forced=True)
         return res.X0, new
 
     def inside(self, p: float) -> bool:
@@ -357,6 +385,7 @@ class _Continuation:
         X, p, steps, it = self.first(x0, warmup)
         point, info, orbit = self._point(X, p, steps, it, None)
         self._accept(point, orbit)
+        X, info = self.rephase(X, p, info, orbit)
         ds = self.set.ds
         while len(self.branch.points) < self.set.max_points:
             if not self.pb.holds(info["steps"], p + ds * info["tau"][-1] * self.sp):
@@ -377,6 +406,7 @@ class _Continuation:
             point, info, orbit = self._point(Xn, pn, steps, it, info)
             self._accept(point, orbit)
             X, p = Xn, pn
+            X, info = self.rephase(X, p, info, orbit)
             ds = min(ds * 1.3, self.set.ds_max) if it <= 3 else ds * (0.7 if it > 5 else 1.0)
         return self._fail(f"{self.set.max_points} points without reaching the end")
 
