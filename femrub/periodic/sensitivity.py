@@ -35,7 +35,8 @@ impact time ``t_k − g_k / ġ_k`` to first order, this adds to ``J_k``::
     J_k += c_k r_kᵀ,   c_k = [(T − I) z P_k + (1 + e) z (ġ_p − ġ_k) / w] / h,
                        r_k = G / ġ_k − (g_k / ġ_k²) G_v                              (2)
 
-on each step that closes an open gap (``g_k > 0``, ``ġ_k < 0``, ``P_k > 0``) under
+on each step that closes an open gap (``g_k > 0``, ``P_k > 0``) at a resolved approach
+velocity (``−ġ_k > |ġ_p − ġ_k|``: faster than the step changes it; not a grazing one) under
 ``"paper"``, ``"plain"`` or ``"predicted"``. Newton keeps Eq. (1) alone, the exact
 derivative of the map it solves; the Floquet multipliers and the branch's tangent take
 Eq. (2), the orbit's monodromy up to ``O(h)`` (a fold of an impacting branch then shows a
@@ -86,7 +87,9 @@ def _saltation(st, Xk, Xp, P, act):
     open gap under a velocity rule (zero elsewhere)."""
     gr, gv, g0, e, w, z, h = st._gr, st._gv, st._g0, st._e, st._w, st._z, st.h
     g_k, gd_k, gd_p = g0 + Xk @ gr, Xk @ gv, Xp @ gv
-    closing = act & (g_k > 0.0) & (gd_k < 0.0)
+    # a resolved approach: faster than the step changes it (a grazing one has no impact
+    # time to first order, and its 1 / ġ_k would be the map's noise, not its slope)
+    closing = act & (g_k > 0.0) & (gd_k < -np.abs(gd_p - gd_k))
     cols, rows = np.zeros_like(Xk), np.zeros_like(Xk)
     if ONE_RULES[st.activation] < 2 or not closing.any():
         return cols, rows
