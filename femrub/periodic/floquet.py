@@ -18,7 +18,10 @@ stability where multipliers cross the unit circle:
 * **Neimark–Sacker** (secondary Hopf, torus): a complex pair crosses ``|μ| = 1``;
 * **branch point**: a real multiplier crosses +1 without a fold; the determinant of the
   bordered Jacobian ``[R_X, R_p; τᵀ]`` changes sign (Seydel, *Practical Bifurcation and
-  Stability Analysis*, 2010, Sec. 5.4).
+  Stability Analysis*, 2010, Sec. 5.4);
+* **stability change**: Eq. (1) changes between the two points and none of the above
+  explains it: a multiplier jumped across the unit circle, as at a nonsmooth transition
+  (an impact appearing at grazing, a contact set changing).
 
 :func:`special_point` names the one a step of the branch passed (between two points).
 """
@@ -30,7 +33,7 @@ import numpy as np
 __all__ = ["SPECIAL", "multipliers", "special_point", "stable"]
 
 #: the names of the special points in ``branch.csv`` (column ``special``)
-SPECIAL = ("fold", "period-doubling", "neimark-sacker", "branch-point")
+SPECIAL = ("fold", "period-doubling", "neimark-sacker", "branch-point", "stability-change")
 #: relative imaginary part below which a multiplier counts as real
 REAL = 1e-8
 
@@ -70,4 +73,6 @@ def special_point(before: dict, after: dict) -> str:
         return "neimark-sacker"
     if before["det_sign"] * after["det_sign"] < 0:
         return "branch-point"
+    if stable(before["mu"]) != stable(after["mu"]):
+        return "stability-change"
     return ""
