@@ -17,10 +17,15 @@ difference in ``p`` at the same number of steps per period. Newton's method on E
 passes folds, where ``R_X`` is singular but the bordered matrix is not; a correction that
 moves farther than ``2 Δs`` from its predictor is refused (it jumped to another part of the
 branch), each Newton step is halved until the residual decreases, and the step shortened
-after a failed correction. Each point keeps
-the number of steps per period ``N = ceil(T(p) / h)`` of its predictor (the step
-``T(p) / N`` follows ``p`` inside it), so the residual is smooth in ``p`` through its
-corrections. The step ``Δs`` grows by 1.3 after a quick correction (at most 3 Newton
+after a failed correction. The branch keeps
+its number of steps per period ``N`` (the step ``T(p) / N`` follows ``p``), so the residual
+is smooth in ``p`` through its corrections, until that step leaves ``FINEST h`` to ``h``;
+the point is then converged again at the same ``p`` with ``N = ceil(T(p) / h)``. After
+each point the orbit's start moves to put its main impact mid-step
+(:mod:`femrub.periodic.phase`), and the point is converged again from there. The tangent
+and the Floquet multipliers take the monodromy with the impact-time terms
+(:mod:`femrub.periodic.sensitivity`, Eq. 2), Newton the step Jacobians' product alone.
+The step ``Δs`` grows by 1.3 after a quick correction (at most 3 Newton
 iterations) up to ``ds_max``, shrinks by 0.7 after a slow one and halves after a failed
 one, down to ``ds_min`` (then the branch stops, ``failed``). The first point is found at
 ``start`` by natural-parameter shooting from the state reached after ``warmup`` periods of
