@@ -201,6 +201,19 @@ def test_fold_of_the_impacting_resonance_is_passed():
         assert bool(pm.orbit(X).P.any()) == impacts
 
 
+def test_a_turn_without_a_multiplier_crossing_one_is_not_a_fold():
+    """``fold`` needs both the turn (``dp/ds`` changes sign) and a real multiplier across +1."""
+    from femrub.periodic.floquet import special_point
+
+    def info(dp, mu):
+        return {"dp": dp, "mu": np.array(mu, dtype=complex), "det_sign": 1.0}
+
+    assert special_point(info(1.0, [0.95, 0.3]), info(-1.0, [1.05, 0.3])) == "fold"
+    assert special_point(info(1.0, [0.7, 0.3]), info(-1.0, [0.8, 0.3])) == ""
+    assert special_point(info(1.0, [0.7, 0.3]), info(1.0, [-1.2, 0.3])) == "period-doubling"
+    assert special_point(info(1.0, [0.7, 0.3]), info(1.0, [1.3, 0.3])) == "stability-change"
+
+
 def test_restart_equals_a_fresh_stepper_from_that_state():
     """``Stepper.restart(X, t)`` then steps = a new θ-method on ``model.with_(x0=X)`` at ``t``,
     bit for bit, with the wall hit in between; a state that is not finite is refused."""
