@@ -5,7 +5,8 @@ Runs ``femrub periodic paper --set physics.thermal=off --set scheme.h=2e-6
 ``--points`` stable points of the branch, runs ``femrub run`` at each of their speeds for
 ``--revolutions`` periods of the forcing, and compares the branch's ``max_tip_displacement``
 with the largest tip displacement of the run's last ``--last`` periods (the transient left
-out). A run whose per-period maxima over those periods spread by more than 2 % has not
+out). Without a stable point it runs at both ends of the range and reports the same
+numbers. A run whose per-period maxima over those periods spread by more than 2 % has not
 settled onto a periodic response (``spread`` in the output): no orbit can agree with it.
 Writes ``DIR/comparison.json`` and prints one line per point; exit status 1 when a stable
 point differs by more than 2 %, a compared run has not settled, the branch has no stable
@@ -32,6 +33,8 @@ import numpy as np
 SETS = ["--set", "physics.thermal=off", "--set", "scheme.h=2e-6"]
 PARAM = "loads.rotation_speed=20000rpm:40000rpm"
 TOLERANCE = 0.02
+#: the ends of PARAM (rad/s): long runs there when the branch has no stable point
+ENDS = (20000 * math.pi / 30, 40000 * math.pi / 30)
 
 
 def _femrub(*args: str) -> int:
@@ -62,6 +65,18 @@ def run_peak(out: Path, speed: float, periods: int, last: int, sets: list) -> tu
     which = np.floor((t_end - t) / period - 1e-9).astype(int)
     peaks = np.array([x[which == j].max() for j in range(last) if np.any(which == j)])
     return float(peaks.max()), float((peaks.max() - peaks.min()) / peaks.max())
+
+
+def settling(out: Path, speed: float, args, sets: list) -> dict:
+    """A long run at ``speed`` (rad/s) when the branch gives no stable point there to compare:
+    its largest tip displacement and the spread of its per-period maxima (whether a periodic
+    response exists for a branch to find)."""
+    run, spread = run_peak(out, speed, args.revolutions, args.last, sets)
+    print(
+        f"{speed:.6g} rad/s: no orbit; run {run:.6g} m, "
+        f"per-period maxima spread {100 * spread:.2f} %"
+    )
+    return {"rotation_speed": speed, "run": run, "spread": spread}
 
 
 def main(argv=None) -> int:
@@ -97,6 +112,7 @@ def main(argv=None) -> int:
         )
     if not pick:
         print(f"no stable point to compare ({summary.get('status')}: {summary.get('message')})")
+    unsettled = [] if pick else [settling(out, speed, args, sets) for speed in ENDS]
     doc = {
         "branch_status": summary.get("status"),
         "branch_message": summary.get("message"),
@@ -104,9 +120,12 @@ def main(argv=None) -> int:
         "stable": len(stable),
         "special": summary.get("special", []),
         "comparisons": result,
+        "runs_without_orbit": unsettled,
     }
     (out / "comparison.json").write_text(json.dumps(doc, indent=2) + "\n")
-    print(json.dumps({k: v for k, v in doc.items() if k != "comparisons"}))
+    print(
+        json.dumps({k: v for k, v in doc.items() if k not in ("comparisons", "runs_without_orbit")})
+    )
     ok = (
         summary.get("status") == "ok"
         and result
