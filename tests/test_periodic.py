@@ -157,6 +157,63 @@ def test_branch_of_linear_orbits_and_its_folder(tmp_path):
         assert {"t", "signal_tip_displacement", "impulse"} <= set(h.files)
 
 
+def test_fold_of_the_impacting_resonance_is_passed():
+    """The damped impact oscillator's impacting resonance peak bends to higher frequencies
+    and folds: continuation in ω from its stable upper branch passes the fold, where a real
+    multiplier crosses +1, and goes on along the unstable branch (ω decreasing, converged
+    points). A time integration just above the fold leaves the impacting orbit for the
+    linear one; just below it keeps impacting."""
+    F, d, e, c, n = 0.2, 0.5, 0.5, 0.1, 2000
+
+    def family(w):
+        return oscillator(w, F=F, d=d, e=e, c=c)
+
+    branch = continue_branch(
+        family,
+        1.3,
+        2.0,
+        h=2 * np.pi / n,
+        key="omega",
+        x0=np.array([d, 0.0]),
+        warmup=200,
+        activation="paper",
+        max_points=26,
+    )
+    w, pts = branch.parameter, branch.points
+    folds = [i for i, p in enumerate(pts) if p.special == "fold"]
+    assert folds, [p.special for p in pts]
+    i = folds[0]
+    assert w[i - 1] == w.max() or w[i] == w.max()  # the branch turns back there
+    after = pts[i:]
+    assert len(after) >= 4 and all(p.converged for p in after)
+    assert np.all(np.diff(w[i:]) < 0) and w[-1] < w.max() - 0.02
+    assert all(p.stable for p in pts[:i]) and not any(p.stable for p in after)
+    real = [
+        np.max(m.real[np.abs(m.imag) < 1e-9]) for m in (pts[i - 1].multipliers, pts[i].multipliers)
+    ]
+    assert real[0] < 1.0 < real[1]
+    top = pts[int(np.argmax(w))]
+    for ratio, impacts in ((1.005, False), (0.99, True)):
+        pm = PeriodMap(family(top.parameter * ratio), 2 * np.pi / n, activation="paper")
+        X = top.X0
+        for _ in range(300):
+            X = pm(X)
+        assert bool(pm.orbit(X).P.any()) == impacts
+
+
+def test_a_turn_without_a_multiplier_crossing_one_is_not_a_fold():
+    """``fold`` needs both the turn (``dp/ds`` changes sign) and a real multiplier across +1."""
+    from femrub.periodic.floquet import special_point
+
+    def info(dp, mu):
+        return {"dp": dp, "mu": np.array(mu, dtype=complex), "det_sign": 1.0}
+
+    assert special_point(info(1.0, [0.95, 0.3]), info(-1.0, [1.05, 0.3])) == "fold"
+    assert special_point(info(1.0, [0.7, 0.3]), info(-1.0, [0.8, 0.3])) == ""
+    assert special_point(info(1.0, [0.7, 0.3]), info(1.0, [-1.2, 0.3])) == "period-doubling"
+    assert special_point(info(1.0, [0.7, 0.3]), info(1.0, [1.3, 0.3])) == "stability-change"
+
+
 def test_restart_equals_a_fresh_stepper_from_that_state():
     """``Stepper.restart(X, t)`` then steps = a new θ-method on ``model.with_(x0=X)`` at ``t``,
     bit for bit, with the wall hit in between; a state that is not finite is refused."""
@@ -189,6 +246,39 @@ def test_step_monodromy_equals_finite_differences(rule):
     assert np.allclose(exact, fd, rtol=1e-5, atol=1e-5 * np.abs(exact).max())
 
 
+def test_multipliers_of_an_impacting_orbit_carry_the_impact_time():
+    """Perturbations that move the impact by many steps return after a period as the
+    orbit's monodromy with the saltation terms says (a linear map fitted to the period
+    map's response); the product of the step Jacobians alone, blind to the impact time,
+    is off by far more."""
+    from femrub.periodic.sensitivity import step_monodromy
+
+    w, n = 1.3, 16000
+    pm = PeriodMap(oscillator(w, F=0.2, d=0.5, e=0.5, c=0.1), 2 * np.pi / w / n, activation="paper")
+    X = np.array([0.5, 0.0])
+    for _ in range(30):
+        X = pm(X)
+    res = Shooting(pm).solve(X)
+    X, orbit = res.X0, pm.orbit(res.X0)
+    assert res.converged and np.count_nonzero(orbit.P) == 1
+    before, after = [], []
+    for angle in np.linspace(0.0, np.pi, 6, endpoint=False):
+        Y = X + 0.03 * np.array([np.cos(angle), np.sin(angle)])
+        for k in range(4):
+            Z = pm(Y)
+            if k:  # the first period settles the perturbation onto the orbit's directions
+                before.append(Y - X)
+                after.append(Z - X)
+            Y = Z
+    fitted = np.linalg.lstsq(np.array(before), np.array(after), rcond=None)[0].T
+    exact = np.sort_complex(np.linalg.eigvals(fitted))
+    salted = np.sort_complex(np.linalg.eigvals(step_monodromy(pm.stepper, orbit, True)))
+    plain = np.sort_complex(np.linalg.eigvals(step_monodromy(pm.stepper, orbit)))
+    assert np.abs(salted - exact).max() < 0.03
+    assert np.abs(plain - exact).max() > 0.2
+    assert np.allclose(np.sort_complex(np.linalg.eigvals(res.monodromy)), salted)
+
+
 @pytest.mark.parametrize(
     ("args", "message"),
     [
@@ -207,3 +297,21 @@ def test_cli_refuses_bad_input_in_one_line_before_any_folder(tmp_path, capsys, a
     err = capsys.readouterr().err.strip()
     assert message in err and len(err.splitlines()) == 1
     assert not out.exists()
+
+
+def test_paper_bar_without_damping_has_no_settled_response_to_start_from(tmp_path, capsys):
+    """The paper's bar without damping (γ = 1/2, plastic impacts) at 20000 rpm: the time
+    integration from rest does not settle (its state changes by a large fraction of its size
+    from period to period), Newton from there finds no orbit, and the branch says both and
+    keeps its folder."""
+    from femrub.app.cli import main
+
+    out = tmp_path / "branch"
+    args = ["periodic", "paper", "--set", "physics.thermal=off", "--set", "scheme.h=2e-6"]
+    args += ["--param", "loads.rotation_speed=20000rpm:40000rpm", "-o", str(out), "--quiet"]
+    assert main(args) == 1
+    err = capsys.readouterr().err
+    assert "no periodic orbit at loads.rotation_speed = 2094.4" in err
+    drift = float(err.split("still changes by ")[1].split()[0])
+    assert "has not settled" in err and drift > 0.1
+    assert (out / "branch.csv").exists() and (out / "summary.json").exists()

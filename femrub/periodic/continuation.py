@@ -17,10 +17,15 @@ difference in ``p`` at the same number of steps per period. Newton's method on E
 passes folds, where ``R_X`` is singular but the bordered matrix is not; a correction that
 moves farther than ``2 Δs`` from its predictor is refused (it jumped to another part of the
 branch), each Newton step is halved until the residual decreases, and the step shortened
-after a failed correction. Each point keeps
-the number of steps per period ``N = ceil(T(p) / h)`` of its predictor (the step
-``T(p) / N`` follows ``p`` inside it), so the residual is smooth in ``p`` through its
-corrections. The step ``Δs`` grows by 1.3 after a quick correction (at most 3 Newton
+after a failed correction. The branch keeps
+its number of steps per period ``N`` (the step ``T(p) / N`` follows ``p``), so the residual
+is smooth in ``p`` through its corrections, until that step leaves ``FINEST h`` to ``h``;
+the point is then converged again at the same ``p`` with ``N = ceil(T(p) / h)``. After
+each point the orbit's start moves to put its main impact mid-step
+(:mod:`femrub.periodic.phase`), and the point is converged again from there. The tangent
+and the Floquet multipliers take the monodromy with the impact-time terms
+(:mod:`femrub.periodic.sensitivity`, Eq. 2), Newton the step Jacobians' product alone.
+The step ``Δs`` grows by 1.3 after a quick correction (at most 3 Newton
 iterations) up to ``ds_max``, shrinks by 0.7 after a slow one and halves after a failed
 one, down to ``ds_min`` (then the branch stops, ``failed``). The first point is found at
 ``start`` by natural-parameter shooting from the state reached after ``warmup`` periods of
@@ -40,9 +45,16 @@ import numpy as np
 
 from .floquet import multipliers, special_point, stable
 from .period import Orbit, PeriodMap
+from .phase import new_start, state_later
 from .shooting import FD_STEP, STALL_TOLERANCE, TOLERANCE, Shooting, _norm, stalled, state_scale
 
 __all__ = ["Branch", "BranchPoint", "check_model", "continue_branch", "measures"]
+
+#: largest scaled distance between an orbit and the same orbit re-converged on another
+#: grid (a new start, a new number of steps): farther, Newton went to another orbit
+SAME_ORBIT = 0.05
+#: smallest step ``T(p) / N``, as a fraction of ``h``, before a branch chooses ``N`` again
+FINEST = 0.75
 
 
 def check_model(model) -> None:
@@ -121,6 +133,7 @@ class BranchPoint:
     period: float
     measures: dict
     special: str = ""
+    t0: float = 0.0
 
     @property
     def stable(self) -> bool:
@@ -162,25 +175,32 @@ class _Problem:
     def __init__(self, family, h, options):
         self.family, self.h, self.options = family, float(h), options
         self._maps = {}
+        self.t0 = 0.0  # the orbits' start (s): :mod:`femrub.periodic.phase`
+
+    def holds(self, steps: int, p: float) -> bool:
+        """``N = steps`` still fits the orbit's period at ``p``: ``FINEST h <= T(p) / N <= h``."""
+        h = self.map(p).period / steps
+        return FINEST * self.h <= h <= self.h * (1.0 + 1e-12)
 
     def map(self, p: float, steps: int | None = None) -> PeriodMap:
-        key = (float(p), steps)
+        key = (float(p), steps, self.t0)
         if key not in self._maps:
             if len(self._maps) > 8:
                 self._maps.pop(next(iter(self._maps)))
             model = self.family(float(p))
             check_model(model)
-            self._maps[key] = PeriodMap(model, self.h, steps=steps, **self.options)
+            self._maps[key] = PeriodMap(model, self.h, steps=steps, t0=self.t0, **self.options)
         return self._maps[key]
 
-    def derivatives(self, X, p, steps, s, dp_scale):
-        """``R``, ``M`` and ``R_p`` at ``(X, p)`` with ``N = steps``."""
+    def derivatives(self, X, p, steps, s, dp_scale, saltation=False):
+        """``R``, ``M`` and ``R_p`` at ``(X, p)`` with ``N = steps``; ``saltation``: ``M``
+        with the impact-time terms (:func:`~femrub.periodic.sensitivity.step_monodromy`)."""
         pm = self.map(p, steps)
         orbit = pm.orbit(X)
-        M = Shooting(pm).monodromy(X, s, orbit)
+        M = Shooting(pm).monodromy(X, s, orbit, saltation)
         dp = FD_STEP * max(abs(p), dp_scale)
         Rp = (self.map(p + dp, steps)(X) - orbit.X[-1]) / dp
-        self._maps.pop((float(p + dp), steps), None)
+        self._maps.pop((float(p + dp), steps, self.t0), None)
         return orbit, M, Rp
 
 
@@ -224,13 +244,17 @@ class _Continuation:
         """The orbit at ``start`` by natural-parameter shooting after ``warmup`` periods."""
         pm = self.pb.map(self.start)
         X = pm.model.x0.copy() if x0 is None else np.asarray(x0, dtype=float)
-        for _ in range(warmup):
-            X = pm(X)
+        drift = math.nan
+        for k in range(warmup):
+            X, before = pm(X), X
+            if k == warmup - 1:
+                drift = _norm(X - before, state_scale(pm.model.layout, np.vstack([X, before])))
         res = self._shooting(pm).solve(X)
         if not res.converged:
             raise RuntimeError(
                 f"no periodic orbit at {self.branch.key} = {self.start:g} (scaled residual "
                 f"{res.residual:.2e} after {res.iterations} Newton iterations)"
+                + _settling(warmup, drift, self.pb.options.get("multiple", 1))
             )
         return res.X0, self.start, pm.steps, res.iterations
 
@@ -239,7 +263,7 @@ class _Continuation:
         pm = self.pb.map(p, steps)
         orbit0 = pm.orbit(X)
         s = state_scale(pm.model.layout, orbit0.X)
-        orbit, M, Rp = self.pb.derivatives(X, p, steps, s, self.sp)
+        orbit, M, Rp = self.pb.derivatives(X, p, steps, s, self.sp, saltation=True)
         if previous is None:
             tau, _, sign = _tangent(M, Rp, s, self.sp)
             tau = tau if tau[-1] * self.direction >= 0 else -tau
@@ -247,7 +271,7 @@ class _Continuation:
         else:
             tau, _, sign = _tangent(M, Rp, s, self.sp, previous["tau"])
         mu = multipliers(M)
-        info = {"mu": mu, "dp": tau[-1], "det_sign": sign, "tau": tau, "s": s}
+        info = {"mu": mu, "dp": tau[-1], "det_sign": sign, "tau": tau, "s": s, "steps": pm.steps}
         special = "" if previous is None or forced else special_point(previous, info)
         r = _norm(orbit.X[-1] - X, s)
         point = BranchPoint(
@@ -262,6 +286,7 @@ class _Continuation:
             pm.period,
             measures(pm.model, orbit, pm.h),
             special,
+            pm.t0,
         )
         return point, info, orbit
 
@@ -271,7 +296,7 @@ class _Continuation:
         iterations)`` once converged or stalled below the stall tolerance, else ``None``."""
         s, tau = info["s"], info["tau"]
         zp = np.append(X / s, p / self.sp) + ds * tau
-        steps = self.pb.map(zp[-1] * self.sp).steps
+        steps = info["steps"]
         z, history = zp.copy(), []
         for k in range(self.set.max_corrections + 1):
             Xk, pk = z[:-1] * s, z[-1] * self.sp
@@ -312,6 +337,41 @@ class _Continuation:
                 best = (rt, zt)
         return None if best is None else best[1]
 
+    def remesh(self, X, p, info):
+        """The orbit at ``p`` again with ``N = ceil(T(p) / h)`` steps per period (natural
+        shooting from ``X``), and its tangent, where the predictor's step left ``FINEST h``
+        to ``h``."""
+        pm = self.pb.map(p)
+        res = self._shooting(pm).solve(X, info["s"])
+        if not res.converged or _norm(res.X0 - X, info["s"]) > SAME_ORBIT:
+            raise RuntimeError(
+                f"no orbit at {self.branch.key} = {p:g} with {pm.steps} steps per period "
+                f"(scaled residual {res.residual:.2e})"
+            )
+        self.log(f"{self.branch.key} = {p:.6g}: {pm.steps} steps per period from here")
+        _, new, _ = self._point(res.X0, p, pm.steps, res.iterations, info, forced=True)
+        return res.X0, new
+
+    def rephase(self, X, p, info, orbit):
+        """The orbit at ``p`` from a start ``t0`` that puts its main impact mid-step
+        (:func:`~femrub.periodic.phase.new_start`), re-converged there, and its tangent;
+        ``(X, info)`` unchanged when the impact is already inside its step or Newton from
+        the new start does not converge to the same orbit (:data:`SAME_ORBIT`)."""
+        pm = self.pb.map(p, info["steps"])
+        start = new_start(pm.model, orbit, pm.h)
+        if start is None:
+            return X, info
+        j, delta = start
+        opts = self.pb.options
+        Xd = state_later(pm.model, orbit.X[j], orbit.t[j], delta, opts["gamma"], opts["activation"])
+        before, self.pb.t0 = self.pb.t0, float(orbit.t[j] + delta)
+        res = self._shooting(self.pb.map(p, info["steps"])).solve(Xd, info["s"])
+        if not res.converged or _norm(res.X0 - Xd, info["s"]) > SAME_ORBIT:
+            self.pb.t0 = before
+            return X, info
+        _, new, _ = self._point(res.X0, p, info["steps"], res.iterations, info, forced=True)
+        return res.X0, new
+
     def inside(self, p: float) -> bool:
         lo, hi = sorted((self.start, self.stop))
         return lo - 1e-12 * self.sp <= p <= hi + 1e-12 * self.sp
@@ -330,8 +390,11 @@ class _Continuation:
         X, p, steps, it = self.first(x0, warmup)
         point, info, orbit = self._point(X, p, steps, it, None)
         self._accept(point, orbit)
+        X, info = self.rephase(X, p, info, orbit)
         ds = self.set.ds
         while len(self.branch.points) < self.set.max_points:
+            if not self.pb.holds(info["steps"], p + ds * info["tau"][-1] * self.sp):
+                X, info = self.remesh(X, p, info)
             got = self.correct(X, p, info, ds)
             if got is None:
                 ds *= 0.5
@@ -348,6 +411,7 @@ class _Continuation:
             point, info, orbit = self._point(Xn, pn, steps, it, info)
             self._accept(point, orbit)
             X, p = Xn, pn
+            X, info = self.rephase(X, p, info, orbit)
             ds = min(ds * 1.3, self.set.ds_max) if it <= 3 else ds * (0.7 if it > 5 else 1.0)
         return self._fail(f"{self.set.max_points} points without reaching the end")
 
@@ -365,6 +429,20 @@ class _Continuation:
     def _fail(self, message: str) -> Branch:
         self.branch.status, self.branch.message = "failed", message
         return self.branch
+
+
+def _settling(warmup: int, drift: float, multiple: int) -> str:
+    """What the time integration before the first Newton iteration says: the scaled change
+    ``max_j |Φ_T(X)_j − X_j| / s_j`` of its state over its last period (``drift``); a
+    time integration that has not settled (drift above the stall tolerance) starts Newton
+    far from any orbit of that period and suggests that none attracts it."""
+    if not warmup or not math.isfinite(drift) or drift <= STALL_TOLERANCE:
+        return ""
+    return (
+        f"; the time integration over {warmup} periods has not settled (its state still "
+        f"changes by {drift:.2g} of its size per period of {multiple} forcing period(s)): "
+        "the response there is not periodic with that period"
+    )
 
 
 def _selected(branch: Branch, orbits: dict, count: int) -> dict:

@@ -4,7 +4,8 @@
   the summary measures of one period (:func:`~femrub.periodic.continuation.measures`;
   ``max_tip_displacement`` in m), ``stable``, ``max_floquet_modulus``,
   ``newton_iterations``, ``residual``, ``special`` (fold, period-doubling,
-  neimark-sacker, branch-point or empty), ``steps_per_period``, ``h`` (s), ``period`` (s);
+  neimark-sacker, branch-point, stability-change or empty), ``steps_per_period``,
+  ``h`` (s), ``period`` (s);
 * ``branch.png``: the first measure (the tip displacement) against the parameter, stable
   stretches solid, unstable dashed, special points marked;
 * ``summary.json``: ``status`` (``ok`` only if every point converged and the branch reached
@@ -73,7 +74,13 @@ def _plot(branch, path: Path) -> None:
         for i in range(len(p) - 1):  # each segment in the style of its end points
             style = "-" if ok[i] and ok[i + 1] else "--"
             ax.plot(p[i : i + 2], y[i : i + 2], style, color="C0")
-        marks = {"fold": "o", "period-doubling": "s", "neimark-sacker": "D", "branch-point": "^"}
+        marks = {
+            "fold": "o",
+            "period-doubling": "s",
+            "neimark-sacker": "D",
+            "branch-point": "^",
+            "stability-change": "v",
+        }
         for kind, marker in marks.items():
             idx = [i for i, q in enumerate(branch.points) if q.special == kind]
             if idx:

@@ -70,7 +70,8 @@ class ShootingResult:
     iterations : Newton iterations.
     converged : ``residual <= tolerance``, or Newton stalled (no 10 % decrease in three
         iterations) below ``stall_tolerance``.
-    monodromy : ``M = ∂Φ_T/∂X0`` (N, N) at ``X0``.
+    monodromy : ``M = ∂Φ_T/∂X0`` (N, N) at ``X0``, with the impact-time terms where the
+        step has them (the orbit's Floquet multipliers: :mod:`femrub.periodic.sensitivity`).
     scale : the scale ``s`` (N,) of the orbit.
     """
 
@@ -119,13 +120,14 @@ class Shooting:
         """``R(X0) = Φ_T(X0) − X0`` (N,), Eq. (1)."""
         return self.map(X0) - X0
 
-    def monodromy(self, X0, scale, orbit=None) -> np.ndarray:
+    def monodromy(self, X0, scale, orbit=None, saltation=False) -> np.ndarray:
         """``M`` (N, N) at ``X0``: the product of the step Jacobians on the orbit's contact set
         where the step has them (:func:`~femrub.periodic.sensitivity.step_monodromy`, with
-        ``derivatives="auto"``), else Eq. (2); ``orbit``: the orbit from ``X0`` when known."""
+        ``derivatives="auto"``; ``saltation``: with its impact-time terms), else Eq. (2);
+        ``orbit``: the orbit from ``X0`` when known."""
         orbit = self.map.orbit(X0) if orbit is None else orbit
         if self.derivatives == "auto":
-            M = step_monodromy(self.map.stepper, orbit)
+            M = step_monodromy(self.map.stepper, orbit, saltation)
             if M is not None:
                 return M
         phi = orbit.X[-1]
@@ -157,7 +159,7 @@ class Shooting:
                 s = state_scale(self.layout, np.vstack([s, self.map.orbit(X).X]))
             orbit = self.map.orbit(X)
         ok = r <= self.tolerance or self.stalled(history)
-        return ShootingResult(X, r, k, ok, self.monodromy(X, s), s)
+        return ShootingResult(X, r, k, ok, self.monodromy(X, s, saltation=True), s)
 
     def stalled(self, history: list) -> bool:
         """:func:`stalled` below ``stall_tolerance``."""
