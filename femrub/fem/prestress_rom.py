@@ -30,6 +30,7 @@ from __future__ import annotations
 
 import functools
 import math
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 
 import numpy as np
@@ -42,7 +43,7 @@ except ImportError:  # pragma: no cover
 from ..blas import one_blas_thread
 from . import centrifugal as cf
 from .forms import lame_parameters
-from .quadrature import CHUNK, gradient_operator
+from .quadrature import CHUNK, THREADS, gradient_operator
 
 __all__ = [
     "EnergyPolynomial",
@@ -183,10 +184,17 @@ def energy_polynomial(op, BV: np.ndarray, previous: EnergyPolynomial | None = No
     lin, _, _, pair = _layout(r, op.linear)
     n_feat = lin.size + pair.size
     n_old = 0 if previous is None else previous.gamma.shape[0]
-    rows = np.zeros((n_feat - n_old, n_feat))
-    with one_blas_thread:  # tall-skinny products: threads only contend
-        for lo in range(0, op.n_points, CHUNK):
+    starts = range(0, op.n_points, CHUNK)
+
+    def part(k):
+        rows = np.zeros((n_feat - n_old, n_feat))
+        for lo in starts[k::THREADS]:
             _gamma_rows(op, BV, lo, r, n_old, rows)
+        return rows
+
+    # the chunks shared between the cores, each on one BLAS thread (tall-skinny products)
+    with one_blas_thread, ThreadPoolExecutor(THREADS) as pool:
+        rows = sum(pool.map(part, range(THREADS)))
     gamma = np.zeros((n_feat, n_feat))
     if n_old:
         gamma[:n_old, :n_old] = previous.gamma

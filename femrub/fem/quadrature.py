@@ -21,6 +21,7 @@ gives the residuals of Ritz pairs on the full mesh.
 
 from __future__ import annotations
 
+import os
 from dataclasses import dataclass
 
 import numpy as np
@@ -35,6 +36,9 @@ __all__ = ["GradientOperator", "gradient_operator"]
 
 #: quadrature points per chunk of the products with many vectors
 CHUNK = 16384
+#: threads sharing the quadrature points or the speeds (the cores this process may use,
+#: at most 4)
+THREADS = max(1, min(4, len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else 1))
 
 
 @dataclass(frozen=True)
