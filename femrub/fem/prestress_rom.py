@@ -218,9 +218,10 @@ class PrestressProblem:
         """A factorisation of the tangent at ``s = Ω²`` (preconditions nearby speeds)."""
         self.factors.append((float(s), solve))
 
-    def replace_factor(self, s: float, solve) -> None:
-        """The factorisation at ``s`` replaced by ``solve`` (added when there is none)."""
-        self.factors = [f for f in self.factors if f[0] != float(s)] + [(float(s), solve)]
+    def drop_factor(self, s: float) -> None:
+        """Forget the factorisation at ``s`` (its memory is released with its last user;
+        the one at rest stays)."""
+        self.factors = [f for f in self.factors if f[0] != float(s) or f[0] == 0.0]
 
     def nearest_solve(self, s: float):
         return min(self.factors, key=lambda f: abs(f[0] - s))[1]
