@@ -321,8 +321,9 @@ def _verdict(method, options, sm, speeds) -> dict:
     samples = len(sm.sample_speeds)
     if per_speed[i] <= tolerance:
         msg = (
-            f"every frequency certified within {100 * per_speed[i]:.2g} % (tolerance "
-            f"{100 * tolerance:g} %) by its residual, {samples} full modal samples"
+            f"every frequency within {100 * per_speed[i]:.2g} % (tolerance "
+            f"{100 * tolerance:g} %) by its residual bound and the prestress estimate, "
+            f"{samples} full modal samples"
         )
         return {"status": "ok", "message": msg, **out}
     msg = (

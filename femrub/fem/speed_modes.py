@@ -1,4 +1,4 @@
-"""Modes of a spinning blade at many speeds, each frequency certified by its residual.
+"""Modes of a spinning blade at many speeds, each frequency checked by its residual.
 
 For a list of rotation speeds, :func:`speed_modes` gives the lowest natural frequencies of
 ``K_T(u(Ω), Ω) x = ω² M x`` (the prestressed tangent of :mod:`femrub.fem.centrifugal`) at
@@ -68,7 +68,7 @@ STATIC_MARGIN = 2.0
 #: extra modes per sample in the Ritz basis
 EXTRA_MODES = 4
 #: relative accuracy asked of the samples' eigenvalues (the samples only span ``W``: the
-#: frequencies reported are its Ritz values, certified by their residuals)
+#: frequencies reported are its Ritz values, checked by their residuals)
 SAMPLE_TOLERANCE = 1e-8
 
 
