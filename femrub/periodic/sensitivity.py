@@ -64,20 +64,20 @@ def _newton_rows(e_k, gv, gvT, w):
 def _impulse_rows(st, Xk, Xp, act) -> np.ndarray:
     """``a_k`` (m, N) of Eq. (1)'s rules on the steps ``act`` (module docstring)."""
     code = ONE_RULES[st.activation]
-    gr, gv, g0, e = st._gr, st._gv, st._g0, st._e
-    T = st._T
-    grT, gvT = gr @ T, gv @ T
+    oc = st.one_contact
+    gr, gv, g0, e = oc.gr, oc.gv, oc.g0, oc.e
+    grT, gvT = gr @ oc.T, gv @ oc.T
     g_k, gd_k = g0 + Xk @ gr, Xk @ gv
     if code in (0, 1):
-        rows = _position_rows(g_k, gr, grT, e, st._gz)
+        rows = _position_rows(g_k, gr, grT, e, oc.gz)
         if code == 1:  # capped: Newton's law where it is below the position target
             g_p, gd_p = g0 + Xp @ gr, Xp @ gv
             target = np.minimum(g_k, 0.0) + e * np.maximum(g_k, 0.0)
-            newton = -(gd_p + e * gd_k) / st._w < (target - g_p) / st._gz
-            rows[newton] = _newton_rows(np.full(int(newton.sum()), e), gv, gvT, st._w)
+            newton = -(gd_p + e * gd_k) / oc.w < (target - g_p) / oc.gz
+            rows[newton] = _newton_rows(np.full(int(newton.sum()), e), gv, gvT, oc.w)
     else:
         e_k = np.where(gd_k > 0.0, 1.0, e) if code in (2, 4) else np.full(g_k.size, e)
-        rows = _newton_rows(e_k, gv, gvT, st._w)
+        rows = _newton_rows(e_k, gv, gvT, oc.w)
     rows[~act] = 0.0
     return rows
 
@@ -85,7 +85,8 @@ def _impulse_rows(st, Xk, Xp, act) -> np.ndarray:
 def _saltation(st, Xk, Xp, P, act):
     """Columns ``c_k`` (m, N) and rows ``r_k`` (m, N) of Eq. (2) on the steps that close an
     open gap under a velocity rule (zero elsewhere)."""
-    gr, gv, g0, e, w, z, h = st._gr, st._gv, st._g0, st._e, st._w, st._z, st.h
+    oc, h = st.one_contact, st.h
+    gr, gv, g0, e, w, z = oc.gr, oc.gv, oc.g0, oc.e, oc.w, oc.z
     g_k, gd_k, gd_p = g0 + Xk @ gr, Xk @ gv, Xp @ gv
     # a resolved approach: faster than the step changes it (a grazing one has no impact
     # time to first order, and its 1 / ġ_k would be the map's noise, not its slope)
@@ -93,7 +94,7 @@ def _saltation(st, Xk, Xp, P, act):
     cols, rows = np.zeros_like(Xk), np.zeros_like(Xk)
     if ONE_RULES[st.activation] < 2 or not closing.any():
         return cols, rows
-    T = st._T
+    T = oc.T
     jump = P[closing, None] * ((T - np.eye(T.shape[0])) @ z)[None, :]
     accel = (1.0 + e) * ((gd_p - gd_k)[closing] / w)[:, None] * z[None, :]
     cols[closing] = (jump + accel) / h
@@ -108,15 +109,16 @@ def step_monodromy(st, orbit, saltation: bool = False) -> np.ndarray | None:
     one-contact path (then the finite differences of :mod:`femrub.periodic.shooting`).
     ``saltation``: with the impact-time terms of Eq. (2) on the steps where a velocity rule
     closes an open gap."""
-    if not getattr(st, "_fast", False):
+    oc = getattr(st, "one_contact", None)
+    if oc is None:
         return None
     X, P = orbit.X, orbit.P[1:, 0]
     Xk = X[:-1]
-    Xp = X[1:] - P[:, None] * st._z[None, :]
+    Xp = X[1:] - P[:, None] * oc.z[None, :]
     act = P > 0.0
     rows = _impulse_rows(st, Xk, Xp, act)
     cols, times = _saltation(st, Xk, Xp, P, act) if saltation else (None, None)
-    T, z = st._T, st._z
+    T, z = oc.T, oc.z
     M = np.eye(X.shape[1])
     for k in range(P.size):  # the product of Eq. (1)'s step Jacobians
         Mk = T @ M + np.outer(z, rows[k] @ M) if act[k] else T @ M

@@ -51,6 +51,8 @@ case and sparse models go step by step, as do ``step()`` and ``iterate()``.
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 import scipy.sparse as sp
 
@@ -69,9 +71,26 @@ from .base import Stepper
 from .record import Friction
 from .theta_blocks import advance_block, prepare
 
-__all__ = ["ThetaMethod", "ACTIVATION_RULES"]
+__all__ = ["ThetaMethod", "ACTIVATION_RULES", "OneContactStep"]
 
 ACTIVATION_RULES = RULES
+
+
+@dataclass(frozen=True)
+class OneContactStep:
+    """The closed-form step of one frictionless contact on a dense model: the free step
+    ``X_p = T X_k + …``, the impulse enters as ``X_{k+1} = X_p + P z``; the gap is
+    ``g0 + gr · X`` (m) and the gap velocity ``gv · X`` (m/s); ``w = gv · z`` and
+    ``gz = gr · z`` are the contact's compliances to its impulse; ``e`` the restitution."""
+
+    T: np.ndarray
+    z: np.ndarray
+    w: float
+    gv: np.ndarray
+    gr: np.ndarray
+    g0: float
+    e: float
+    gz: float
 
 
 class ThetaMethod(Stepper):
@@ -192,6 +211,16 @@ class ThetaMethod(Stepper):
             self._memo = (None, 0.0, None)
             self._n3 = c.n
         prepare(self)
+
+    @property
+    def one_contact(self) -> OneContactStep | None:
+        """The operators of the one-contact closed-form step, or ``None`` when this stepper
+        does not take it (several contacts, friction, a sparse model, …)."""
+        if not self._fast:
+            return None
+        return OneContactStep(
+            self._T, self._z, self._w, self._gv, self._gr, self._g0, self._e, self._gz
+        )
 
     def _restart(self):
         self._sk = self._signal_values(self.t)
