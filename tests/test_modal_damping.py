@@ -153,7 +153,7 @@ def test_each_mode_of_the_run_s_model_reports_its_own_rayleigh_ratio():
     a, b = d["rayleigh"]
     w = 2 * np.pi * f
     # Rayleigh, mode by mode: the coupled model's eigenvalues move a ratio by about 1e-8 from
-    # build to build (2e-6 relative on the smallest); modal damping would differ by O(1)
+    # build to build (up to 2e-6 relative); modal damping would differ by O(1)
     np.testing.assert_allclose(z, a / (2 * w) + b * w / 2, rtol=1e-5)
     assert z[0] == pytest.approx(0.005, rel=1e-3) and z[4] == pytest.approx(0.005, rel=1e-2)
     assert np.all(z[1:4] < 0.005) and z[-1] > 0.005  # less between, more above
