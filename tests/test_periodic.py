@@ -246,6 +246,28 @@ def test_step_monodromy_equals_finite_differences(rule):
     assert np.allclose(exact, fd, rtol=1e-5, atol=1e-5 * np.abs(exact).max())
 
 
+@pytest.mark.parametrize("rule", ["position", "paper"])
+def test_checked_differences_refuse_columns_that_cross_an_impact(rule):
+    """A finite-difference step that moves the impact by a step gives a column of size
+    ``jump / δ``: the plain differences are then far from the step Jacobians' product, the
+    checked ones take those columns again at smaller steps and equal it; with a step whose
+    every refinement still crosses, the column is counted unsettled."""
+    from femrub.periodic.shooting import checked_differences, differences
+
+    omega = 0.8
+    pm = PeriodMap(oscillator(omega), 2 * np.pi / omega / 1000, activation=rule)
+    X0 = impact_orbit(omega)[2]
+    image = pm(X0)
+    exact = Shooting(pm).monodromy(X0, np.ones(2))
+    delta = 1e-2 * (1.0 + np.abs(X0))
+    plain = differences(pm, X0, image, delta)
+    checked, unsettled = checked_differences(pm, X0, image, delta, np.ones(2))
+    assert np.abs(plain - exact).max() > 0.5 * np.abs(exact).max()
+    assert unsettled == 0
+    assert np.allclose(checked, exact, rtol=1e-6, atol=1e-6 * np.abs(exact).max())
+    assert checked_differences(pm, X0, image, 10 * delta, np.ones(2))[1] > 0
+
+
 def test_multipliers_of_an_impacting_orbit_carry_the_impact_time():
     """Perturbations that move the impact by many steps return after a period as the
     orbit's monodromy with the saltation terms says (a linear map fitted to the period

@@ -283,7 +283,9 @@ def _periodic(args) -> int:
     out = Path(args.out or f"{safe_name(scene.name)}-periodic")
     t0 = time.perf_counter()
     with claim(out, "periodic", overwrite=args.overwrite):
-        family = scene_family(scene.with_changes({key: start}), key, log=_log(args))
+        family = scene_family(
+            scene.with_changes({key: start}), key, log=_log(args), cache=_cache(args, _log(args))
+        )
         check_model(family(start))
         s = scene["scheme"]
         branch = continue_branch(

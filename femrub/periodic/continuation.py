@@ -46,13 +46,25 @@ import numpy as np
 from .floquet import multipliers, special_point, stable
 from .period import Orbit, PeriodMap
 from .phase import new_start, state_later
-from .shooting import FD_STEP, STALL_TOLERANCE, TOLERANCE, Shooting, _norm, stalled, state_scale
+from .shooting import (
+    FD_STEP,
+    RENEW,
+    STALL_TOLERANCE,
+    TOLERANCE,
+    Shooting,
+    _norm,
+    stalled,
+    state_scale,
+)
 
 __all__ = ["Branch", "BranchPoint", "check_model", "continue_branch", "measures"]
 
 #: largest scaled distance between an orbit and the same orbit re-converged on another
 #: grid (a new start, a new number of steps): farther, Newton went to another orbit
 SAME_ORBIT = 0.05
+#: Broyden corrections counted as one Newton iteration with fresh derivatives (for the
+#: largest number of corrections and the step control)
+BROYDEN_COST = 3
 #: smallest step ``T(p) / N``, as a fraction of ``h``, before a branch chooses ``N`` again
 FINEST = 0.75
 
@@ -120,6 +132,10 @@ class BranchPoint:
     steps, h, period : θ-method steps per period, their size (s), the period (s).
     measures : :func:`measures` of its period.
     special : what the step to it passed (:data:`~femrub.periodic.floquet.SPECIAL`) or ``""``.
+    t0 : the orbit's start (s).
+    unsettled : columns of its finite-difference monodromy that depend on the step
+        (:func:`~femrub.periodic.shooting.checked_differences`); above 0 its multipliers,
+        ``stable`` and the special points next to it are uncertain.
     """
 
     parameter: float
@@ -134,6 +150,7 @@ class BranchPoint:
     measures: dict
     special: str = ""
     t0: float = 0.0
+    unsettled: int = 0
 
     @property
     def stable(self) -> bool:
@@ -149,8 +166,9 @@ class Branch:
     """A branch of periodic orbits (:func:`continue_branch`).
 
     ``status``: ``"ok"`` when every point converged and the branch reached ``stop``,
-    ``"failed"`` otherwise (``message`` says why; the points found are kept),
-    ``"interrupted"`` after Ctrl-C. ``orbits``: one period of selected points
+    ``"inaccurate"`` when so but some points' multipliers are uncertain
+    (``BranchPoint.unsettled``), ``"failed"`` otherwise (``message`` says why; the points
+    found are kept), ``"interrupted"`` after Ctrl-C. ``orbits``: one period of selected points
     (index -> :class:`~femrub.periodic.period.Orbit`).
     """
 
@@ -192,16 +210,66 @@ class _Problem:
             self._maps[key] = PeriodMap(model, self.h, steps=steps, t0=self.t0, **self.options)
         return self._maps[key]
 
-    def derivatives(self, X, p, steps, s, dp_scale, saltation=False):
-        """``R``, ``M`` and ``R_p`` at ``(X, p)`` with ``N = steps``; ``saltation``: ``M``
-        with the impact-time terms (:func:`~femrub.periodic.sensitivity.step_monodromy`)."""
+    def derivatives(self, X, p, steps, s, dp_scale, floquet=False):
+        """``(orbit, M, R_p, unsettled)`` at ``(X, p)`` with ``N = steps``; ``floquet``: ``M``
+        of the Floquet multipliers (:meth:`~femrub.periodic.shooting.Shooting.
+        floquet_monodromy`: the impact-time terms, or checked differences), else Newton's."""
         pm = self.map(p, steps)
         orbit = pm.orbit(X)
-        M = Shooting(pm).monodromy(X, s, orbit, saltation)
+        shooting = Shooting(pm)
+        if floquet:
+            M, unsettled = shooting.floquet_monodromy(X, s, orbit)
+        else:
+            M, unsettled = shooting.monodromy(X, s, orbit), 0
         dp = FD_STEP * max(abs(p), dp_scale)
         Rp = (self.map(p + dp, steps)(X) - orbit.X[-1]) / dp
         self._maps.pop((float(p + dp), steps, self.t0), None)
-        return orbit, M, Rp
+        return orbit, M, Rp, unsettled
+
+
+class _Bordered:
+    """The scaled ``J = [R_X diag(s), R_p s_p]`` (rows over ``s``) of the corrections
+    (:meth:`_Continuation.correct`).
+
+    With the step Jacobians (cheap) ``J`` is taken anew at each correction. With finite
+    differences the first correction uses the previous point's ``J`` (its tangent's
+    matrix) and each later one Broyden's update of it in the scaled unknowns ``z``::
+
+        J ← J + (ΔR − J Δz) Δzᵀ / (Δzᵀ Δz)                               (2)
+
+    ``J`` is taken anew when a correction does not lower the residual by 10 %
+    (:data:`~femrub.periodic.shooting.RENEW`), or when the corrections stall on an updated
+    matrix.
+    """
+
+    def __init__(self, problem, info, sp):
+        self.pb, self.s, self.sp = problem, info["s"], sp
+        self.exact = info["exact"]
+        self.J = None if self.exact else info["J"]
+        self.fresh, self._last = False, None
+
+    def update(self, z, R, history) -> None:
+        if self._last is not None and self.J is not None:
+            if self.exact or history[-1] > RENEW * history[-2]:
+                self.J = None
+            else:
+                dz, dR = z - self._last[0], R - self._last[1]
+                self.J = self.J + np.outer(dR - self.J @ dz, dz) / max(float(dz @ dz), 1e-300)
+                self.fresh = False
+        self._last = (z.copy(), R.copy())
+
+    def renew(self) -> bool:
+        """Whether a stall may be an updated matrix's: then the next one is taken anew."""
+        if self.exact or self.fresh:
+            return False
+        self.J = None
+        return True
+
+    def at(self, X, p, steps) -> np.ndarray:
+        if self.J is None:
+            _, M, Rp, _ = self.pb.derivatives(X, p, steps, self.s, self.sp)
+            self.J, self.fresh = _tangent(M, Rp, self.s, self.sp)[1], True
+        return self.J
 
 
 def _tangent(M, Rp, s, sp, previous=None):
@@ -249,7 +317,7 @@ class _Continuation:
             X, before = pm(X), X
             if k == warmup - 1:
                 drift = _norm(X - before, state_scale(pm.model.layout, np.vstack([X, before])))
-        res = self._shooting(pm).solve(X)
+        res = self._shooting(pm).solve(X, monodromy=False)
         if not res.converged:
             raise RuntimeError(
                 f"no periodic orbit at {self.branch.key} = {self.start:g} (scaled residual "
@@ -263,15 +331,16 @@ class _Continuation:
         pm = self.pb.map(p, steps)
         orbit0 = pm.orbit(X)
         s = state_scale(pm.model.layout, orbit0.X)
-        orbit, M, Rp = self.pb.derivatives(X, p, steps, s, self.sp, saltation=True)
+        orbit, M, Rp, unsettled = self.pb.derivatives(X, p, steps, s, self.sp, floquet=True)
         if previous is None:
-            tau, _, sign = _tangent(M, Rp, s, self.sp)
+            tau, J, sign = _tangent(M, Rp, s, self.sp)
             tau = tau if tau[-1] * self.direction >= 0 else -tau
             sign = -sign if tau[-1] * self.direction < 0 else sign
         else:
-            tau, _, sign = _tangent(M, Rp, s, self.sp, previous["tau"])
+            tau, J, sign = _tangent(M, Rp, s, self.sp, previous["tau"])
         mu = multipliers(M)
         info = {"mu": mu, "dp": tau[-1], "det_sign": sign, "tau": tau, "s": s, "steps": pm.steps}
+        info.update(J=J, exact=Shooting(pm).exact)
         special = "" if previous is None or forced else special_point(previous, info)
         r = _norm(orbit.X[-1] - X, s)
         point = BranchPoint(
@@ -287,28 +356,38 @@ class _Continuation:
             measures(pm.model, orbit, pm.h),
             special,
             pm.t0,
+            unsettled,
         )
         return point, info, orbit
 
     def correct(self, X, p, info, ds):
         """Damped Newton on Eq. (1) from the predictor ``z_k + Δs τ_k`` (each step halved
         until the residual decreases, within ``2 Δs`` of the predictor); ``(X, p, steps,
-        iterations)`` once converged or stalled below the stall tolerance, else ``None``."""
+        iterations)`` once converged or stalled below the stall tolerance, else ``None``.
+        Where ``R_X`` comes from finite differences, the corrections start from the previous
+        point's ``[R_X, R_p]`` and update it by Broyden's formula (:class:`_Bordered`)."""
         s, tau = info["s"], info["tau"]
         zp = np.append(X / s, p / self.sp) + ds * tau
         steps = info["steps"]
         z, history = zp.copy(), []
-        for k in range(self.set.max_corrections + 1):
+        jacobian = _Bordered(self.pb, info, self.sp)
+        limit = self.set.max_corrections * (1 if jacobian.exact else BROYDEN_COST)
+        for k in range(limit + 1):
             Xk, pk = z[:-1] * s, z[-1] * self.sp
             try:
-                orbit, M, Rp = self.pb.derivatives(Xk, pk, steps, s, self.sp)
+                R = (self.pb.map(pk, steps)(Xk) - Xk) / s
             except (ValueError, FloatingPointError):
                 return None
-            R = (orbit.X[-1] - Xk) / s
             history.append(float(np.abs(R).max()))
-            if history[-1] <= self.set.tolerance or stalled(history, self.set.stall_tolerance):
+            jacobian.update(z, R, history)
+            if history[-1] <= self.set.tolerance:
                 return Xk, pk, steps, k
-            _, J, _ = _tangent(M, Rp, s, self.sp)
+            if stalled(history, self.set.stall_tolerance) and not jacobian.renew():
+                return Xk, pk, steps, k
+            try:
+                J = jacobian.at(Xk, pk, steps)
+            except (ValueError, FloatingPointError):
+                return None
             dz = np.linalg.solve(np.vstack([J, tau]), -np.append(R, tau @ (z - zp)))
             z = self._damped(z, dz, history[-1], (zp, ds, s, steps))
             if z is None:
@@ -342,7 +421,7 @@ class _Continuation:
         shooting from ``X``), and its tangent, where the predictor's step left ``FINEST h``
         to ``h``."""
         pm = self.pb.map(p)
-        res = self._shooting(pm).solve(X, info["s"])
+        res = self._shooting(pm).solve(X, info["s"], monodromy=False)
         if not res.converged or _norm(res.X0 - X, info["s"]) > SAME_ORBIT:
             raise RuntimeError(
                 f"no orbit at {self.branch.key} = {p:g} with {pm.steps} steps per period "
@@ -355,8 +434,13 @@ class _Continuation:
     def rephase(self, X, p, info, orbit):
         """The orbit at ``p`` from a start ``t0`` that puts its main impact mid-step
         (:func:`~femrub.periodic.phase.new_start`), re-converged there, and its tangent;
-        ``(X, info)`` unchanged when the impact is already inside its step or Newton from
-        the new start does not converge to the same orbit (:data:`SAME_ORBIT`)."""
+        ``(X, info)`` unchanged when the impact is already inside its step, when Newton from
+        the new start does not converge to the same orbit (:data:`SAME_ORBIT`), or when the
+        map has no step Jacobians (several contacts or friction: the other impacts and the
+        stick-slip switches keep jumping wherever the start is, and a new start would cost
+        a finite-difference monodromy)."""
+        if not info["exact"]:
+            return X, info
         pm = self.pb.map(p, info["steps"])
         start = new_start(pm.model, orbit, pm.h)
         if start is None:
@@ -365,7 +449,7 @@ class _Continuation:
         opts = self.pb.options
         Xd = state_later(pm.model, orbit.X[j], orbit.t[j], delta, opts["gamma"], opts["activation"])
         before, self.pb.t0 = self.pb.t0, float(orbit.t[j] + delta)
-        res = self._shooting(self.pb.map(p, info["steps"])).solve(Xd, info["s"])
+        res = self._shooting(self.pb.map(p, info["steps"])).solve(Xd, info["s"], monodromy=False)
         if not res.converged or _norm(res.X0 - Xd, info["s"]) > SAME_ORBIT:
             self.pb.t0 = before
             return X, info
@@ -381,7 +465,7 @@ class _Continuation:
         end = self.stop if abs(pn - self.stop) < abs(pn - self.start) else self.start
         w = (end - p) / (pn - p)
         pm = self.pb.map(end)
-        res = self._shooting(pm).solve((1 - w) * X + w * Xn, previous["s"])
+        res = self._shooting(pm).solve((1 - w) * X + w * Xn, previous["s"], monodromy=False)
         if not res.converged:
             return None
         return self._point(res.X0, end, pm.steps, res.iterations, previous)
@@ -412,6 +496,7 @@ class _Continuation:
             self._accept(point, orbit)
             X, p = Xn, pn
             X, info = self.rephase(X, p, info, orbit)
+            it = it if info["exact"] else it / BROYDEN_COST
             ds = min(ds * 1.3, self.set.ds_max) if it <= 3 else ds * (0.7 if it > 5 else 1.0)
         return self._fail(f"{self.set.max_points} points without reaching the end")
 
@@ -535,6 +620,14 @@ def continue_branch(  # noqa: PLR0913 (keyword-only options of a public entry po
         branch.status, branch.message = "failed", str(exc)
     if branch.status == "ok" and not all(p.converged for p in branch.points):
         branch.status, branch.message = "failed", "a point did not converge"
+    uncertain = sum(p.unsettled > 0 for p in branch.points)
+    if branch.status == "ok" and uncertain:
+        branch.status = "inaccurate"
+        branch.message = (
+            f"{uncertain} of {len(branch.points)} points have uncertain Floquet multipliers: "
+            "their period map switches contacts within every finite-difference step tried "
+            "(branch.csv column unsettled_columns); their stability is not established"
+        )
     if branch.status == "ok":
         loose = sum(p.residual > tolerance for p in branch.points)
         branch.message = f"{len(branch.points)} periodic orbits, every one converged" + (

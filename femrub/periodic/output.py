@@ -3,13 +3,16 @@
 * ``branch.csv``: one row per point, the parameter in a column named after its key (SI),
   the summary measures of one period (:func:`~femrub.periodic.continuation.measures`;
   ``max_tip_displacement`` in m), ``stable``, ``max_floquet_modulus``,
-  ``newton_iterations``, ``residual``, ``special`` (fold, period-doubling,
-  neimark-sacker, branch-point, stability-change or empty), ``steps_per_period``,
+  ``unsettled_columns`` (finite-difference monodromy columns that depend on the step: the
+  multipliers are uncertain when above 0), ``newton_iterations``, ``residual``,
+  ``special`` (fold, period-doubling, neimark-sacker, branch-point, stability-change or
+  empty), ``steps_per_period``,
   ``h`` (s), ``period`` (s);
 * ``branch.png``: the first measure (the tip displacement) against the parameter, stable
   stretches solid, unstable dashed, special points marked;
 * ``summary.json``: ``status`` (``ok`` only if every point converged and the branch reached
-  its end), ``message``, the key and range, counts, the special points, ``wall_seconds``;
+  its end; ``inaccurate`` when some points' multipliers are uncertain), ``message``, the
+  key and range, counts, the special points, ``wall_seconds``;
 * ``orbits/NNN/history.npz``: one period of each selected orbit with the keys of a run's
   history (``t``, ``gap``, ``impulse``, ``normal_force``, ``signal_<name>``).
 """
@@ -27,7 +30,14 @@ from ..output.safe_write import atomic_file
 
 __all__ = ["write_branch"]
 
-FIXED = ("stable", "max_floquet_modulus", "newton_iterations", "residual", "special")
+FIXED = (
+    "stable",
+    "max_floquet_modulus",
+    "unsettled_columns",
+    "newton_iterations",
+    "residual",
+    "special",
+)
 
 
 def _rows(branch) -> tuple[list, list]:
@@ -41,6 +51,7 @@ def _rows(branch) -> tuple[list, list]:
                 *(p.measures.get(m, math.nan) for m in measures),
                 int(p.stable),
                 p.max_floquet_modulus,
+                p.unsettled,
                 p.iterations,
                 p.residual,
                 p.special,

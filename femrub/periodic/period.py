@@ -19,6 +19,7 @@ algebra is written here: the period map is a client of the stepper.
 
 from __future__ import annotations
 
+import copy
 import math
 from dataclasses import dataclass
 
@@ -134,8 +135,26 @@ class PeriodMap:
         self.h = self.period / self.steps
         self.t0 = float(t0)
         self.model = model
-        self.stepper = ThetaMethod(model, self.h, gamma=gamma, activation=activation, t0=t0)
+        self._options = {"gamma": gamma, "activation": activation}
+        self.stepper = ThetaMethod(model, self.h, t0=t0, **self._options)
         self._block = self.stepper.block_writer()
+        self._copies = [self]
+
+    @property
+    def compiled(self) -> bool:
+        """Whether whole periods run in one compiled call (which releases the GIL)."""
+        return self._block is not None
+
+    def copies(self, count: int) -> list[PeriodMap]:
+        """``count`` maps equal to this one, each with its own stepper (this one first): the
+        maps of threads that run periods side by side."""
+        while len(self._copies) < count:
+            twin = copy.copy(self)
+            twin.stepper = ThetaMethod(self.model, self.h, t0=self.t0, **self._options)
+            twin._block = twin.stepper.block_writer()
+            twin._copies = []
+            self._copies.append(twin)
+        return self._copies[:count]
 
     @property
     def n(self) -> int:

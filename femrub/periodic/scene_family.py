@@ -50,11 +50,12 @@ def parse_range(text: str, scene) -> tuple[str, float, float]:
     return key, lo, hi
 
 
-def scene_family(scene, key: str, *, log=None):
-    """``p -> model`` of ``scene`` along ``key`` (module docstring); ``p`` in SI."""
+def scene_family(scene, key: str, *, log=None, cache=None):
+    """``p -> model`` of ``scene`` along ``key`` (module docstring); ``p`` in SI; ``cache``:
+    a :class:`~femrub.app.cache.ModelCache` of built models, or ``None``."""
     from ..app.simulation import SceneBuilds
 
-    builds = SceneBuilds()
+    builds = SceneBuilds(cache)
     base = builds.build(scene, log=log).model
     if key == "loads.rotation_speed" and base.sweep is not None:
         return lambda p: base.with_parameters(rotation_speed=p)
