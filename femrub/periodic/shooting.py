@@ -302,9 +302,10 @@ def checked_differences(period_map: PeriodMap, X0, image, delta, scale) -> tuple
     A perturbation that switches a contact inside the period (stick to slip, an impact one
     step earlier) gives a column of size ``jump / δ``, not a derivative: on reduced Rotor 37
     (16 frictional contacts) the largest multiplier of one orbit is 1.165 at ε = 1e-8 and
-    1e-7 but 49 at ε = 1e-6, where one column of 176 crosses a switch. A column is kept when it agrees with the column of ``δ / 10`` to
-    :data:`CHECK_TOLERANCE` (scaled by ``s``, relative to the column's largest entry or 1);
-    the others are taken again at ``δ / 10``, down to :data:`CHECK_LEVELS` times.
+    1e-7 but 49 at ε = 1e-6, where one column of 176 crosses a switch. A column is kept
+    when it agrees with the column of ``δ / 10`` to :data:`CHECK_TOLERANCE` (scaled by
+    ``s``, relative to the column's largest entry or 1); the others are taken again at
+    ``δ / 10``, down to :data:`CHECK_LEVELS` times.
     ``unsettled`` counts the columns that never agree (the map switches within every
     step tried): the multipliers are then uncertain.
     """
