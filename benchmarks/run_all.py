@@ -291,6 +291,7 @@ OTHER_PAGES = {
     "rotor37-costs.md": "Rotor 37: mesh to reduced model, the frictional step, output",
     "speed-map-costs.md": "A 40-speed interaction map: where a sweep point's time goes",
     "prestress-campbell-costs.md": "Centrifugal prestress and Campbell diagrams",
+    "periodic-rotor37.md": "Periodic orbits of reduced Rotor 37: cost and time runs",
 }
 
 #: the full tables the studies write (linked from the overview)

@@ -246,6 +246,23 @@ def test_step_monodromy_equals_finite_differences(rule):
     assert np.allclose(exact, fd, rtol=1e-5, atol=1e-5 * np.abs(exact).max())
 
 
+def test_finite_difference_newton_takes_one_monodromy_and_broyden_updates(monkeypatch):
+    """With finite differences Newton takes the monodromy once and then Broyden's update
+    (one period per iteration): it ends on the orbit of Newton with the step Jacobians."""
+    import femrub.periodic.shooting as shooting
+
+    omega = 0.8
+    X0 = impact_orbit(omega)[2]
+    pm = PeriodMap(oscillator(omega), 2 * np.pi / omega / 8000)
+    taken = []
+    plain = shooting.differences
+    monkeypatch.setattr(shooting, "differences", lambda *a, **k: taken.append(1) or plain(*a, **k))
+    fd = Shooting(pm, tolerance=1e-9, derivatives="fd").solve(1.3 * X0, monodromy=False)
+    exact = Shooting(pm, tolerance=1e-9).solve(1.3 * X0, monodromy=False)
+    assert fd.converged and fd.iterations >= 2 and len(taken) == 1
+    assert np.allclose(fd.X0, exact.X0, rtol=0, atol=1e-9)
+
+
 @pytest.mark.parametrize("rule", ["position", "paper"])
 def test_checked_differences_refuse_columns_that_cross_an_impact(rule):
     """A finite-difference step that moves the impact by a step gives a column of size
