@@ -285,6 +285,27 @@ def test_checked_differences_refuse_columns_that_cross_an_impact(rule):
     assert checked_differences(pm, X0, image, 10 * delta, np.ones(2))[1] > 0
 
 
+def test_a_landing_held_on_the_wall_keeps_the_step_multipliers():
+    """A plastic impact (e = 0) that the next steps hold on the wall: where in its step it
+    lands moves nothing once the mass is held, so the Floquet multipliers (the monodromy
+    with the impact-time terms) are those of the step Jacobians' product and of the decay
+    of a perturbation in time integration (the impact-time term of a bounce gave 1e-4)."""
+    omega = 0.8
+    model = oscillator(omega, d=0.3, e=0.0, c=0.1)
+    pm = PeriodMap(model, 2 * np.pi / omega / 2000, activation="paper")
+    X = np.zeros(2)
+    for _ in range(400):
+        X = pm(X)
+    res = Shooting(pm, tolerance=1e-10).solve(X)
+    assert res.converged and np.count_nonzero(pm.orbit(res.X0).P) > 100  # held
+    mu = np.abs(np.linalg.eigvals(res.monodromy)).max()
+    Y, distance = res.X0 + 1e-3 * res.scale, []
+    for _ in range(40):
+        Y = pm(Y)
+        distance.append(np.max(np.abs(Y - res.X0) / res.scale))
+    assert mu == pytest.approx((distance[-1] / distance[-11]) ** 0.1, rel=1e-3)
+
+
 def test_multipliers_of_an_impacting_orbit_carry_the_impact_time():
     """Perturbations that move the impact by many steps return after a period as the
     orbit's monodromy with the saltation terms says (a linear map fitted to the period

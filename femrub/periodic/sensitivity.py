@@ -37,10 +37,14 @@ impact time ``t_k − g_k / ġ_k`` to first order, this adds to ``J_k``::
 
 on each step that closes an open gap (``g_k > 0``, ``P_k > 0``) at a resolved approach
 velocity (``−ġ_k > |ġ_p − ġ_k|``: faster than the step changes it; not a grazing one) under
-``"paper"``, ``"plain"`` or ``"predicted"``. Newton keeps Eq. (1) alone, the exact
-derivative of the map it solves; the Floquet multipliers and the branch's tangent take
-Eq. (2), the orbit's monodromy up to ``O(h)`` (a fold of an impacting branch then shows a
-real multiplier at +1 and a turning tangent).
+``"paper"``, ``"plain"`` or ``"predicted"``, and after which the contact opens (a bounce).
+A landing that the next step holds (a plastic impact onto a sustained contact) leaves the
+contact on the obstacle wherever in its step it landed: the product of Eq. (1) is then the
+orbit's monodromy (on a clamped rod and a damped oscillator held on a wall it equals the
+decay of perturbations in time integration; Eq. (2) there would be wrong). Newton keeps
+Eq. (1) alone, the exact derivative of the map it solves; the Floquet multipliers and the
+branch's tangent take Eq. (2), the orbit's monodromy up to ``O(h)`` (a fold of an
+impacting branch then shows a real multiplier at +1 and a turning tangent).
 """
 
 from __future__ import annotations
@@ -91,6 +95,9 @@ def _saltation(st, Xk, Xp, P, act):
     # a resolved approach: faster than the step changes it (a grazing one has no impact
     # time to first order, and its 1 / ġ_k would be the map's noise, not its slope)
     closing = act & (g_k > 0.0) & (gd_k < -np.abs(gd_p - gd_k))
+    # ... after which the contact opens: a landing that the next step holds (a plastic
+    # impact onto a sustained contact) leaves the tip on the obstacle whatever its time
+    closing &= ~np.roll(act, -1)
     cols, rows = np.zeros_like(Xk), np.zeros_like(Xk)
     if ONE_RULES[st.activation] < 2 or not closing.any():
         return cols, rows
