@@ -1,9 +1,11 @@
 """Branches of periodic orbits by pseudo-arclength continuation in one parameter.
 
 The unknowns are ``y = (X0, p)``: the orbit's start and the parameter (a rotation speed
-Ω in rad/s, a clearance in m, ...), in scaled form ``z = (X0 / s, p / s_p)`` with ``s`` the
-orbit's size per state block (:func:`~femrub.periodic.shooting.state_scale`) and ``s_p``
-the parameter range. A branch point solves the shooting residual (``R``, Eq. 1 of
+Ω in rad/s, a clearance in m, ...), in scaled form ``z = (X0 / a, p / s_p)``, ``a = s √N``
+with ``s`` the orbit's size per state block (:func:`~femrub.periodic.shooting.state_scale`),
+``N`` the size of the state and ``s_p`` the parameter range: a step ``Δs`` is a
+root-mean-square relative change of the state (the same for 2 or 200 coordinates) against a
+fraction of the range. A branch point solves the shooting residual (``R``, Eq. 1 of
 :mod:`femrub.periodic.shooting`) and the arclength condition (Keller's pseudo-arclength;
 Seydel 2010, Sec. 4.5)::
 
@@ -11,25 +13,24 @@ Seydel 2010, Sec. 4.5)::
     τ_kᵀ (z − z_k) − Δs = 0                                            (1)
 
 from the predictor ``z_k + Δs τ_k`` along the unit tangent ``τ_k``, the null vector of the
-scaled Jacobian ``[R_X diag(s), R_p s_p]`` oriented as the step before (the first one
-towards ``stop``). ``R_X = M − I`` is the monodromy of Eq. (2) there; ``R_p`` is a finite
-difference in ``p`` at the same number of steps per period. Newton's method on Eq. (1)
-passes folds, where ``R_X`` is singular but the bordered matrix is not; a correction that
-moves farther than ``2 Δs`` from its predictor is refused (it jumped to another part of the
-branch), each Newton step is halved until the residual decreases, and the step shortened
-after a failed correction. The branch keeps
-its number of steps per period ``N`` (the step ``T(p) / N`` follows ``p``), so the residual
-is smooth in ``p`` through its corrections, until that step leaves ``FINEST h`` to ``h``;
-the point is then converged again at the same ``p`` with ``N = ceil(T(p) / h)``. After
-each point the orbit's start moves to put its main impact mid-step
-(:mod:`femrub.periodic.phase`), and the point is converged again from there. The tangent
-and the Floquet multipliers take the monodromy with the impact-time terms
-(:mod:`femrub.periodic.sensitivity`, Eq. 2), Newton the step Jacobians' product alone.
-The step ``Δs`` grows by 1.3 after a quick correction (at most 3 Newton
-iterations) up to ``ds_max``, shrinks by 0.7 after a slow one and halves after a failed
-one, down to ``ds_min`` (then the branch stops, ``failed``). The first point is found at
-``start`` by natural-parameter shooting from the state reached after ``warmup`` periods of
-time integration. The branch ends at the first point beyond ``start``–``stop``, replaced
+scaled Jacobian ``[R_X diag(a), R_p s_p]`` (rows over ``s``) oriented as the step before
+(the first one towards ``stop``). ``R_X = M − I`` is the monodromy of Eq. (2) there; ``R_p``
+is a finite difference in ``p`` at the same number of steps per period. Newton's method on
+Eq. (1) passes folds, where ``R_X`` is singular but the bordered matrix is not; a correction
+that moves farther than ``2 Δs`` from its predictor is refused (it jumped to another part of
+the branch), each Newton step is halved until the residual decreases, and the step shortened
+after a failed correction. The branch keeps its number of steps per period ``N`` (the step
+``T(p) / N`` follows ``p``), so the residual is smooth in ``p`` through its corrections,
+until that step leaves ``FINEST h`` to ``h``; the point is then converged again at the same
+``p`` with ``N = ceil(T(p) / h)``. After each point the orbit's start moves to put its main
+impact mid-step (:mod:`femrub.periodic.phase`; one-contact maps only), and the point is
+converged again from there. The tangent and the Floquet multipliers take the monodromy with
+the impact-time terms (:mod:`femrub.periodic.sensitivity`, Eq. 2), Newton the step
+Jacobians' product alone. The step ``Δs`` grows by 1.3 after a quick correction (at most 3
+Newton iterations) up to ``ds_max``, shrinks by 0.7 after a slow one and halves after a
+failed one, down to ``ds_min`` (then the branch stops, ``failed``). The first point is found
+at ``start`` by natural-parameter shooting from the state reached after ``warmup`` periods
+of time integration. The branch ends at the first point beyond ``start``–``stop``, replaced
 by the orbit exactly at that end.
 
 Each point carries its Floquet multipliers (:mod:`femrub.periodic.floquet`), the summary
@@ -228,7 +229,7 @@ class _Problem:
 
 
 class _Bordered:
-    """The scaled ``J = [R_X diag(s), R_p s_p]`` (rows over ``s``) of the corrections
+    """The scaled ``J = [R_X diag(a), R_p s_p]`` (rows over ``s``) of the corrections
     (:meth:`_Continuation.correct`).
 
     With the step Jacobians (cheap) ``J`` is taken anew at each correction. With finite
@@ -243,7 +244,7 @@ class _Bordered:
     """
 
     def __init__(self, problem, info, sp):
-        self.pb, self.s, self.sp = problem, info["s"], sp
+        self.pb, self.s, self.a, self.sp = problem, info["s"], info["a"], sp
         self.exact = info["exact"]
         self.J = None if self.exact else info["J"]
         self.fresh, self._last = False, None
@@ -268,14 +269,14 @@ class _Bordered:
     def at(self, X, p, steps) -> np.ndarray:
         if self.J is None:
             _, M, Rp, _ = self.pb.derivatives(X, p, steps, self.s, self.sp)
-            self.J, self.fresh = _tangent(M, Rp, self.s, self.sp)[1], True
+            self.J, self.fresh = _tangent(M, Rp, self.s, self.a, self.sp)[1], True
         return self.J
 
 
-def _tangent(M, Rp, s, sp, previous=None):
-    """Unit null vector of the scaled ``[R_X diag(s), R_p s_p]`` (rows scaled by ``1/s``),
+def _tangent(M, Rp, s, a, sp, previous=None):
+    """Unit null vector of the scaled ``[R_X diag(a), R_p s_p]`` (rows scaled by ``1/s``),
     oriented as ``previous`` (``(τ, det sign of the bordered matrix)``)."""
-    J = np.hstack([(M - np.eye(s.size)) * (s[None, :] / s[:, None]), (Rp * sp / s)[:, None]])
+    J = np.hstack([(M - np.eye(s.size)) * (a[None, :] / s[:, None]), (Rp * sp / s)[:, None]])
     tau = np.linalg.svd(J)[2][-1]
     if previous is not None and tau @ previous < 0:
         tau = -tau
@@ -331,15 +332,17 @@ class _Continuation:
         pm = self.pb.map(p, steps)
         orbit0 = pm.orbit(X)
         s = state_scale(pm.model.layout, orbit0.X)
+        a = s * math.sqrt(s.size)  # the unknowns' scale: Δs is a root-mean-square change
         orbit, M, Rp, unsettled = self.pb.derivatives(X, p, steps, s, self.sp, floquet=True)
         if previous is None:
-            tau, J, sign = _tangent(M, Rp, s, self.sp)
+            tau, J, sign = _tangent(M, Rp, s, a, self.sp)
             tau = tau if tau[-1] * self.direction >= 0 else -tau
             sign = -sign if tau[-1] * self.direction < 0 else sign
         else:
-            tau, J, sign = _tangent(M, Rp, s, self.sp, previous["tau"])
+            tau, J, sign = _tangent(M, Rp, s, a, self.sp, previous["tau"])
         mu = multipliers(M)
-        info = {"mu": mu, "dp": tau[-1], "det_sign": sign, "tau": tau, "s": s, "steps": pm.steps}
+        info = {"mu": mu, "dp": tau[-1], "det_sign": sign, "tau": tau, "s": s, "a": a}
+        info["steps"] = pm.steps
         info.update(J=J, exact=Shooting(pm).exact)
         special = "" if previous is None or forced else special_point(previous, info)
         r = _norm(orbit.X[-1] - X, s)
@@ -366,14 +369,14 @@ class _Continuation:
         iterations)`` once converged or stalled below the stall tolerance, else ``None``.
         Where ``R_X`` comes from finite differences, the corrections start from the previous
         point's ``[R_X, R_p]`` and update it by Broyden's formula (:class:`_Bordered`)."""
-        s, tau = info["s"], info["tau"]
-        zp = np.append(X / s, p / self.sp) + ds * tau
+        s, a, tau = info["s"], info["a"], info["tau"]
+        zp = np.append(X / a, p / self.sp) + ds * tau
         steps = info["steps"]
         z, history = zp.copy(), []
         jacobian = _Bordered(self.pb, info, self.sp)
         limit = self.set.max_corrections * (1 if jacobian.exact else BROYDEN_COST)
         for k in range(limit + 1):
-            Xk, pk = z[:-1] * s, z[-1] * self.sp
+            Xk, pk = z[:-1] * a, z[-1] * self.sp
             try:
                 R = (self.pb.map(pk, steps)(Xk) - Xk) / s
             except (ValueError, FloatingPointError):
@@ -389,7 +392,7 @@ class _Continuation:
             except (ValueError, FloatingPointError):
                 return None
             dz = np.linalg.solve(np.vstack([J, tau]), -np.append(R, tau @ (z - zp)))
-            z = self._damped(z, dz, history[-1], (zp, ds, s, steps))
+            z = self._damped(z, dz, history[-1], (zp, ds, s, a, steps))
             if z is None:
                 return None
         return None
@@ -398,14 +401,14 @@ class _Continuation:
         """``z + α dz`` for the first ``α = 1, 1/2, …`` that lowers the residual ``r``, else
         the best of the tries; ``None`` when every try leaves ``2 Δs`` of the predictor or
         the model's domain."""
-        zp, ds, s, steps = frame
+        zp, ds, s, a, steps = frame
         best, alpha = None, 1.0
         for _ in range(6):
             zt = z + alpha * dz
             alpha *= 0.5
             if np.linalg.norm(zt - zp) > 2.0 * abs(ds):  # left for another branch
                 continue
-            Xt, pt = zt[:-1] * s, zt[-1] * self.sp
+            Xt, pt = zt[:-1] * a, zt[-1] * self.sp
             try:
                 rt = _norm(self.pb.map(pt, steps)(Xt) - Xt, s)
             except (ValueError, FloatingPointError):
