@@ -6,13 +6,14 @@ casing; through the model cache), continues its periodic orbits in the rotation 
 ``--start`` towards ``--stop`` for at most ``--points`` points (``femrub.periodic.
 continue_branch``) and records per point the speed, the largest tip displacement of the
 orbit, its largest Floquet multiplier, whether the finite-difference monodromy settled
-(``unsettled_columns``) and the wall time. The points of the stretch's first, middle and last
-point are then integrated in time from rest over ``--periods`` forcing periods by the same
-θ-method (the period map iterated, the same steps): the largest tip displacement of the
-last ``--last`` periods is compared with the orbit's, with the spread of the per-period
-maxima (0 for a run that settled onto a periodic response). From the stretch it
+(``unsettled_columns``) and the wall time. The stretch's two ends and up to three of its
+stable points are then integrated in time from rest over ``--periods`` forcing periods by
+the same θ-method (the period map iterated, the same steps): the largest tip displacement
+of the last ``--last`` periods is compared with the orbit's, with the spread of the
+per-period maxima (0 for a run that settled onto a periodic response). From the stretch it
 extrapolates what the whole range would cost at the same rate (points per rad/s, seconds
-per point), to compare with the 40-speed sweep of ``benchmarks/speed_map.py``.
+per point), to compare with the 40-speed sweep of ``benchmarks/speed_map.py``. A stretch
+that stops early (the continuation's step below its floor) says so in its status.
 
 Writes ``docs/performance/periodic_rotor37.json`` and renders
 ``docs/performance/periodic-rotor37.md`` (``--no-write``: print only).
@@ -64,6 +65,16 @@ def stretch(model, args, h: float) -> tuple:
 
     branch = continue_branch(model, args.start, args.stop, h=h, max_points=args.points, log=log)
     return branch, time.perf_counter() - t0, clock
+
+
+def _picks(points) -> list[int]:
+    """The points integrated in time: the stretch's two ends and up to three stable points
+    (spread over those there are)."""
+    if not points:
+        return []
+    stable = [i for i, p in enumerate(points) if p.stable]
+    spread = [stable[j] for j in np.linspace(0, len(stable) - 1, min(3, len(stable))).astype(int)]
+    return sorted({0, len(points) - 1, *spread})
 
 
 def time_run(model, point, periods: int, last: int) -> dict:
@@ -123,7 +134,8 @@ def page(doc: dict) -> str:
             ],
         ),
         "",
-        "Time integrations from rest at three of its points (the same θ-method and steps):",
+        "Time integrations from rest at its ends and at up to three stable points (the same "
+        "θ-method and steps):",
         "",
         C.md_table(
             _speeds(doc["runs"]),
@@ -181,7 +193,7 @@ def main(argv=None) -> int:
         }
         for p, s in zip(branch.points, seconds)
     ]
-    picks = sorted({0, len(branch.points) // 2, len(branch.points) - 1}) if pts else []
+    picks = _picks(branch.points)
     runs = [time_run(model, branch.points[i], args.periods, args.last) for i in picks]
     for r in runs:
         print(r)
