@@ -49,9 +49,9 @@ from .period import Orbit, PeriodMap
 from .phase import new_start, state_later
 from .shooting import (
     FD_STEP,
-    RENEW,
     STALL_TOLERANCE,
     TOLERANCE,
+    Broyden,
     Shooting,
     _norm,
     stalled,
@@ -228,51 +228,6 @@ class _Problem:
         return orbit, M, Rp, unsettled
 
 
-class _Bordered:
-    """The scaled ``J = [R_X diag(a), R_p s_p]`` (rows over ``s``) of the corrections
-    (:meth:`_Continuation.correct`).
-
-    With the step Jacobians (cheap) ``J`` is taken anew at each correction. With finite
-    differences the first correction uses the previous point's ``J`` (its tangent's
-    matrix) and each later one Broyden's update of it in the scaled unknowns ``z``::
-
-        J ← J + (ΔR − J Δz) Δzᵀ / (Δzᵀ Δz)                               (2)
-
-    ``J`` is taken anew when a correction does not lower the residual by 10 %
-    (:data:`~femrub.periodic.shooting.RENEW`), or when the corrections stall on an updated
-    matrix.
-    """
-
-    def __init__(self, problem, info, sp):
-        self.pb, self.s, self.a, self.sp = problem, info["s"], info["a"], sp
-        self.exact = info["exact"]
-        self.J = None if self.exact else info["J"]
-        self.fresh, self._last = False, None
-
-    def update(self, z, R, history) -> None:
-        if self._last is not None and self.J is not None:
-            if self.exact or history[-1] > RENEW * history[-2]:
-                self.J = None
-            else:
-                dz, dR = z - self._last[0], R - self._last[1]
-                self.J = self.J + np.outer(dR - self.J @ dz, dz) / max(float(dz @ dz), 1e-300)
-                self.fresh = False
-        self._last = (z.copy(), R.copy())
-
-    def renew(self) -> bool:
-        """Whether a stall may be an updated matrix's: then the next one is taken anew."""
-        if self.exact or self.fresh:
-            return False
-        self.J = None
-        return True
-
-    def at(self, X, p, steps) -> np.ndarray:
-        if self.J is None:
-            _, M, Rp, _ = self.pb.derivatives(X, p, steps, self.s, self.sp)
-            self.J, self.fresh = _tangent(M, Rp, self.s, self.a, self.sp)[1], True
-        return self.J
-
-
 def _tangent(M, Rp, s, a, sp, previous=None):
     """Unit null vector of the scaled ``[R_X diag(a), R_p s_p]`` (rows scaled by ``1/s``),
     oriented as ``previous`` (``(τ, det sign of the bordered matrix)``)."""
@@ -341,9 +296,8 @@ class _Continuation:
         else:
             tau, J, sign = _tangent(M, Rp, s, a, self.sp, previous["tau"])
         mu = multipliers(M)
-        info = {"mu": mu, "dp": tau[-1], "det_sign": sign, "tau": tau, "s": s, "a": a}
-        info["steps"] = pm.steps
-        info.update(J=J, exact=Shooting(pm).exact)
+        info = {"mu": mu, "dp": tau[-1], "det_sign": sign, "tau": tau, "s": s, "a": a, "J": J}
+        info.update(steps=pm.steps, exact=Shooting(pm).exact)
         special = "" if previous is None or forced else special_point(previous, info)
         r = _norm(orbit.X[-1] - X, s)
         point = BranchPoint(
@@ -368,12 +322,13 @@ class _Continuation:
         until the residual decreases, within ``2 Δs`` of the predictor); ``(X, p, steps,
         iterations)`` once converged or stalled below the stall tolerance, else ``None``.
         Where ``R_X`` comes from finite differences, the corrections start from the previous
-        point's ``[R_X, R_p]`` and update it by Broyden's formula (:class:`_Bordered`)."""
+        point's ``[R_X, R_p]`` and update it by Broyden's formula in the scaled unknowns
+        (:class:`~femrub.periodic.shooting.Broyden`, unit weights)."""
         s, a, tau = info["s"], info["a"], info["tau"]
         zp = np.append(X / a, p / self.sp) + ds * tau
         steps = info["steps"]
-        z, history = zp.copy(), []
-        jacobian = _Bordered(self.pb, info, self.sp)
+        z, history, last = zp.copy(), [], None
+        jacobian = Broyden(self._bordered(s, a), info["exact"], info["J"])
         limit = self.set.max_corrections * (1 if jacobian.exact else BROYDEN_COST)
         for k in range(limit + 1):
             Xk, pk = z[:-1] * a, z[-1] * self.sp
@@ -382,7 +337,9 @@ class _Continuation:
             except (ValueError, FloatingPointError):
                 return None
             history.append(float(np.abs(R).max()))
-            jacobian.update(z, R, history)
+            if last is not None:
+                jacobian.update(z - last[0], R - last[1], history[-1] / history[-2])
+            last = (z, R)
             if history[-1] <= self.set.tolerance:
                 return Xk, pk, steps, k
             if stalled(history, self.set.stall_tolerance) and not jacobian.renew():
@@ -396,6 +353,16 @@ class _Continuation:
             if z is None:
                 return None
         return None
+
+    def _bordered(self, s, a):
+        """``(X, p, steps) -> J``: the scaled ``[R_X diag(a), R_p s_p]`` (rows over ``s``) of
+        the corrections, from fresh derivatives."""
+
+        def take(X, p, steps):
+            _, M, Rp, _ = self.pb.derivatives(X, p, steps, s, self.sp)
+            return _tangent(M, Rp, s, a, self.sp)[1]
+
+        return take
 
     def _damped(self, z, dz, r, frame):
         """``z + α dz`` for the first ``α = 1, 1/2, …`` that lowers the residual ``r``, else

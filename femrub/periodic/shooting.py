@@ -24,7 +24,7 @@ inside one contact regime when a full step would jump across a grazing orbit.
 Eq. (2) costs one period per coordinate (on a compiled period map the columns run on
 :data:`~femrub.fem.quadrature.THREADS` threads, each with its own copy of the stepper), so
 Newton takes it only at its first iteration and when the residual stops falling, and
-updates ``R_X`` in between by Broyden's rank-one formula (Eq. 3, :class:`_Jacobian`).
+updates ``R_X`` in between by Broyden's rank-one formula (Eq. 3, :class:`Broyden`).
 
 The eigenvalues of ``M`` at the solution are the orbit's Floquet multipliers
 (:mod:`femrub.periodic.floquet`).
@@ -42,6 +42,7 @@ from .period import PeriodMap
 from .sensitivity import step_monodromy
 
 __all__ = [
+    "Broyden",
     "Shooting",
     "ShootingResult",
     "checked_differences",
@@ -162,10 +163,8 @@ class Shooting:
         ``derivatives="auto"``; ``saltation``: with its impact-time terms), else Eq. (2);
         ``orbit``: the orbit from ``X0`` when known."""
         orbit = self.map.orbit(X0) if orbit is None else orbit
-        if self.derivatives == "auto":
-            M = step_monodromy(self.map.stepper, orbit, saltation)
-            if M is not None:
-                return M
+        if self.exact:
+            return step_monodromy(self.map.stepper, orbit, saltation)
         return differences(self.map, X0, orbit.X[-1], self.eps * (scale + np.abs(X0)))
 
     def floquet_monodromy(self, X0, scale, orbit=None) -> tuple[np.ndarray, int]:
@@ -173,12 +172,14 @@ class Shooting:
         Jacobians with their impact-time terms where the step has them (``unsettled = 0``),
         else Eq. (2) checked column by column (:func:`checked_differences`)."""
         orbit = self.map.orbit(X0) if orbit is None else orbit
-        if self.derivatives == "auto":
-            M = step_monodromy(self.map.stepper, orbit, True)
-            if M is not None:
-                return M, 0
+        if self.exact:
+            return self.monodromy(X0, scale, orbit, saltation=True), 0
         delta = self.eps * (scale + np.abs(X0))
         return checked_differences(self.map, X0, orbit.X[-1], delta, scale)
+
+    def _residual_jacobian(self, X0, scale, orbit) -> np.ndarray:
+        """``R_X = M − I`` at ``X0`` (Newton's matrix of Eq. 1)."""
+        return self.monodromy(X0, scale, orbit) - np.eye(X0.size)
 
     def solve(self, X0, scale=None, monodromy: bool = True) -> ShootingResult:
         """Newton's method on Eq. (1) from ``X0`` (module docstring); ``monodromy``: return
@@ -189,19 +190,20 @@ class Shooting:
         s = state_scale(self.layout, orbit.X) if scale is None else scale
         R = orbit.X[-1] - X
         r = _norm(R, s)
-        k, history, jacobian = 0, [r], _Jacobian(self, s)
+        k, history = 0, [r]
+        jacobian = Broyden(self._residual_jacobian, self.exact)
         while r > self.tolerance and k < self.max_iterations:
             if self.stalled(history) and not jacobian.renew():
                 break
-            J = jacobian.at(X, orbit)
+            J = jacobian.at(X, s, orbit)
             dX = np.linalg.lstsq(J, -R, rcond=None)[0]
             Xn, Rn, rn = self._damped(X, dX, r, s)
-            jacobian.update(Xn - X, Rn - R, rn / r)
+            jacobian.update(Xn - X, Rn - R, rn / r, s)
             X, R, r = Xn, Rn, rn
             k += 1
             history.append(r)
             if scale is None:
-                s = jacobian.s = state_scale(self.layout, np.vstack([s, self.map.orbit(X).X]))
+                s = state_scale(self.layout, np.vstack([s, self.map.orbit(X).X]))
             orbit = self.map.orbit(X)
         ok = r <= self.tolerance or self.stalled(history)
         M, unsettled = self.floquet_monodromy(X, s) if monodromy else (None, 0)
@@ -232,40 +234,52 @@ class Shooting:
         return best
 
 
-class _Jacobian:
-    """``R_X = M − I`` of one Newton iteration (:meth:`Shooting.solve`).
+class Broyden:
+    """A Jacobian taken by ``take(*args)`` and, between two takes, updated by Broyden's
+    rank-one formula with the weights ``w = 1 / scale²`` of the unknowns (Dennis & Schnabel
+    1996, Sec. 8.1)::
 
-    Exact derivatives (the step Jacobians) are taken anew at each iteration. Finite
-    differences (Eq. 2) cost one period per column, so between two of them ``R_X`` follows
-    Broyden's rank-one update in the orbit's scale ``s`` (Dennis & Schnabel 1996, Sec. 8.1)::
+        J ← J + (ΔR − J Δx) (w Δx)ᵀ / (Δxᵀ (w Δx))                        (3)
 
-        R_X ← R_X + (ΔR − R_X ΔX) (ΔX / s²)ᵀ / (ΔXᵀ (ΔX / s²))               (3)
+    for Newton's method on Eq. (1) (:meth:`Shooting.solve`, the orbit's scale ``s``) and
+    for the bordered corrections of a branch (:mod:`femrub.periodic.continuation`, scaled
+    unknowns, ``w = 1``). An ``exact`` Jacobian (the step Jacobians: cheap) is taken anew
+    at every step; one from finite differences (Eq. 2, one period per column) is taken anew
+    when a step does not lower the residual by 10 % (:data:`RENEW`), or when Newton stalls
+    on an updated matrix (:meth:`renew`).
 
-    and is taken anew when a step does not lower the residual by 10 % (:data:`RENEW`), or
-    when Newton stalls on an updated matrix.
+    Parameters
+    ----------
+    take : callable returning a fresh Jacobian from the arguments of :meth:`at`.
+    exact : whether ``take`` gives exact derivatives cheaply (then no update).
+    J : a Jacobian to start from (e.g. the previous branch point's), or ``None``.
     """
 
-    def __init__(self, shooting: Shooting, s: np.ndarray):
-        self.shooting, self.s = shooting, s
-        self.J, self.fresh = None, False
+    def __init__(self, take, exact: bool, J=None):
+        self.take, self.exact = take, bool(exact)
+        self.J = None if self.exact else J
+        self.fresh = False
 
-    def at(self, X, orbit) -> np.ndarray:
+    def at(self, *args) -> np.ndarray:
+        """The current Jacobian (taken anew when there is none)."""
         if self.J is None:
-            M = self.shooting.monodromy(X, self.s, orbit)
-            self.J, self.fresh = M - np.eye(X.size), True
+            self.J, self.fresh = self.take(*args), True
         return self.J
 
-    def update(self, dX, dR, ratio: float) -> None:
-        if self.shooting.exact or ratio > RENEW:
+    def update(self, dx, dR, ratio: float, scale=1.0) -> None:
+        """Eq. (3) after a step ``dx`` that changed the residual by ``dR`` and multiplied
+        its norm by ``ratio``, with the weights ``w = 1 / scale²``; the next :meth:`at`
+        takes a fresh one when the update is not worth it."""
+        if self.J is None or self.exact or ratio > RENEW:
             self.J = None
             return
-        w = dX / self.s**2
-        self.J = self.J + np.outer(dR - self.J @ dX, w) / max(float(dX @ w), 1e-300)
+        w = dx / scale**2
+        self.J = self.J + np.outer(dR - self.J @ dx, w) / max(float(dx @ w), 1e-300)
         self.fresh = False
 
     def renew(self) -> bool:
         """Whether a stall may be an updated matrix's: then the next one is taken anew."""
-        if self.shooting.exact or self.fresh:
+        if self.exact or self.fresh:
             return False
         self.J = None
         return True
