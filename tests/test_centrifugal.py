@@ -154,3 +154,23 @@ def test_warm_start_reaches_the_cold_equilibrium(rod):
         centrifugal_prestress(disc, material, 1000.0, "nonlinear", start=near).iterations
         < cold.iterations
     )
+
+
+def test_a_diverging_load_increment_is_rejected_once(rod):
+    """A rod too soft for Newton at the full load (its first correction grows in energy,
+    ``Θ₀`` about 3.6) and at half of it: the continuation rejects the full load once, after
+    two iterations, and goes straight to the quarter that growth predicts, which converges
+    (halving once per rejection would spend two more iterations on the half). It reaches
+    the equilibrium of a continuation warm-started from a quarter of the load."""
+    blade, disc, R, L = rod
+    material = Material(young=7e7, rho=8000.0, poisson=0.3)
+    messages = []
+    ps = centrifugal_prestress(disc, material, 1000.0, "nonlinear", log=messages.append)
+    assert ps.rejected == 1 and ps.increments > 1 and ps.residual < 1e-9
+    first = next(i for i, m in enumerate(messages) if "rejected" in m)
+    assert sum("Newton iteration" in m for m in messages[:first]) == 2
+    assert "next 0.25 of Ω²" in messages[first]
+    assert sum("Newton iteration 0," in m for m in messages) == ps.increments + ps.rejected
+    quarter = centrifugal_prestress(disc, material, 500.0, "nonlinear")
+    again = centrifugal_prestress(disc, material, 1000.0, "nonlinear", start=quarter)
+    np.testing.assert_allclose(ps.u, again.u, rtol=0, atol=1e-9 * np.abs(again.u).max())
