@@ -188,6 +188,47 @@ def test_one_map_to_the_mesh_for_every_speed(tmp_path, monkeypatch):
     _same_model(hit.model, b.model)
 
 
+def test_a_map_the_cache_holds_is_not_written_again(tmp_path):
+    """A build at another speed with nothing kept in memory (another run or process) finds
+    the map to the mesh in the cache: the entry is not written a second time."""
+    local = ModelCache(tmp_path / "c")
+    notes = []
+    _build(local, notes)
+    assert any("map stored" in n for n in notes)
+    (entry,) = _stored(local, "map")
+    data = local.root / f"{entry['key']}.npz"
+    written = data.stat().st_mtime_ns
+    notes.clear()
+    faster = _build(local, notes, **{"loads.rotation_speed": 1700.0})
+    assert "cache" not in faster.report["reduction"]  # reduced anew, its map not stored
+    assert not any("map stored" in n for n in notes), notes
+    assert data.stat().st_mtime_ns == written and len(_stored(local, "map")) == 1
+
+
+def test_a_model_at_another_speed_is_not_hashed_again(monkeypatch):
+    """Builds in a row key a model at another speed (the same arrays) by the key of the one
+    before, without hashing its arrays again; a model with other arrays is hashed (the same
+    content, the same key; another content, another key)."""
+    import dataclasses
+
+    import femrub as fr
+    from femrub.app import cached
+    from femrub.scene.units import rpm
+
+    model = fr.bar_model()
+    kept = cached.Kept()
+    key = cached.Stages(kept=kept)._model_key(model)
+    faster = model.with_parameters(rotation_speed=rpm(3000.0))
+    with monkeypatch.context() as m:
+        m.setattr(cached, "content_key", lambda *a: pytest.fail("hashed again"))
+        assert cached.Stages(kept=kept)._model_key(faster) == key
+    assert cached.Stages()._model_key(faster) == key  # nothing kept: hashed, the same key
+    copied = dataclasses.replace(faster, B=faster.B.copy())
+    assert cached.Stages(kept=kept)._model_key(copied) == key
+    changed = dataclasses.replace(faster, B=2.0 * faster.B)
+    assert cached.Stages(kept=kept)._model_key(changed) != key
+
+
 @pytest.mark.parametrize("damage", ["corrupt", "missing"])
 def test_corrupt_or_missing_map_rebuilds_the_reduction(first, tmp_path, monkeypatch, damage):
 
@@ -252,13 +293,17 @@ def test_store_load_clear_and_info(tmp_path):
     cache = ModelCache(tmp_path)
     obj = {"a": np.arange(10.0), "b": "text"}
     key = content_key("x", obj["a"])
-    assert cache.load(key) is None
+    assert cache.load(key) is None and not cache.holds(key)
     assert cache.store(key, obj, stage="test")
+    assert cache.holds(key)
     back = cache.load(key)
     np.testing.assert_array_equal(back["a"], obj["a"])
     assert cache.info()["entries"] == 1
+    data = cache.root / f"{key}.npz"
+    data.write_bytes(data.read_bytes()[:-1])  # cut short: not held (a load finds it corrupt)
+    assert not cache.holds(key)
     assert cache.clear()[0] == 1 and cache.info()["entries"] == 0
-    assert cache.load(key) is None
+    assert cache.load(key) is None and not cache.holds(key)
 
 
 def test_keys_follow_content():

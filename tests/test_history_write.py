@@ -50,3 +50,36 @@ def test_npz_is_a_compressed_numpy_archive(tmp_path):
     np.testing.assert_array_equal(back.signals["tip_displacement"], res.signals["tip_displacement"])
     with zipfile.ZipFile(path) as zf:  # compressed, as numpy.savez_compressed writes
         assert {i.compress_type for i in zf.infolist()} == {zipfile.ZIP_DEFLATED}
+
+
+def test_npz_stores_what_does_not_deflate_as_it_is(tmp_path):
+    """Arrays whose bytes barely deflate (noise-like floats of a long run) are stored as they
+    are, those that do (a mostly zero contact history) deflated; both read back bit for bit
+    with their dtypes, every row kept."""
+    rng = np.random.default_rng(3)
+    n = 40_000
+    t = np.linspace(0.0, 1.0, n + 1)
+    impulse = np.zeros((n + 1, 3))
+    impulse[::97, 1] = 1e-3
+    res = R.Results(
+        scheme="theta",
+        h=1.0 / n,
+        t=t,
+        signals={"tip_displacement": rng.standard_normal((n + 1, 1))},
+        gap=rng.standard_normal((n + 1, 3)),
+        impulse=impulse,
+        contact_state=np.zeros((n + 1, 3), dtype=np.int8),
+        steps=n,
+    )
+    path = res.save_npz(tmp_path / "history.npz")
+    with zipfile.ZipFile(path) as zf:
+        kinds = {i.filename: i.compress_type for i in zf.infolist()}
+    assert kinds["gap.npy"] == kinds["signal_tip_displacement.npy"] == zipfile.ZIP_STORED
+    assert kinds["impulse.npy"] == kinds["normal_force.npy"] == zipfile.ZIP_DEFLATED
+    assert kinds["contact_state.npy"] == kinds["meta.npy"] == zipfile.ZIP_DEFLATED
+    with np.load(path) as d:
+        for key, want in [("gap", res.gap), ("impulse", impulse), ("t", t)]:
+            assert d[key].dtype == want.dtype
+            np.testing.assert_array_equal(d[key], want)
+        assert d["contact_state"].dtype == np.int8 and d["contact_state"].shape == (n + 1, 3)
+        np.testing.assert_array_equal(d["signal_tip_displacement"], res.signals["tip_displacement"])

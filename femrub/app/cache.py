@@ -347,6 +347,22 @@ class ModelCache:
             pass
         return obj
 
+    def holds(self, key: str) -> bool:
+        """Whether the folder holds an entry ``key`` (valid metadata and a data file of the
+        size it records), marked as just used; its checksum is checked when it is loaded. An
+        entry is content-addressed: storing it again would write the same bytes."""
+        data, meta = self._paths(key)
+        if not self.is_marked():
+            return False
+        try:
+            info = self._read_meta(key)
+            if info is None or data.lstat().st_size != info["size"]:
+                return False
+            os.utime(meta, follow_symlinks=False)  # least recently used order
+        except (OSError, ValueError):
+            return False
+        return True
+
     def store(self, key: str, obj, *, stage: str, describe: str = "") -> bool:
         """Store ``obj`` under ``key``; ``False`` when it cannot be (not data, too large,
         the folder not femrub's or not writable: the run goes on without the cache)."""

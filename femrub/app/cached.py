@@ -78,7 +78,8 @@ class Kept:
     ``discretisation``: the finite-element bases of the mesh; ``assembly``: the Eq. (2)
     blocks without their bases (``assembly_key``: its key); ``reductor``: the last reductor
     built or loaded, detached from its full model (its bases are speed-free); ``map``: the
-    map to the mesh of the largest reduced model (the same for every speed).
+    map to the mesh of the largest reduced model (the same for every speed); ``model_key``:
+    the last full model's hashed arrays and their key (``(parts, key)``).
     """
 
     discretisation: dict = dataclasses.field(default_factory=dict)
@@ -86,6 +87,7 @@ class Kept:
     reductor: dict = dataclasses.field(default_factory=dict)
     map: dict = dataclasses.field(default_factory=dict)
     assembly_key: str | None = None
+    model_key: tuple | None = None
 
     @staticmethod
     def last(memo: dict, key, value) -> None:
@@ -235,8 +237,12 @@ class Stages:
         return ps
 
     def _model_key(self, model) -> str:
+        """The key of every state-space array the reduction projects; builds in a row take
+        the last one's again when those arrays are the very same objects (a model at
+        another speed shares them:
+        :meth:`~femrub.model.first_order.FirstOrderModel.with_parameters`)."""
         n = model.n_dofs
-        return content_key(
+        parts = (
             self._mats_key,
             model.layout,
             model.boundary,
@@ -249,6 +255,12 @@ class Stages:
             model.energy,
             model.to_full,
         )
+        last = self.kept.model_key
+        if last is not None and _same_objects(last[0], parts):
+            return last[1]
+        key = content_key(*parts)
+        self.kept.model_key = (parts, key)
+        return key
 
     def reduce(self, model, scene, log=None, make_stepper=None, limits=None, on_run=None):
         """:func:`~femrub.analysis.reduction_check.reduce_checked`: ``(reduced, reductor,
@@ -300,7 +312,8 @@ class Stages:
         """Store ``reduced`` (entry ``reduction``) and its largest model's map (``map``)."""
         entry, shared = _detach(reduced, report, reductor.R.shape[1])
         if shared is not None and self.kept.map.get(map_key) is not shared:
-            self._keep("map", map_key, shared, f"map to the mesh {shared.shape}")
+            if not self.cache.holds(map_key):  # stored by another point, process or run
+                self._keep("map", map_key, shared, f"map to the mesh {shared.shape}")
             Kept.last(self.kept.map, map_key, shared)
         self._keep("reduction", key, entry, f"{reduced.n_dofs} dofs")
 
@@ -345,6 +358,28 @@ def _run_key(scene, make_stepper, limits) -> list:
     for key in ("step_check", "step_tolerance"):
         run[0].pop(key, None)
     return [t_end, run]
+
+
+def _same_objects(a, b) -> bool:
+    """Whether ``a`` and ``b`` hold the very same objects, container by container (dicts in
+    the same order, lists, tuples); equal strings count as the same, and so do arrays that
+    view the same memory the same way (a dataclass's ``__post_init__`` may wrap an array it
+    is handed in a new view of it)."""
+    if isinstance(a, np.ndarray) and isinstance(b, np.ndarray):
+        return a is b or _same_view(a, b)
+    if isinstance(a, dict):
+        return (
+            isinstance(b, dict) and list(a) == list(b) and all(_same_objects(a[k], b[k]) for k in a)
+        )
+    if isinstance(a, list | tuple):
+        return type(a) is type(b) and len(a) == len(b) and all(map(_same_objects, a, b))
+    return a is b or (isinstance(a, str) and a == b)
+
+
+def _same_view(a: np.ndarray, b: np.ndarray) -> bool:
+    """Whether ``a`` and ``b`` read the same bytes as the same elements."""
+    layout = (a.dtype, a.shape, a.strides, a.__array_interface__["data"][0])
+    return layout == (b.dtype, b.shape, b.strides, b.__array_interface__["data"][0])
 
 
 def _mesh_parts(disc) -> tuple:
