@@ -35,7 +35,7 @@ from .forms import lame_parameters
 from .linalg import sparse_lu
 from .quadrature import gradient_operator
 
-__all__ = ["METHODS", "Prestress", "centrifugal_prestress"]
+__all__ = ["METHODS", "Prestress", "PrestressForms", "centrifugal_prestress"]
 
 METHODS = ("linear", "nonlinear")
 
@@ -77,11 +77,19 @@ class Prestress:
         return points.normal_displacement(self.u)
 
 
-class _Forms:
+class PrestressForms:
     """The forms of :mod:`femrub.fem.centrifugal` on one basis, with fixed parameters: the
     load by its scikit-fem form, the internal force and the tangent through the compiled
     kernels of :class:`~femrub.fem.quadrature.GradientOperator` (equal to the forms of
-    :mod:`femrub.fem.centrifugal` to round-off, several times cheaper on a blade mesh)."""
+    :mod:`femrub.fem.centrifugal` to round-off, several times cheaper on a blade mesh).
+
+    Parameters
+    ----------
+    basis : the vector scikit-fem basis of the displacement (3D).
+    material : :class:`~femrub.fem.material.Material` (``rho``, ``young``, ``poisson``).
+    axis : the rotation axis (:func:`femrub.fem.centrifugal.axis_params`).
+    linear : small-displacement kinematics (``E = ε(u)``) instead of Green–Lagrange.
+    """
 
     def __init__(self, basis, material, axis, linear: bool):
         self.lam, self.mu = lame_parameters(material.young, material.poisson, 3)
@@ -159,7 +167,7 @@ def centrifugal_prestress(
         raise ValueError(f"rotation speed must be finite, got {omega!r}")
     basis = disc.basis_u
     free = _free(basis, disc.fixed_u)
-    forms = _Forms(basis, material, disc.blade.axis, method == "linear")
+    forms = PrestressForms(basis, material, disc.blade.axis, method == "linear")
     w2 = omega * omega
     u = np.zeros(basis.N)
     if w2 == 0.0:

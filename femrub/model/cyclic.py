@@ -42,8 +42,8 @@ from scipy.spatial import cKDTree
 from ..fem import centrifugal as cf
 from ..fem.discretisation import assemble, discretise
 from ..fem.eigen import lowest_hermitian_modes
-from ..fem.forms import lame_parameters
 from ..fem.linalg import sparse_lu
+from ..fem.prestress import PrestressForms
 from ..geometry.cyclic_sector import SectorMesh, cyclic_plane_distance, face_pairs
 
 __all__ = [
@@ -186,26 +186,24 @@ def _prestress_state(basis, material, free, T0, omega, method, start=None):
     """Static displacement at Ω (k = 0 on the sector) and the tangent on the free dofs.
 
     Newton from ``start`` (m, every dof; zeros when ``None``); ``"linear"`` takes one step,
-    exact from any start since its residual is affine in ``u``."""
-    lam, mu = lame_parameters(material.young, material.poisson, 3)
+    exact from any start since its residual is affine in ``u``. The internal force and the
+    tangent are those of the blade's prestress
+    (:class:`~femrub.fem.prestress.PrestressForms`: compiled products with the gradient at
+    the quadrature points)."""
     linear = method == "linear"
-    rho, w2 = float(material.rho), omega * omega
-    MP = sp.csr_matrix(cf.spin_mass(basis, rho, AXIS))[free][:, free]
+    forms = PrestressForms(basis, material, AXIS, linear)
+    w2 = omega * omega
+    MP = sp.csr_matrix(cf.spin_mass(basis, forms.rho, AXIS))[free][:, free]
     u = np.zeros(basis.N) if start is None else np.array(start, dtype=float)
 
     def tangent(u):
-        return (
-            sp.csr_matrix(cf.tangent_stiffness(basis, u, lam, mu, linear))[free][:, free] - w2 * MP
-        )
+        return sp.csr_matrix(forms.tangent(u, None, 0.0))[free][:, free] - w2 * MP
 
     def residual(u):
-        r = cf.internal_force(basis, u, lam, mu, linear) - cf.centrifugal_force(
-            basis, u, rho * w2, AXIS
-        )
-        return T0.T @ r[free]
+        return T0.T @ (forms.internal(u) - forms.force(u, w2))[free]
 
     zero = np.zeros(basis.N)
-    scale = float(np.linalg.norm(T0.T @ cf.centrifugal_force(basis, zero, rho * w2, AXIS)[free]))
+    scale = float(np.linalg.norm(T0.T @ forms.force(zero, w2)[free]))
     for _ in range(1 if linear else 30):
         r = residual(u)
         if np.linalg.norm(r) <= 1e-10 * scale:
