@@ -26,7 +26,7 @@ import scipy.sparse.linalg as spla
 from .. import progress
 from ..blas import one_blas_thread
 from .block_eigen import block_lowest, block_sizes
-from .linalg import PARDISO_ABOVE, sparse_lu
+from .linalg import sparse_lu
 
 __all__ = [
     "DENSE_EIGEN_BELOW",
@@ -45,10 +45,11 @@ DENSE_EIGEN_BELOW = 400
 FREE_SHIFT = -1.0
 #: Problem sizes from which block shift-invert Lanczos (:mod:`femrub.fem.block_eigen`)
 #: replaces ARPACK for :data:`BLOCK_EIGEN_MODES` modes or more: where the factorisation is
-#: Pardiso's, whose solves of a block of right-hand sides cost a small multiple of one,
-#: and ARPACK's vector-by-vector reorthogonalisation of a basis of ``2 k + 1`` vectors costs
-#: as much as its solves (docs/performance.md).
-BLOCK_EIGEN_ABOVE = PARDISO_ABOVE
+#: Pardiso's (from :data:`~femrub.fem.linalg.PARDISO_ABOVE`), whose solves of a block of
+#: right-hand sides cost a small multiple of one, and ARPACK's vector-by-vector
+#: reorthogonalisation of a basis of ``2 k + 1`` vectors costs as much as its solves
+#: (docs/performance.md).
+BLOCK_EIGEN_ABOVE = 20_000
 #: Fewest modes for which the block solver is used (fewer: ARPACK is as fast).
 BLOCK_EIGEN_MODES = 16
 

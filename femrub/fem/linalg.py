@@ -32,8 +32,11 @@ __all__ = [
 
 DENSE_BELOW = 600
 #: Size above which MKL Pardiso replaces SuperLU for one-off factorisations with many
-#: right-hand sides (reduction, eigen-solvers); docs/performance.md has the measurements.
-PARDISO_ABOVE = 20_000
+#: right-hand sides (reduction, eigen-solvers, prestress tangents): on 3D P2 elasticity
+#: SuperLU is faster below about 2,000 unknowns, Pardiso 2 to 3 times faster from 3,500 and
+#: 4 to 6 times from 10,000 (``benchmarks/factorisation_size.py``,
+#: docs/performance/blade-scale.md).
+PARDISO_ABOVE = 3_000
 
 #: Condition number estimate above which a symmetric matrix is called singular.
 SINGULAR_CONDITION = 1e14
