@@ -9,8 +9,9 @@ library of the process (numpy's and scipy's OpenBLAS alike) runs on one thread.
 It is shared by every thread of the process: the limits hold while any thread is inside
 (the stepping and a background VTK writer may be inside together) and the last one out
 restores them, whichever thread that is (threadpoolctl otherwise lets only the first thread
-that limited a process-wide pool change it again). The libraries are found once (a few ms),
-on first use.
+that limited a process-wide pool change it again). The libraries are found on first use (a
+few ms) and again after :func:`libraries_loaded` (femrub calls it when it loads MKL for
+Pardiso, :func:`femrub.fem.linalg.pardiso_available`).
 """
 
 from __future__ import annotations
@@ -19,7 +20,7 @@ import threading
 
 from threadpoolctl import ThreadpoolController
 
-__all__ = ["SERIAL_SETUP_DOFS", "one_blas_thread"]
+__all__ = ["SERIAL_SETUP_DOFS", "libraries_loaded", "one_blas_thread"]
 
 #: models of at most this many coordinates are also set up on one BLAS thread (dense
 #: reduced models; larger ones, full sparse models, keep the threads for their set-up)
@@ -33,11 +34,17 @@ class _OneBLASThread:
     def __init__(self):
         self._lock, self._inside, self._limiter = threading.Lock(), 0, None
         self._controller: ThreadpoolController | None = None
+        self._stale = False
+
+    def forget(self) -> None:
+        """Find the libraries again at the next outermost entry (limits in force stay)."""
+        self._stale = True
 
     def __enter__(self):
         with self._lock:
             if not self._inside:
-                self._controller = self._controller or ThreadpoolController()
+                if self._controller is None or self._stale:
+                    self._controller, self._stale = ThreadpoolController(), False
                 _take_control(self._controller)
                 self._limiter = self._controller.limit(limits=1, user_api="blas")
             self._inside += 1
@@ -61,3 +68,9 @@ def _take_control(controller: ThreadpoolController) -> None:
 
 
 one_blas_thread = _OneBLASThread()
+
+
+def libraries_loaded() -> None:
+    """Tell :data:`one_blas_thread` that the process loaded a BLAS library since its last
+    entry (MKL with Pardiso): the next outermost entry limits it too."""
+    one_blas_thread.forget()

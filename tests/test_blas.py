@@ -1,8 +1,12 @@
 """One BLAS thread for small dense work: the shared context and the steppers' set-up."""
 
+import os
+import subprocess
+import sys
 import threading
 
 import numpy as np
+import pytest
 from threadpoolctl import threadpool_info
 
 from femrub.blas import SERIAL_SETUP_DOFS, one_blas_thread
@@ -58,3 +62,25 @@ def test_a_small_model_is_set_up_on_one_blas_thread(monkeypatch):
     st = ThetaMethod(model, 1e-5)
     assert seen and set(seen[0]) == {1}
     assert np.all(np.isfinite(st.step().X))
+
+
+def test_mkl_loaded_after_first_use_is_limited_too():
+    """A process that entered the context before loading Pardiso's MKL (a small model's
+    set-up, then a large factorisation) still runs MKL on one thread inside it; in a fresh
+    process, since the pytest process may have loaded MKL already."""
+    pytest.importorskip("pypardiso")
+    code = (
+        "from threadpoolctl import threadpool_info\n"
+        "from femrub.blas import one_blas_thread\n"
+        "from femrub.fem.linalg import pardiso_available\n"
+        "with one_blas_thread: pass\n"
+        "assert pardiso_available()\n"
+        "assert any(l['internal_api'] == 'mkl' for l in threadpool_info())\n"
+        "with one_blas_thread:\n"
+        "    seen = {l['internal_api']: l['num_threads'] for l in threadpool_info()\n"
+        "            if l['user_api'] == 'blas'}\n"
+        "assert set(seen.values()) == {1}, seen\n"
+    )
+    subprocess.run(
+        [sys.executable, "-c", code], check=True, env={**os.environ, "MKL_NUM_THREADS": "2"}
+    )

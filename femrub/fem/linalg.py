@@ -18,6 +18,7 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 from .. import progress
+from ..blas import libraries_loaded
 from .spmm import block_columns, csr_dense
 
 __all__ = [
@@ -61,6 +62,7 @@ def pardiso_available() -> bool:
         solver = pypardiso.PyPardisoSolver()
     except (ImportError, OSError):
         return False
+    libraries_loaded()  # MKL's threads are limited with the other BLAS libraries
     path = getattr(solver.libmkl, "_name", None)
     if path:
         os.environ.setdefault("PYPARDISO_MKL_RT", path)
