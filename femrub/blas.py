@@ -11,7 +11,10 @@ It is shared by every thread of the process: the limits hold while any thread is
 restores them, whichever thread that is (threadpoolctl otherwise lets only the first thread
 that limited a process-wide pool change it again). The libraries are found on first use (a
 few ms) and again after :func:`libraries_loaded` (femrub calls it when it loads MKL for
-Pardiso, :func:`femrub.fem.linalg.pardiso_available`).
+Pardiso, :func:`femrub.fem.linalg.pardiso_available`). MKL's number of threads, as
+threadpoolctl sets and reads it, belongs to the calling thread: inside the context MKL runs
+on one thread in the thread that entered it first, not in the others (femrub calls MKL only
+through Pardiso, in set-ups, never in the stepping).
 """
 
 from __future__ import annotations
