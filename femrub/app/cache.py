@@ -213,6 +213,15 @@ def validate_entry(info, key: str) -> dict:
     return info
 
 
+def _mark_used(meta: Path) -> bool:
+    """Touch an entry's metadata (the least recently used order); ``False`` if it cannot be."""
+    try:
+        os.utime(meta, follow_symlinks=False)
+    except OSError:
+        return False
+    return True
+
+
 def _open_read(path: Path):
     """``path`` opened for reading without following a symbolic link."""
     return os.fdopen(os.open(path, os.O_RDONLY | _NOFOLLOW), "rb")
@@ -341,10 +350,7 @@ class ModelCache:
             )
             self._remove(key)
             return None
-        try:
-            os.utime(meta, follow_symlinks=False)  # least recently used order
-        except OSError:
-            pass
+        _mark_used(meta)
         return obj
 
     def holds(self, key: str) -> bool:
@@ -358,10 +364,9 @@ class ModelCache:
             info = self._read_meta(key)
             if info is None or data.lstat().st_size != info["size"]:
                 return False
-            os.utime(meta, follow_symlinks=False)  # least recently used order
         except (OSError, ValueError):
             return False
-        return True
+        return _mark_used(meta)
 
     def store(self, key: str, obj, *, stage: str, describe: str = "") -> bool:
         """Store ``obj`` under ``key``; ``False`` when it cannot be (not data, too large,
