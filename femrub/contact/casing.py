@@ -219,3 +219,52 @@ class SweptGapRate:
 
     def over_times(self, t):
         return self.omega * self.profile.slope(self.omega * t[:, None] + self.angles)
+
+
+def _ramp(t, duration: float):
+    """``s(t) = (1 − cos(π t / T)) / 2`` up to ``T = duration``, 1 after, and ``ds/dt``."""
+    t = np.asarray(t, dtype=float)
+    x = np.clip(t / duration, 0.0, 1.0)
+    on = (t > 0.0) & (t < duration)
+    return 0.5 * (1.0 - np.cos(np.pi * x)), np.where(
+        on, 0.5 * np.pi / duration * np.sin(np.pi * x), 0.0
+    )
+
+
+class RampedSweptGap:
+    """The swept gap of a profile whose departure from its clearance grows from zero:
+    ``g_i(t) = c + offset_i + s(t) (g(ω t + φ_i) − c)`` with the smooth ramp ``s`` of
+    duration ``ramp`` (s) (a casing distorted progressively, so that no contact starts
+    inside it when many blades sit around it); :meth:`rate` is its time derivative."""
+
+    def __init__(self, profile: CasingProfile, omega: float, angles, offset, ramp: float):
+        self.profile, self.omega, self.angles, self.offset = profile, omega, angles, offset
+        self.ramp = float(ramp)
+        self.clearance = float(profile.clearance)
+
+    def _parts(self, t):
+        psi = self.omega * t + self.angles
+        s, ds = _ramp(t, self.ramp)
+        return psi, s, ds
+
+    def __call__(self, t):
+        psi, s, _ = self._parts(t)
+        return self.clearance + self.offset + s * (self.profile.gap(psi) - self.clearance)
+
+    def over_times(self, t):
+        return self(np.asarray(t, dtype=float)[:, None])
+
+
+class RampedSweptGapRate:
+    """``dg_i/dt`` of :class:`RampedSweptGap` (m/s), same calls."""
+
+    def __init__(self, gap: RampedSweptGap):
+        self.gap = gap
+
+    def __call__(self, t):
+        g = self.gap
+        psi, s, ds = g._parts(t)
+        return ds * (g.profile.gap(psi) - g.clearance) + s * g.omega * g.profile.slope(psi)
+
+    def over_times(self, t):
+        return self(np.asarray(t, dtype=float)[:, None])

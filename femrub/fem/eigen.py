@@ -31,6 +31,7 @@ from .linalg import sparse_lu
 __all__ = [
     "DENSE_EIGEN_BELOW",
     "angular_frequencies",
+    "hermitian_solver",
     "largest_modulus",
     "lowest_hermitian_modes",
     "lowest_modes",
@@ -175,13 +176,42 @@ def largest_modulus(A, B) -> float:
     return float(np.max(np.abs(ev)))
 
 
-def lowest_hermitian_modes(K, M, k: int, *, tol: float = 1e-12):
+def _real_solve(lu, rhs):
+    rhs = np.asarray(rhs, dtype=complex)
+    return lu.solve(np.ascontiguousarray(rhs.real)) + 1j * lu.solve(np.ascontiguousarray(rhs.imag))
+
+
+def hermitian_solver(K, what: str = "cyclic stiffness"):
+    """``rhs -> K⁻¹ rhs`` for a complex Hermitian positive definite sparse ``K`` (n, n).
+
+    ``K = A + iB`` (``A`` symmetric, ``B`` antisymmetric) is factorised once as the real
+    symmetric ``[[A, −B], [B, A]]`` (:func:`~femrub.fem.linalg.sparse_lu`); the solver takes
+    a complex vector or ``(n, m)`` block.
+    """
+    n = K.shape[0]
+    Kc = sp.csc_matrix(K, dtype=complex)
+    if not np.any(Kc.imag.data):  # a real K (k = 0, N/2): its own factor, half the size
+        Kr = sp.csc_matrix((np.ascontiguousarray(Kc.data.real), Kc.indices, Kc.indptr), Kc.shape)
+        lu_real = sparse_lu(Kr, symmetric=True, what=what)
+        return lambda rhs: _real_solve(lu_real, rhs)
+    real = sp.bmat([[Kc.real, -Kc.imag], [Kc.imag, Kc.real]]).tocsc()
+    lu = sparse_lu(real, symmetric=True, what=what)
+
+    def solve(rhs):
+        rhs = np.asarray(rhs, dtype=complex)
+        z = lu.solve(np.concatenate([rhs.real, rhs.imag]))
+        return z[:n] + 1j * z[n:]
+
+    return solve
+
+
+def lowest_hermitian_modes(K, M, k: int, *, tol: float = 1e-12, solve=None):
     """The ``k`` lowest eigenpairs of ``K x = λ M x`` with ``K``, ``M`` complex Hermitian
     (``M`` positive definite), as the cyclic-symmetry problems of one nodal diameter.
 
     Dense LAPACK ``eigh`` below :data:`DENSE_EIGEN_BELOW` unknowns, else ARPACK in complex
-    arithmetic, shift-invert about σ = 0; ``K`` is factorised as its real symmetric form
-    ``[[Re K, −Im K], [Im K, Re K]]`` (:func:`~femrub.fem.linalg.sparse_lu`).
+    arithmetic, shift-invert about σ = 0 with ``solve`` (``rhs -> K⁻¹ rhs``; by default
+    :func:`hermitian_solver` of ``K``).
 
     Returns
     -------
@@ -195,14 +225,7 @@ def lowest_hermitian_modes(K, M, k: int, *, tol: float = 1e-12):
         with one_blas_thread:
             return sla.eigh(_dense(K), _dense(M), subset_by_index=[0, k - 1])
     Kc, Mc = sp.csc_matrix(K, dtype=complex), sp.csc_matrix(M, dtype=complex)
-    # K = A + iB (A symmetric, B antisymmetric) solved as the real symmetric [[A, −B], [B, A]]
-    real = sp.bmat([[Kc.real, -Kc.imag], [Kc.imag, Kc.real]]).tocsc()
-    lu = sparse_lu(real, symmetric=True, what="cyclic stiffness")
-
-    def solve(rhs):
-        z = lu.solve(np.concatenate([rhs.real, rhs.imag]))
-        return z[:n] + 1j * z[n:]
-
+    solve = hermitian_solver(Kc) if solve is None else solve
     opinv = spla.LinearOperator((n, n), matvec=solve, dtype=complex)
     with progress.phase(f"eigen-solve: {k} lowest modes of {n} complex unknowns (ARPACK)"):
         lam, V = spla.eigsh(Kc, k=k, M=Mc, sigma=0.0, OPinv=opinv, which="LM", tol=tol)

@@ -86,6 +86,8 @@ class CyclicStructure:
         Static displacement at Ω on every dof (m; zeros without prestress).
     basis : skfem.Basis
         The sector's P2 vector basis.
+    disc : Discretisation
+        The sector's discretisation (its ``basis_u`` is ``basis``), or ``None``.
     """
 
     sector: SectorMesh
@@ -98,6 +100,7 @@ class CyclicStructure:
     prestress: str
     static: np.ndarray
     basis: object = field(repr=False)
+    disc: object = field(default=None, repr=False)
 
     @property
     def n_sectors(self) -> int:
@@ -243,7 +246,7 @@ def cyclic_structure(
     left, right = _face_map(disc.basis_u, sector, free)
     static = np.zeros(disc.basis_u.N)
     rest = CyclicStructure(
-        sector, mats.K, mats.M, free, left, right, 0.0, prestress, static, disc.basis_u
+        sector, mats.K, mats.M, free, left, right, 0.0, prestress, static, disc.basis_u, disc
     )
     return spinning(rest, material, omega)
 

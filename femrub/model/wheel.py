@@ -1,0 +1,352 @@
+"""A bladed disk rubbing a flexible casing ring: every blade tip against the casing.
+
+The disk's sector (:mod:`femrub.model.cyclic`, prestressed at Ω) and the casing ring's
+sector are reduced harmonic by harmonic (:mod:`femrub.reduction.cyclic_ritz`: the modes of
+every nodal diameter and, for the disk, the residual shapes of the tip contacts), so the
+whole wheel is never meshed. The state is ``u = [disk coordinates, casing coordinates]``
+(mass ``I``): the disk's ``diag(ω̂²)`` stiffness and modal damping ``2 ζ_d ω̂``, the casing's
+rotating-frame blocks (:mod:`femrub.model.casing_waves`, Eq. 1 there).
+
+Contact ``(s, p)``: point ``p`` of the tip of blade ``s`` (at ``φ_sp = s α + φ_p`` in the
+rotor's frame), with the gap of the single blade's rub (:mod:`femrub.model.rub`)::
+
+    g_sp(t) = c(σ Ω t + φ_sp) + (r_tip − r_p) − n_p · u_static(p)
+              − n_sp · (u_blade(s, p) − u_casing(φ_sp))                          (1)
+
+``c(ψ)`` the clearance of the round casing plus its ``k``-lobed out-of-roundness
+``a cos(k (ψ − ψ_0))`` (:class:`~femrub.geometry.casing_ring.RingDistortion`; the bore's
+radius grows at a crest), ``r_tip`` the blades' largest tip radius, ``u_static`` the
+centrifugal growth at Ω. Coulomb friction acts along the axial and circumferential tangents
+with the casing sliding at ``−σ Ω r_p`` (:func:`~femrub.contact.casing.sliding_velocity`);
+the tangential relative displacement is the blade's less the casing's.
+
+Mistuning: blade ``s`` has its stiffness scaled by ``1 + δ_s``. With ``K_b`` the stiffness of
+the elements above the disk's rim on the sector and ``U_s`` the disk coordinates' field in
+sector ``s``, the disk's reduced stiffness gains ``Σ_s δ_s U_sᵀ K_b U_s`` (the tuned basis
+kept, as in component mode mistuning).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, replace
+
+import numpy as np
+import scipy.sparse as sp
+
+from ..contact.casing import (
+    Concentric,
+    Lobed,
+    RampedSweptGap,
+    RampedSweptGapRate,
+    sliding_velocity,
+    swept_gap,
+)
+from ..contact.points import ContactPoints, locate_contacts
+from ..fem.assembly import ThermoelasticMatrices
+from ..fem.elasticity import isotropic_stiffness
+from ..fem.forms import lame_parameters
+from ..geometry.cyclic_sector import axis_rotation, sector_angle
+from ..reduction.cyclic_ritz import CyclicBasis
+from .build import ContactSpec, first_order_model
+from .casing_waves import CasingWaves, cylindrical_components, rotating_blocks
+from .first_order import CasingSweep, FirstOrderModel, Parameters
+
+__all__ = [
+    "WheelConfig",
+    "WheelMap",
+    "contact_rows_of_sector",
+    "mistuning_stiffness",
+    "tip_contacts",
+    "wheel_model",
+]
+
+
+@dataclass(frozen=True)
+class WheelConfig:
+    """What a bladed-disk rub needs besides its structures (SI units).
+
+    Attributes
+    ----------
+    rotation_speed : float
+        Ω (rad/s), the speed the disk was prestressed at.
+    clearance : float
+        Radial clearance (m) between the round casing's bore and the blades' largest tip
+        radius at rest.
+    lobes, distortion, distortion_phase : int, float, float
+        The casing's out-of-roundness ``a cos(k (ψ − ψ_0))`` (m; rad).
+    direction : float
+        σ: +1 counterclockwise about ``+x``, −1 clockwise.
+    friction : float
+        Coulomb μ.
+    restitution : float
+        Newton's coefficient e.
+    disk_damping, casing_damping : float
+        Modal damping ratios ζ_d and ζ_c.
+    ramp : float
+        Time (s) over which the out-of-roundness grows from zero (0: there from the start).
+    """
+
+    rotation_speed: float
+    clearance: float
+    lobes: int = 0
+    distortion: float = 0.0
+    distortion_phase: float = 0.0
+    direction: float = 1.0
+    friction: float = 0.0
+    restitution: float = 0.0
+    disk_damping: float = 0.0
+    casing_damping: float = 0.0
+    ramp: float = 0.0
+
+
+@dataclass(frozen=True)
+class WheelMap:
+    """What output needs to turn a wheel state into blades and fields.
+
+    Attributes
+    ----------
+    disk : CyclicBasis
+        The disk's coordinates (the first ``disk.size`` of ``u``).
+    casing : CasingWaves or None
+        The casing's coordinates (the next ``casing.size``).
+    contacts : ContactPoints
+        The tip contacts of the sector's blade (sector axes).
+    n_blades : int
+        ``N``.
+    """
+
+    disk: CyclicBasis
+    casing: CasingWaves | None
+    contacts: ContactPoints
+    n_blades: int
+
+    @property
+    def n_disk(self) -> int:
+        return self.disk.size
+
+    @property
+    def n_casing(self) -> int:
+        return 0 if self.casing is None else self.casing.size
+
+
+def tip_contacts(structure, n_points: int) -> ContactPoints:
+    """``n_points`` contacts on the tip face of the sector's blade, spread along its chord.
+
+    The tip face's vertices are ordered along the face's longest principal direction (the
+    chord) and the vertices nearest to ``n_points`` evenly spaced positions are taken
+    (each once); each contact acts on its part of the tip face
+    (:func:`~femrub.contact.points.locate_contacts`, ``spread = "patch"``).
+    """
+    mesh = structure.sector.mesh
+    tip = np.unique(mesh.require("tip"))
+    p = mesh.mesh.p[:, tip]
+    centred = p - p.mean(axis=1, keepdims=True)
+    chord = np.linalg.svd(centred, full_matrices=False)[0][:, 0]
+    s = chord @ centred
+    targets = np.linspace(s.min(), s.max(), n_points + 2)[1:-1]
+    picked = []
+    for t in targets:
+        order = np.argsort(np.abs(s - t) + 1e-3 * np.abs(centred).sum(axis=0))
+        picked.append(next(i for i in order if i not in picked))
+    return locate_contacts(structure.disc, p[:, picked], spread="patch")
+
+
+def contact_rows_of_sector(structure, contacts: ContactPoints):
+    """Normal ``(n_c, n_free)`` and tangent ``(2 n_c, n_free)`` rows of the contacts."""
+    means = contacts.patch if contacts.patch is not None else contacts._means(structure.basis.N)
+    means = sp.csr_matrix(means)[:, structure.free]
+    normal = contacts._directions(contacts.normals[:, None, :]) @ means
+    tangent = contacts._directions(contacts.tangents) @ means
+    return sp.csr_matrix(normal), sp.csr_matrix(tangent)
+
+
+def _casing_profile(config: WheelConfig):
+    if config.lobes and config.distortion:
+        phase = config.distortion_phase + math.pi / config.lobes  # crest: a larger bore
+        return Lobed(config.clearance, abs(config.distortion), int(config.lobes), phase)
+    return Concentric(config.clearance)
+
+
+def mistuning_stiffness(
+    structure, disk: CyclicBasis, factors, material, rim_radius: float
+) -> np.ndarray:
+    """``Σ_s δ_s U_sᵀ K_b U_s`` (module docstring) on the disk's coordinates.
+
+    ``K_b``: the elastic stiffness (``material``) of the sector's elements whose vertices all
+    lie outside ``rim_radius`` (m): the blade, without the disk or the prestress.
+    """
+    factors = np.asarray(factors, dtype=float)
+    mesh = structure.sector.mesh.mesh
+    radius = np.hypot(mesh.p[1], mesh.p[2])
+    blade = np.flatnonzero(np.all(radius[mesh.t] > rim_radius * (1.0 + 1e-9), axis=0))
+    lam, mu = lame_parameters(material.young, material.poisson, 3)
+    Kb = isotropic_stiffness(structure.basis.with_elements(blade), lam, mu)
+    Kb = sp.csr_matrix(Kb)[structure.free][:, structure.free]
+    out = np.zeros((disk.size, disk.size))
+    for s, delta in enumerate(factors):
+        if delta == 0.0:
+            continue
+        U = disk.sector_field(np.eye(disk.size), s)  # (n_free, size)
+        out += delta * (U.T @ (Kb @ U))
+    return 0.5 * (out + out.T)
+
+
+def _frames(contacts: ContactPoints, n_blades: int) -> np.ndarray:
+    """``(N n_c, 3, 3)``: normal, axial and circumferential directions in global axes."""
+    local = contacts.frames()  # (n_c, 3, 3) in the sector's axes
+    alpha = 2.0 * math.pi / n_blades
+    turns = np.stack([axis_rotation(s * alpha) for s in range(n_blades)])
+    return np.einsum("sab,pdb->spda", turns, local).reshape(-1, 3, 3)
+
+
+def _contact_rows(disk, casing, structure, contacts, n_blades):
+    """Normal ``(N n_c, n_u)`` and tangent ``(2 N n_c, n_u)`` rows (blade less casing)."""
+    normal, tangent = contact_rows_of_sector(structure, contacts)
+    nc = contacts.n
+    Dn = disk.sector_rows(normal).reshape(n_blades * nc, -1)
+    Dt = disk.sector_rows(tangent).reshape(n_blades * 2 * nc, -1)
+    if casing is None:
+        return Dn, Dt
+    phi = sector_angle(contacts.points)
+    angles = (2.0 * math.pi / n_blades * np.arange(n_blades)[:, None] + phi).ravel()
+    Cn = casing.rows(
+        angles, np.tile(cylindrical_components(contacts.normals, phi).T, (n_blades, 1))
+    )
+    tang = [cylindrical_components(contacts.tangents[:, j, :], phi).T for j in range(2)]
+    dirs = np.tile(np.stack(tang, 1).reshape(2 * nc, 3), (n_blades, 1))
+    Ct = casing.rows(np.repeat(angles, 2), dirs)
+    return np.hstack([Dn, -Cn]), np.hstack([Dt, -Ct])
+
+
+def _matrices(disk, casing, config, extra_stiffness):
+    """``M, C, K`` of the state's displacement block and the circulatory form ``K_a``."""
+    w = disk.omega
+    Md, Cd = sp.identity(w.size), sp.diags(2.0 * config.disk_damping * w)
+    Kd = sp.diags(w * w) + (0.0 if extra_stiffness is None else sp.csr_matrix(extra_stiffness))
+    if casing is None:
+        return Md, Cd, sp.csr_matrix(Kd), sp.csr_matrix((w.size, w.size))
+    Mc, Cc, Kc, Ka = rotating_blocks(
+        casing, config.rotation_speed, config.direction, config.casing_damping
+    )
+    blocks = [sp.block_diag([a, b], format="csr") for a, b in ((Md, Mc), (Cd, Cc), (Kd, Kc))]
+    zero = sp.csr_matrix((w.size, w.size))
+    return (*blocks, sp.block_diag([zero, Ka], format="csr"))
+
+
+def _as_matrices(M, C, K) -> ThermoelasticMatrices:
+    n = M.shape[0]
+    empty = sp.csr_matrix((0, 0))
+    return ThermoelasticMatrices(
+        M=sp.csr_matrix(M),
+        C=sp.csr_matrix(C),
+        K=sp.csr_matrix(K),
+        Kut=sp.csr_matrix((n, 0)),
+        Ctu=sp.csr_matrix((0, n)),
+        Ctt=empty,
+        Ktt=empty,
+        free_u=np.arange(n),
+        free_t=np.zeros(0, dtype=int),
+        n_u_all=n,
+        n_t_all=0,
+        info={"coupling": None},
+    )
+
+
+def _observations(Dn: np.ndarray, n_blades: int, nc: int, n_u: int) -> dict:
+    """Mean normal tip displacement of blade 0 and of every blade (the blade alone), rows
+    on the ``n_u`` displacement coordinates (``Dn`` on the disk's)."""
+    Dn = np.hstack([Dn, np.zeros((Dn.shape[0], n_u - Dn.shape[1]))])
+    per_blade = Dn.reshape(n_blades, nc, -1).mean(axis=1)
+    return {
+        "tip_displacement": ("u", per_blade[:1]),
+        "tip_velocity": ("v", per_blade[:1]),
+        "blade_tip_displacement": ("u", per_blade),
+        "contact_displacement": ("u", Dn),
+    }
+
+
+def wheel_model(
+    config: WheelConfig,
+    structure,
+    disk: CyclicBasis,
+    contacts: ContactPoints,
+    casing: CasingWaves | None = None,
+    *,
+    tip_radius: float,
+    mistuning=None,
+) -> tuple[FirstOrderModel, WheelMap]:
+    """The first-order model of the wheel against the casing (module docstring).
+
+    Parameters
+    ----------
+    config : WheelConfig
+        Speed, clearance, distortion, friction, damping.
+    structure : CyclicStructure
+        The disk's sector at ``config.rotation_speed`` (its ``static`` growth enters Eq. 1).
+    disk : CyclicBasis
+        Its harmonic bases (with the residual shapes of ``contacts``).
+    contacts : ContactPoints
+        The tip contacts of the sector's blade (:func:`tip_contacts`).
+    casing : CasingWaves, optional
+        The flexible casing; a rigid one when ``None``.
+    tip_radius : float
+        The blades' largest tip radius (m) at rest.
+    mistuning : numpy.ndarray, optional
+        ``(n_disk, n_disk)`` stiffness added to the disk's coordinates
+        (:func:`mistuning_stiffness`).
+    """
+    N, nc = disk.n_sectors, contacts.n
+    Nrows, Trows = _contact_rows(disk, casing, structure, contacts, N)
+    M, C, K, Ka = _matrices(disk, casing, config, mistuning)
+    growth = contacts.normal_displacement(structure.static)
+    phi = sector_angle(contacts.points)
+    angles = (2.0 * math.pi / N * np.arange(N)[:, None] + phi).ravel()
+    offsets = np.tile(tip_radius - contacts.radii - growth, N)
+    profile = _casing_profile(config)
+    omega = float(config.rotation_speed)
+    gap, rate = swept_gap(profile, angles, omega, offsets, config.direction)
+    if config.ramp > 0.0 and rate is not None:
+        gap = RampedSweptGap(profile, config.direction * omega, angles, offsets, config.ramp)
+        rate = RampedSweptGapRate(gap)
+    radii = np.tile(contacts.radii, N)
+    friction = {}
+    if config.friction > 0.0:
+        friction = dict(
+            tangents=Trows,
+            friction=float(config.friction),
+            casing_velocity=sliding_velocity(radii, omega, config.direction),
+            frames=_frames(contacts, N),
+        )
+    spec = ContactSpec(
+        normals=Nrows,
+        gap=gap,
+        gap_rate=rate,
+        restitution=config.restitution,
+        names=[f"blade{s}_contact{p}" for s in range(N) for p in range(nc)],
+        **friction,
+    )
+    n_disk = disk.size
+    model = first_order_model(
+        _as_matrices(M, C, K),
+        contact=spec,
+        observe=_observations(Nrows[:, :n_disk], N, nc, Nrows.shape[1]),
+        thermal=False,
+        info=dict(
+            kind="bladed-disk",
+            n_blades=N,
+            n_contacts=N * nc,
+            disk_coordinates=n_disk,
+            casing_coordinates=0 if casing is None else casing.size,
+            rotation_speed=omega,
+            rotation_direction=float(config.direction),
+        ),
+        length_scale=float(tip_radius),
+        parameters=Parameters(rotation_speed=omega),
+        sweep=CasingSweep(profile, angles, offsets, radii, omega, config.direction),
+    )
+    energy = model.energy
+    n_u = model.layout.n_u
+    circulatory = sp.bmat([[None, sp.csr_matrix((n_u, n_u))], [-Ka, None]], format="csr")
+    model = model.with_(energy=replace(energy, Pd=sp.csr_matrix(energy.Pd + circulatory)))
+    return model, WheelMap(disk, casing, contacts, N)
