@@ -165,6 +165,19 @@ def test_tuned_wheel_rub_closes_its_energy_balance(rub):
     assert np.abs(e["energy_error"]).max() < 1e-9 * exchanged
 
 
+def test_energy_forms_give_the_power_of_the_free_wheel(rub):
+    """``dE/dt = Ẋᵀ (Q_k + Q_e) X`` equals the damping form ``Xᵀ P_d X`` on any state of the
+    free wheel (no contact, no load), gyroscopic and circulatory casing terms included."""
+    model, _, _ = rub
+    f = model.energy
+    rng = np.random.default_rng(3)
+    X = rng.standard_normal(model.layout.n)
+    rate = spla.spsolve(model.A.tocsc(), model.B @ X)
+    Q = f.Qk + f.Qe
+    power = rate @ (0.5 * (Q + Q.T) @ X)  # d/dt of ½ Xᵀ Q X
+    assert power == pytest.approx(X @ (f.Pd @ X), rel=1e-10)
+
+
 def test_blades_a_lobe_apart_carry_the_same_forces(rub):
     """Blades a lobe period apart (2 of the 6 for 3 lobes) meet the same casing at the same
     instants from the same start: their forces are equal at every step."""
