@@ -32,7 +32,11 @@ SAFETY = 0.5
 
 def lobe_passage(scene) -> float:
     """Duration (s) of one lobe passage of the casing (0 without lobes or rotation)."""
-    w = lobe_passing_frequency(scene["contact"]["casing"], scene["loads"]["rotation_speed"])
+    omega = scene["loads"]["rotation_speed"]
+    if scene.get("rotor.sectors") is not None:  # a bladed disk: the casing ring's lobes
+        lobes = scene["casing"]["ring"]["lobes"]
+        return 2.0 * np.pi / (lobes * omega) if lobes and omega > 0 else 0.0
+    w = lobe_passing_frequency(scene["contact"]["casing"], omega)
     return 2.0 * np.pi / w if w else 0.0
 
 

@@ -288,6 +288,8 @@ def _output_rows(report: dict) -> list[tuple[str, str]]:
 
 def explain(report: dict, reach_key=None) -> str:
     """Format a build report (:func:`femrub.app.simulation.build`) as aligned text."""
+    if report.get("kind") == "bladed-disk":
+        return _aligned(_wheel_rows(report))
     rows = [("scene", f"{report['scene']} ({report['source']})"), ("geometry", report["geometry"])]
     p = report.get("parametric")
     if p:
@@ -304,4 +306,43 @@ def explain(report: dict, reach_key=None) -> str:
     rows += [("reduction", x) for x in _reduction(report["reduction"])]
     rows += _scheme_rows(report)
     rows += _output_rows(report)
+    return _aligned(rows)
+
+
+def _aligned(rows) -> str:
     return "\n".join(f"  {k:<10} {v}" for k, v in rows)
+
+
+def _wheel_rows(report: dict) -> list:
+    """The rows of a bladed disk's build (:mod:`femrub.app.wheel`)."""
+    w = report["bladed_disk"]
+    err = report["reduction"]["error"]
+    step = report.get("time_step", {})
+    scheme = report.get("scheme", {})
+    return [
+        ("scene", f"{report['scene']} ({report['source']})"),
+        (
+            "wheel",
+            f"{w['blades']} blades, {w['contacts_per_blade']} tip contacts each, "
+            f"{w['sector_free_dofs']} free dofs per sector; casing: {w['casing']}; "
+            f"direction {'counterclockwise' if w['direction'] > 0 else 'clockwise'}",
+        ),
+        (
+            "model",
+            f"{w['disk_coordinates']} disk and {w['casing_coordinates']} casing coordinates "
+            "(per nodal diameter: modes and the tip contacts' residual shapes)",
+        ),
+        (
+            "reduction",
+            f"estimated error {100 * err['estimate']:.3g} % against the richer wheel "
+            f"{err['reference_sizes']} (tolerance {100 * err['tolerance']:.3g} %)",
+        ),
+        (
+            "time step",
+            f"estimated error {100 * step.get('estimate', 0.0):.3g} % "
+            f"(tolerance {100 * step.get('tolerance', 0.0):.3g} %)",
+        ),
+        ("scheme", f"{scheme.get('name')} h = {scheme.get('h'):g} s, {scheme.get('steps')} steps"),
+        ("outputs", "no VTK for a bladed disk yet"),
+        ("timings", format_timings(report.get("timings", {}))),
+    ]

@@ -247,6 +247,10 @@ class _Clock:
 def _build(scene, log, modes, stages, with_stepper=True) -> Simulation:
     scene.check_files()
     check_run(scene)
+    if scene.get("rotor.sectors") is not None:  # every blade of a wheel: its own pipeline
+        from .wheel import build_wheel
+
+        return build_wheel(scene, log)
     # the first run on this machine: the kernels it needs, compiled beside the build
     if jit.compile_in_background(tr.kernel_kinds(scene)) and log:
         log("compiling the contact kernels in a background process (first run here) ...")

@@ -4,10 +4,8 @@
   takes ``round(t_end / h)`` steps: otherwise the run would end short of ``t_end``, or
   past it, and still say ``ok``); the message gives both fixes;
 * :func:`check_friction`: the Coulomb coefficient μ (``contact.friction``) is at most
-  :data:`MAX_FRICTION` (a percentage or a typing slip, not a material pair).
-
-* :func:`check_bladed_disk`: a bladed disk (``rotor.sectors``) has modes
-  (``femrub modes``) but no time integration yet.
+  :data:`MAX_FRICTION` (a percentage or a typing slip, not a material pair);
+* :func:`check_bladed_disk`: what a bladed-disk run (``rotor.sectors``) does not model.
 
 :func:`check_run` applies them all; ``femrub run``, ``check`` and ``sweep`` call it on every
 scene (every point of a sweep) before building anything.
@@ -80,17 +78,26 @@ def check_friction(scene) -> None:
         )
 
 
+#: what a bladed-disk run does not model, as ``(key, refused when, the value's meaning)``
+_WHEEL_REFUSALS = (
+    ("physics.thermal", lambda v: v == "on", "a bladed disk runs without temperature dofs"),
+    ("contact.abradable.thickness", lambda v: v > 0, "no abradable coating on the ring yet"),
+    ("contact.casing_heat.thickness", lambda v: v > 0, "no casing heat model on the ring yet"),
+    ("loads.tip_force.law", lambda v: v != "none", "no tip force on a bladed disk"),
+    ("outputs.probes", lambda v: bool(v), "no node probes on a bladed disk yet"),
+    ("scheme.name", lambda v: v != "theta", "a bladed disk runs the θ-method"),
+)
+
+
 def check_bladed_disk(scene) -> None:
-    """Refuse to time-integrate a bladed disk (``rotor.sectors``): only its modes exist."""
-    sectors = scene.get("rotor.sectors")
-    if sectors is not None:
-        fail(
-            "rotor.sectors",
-            sectors,
-            "time integration of a bladed disk is not available yet; `femrub modes SCENE` "
-            "writes its modes by nodal diameter, its casing ring's and their coincidence "
-            "speeds (remove rotor.sectors to run the single blade)",
-        )
+    """Refuse what a bladed-disk run (``rotor.sectors``, :mod:`femrub.app.wheel`) does not
+    model, one key at a time."""
+    if scene.get("rotor.sectors") is None:
+        return
+    for key, refused, why in _WHEEL_REFUSALS:
+        value = scene.get(key)
+        if value is not None and refused(value):
+            fail(key, value, f"{why}; remove it, or remove rotor.sectors to run one blade")
 
 
 def check_run(scene) -> None:

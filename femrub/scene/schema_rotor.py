@@ -33,6 +33,10 @@ ROTOR = {
         **POS,
     ),
     "families": Spec(I, 3, lo=1, hi=30, doc="mode families computed per nodal diameter"),
+    "contacts": Spec(I, 3, lo=1, hi=20, doc="contacts on each blade's tip, along its chord"),
+    "damping_ratio": _f(
+        0.01, "none", "modal damping ratio of the disk's modes (time integration)", lo=0.0, hi=1.0
+    ),
 }
 
 CASING_RING = {
@@ -56,6 +60,16 @@ CASING_RING = {
         None, "length", "element size (default: the larger of thickness and axial_length/6)", **POS
     ),
     "families": Spec(I, 3, lo=1, hi=30, doc="mode families computed per nodal diameter"),
+    "phase": _f(0.0, "angle", "angle of the first lobe's crest (the widest bore)"),
+    "damping_ratio": _f(
+        0.01, "none", "modal damping ratio of the ring's modes (time integration)", lo=0.0, hi=1.0
+    ),
+    "ramp": _f(
+        None,
+        "time",
+        "time over which the out-of-roundness grows from zero (default: two revolutions)",
+        **NONNEG,
+    ),
 }
 
 CASING_SECTION = {"ring": CASING_RING}

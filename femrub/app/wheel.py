@@ -1,0 +1,253 @@
+"""A bladed-disk scene (``rotor.sectors``) as a runnable simulation: every blade against the casing.
+
+The scene's disk sector (``rotor.*``, the NACA blade of ``geometry.*``) is prestressed at
+``loads.rotation_speed`` (``loads.centrifugal``) and reduced per nodal diameter with the
+residual shapes of ``rotor.contacts`` contacts on each blade's tip; the casing ring
+(``casing.ring.*``, when it has a ``thickness``; a rigid round casing otherwise) enters as
+waves of the rotating frame (:mod:`femrub.model.wheel`). The model is its own full model:
+its coordinates are mass-normalised, so the mass norm of the wheel's displacement is the
+norm of its displacement coordinates.
+
+Checks, as for a single blade, both stepping the scene's scheme to ``scheme.t_end``:
+
+* the *reduction error estimate*: the run against the same wheel with richer bases
+  (``rotor.families + 2`` modes per nodal diameter on the disk, ``casing.ring.families + 1``
+  on the casing). The richer disk basis spans the run's (modes and residual shapes of the
+  same contacts), so the run's states are carried into the richer coordinates exactly
+  (:func:`transfer`) and compared there by :func:`~femrub.reduction.estimate.estimate`
+  (contact impulses per lobe passage, the wheel's displacement in the mass norm; with the
+  round-off twin of the richer model when the response is sensitive);
+* the *time-step check* (:func:`~femrub.analysis.step_check.check_step`).
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.sparse as sp
+
+from ..analysis.reduction_check import lobe_passage
+from ..analysis.step_check import check_step
+from ..geometry.rotation_direction import derive_rotation_direction
+from ..model.casing_waves import casing_waves
+from ..model.cyclic import cyclic_structure
+from ..model.wheel import WheelConfig, contact_rows_of_sector, tip_contacts, wheel_model
+from ..reduction.cyclic_ritz import CyclicBasis, cyclic_basis
+from ..reduction.estimate import HORIZON_SHARE, estimate, perturbed
+from . import translate as tr
+from .modes import casing_sector, ring_material, rotor_sector
+from .scheme import bare_stepper, stepper_of
+
+__all__ = ["WheelParts", "build_wheel", "transfer", "wheel_parts"]
+
+#: Modes per nodal diameter the reference model adds on the disk and on the casing.
+REFERENCE_EXTRA = (2, 1)
+#: States stored per run for the field comparison.
+CHECKPOINTS = 5
+
+
+@dataclass(frozen=True)
+class WheelParts:
+    """What every wheel model of a scene shares: the sectors, the contacts, the configuration."""
+
+    disk: object  # CyclicStructure at Ω
+    contacts: object
+    rows: sp.csr_matrix
+    ring: object  # CyclicStructure of the casing ring, or None
+    bore: float
+    tip_radius: float
+    config: WheelConfig
+
+
+def _direction(scene, sector) -> float:
+    given = scene["loads"]["rotation_direction"]
+    if given == "auto":
+        return derive_rotation_direction(sector.mesh).sign
+    return 1.0 if given == "counterclockwise" else -1.0
+
+
+def _config(scene, sector) -> WheelConfig:
+    ring, rotor = scene["casing"]["ring"], scene["rotor"]
+    omega = float(scene["loads"]["rotation_speed"])
+    ramp = ring.get("ramp")
+    if ramp is None:
+        ramp = 2.0 * 2.0 * math.pi / omega if omega > 0 else 0.0
+    return WheelConfig(
+        rotation_speed=omega,
+        clearance=ring["clearance"],
+        lobes=ring["lobes"],
+        distortion=ring["distortion"],
+        distortion_phase=math.radians(ring["phase"]),
+        direction=_direction(scene, sector),
+        friction=scene["contact"]["friction"],
+        restitution=scene["contact"]["restitution"],
+        disk_damping=rotor["damping_ratio"],
+        casing_damping=ring["damping_ratio"],
+        ramp=ramp,
+    )
+
+
+def wheel_parts(scene, log=None) -> WheelParts:
+    """Mesh and assemble the scene's sectors, prestress the disk, place the contacts."""
+    sector = rotor_sector(scene)
+    material = tr.material_of(scene)
+    method = tr.centrifugal_of(scene) or "off"
+    omega = float(scene["loads"]["rotation_speed"])
+    if log:
+        log(f"bladed disk: sector of {sector.n_sectors}, prestress {method} at {omega:g} rad/s")
+    disk = cyclic_structure(sector, material, omega=omega, prestress=method)
+    contacts = tip_contacts(disk, scene["rotor"]["contacts"])
+    normal, tangent = contact_rows_of_sector(disk, contacts)
+    tip_radius = float(sector.info["tip_radius"])
+    ring = None
+    bore = tip_radius + scene["casing"]["ring"]["clearance"]
+    if scene["casing"]["ring"].get("thickness") is not None:
+        ring = cyclic_structure(casing_sector(scene, tip_radius), ring_material(scene))
+    return WheelParts(
+        disk,
+        contacts,
+        sp.vstack([normal, tangent]).tocsr(),
+        ring,
+        bore,
+        tip_radius,
+        _config(scene, sector),
+    )
+
+
+def _bases(parts: WheelParts, disk_modes: int, casing_modes: int):
+    disk = cyclic_basis(parts.disk, disk_modes, parts.rows)
+    waves = None
+    if parts.ring is not None:
+        reading = parts.bore * (1.0 + 1e-6)  # just inside the ring's bore
+        waves = casing_waves(parts.ring, casing_modes, parts.contacts.points[0], reading)
+    return disk, waves
+
+
+def _model(parts: WheelParts, disk, waves):
+    return wheel_model(
+        parts.config, parts.disk, disk, parts.contacts, waves, tip_radius=parts.tip_radius
+    )
+
+
+def transfer(small: CyclicBasis, rich: CyclicBasis, mass) -> np.ndarray:
+    """``(rich.size, small.size)``: the coordinates in ``rich`` of the fields of ``small``'s
+    coordinates, ``W_richᴴ M W_small`` per nodal diameter (exact when ``rich``'s span holds
+    ``small``'s), as real coordinates (:class:`~femrub.reduction.cyclic_ritz.CyclicBasis`)."""
+    out = np.zeros((rich.size, small.size))
+    blocks = {h.k: (h, start, m, pair) for h, start, m, pair in rich.blocks()}
+    for h, start, m, pair in small.blocks():
+        hr, rs, mr, _ = blocks[h.k]
+        P = hr.shapes.conj().T @ (mass @ h.shapes)  # (mr, m)
+        if pair:
+            out[rs : rs + mr, start : start + m] = P.real
+            out[rs : rs + mr, start + m : start + 2 * m] = -P.imag
+            out[rs + mr : rs + 2 * mr, start : start + m] = P.imag
+            out[rs + mr : rs + 2 * mr, start + m : start + 2 * m] = P.real
+        else:
+            out[rs : rs + mr, start : start + m] = P.real
+    return out
+
+
+def _state_transfer(parts, small, rich) -> np.ndarray:
+    """States ``[u, v]`` of the small wheel into the rich wheel's (displacement and velocity
+    alike)."""
+    (disk_s, waves_s), (disk_r, waves_r) = small, rich
+    T = transfer(disk_s, disk_r, parts.disk.M)
+    if waves_s is not None:
+        T = sp.block_diag([T, transfer(waves_s.basis, waves_r.basis, parts.ring.M)]).toarray()
+    return np.kron(np.eye(2), T)
+
+
+def _run(model, scene, limits, lean=0):
+    stepper = bare_stepper(scene, model)
+    t_end = scene["scheme"]["t_end"]
+    every = max(1, stepper.steps_to(t_end) // CHECKPOINTS)
+    t0 = time.perf_counter()
+    res = stepper.run(t_end, store_every=every, limits=limits, lean=lean)
+    return res, time.perf_counter() - t0
+
+
+def _reduction_check(scene, parts, small, model, limits, log):
+    """The run and the estimate of its reduction error against the richer wheel."""
+    r = scene["rotor"]
+    sizes = (r["families"], scene["casing"]["ring"]["families"])
+    rich_sizes = tuple(a + b for a, b in zip(sizes, REFERENCE_EXTRA, strict=True))
+    rich = _bases(parts, *rich_sizes)
+    rich_model, _ = _model(parts, *rich)
+    T = _state_transfer(parts, small, rich)
+    if log:
+        log(f"reduction error estimate: the run ({model.n_dofs} coordinates) ...")
+    run, wall = _run(model, scene, limits)
+    if log:
+        log(f"reduction error estimate: the richer wheel ({rich_model.n_dofs} coordinates) ...")
+    ref, _ = _run(rich_model, scene, limits, lean=1)
+    window = lobe_passage(scene)
+    a, b = (sizes, run, run.states @ T.T), (rich_sizes, ref, ref.states)
+    tol = scene["reduction"]["tolerance"]
+    err = estimate(a, b, rich_model, window=window)
+    if err["estimate"] > HORIZON_SHARE * tol:  # a sensitive response? its twin says
+        twin, _ = _run(perturbed(rich_model), scene, limits, lean=1)
+        err = estimate(a, b, rich_model, window=window, twin=(twin, twin.states), tolerance=tol)
+    err.update(tolerance=tol, method="cyclic: " + err["method"])
+    return err, run, wall
+
+
+def build_wheel(scene, log=None):
+    """The :class:`~femrub.app.simulation.Simulation` of a bladed-disk scene (module
+    docstring): the wheel's model (also its full model), its stepper, its run (stepped by the
+    reduction error estimate) and the report."""
+    from .simulation import Simulation
+
+    timings, t0 = {}, time.perf_counter()
+    parts = wheel_parts(scene, log)
+    timings["assembly"] = time.perf_counter() - t0
+    t1 = time.perf_counter()
+    small = _bases(parts, scene["rotor"]["families"], scene["casing"]["ring"]["families"])
+    model, _ = _model(parts, *small)
+    timings["reduction"] = time.perf_counter() - t1
+    limits = {}
+    report = _report(scene, parts, model)
+    t2 = time.perf_counter()
+    err, run, wall = _reduction_check(scene, parts, small, model, limits, log)
+    report["reduction"] = {"method": "cyclic", "error": err}
+    states = run.states
+    step, _, _ = check_step(
+        scene,
+        model,
+        model,
+        lambda m, h: bare_stepper(scene, m, h=h),
+        limits,
+        run=(run, states),
+    )
+    report["time_step"] = step
+    timings["checks"] = time.perf_counter() - t2 - wall
+    stepper = stepper_of(scene, model, report)
+    report["timings"] = timings
+    return Simulation(
+        scene, model, model, None, None, stepper, limits, report, timings, (run, wall)
+    )
+
+
+def _report(scene, parts: WheelParts, model) -> dict:
+    c = parts.config
+    return {
+        "scene": scene.name,
+        "source": scene.source,
+        "kind": "bladed-disk",
+        "dropped": [],
+        "bladed_disk": {
+            "blades": model.info["n_blades"],
+            "contacts_per_blade": parts.contacts.n,
+            "disk_coordinates": model.info["disk_coordinates"],
+            "casing_coordinates": model.info["casing_coordinates"],
+            "sector_free_dofs": int(parts.disk.free.size),
+            "casing": "flexible ring" if parts.ring is not None else "rigid",
+            "tip_radius": parts.tip_radius,
+            "direction": c.direction,
+            "ramp": c.ramp,
+        },
+        "model": {"n_dofs": model.n_dofs},
+    }
