@@ -103,16 +103,17 @@ def test_coincidence_speeds_follow_from_the_modes(modes_folder):
     assert not (out / "campbell.png").exists()
 
 
-def test_modes_keeps_a_finished_folder_and_run_refuses_a_bladed_disk(modes_folder, capsys):
+def test_modes_keeps_a_finished_folder_and_run_refuses_what_a_wheel_lacks(modes_folder, capsys):
     scene, out = modes_folder
     capsys.readouterr()
     assert main(["modes", str(scene), "-o", str(out), "-q"]) == 2
     assert "--overwrite" in capsys.readouterr().err
-    assert main(["run", str(scene), "-o", str(out.parent / "run"), "-q"]) == 2
+    run = ["run", str(scene), "-o", str(out.parent / "run"), "-q", "--set=physics.thermal=on"]
+    assert main(run) == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1
-    assert "time integration of a bladed disk is not available yet" in err
-    assert "femrub modes" in err and not (out.parent / "run").exists()
+    assert "physics.thermal = 'on'" in err and "bladed disk runs without temperature" in err
+    assert not (out.parent / "run").exists()
 
 
 @pytest.mark.parametrize(

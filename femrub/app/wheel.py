@@ -32,10 +32,10 @@ import scipy.sparse as sp
 from ..analysis.reduction_check import lobe_passage
 from ..analysis.step_check import check_step
 from ..geometry.rotation_direction import derive_rotation_direction
-from ..model.casing_waves import casing_waves
+from ..model.casing_waves import casing_harmonics, waves_of
 from ..model.cyclic import cyclic_structure
 from ..model.wheel import WheelConfig, contact_rows_of_sector, tip_contacts, wheel_model
-from ..reduction.cyclic_ritz import CyclicBasis, cyclic_basis
+from ..reduction.cyclic_ritz import CyclicBasis, cyclic_bases
 from ..reduction.estimate import HORIZON_SHARE, estimate, perturbed
 from . import translate as tr
 from .modes import casing_sector, ring_material, rotor_sector
@@ -117,13 +117,17 @@ def wheel_parts(scene, log=None) -> WheelParts:
     )
 
 
-def _bases(parts: WheelParts, disk_modes: int, casing_modes: int):
-    disk = cyclic_basis(parts.disk, disk_modes, parts.rows)
-    waves = None
-    if parts.ring is not None:
-        reading = parts.bore * (1.0 + 1e-6)  # just inside the ring's bore
-        waves = casing_waves(parts.ring, casing_modes, parts.contacts.points[0], reading)
-    return disk, waves
+def _bases(parts: WheelParts, sizes) -> list:
+    """``(disk basis, casing waves)`` for each ``(disk modes, casing modes)`` of ``sizes``
+    (one factorisation and eigen-solve per nodal diameter for them all)."""
+    disks = cyclic_bases(parts.disk, [d for d, _ in sizes], parts.rows)
+    if parts.ring is None:
+        return [(d, None) for d in disks]
+    harmonics = casing_harmonics(parts.ring.n_sectors)
+    rings = cyclic_bases(parts.ring, [c for _, c in sizes], harmonics=harmonics)
+    reading = parts.bore * (1.0 + 1e-6)  # just inside the ring's bore
+    axial = parts.contacts.points[0]
+    return [(d, waves_of(parts.ring, r, axial, reading)) for d, r in zip(disks, rings, strict=True)]
 
 
 def _model(parts: WheelParts, disk, waves):
@@ -170,12 +174,15 @@ def _run(model, scene, limits, lean=0):
     return res, time.perf_counter() - t0
 
 
-def _reduction_check(scene, parts, small, model, limits, log):
+def _sizes(scene) -> tuple:
+    """The run's ``(disk, casing)`` modes per nodal diameter and the reference's."""
+    sizes = (scene["rotor"]["families"], scene["casing"]["ring"]["families"])
+    return sizes, tuple(a + b for a, b in zip(sizes, REFERENCE_EXTRA, strict=True))
+
+
+def _reduction_check(scene, parts, small, rich, model, limits, log):
     """The run and the estimate of its reduction error against the richer wheel."""
-    r = scene["rotor"]
-    sizes = (r["families"], scene["casing"]["ring"]["families"])
-    rich_sizes = tuple(a + b for a, b in zip(sizes, REFERENCE_EXTRA, strict=True))
-    rich = _bases(parts, *rich_sizes)
+    sizes, rich_sizes = _sizes(scene)
     rich_model, _ = _model(parts, *rich)
     T = _state_transfer(parts, small, rich)
     if log:
@@ -205,13 +212,13 @@ def build_wheel(scene, log=None):
     parts = wheel_parts(scene, log)
     timings["assembly"] = time.perf_counter() - t0
     t1 = time.perf_counter()
-    small = _bases(parts, scene["rotor"]["families"], scene["casing"]["ring"]["families"])
+    small, rich = _bases(parts, _sizes(scene))
     model, _ = _model(parts, *small)
     timings["reduction"] = time.perf_counter() - t1
     limits = {}
     report = _report(scene, parts, model)
     t2 = time.perf_counter()
-    err, run, wall = _reduction_check(scene, parts, small, model, limits, log)
+    err, run, wall = _reduction_check(scene, parts, small, rich, model, limits, log)
     report["reduction"] = {"method": "cyclic", "error": err}
     states = run.states
     step, _, _ = check_step(

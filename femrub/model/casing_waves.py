@@ -37,10 +37,12 @@ from ..reduction.cyclic_ritz import CyclicBasis
 
 __all__ = [
     "CasingWaves",
+    "casing_harmonics",
     "casing_waves",
     "cylindrical_components",
     "ring_amplitudes",
     "rotating_blocks",
+    "waves_of",
 ]
 
 #: Gauss points over the sector's angle for the Fourier amplitude of a mode.
@@ -143,20 +145,29 @@ class CasingWaves:
         return out
 
 
-def casing_waves(structure, n_modes: int, axial: np.ndarray, radius: float) -> CasingWaves:
-    """The ring's ``n_modes`` lowest modes of every ``k`` from 0 to ``⌈N/2⌉ − 1`` as waves
-    read at the axial positions ``axial`` (m) and the bore ``radius`` (m).
+def casing_harmonics(n_sectors: int) -> list[int]:
+    """The nodal diameters a ring of ``n_sectors`` carries as waves: 0 to ``⌈N/2⌉ − 1``.
 
     ``k = N/2`` is left out: on an even ``N`` the sector holds only its standing wave in
     phase with the sectors, which does not turn into a wave of the rotating frame.
     """
-    from ..reduction.cyclic_ritz import harmonic_basis
+    return [k for k in range(n_sectors // 2 + 1) if 2 * k != n_sectors]
 
-    N = structure.n_sectors
-    ks = [k for k in range(N // 2 + 1) if 2 * k != N]
-    bases = tuple(harmonic_basis(structure, k, n_modes) for k in ks)
-    amplitudes = tuple(ring_amplitudes(structure, b, axial, radius) for b in bases)
-    return CasingWaves(CyclicBasis(N, bases), amplitudes)
+
+def waves_of(structure, basis: CyclicBasis, axial: np.ndarray, radius: float) -> CasingWaves:
+    """The ring's harmonic ``basis`` (of :func:`casing_harmonics`) as waves read at the axial
+    positions ``axial`` (m) and the bore ``radius`` (m)."""
+    amplitudes = tuple(ring_amplitudes(structure, b, axial, radius) for b in basis.harmonics)
+    return CasingWaves(basis, amplitudes)
+
+
+def casing_waves(structure, n_modes: int, axial: np.ndarray, radius: float) -> CasingWaves:
+    """The ring's ``n_modes`` lowest modes of every nodal diameter of
+    :func:`casing_harmonics` as waves (:func:`waves_of`)."""
+    from ..reduction.cyclic_ritz import cyclic_basis
+
+    harmonics = casing_harmonics(structure.n_sectors)
+    return waves_of(structure, cyclic_basis(structure, n_modes, harmonics=harmonics), axial, radius)
 
 
 def rotating_blocks(waves: CasingWaves, omega_rotor: float, direction: float, damping: float):

@@ -37,7 +37,13 @@ import scipy.sparse as sp
 from ..fem.eigen import hermitian_solver, lowest_hermitian_modes
 from ..model.cyclic import CyclicStructure, cyclic_projection
 
-__all__ = ["CyclicBasis", "HarmonicBasis", "cyclic_basis", "harmonic_basis"]
+__all__ = [
+    "CyclicBasis",
+    "HarmonicBasis",
+    "cyclic_bases",
+    "cyclic_basis",
+    "harmonic_basis",
+]
 
 #: Residual shapes whose mass-norm share is below this (relative) are dropped as dependent.
 DEPENDENT_BELOW = 1e-10
@@ -69,13 +75,56 @@ def _hermitian(A):
     return 0.5 * (A + A.conj().T)
 
 
-def _residual_shapes(Kk, Mk, solve, Q, lam, loads):
-    """Residual attachment shapes ``K⁻¹F − Q Λ⁻¹ Qᴴ F``, ``M``-orthonormal and ``M``-orthogonal
-    to ``Q`` (dependent ones dropped)."""
-    X = np.column_stack([solve(loads[:, j]) for j in range(loads.shape[1])])
-    X -= Q @ ((Q.conj().T @ loads) / lam[:, None])
+def _residual_shapes(Mk, Q, lam, static, loads):
+    """Residual attachment shapes ``K⁻¹F − Q Λ⁻¹ Qᴴ F`` (``static`` = ``K⁻¹F``),
+    ``M``-orthonormal and ``M``-orthogonal to ``Q`` (dependent ones dropped)."""
+    X = static - Q @ ((Q.conj().T @ loads) / lam[:, None])
     X -= Q @ (Q.conj().T @ (Mk @ X))
     return _orthonormal(X, Mk)
+
+
+@dataclass(frozen=True)
+class _Harmonic:
+    """What the Ritz bases of one nodal diameter share: the projected matrices, the most
+    modes asked for and the static responses to the loads."""
+
+    k: int
+    real: bool
+    T: object
+    Kk: object
+    Mk: object
+    lam: np.ndarray
+    Q: np.ndarray
+    loads: np.ndarray | None
+    static: np.ndarray | None
+
+
+def _harmonic(structure: CyclicStructure, k: int, n_modes: int, load_rows) -> _Harmonic:
+    T = cyclic_projection(structure, k)
+    Th = T.conj().T
+    Kk = _hermitian((Th @ structure.K @ T).tocsr())
+    Mk = _hermitian((Th @ structure.M @ T).tocsr())
+    solve = hermitian_solver(Kk)
+    lam, Q = lowest_hermitian_modes(Kk, Mk, min(n_modes, Kk.shape[0]), solve=solve)
+    loads = static = None
+    if load_rows is not None and load_rows.shape[0]:
+        loads = np.asarray((Th @ sp.csr_matrix(load_rows).T).toarray(), dtype=complex)
+        static = np.column_stack([solve(loads[:, j]) for j in range(loads.shape[1])])
+    real = _is_real_harmonic(k, structure.n_sectors)
+    return _Harmonic(int(k), real, T, Kk, Mk, lam, Q, loads, static)
+
+
+def _ritz(h: _Harmonic, n_modes: int) -> HarmonicBasis:
+    """The Ritz basis of ``h`` with its ``n_modes`` lowest modes (and the residual shapes)."""
+    lam, Q = h.lam[:n_modes], h.Q[:, :n_modes]
+    basis = Q
+    if h.loads is not None:
+        basis = np.column_stack([Q, _residual_shapes(h.Mk, Q, lam, h.static, h.loads)])
+    if h.real:  # real shapes: a real span of the same size
+        basis = _real_span(basis, h.Mk)
+    w2, V = sla.eigh(_hermitian(basis.conj().T @ (h.Kk @ basis)))
+    omega = np.sqrt(np.clip(w2, 0.0, None))
+    return HarmonicBasis(h.k, omega, h.T @ (basis @ V), Q.shape[1])
 
 
 def _real_span(B, Mk):
@@ -120,22 +169,7 @@ def harmonic_basis(
         ``(r, n_free)`` real rows where loads act (e.g. contact patch means); their residual
         shapes join the basis.
     """
-    T = cyclic_projection(structure, k)
-    Th = T.conj().T
-    Kk = _hermitian((Th @ structure.K @ T).tocsr())
-    Mk = _hermitian((Th @ structure.M @ T).tocsr())
-    solve = hermitian_solver(Kk)
-    lam, Q = lowest_hermitian_modes(Kk, Mk, min(n_modes, Kk.shape[0]), solve=solve)
-    basis = Q
-    if load_rows is not None and load_rows.shape[0]:
-        loads = np.asarray((Th @ sp.csr_matrix(load_rows).T).toarray(), dtype=complex)
-        basis = np.column_stack([Q, _residual_shapes(Kk, Mk, solve, Q, lam, loads)])
-    if _is_real_harmonic(k, structure.n_sectors):  # real shapes: a real span of the same size
-        basis = _real_span(basis, Mk)
-    stiffness = _hermitian(basis.conj().T @ (Kk @ basis))
-    w2, V = sla.eigh(stiffness)
-    omega = np.sqrt(np.clip(w2, 0.0, None))
-    return HarmonicBasis(int(k), omega, T @ (basis @ V), Q.shape[1])
+    return _ritz(_harmonic(structure, k, n_modes, load_rows), n_modes)
 
 
 def _is_real_harmonic(k: int, n_sectors: int) -> bool:
@@ -232,11 +266,18 @@ class CyclicBasis:
         return out
 
 
+def cyclic_bases(structure: CyclicStructure, sizes, load_rows=None, harmonics=None) -> list:
+    """:class:`CyclicBasis` of every nodal diameter in ``harmonics`` (default all,
+    ``0 .. ⌊N/2⌋``) with each number of modes of ``sizes``, one factorisation and one
+    eigen-solve per nodal diameter for them all (the larger sizes' spans hold the smaller's)."""
+    ks = structure.nodal_diameters if harmonics is None else sorted(set(harmonics))
+    parts = [_harmonic(structure, int(k), max(sizes), load_rows) for k in ks]
+    return [CyclicBasis(structure.n_sectors, tuple(_ritz(h, n) for h in parts)) for n in sizes]
+
+
 def cyclic_basis(
     structure: CyclicStructure, n_modes: int, load_rows=None, harmonics=None
 ) -> CyclicBasis:
     """:func:`harmonic_basis` of every nodal diameter in ``harmonics`` (default all,
     ``0 .. ⌊N/2⌋``), as one :class:`CyclicBasis`."""
-    ks = structure.nodal_diameters if harmonics is None else sorted(set(harmonics))
-    bases = tuple(harmonic_basis(structure, int(k), n_modes, load_rows) for k in ks)
-    return CyclicBasis(structure.n_sectors, bases)
+    return cyclic_bases(structure, [n_modes], load_rows, harmonics)[0]
