@@ -155,7 +155,9 @@ def _rub(sector, flexible: bool, friction: float = 0.02):
         casing_damping=0.01,
         ramp=2 * revolution,
     )
-    model, _ = wheel_model(config, spinning_disk, disk, contacts, waves, tip_radius=tip_radius)
+    model, _ = wheel_model(
+        config, spinning_disk, disk, contacts, waves, tip_radius=tip_radius, blade_size=0.03
+    )
     steps = 3000  # per revolution: a blade passage is 500 steps
     return model, fr.ThetaMethod(model, h=revolution / steps).run(20 * revolution), contacts.n
 

@@ -37,6 +37,7 @@ from ..model.cyclic import cyclic_structure
 from ..model.wheel import WheelConfig, contact_rows_of_sector, tip_contacts, wheel_model
 from ..reduction.cyclic_ritz import CyclicBasis, cyclic_bases
 from ..reduction.estimate import HORIZON_SHARE, estimate, perturbed
+from ..scene.spec import fail
 from . import translate as tr
 from .modes import casing_sector, ring_material, rotor_sector
 from .scheme import bare_stepper, stepper_of
@@ -106,6 +107,7 @@ def wheel_parts(scene, log=None) -> WheelParts:
     bore = tip_radius + scene["casing"]["ring"]["clearance"]
     if scene["casing"]["ring"].get("thickness") is not None:
         ring = cyclic_structure(casing_sector(scene, tip_radius), ring_material(scene))
+    _check_start(scene, disk, contacts, tip_radius)
     return WheelParts(
         disk,
         contacts,
@@ -115,6 +117,24 @@ def wheel_parts(scene, log=None) -> WheelParts:
         tip_radius,
         _config(scene, sector),
     )
+
+
+def _check_start(scene, disk, contacts, tip_radius: float) -> None:
+    """Refuse a clearance the blades' centrifugal growth closes before the first step (the
+    out-of-roundness ramps in from zero, so only the round clearance counts at the start)."""
+    ring = scene["casing"]["ring"]
+    growth = contacts.normal_displacement(disk.static)
+    start = ring["clearance"] + tip_radius - contacts.radii - growth
+    if ring.get("ramp") == 0.0:
+        start = start - ring["distortion"]
+    if start.min() < 0.0:
+        need = ring["clearance"] - start.min()
+        fail(
+            "casing.ring.clearance",
+            ring["clearance"],
+            f"the blades start {-start.min():.3g} m inside the casing (their centrifugal "
+            f"growth at Ω is {growth.max():.3g} m); use casing.ring.clearance >= {need:.3g} m",
+        )
 
 
 def _bases(parts: WheelParts, sizes) -> list:
@@ -131,8 +151,15 @@ def _bases(parts: WheelParts, sizes) -> list:
 
 
 def _model(parts: WheelParts, disk, waves):
+    blade = parts.tip_radius - parts.disk.sector.info["rim_radius"]
     return wheel_model(
-        parts.config, parts.disk, disk, parts.contacts, waves, tip_radius=parts.tip_radius
+        parts.config,
+        parts.disk,
+        disk,
+        parts.contacts,
+        waves,
+        tip_radius=parts.tip_radius,
+        blade_size=blade,
     )
 
 

@@ -274,6 +274,7 @@ def wheel_model(
     casing: CasingWaves | None = None,
     *,
     tip_radius: float,
+    blade_size: float,
     mistuning=None,
 ) -> tuple[FirstOrderModel, WheelMap]:
     """The first-order model of the wheel against the casing (module docstring).
@@ -292,6 +293,9 @@ def wheel_model(
         The flexible casing; a rigid one when ``None``.
     tip_radius : float
         The blades' largest tip radius (m) at rest.
+    blade_size : float
+        The blade's size (m; the model's ``length_scale``, which scales its stop limit on
+        displacements).
     mistuning : numpy.ndarray, optional
         ``(n_disk, n_disk)`` stiffness added to the disk's coordinates
         (:func:`mistuning_stiffness`).
@@ -341,7 +345,7 @@ def wheel_model(
             rotation_speed=omega,
             rotation_direction=float(config.direction),
         ),
-        length_scale=float(tip_radius),
+        length_scale=float(blade_size),
         parameters=Parameters(rotation_speed=omega),
         sweep=CasingSweep(profile, angles, offsets, radii, omega, config.direction),
     )
