@@ -12,12 +12,12 @@ from __future__ import annotations
 import numpy as np
 import pytest
 from scipy.spatial import cKDTree
+from small_wheel import STEEL, TITANIUM, N, disk_sector
 
 from femrub.fem.discretisation import assemble, discretise
 from femrub.fem.eigen import lowest_modes
 from femrub.fem.material import Material
 from femrub.fem.prestress import centrifugal_prestress
-from femrub.geometry.bladed_disk import bladed_disk_sector
 from femrub.geometry.casing_ring import RingDistortion, casing_ring_sector
 from femrub.geometry.cyclic_sector import axis_rotation, face_pairs, full_wheel
 from femrub.model.cyclic import (
@@ -28,15 +28,10 @@ from femrub.model.cyclic import (
     nodal_diameter_content,
 )
 
-N = 6
-TITANIUM = Material(young=110e9, rho=4500.0, poisson=0.3)
-STEEL = Material(young=200e9, rho=7800.0, poisson=0.3)
-BLADE = dict(code="0012", span=0.03, root_chord=0.015, tip_chord=0.012, twist=20.0, n_sections=3)
-
 
 @pytest.fixture(scope="module")
 def disk():
-    return bladed_disk_sector(N, 0.02, 0.045, 0.015, BLADE, h=0.015, h_min=0.01)
+    return disk_sector()
 
 
 @pytest.fixture(scope="module")

@@ -18,12 +18,11 @@ import scipy.linalg as sla
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 from scipy.spatial import cKDTree
+from small_wheel import STEEL, TITANIUM, N, disk_sector
 
 import femrub as fr
 from femrub.fem.discretisation import assemble, discretise
 from femrub.fem.eigen import lowest_modes
-from femrub.fem.material import Material
-from femrub.geometry.bladed_disk import bladed_disk_sector
 from femrub.geometry.casing_ring import casing_ring_sector
 from femrub.geometry.cyclic_sector import axis_rotation, full_wheel
 from femrub.model.casing_waves import casing_waves, rotating_blocks
@@ -37,17 +36,13 @@ from femrub.model.wheel import (
 )
 from femrub.reduction.cyclic_ritz import cyclic_basis
 
-N = 6
-TITANIUM = Material(young=110e9, rho=4500.0, poisson=0.3)
-STEEL = Material(young=200e9, rho=7800.0, poisson=0.3)
-BLADE = dict(code="0012", span=0.03, root_chord=0.015, tip_chord=0.012, twist=20.0, n_sections=3)
 SPEED = 1000.0  # rad/s
 CLEARANCE = 2e-5  # m
 
 
 @pytest.fixture(scope="module")
 def sector():
-    return bladed_disk_sector(N, 0.02, 0.045, 0.015, BLADE, h=0.015, h_min=0.01)
+    return disk_sector()
 
 
 @pytest.fixture(scope="module")
