@@ -43,7 +43,8 @@ def simulate(reductor, sizes, make_stepper, t_end, checkpoints=5, limits=None, t
     itself can reach, not past a physical stop. ``twin``: the initial state perturbed
     (:func:`~femrub.reduction.estimate.perturbed`). ``lean = 1``: a run that is only
     compared, recorded with what :func:`~femrub.reduction.estimate.estimate` reads
-    (``RunOptions.lean``).
+    (``RunOptions.lean`` and ``compared``: no balance, Coulomb check, gaps or slip rows;
+    stopped by the stop limits as the run is).
     """
     what = "twin" if twin else "run"
     with phase(f"reduction error estimate: {what} of sizes {list(sizes)} to {t_end:g} s") as p:
@@ -65,7 +66,7 @@ def simulate(reductor, sizes, make_stepper, t_end, checkpoints=5, limits=None, t
 def _simulate(m, reductor, sizes, make_stepper, t_end, checkpoints, limits, lean):
     st = make_stepper(m)
     every = max(1, st.steps_to(t_end) // checkpoints)
-    res = st.run(t_end, store_every=every, limits=limits, lean=lean)
+    res = st.run(t_end, store_every=every, limits=limits, lean=lean, compared=lean > 0)
     return res, reductor.reconstruct(res.states, *sizes)
 
 
@@ -110,7 +111,8 @@ def checked_sizes(red, model, want, make_stepper, scene, report, log, limits, on
     # a run that carries a history outside X (wear, casing heat) is stepped again as the
     # scene's run (whose stepper keeps the history the results folder writes): every run
     # here recorded lean (only what estimate() reads, so that the runs it holds together
-    # stay small); otherwise those that are never the run
+    # stay small, and none of the checks of a run's own verdict); otherwise those that are
+    # never the run
     whole = model.contact is None or not model.contact.carried_state
     cands = [want] if want is not None else ladder(most)
     lean = int(not whole or (want is not None and want != most))  # the reference

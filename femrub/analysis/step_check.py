@@ -6,8 +6,9 @@ difference with a richer run, here the run's own model at half the step, from th
 initial state to the same end time and stop limits. The fine run is recorded coarsened to
 the run's steps (``RunOptions.lean = 2``, the rows :func:`coarsen` would keep: its impulses
 summed over each pair of steps, its signals at the run's times; fields at the same
-checkpoints; its per-step gaps, friction rows and energy balance never stored, its verdict
-measured on them as they pass: :mod:`femrub.output.kept_rows`) and both are compared with
+checkpoints: :mod:`femrub.output.kept_rows`) as a run only compared
+(``RunOptions.compared``: its gaps, friction rows, energy balance and Coulomb check never
+evaluated; its status, ``status_reference``, says how it ended) and both are compared with
 the estimate's measures
 (contact impulse per lobe passage, contact temperature history, displacement and
 temperature fields; a round-off twin of the fine run splits a sensitive response into a
@@ -83,7 +84,7 @@ def full_states(model, full):
 def _simulate(stepper, t_end, every, limits, fields, lean=0):
     """Run ``stepper`` to ``t_end``, full states stored every ``every`` steps (``lean``:
     :class:`~femrub.analysis.options.RunOptions`')."""
-    res = stepper.run(t_end, store_every=every, limits=limits, lean=lean)
+    res = stepper.run(t_end, store_every=every, limits=limits, lean=lean, compared=lean > 0)
     return res, fields(res.states)
 
 
