@@ -220,6 +220,21 @@ def test_a_compared_run_evaluates_no_balance_coulomb_check_or_gap_rows(blade, mo
     assert "gap" in rows
 
 
+def count_meters(monkeypatch) -> list:
+    """The sizes of the models whose runs meter their energy balance, as they start."""
+    from femrub.output import recorder
+
+    metered = []
+
+    class Meter(recorder.EnergyMeter):
+        def __init__(self, model, capacity):
+            metered.append(model.n_dofs)
+            super().__init__(model, capacity)
+
+    monkeypatch.setattr(recorder, "EnergyMeter", Meter)
+    return metered
+
+
 def _recorded_whole(monkeypatch, module):
     """``module._simulate`` recording every row and coarsening afterwards, as before lean
     records (the step check: ``coarsen(res, 2)``; the estimate: ``res.lean()``)."""
@@ -245,17 +260,9 @@ def test_the_step_check_and_the_estimate_are_those_of_whole_records(blade, monke
     from femrub.analysis import step_check as sc
     from femrub.app import build
     from femrub.app.scheme import bare_stepper
-    from femrub.output import recorder
     from femrub.scene import load_scene
 
-    metered = []
-
-    class Meter(recorder.EnergyMeter):
-        def __init__(self, model, capacity):
-            metered.append(model.n_dofs)
-            super().__init__(model, capacity)
-
-    monkeypatch.setattr(recorder, "EnergyMeter", Meter)
+    metered = count_meters(monkeypatch)
 
     # a step tolerance low enough that the round-off twin is stepped too
     changes = {**SCENE, "scheme.step_check": True, "scheme.step_tolerance": 1e-6}

@@ -93,7 +93,9 @@ def _largest(err, tried) -> dict:
     )
 
 
-def checked_sizes(red, model, want, make_stepper, scene, report, log, limits, on_run=None):
+def checked_sizes(
+    red, model, want, make_stepper, scene, report, log, limits, on_run=None, reuse_run=True
+):
     """Sizes to run and their a-posteriori estimate (``report["error"]``).
 
     ``want``: the sizes asked for (``None`` for ``"auto"``: the smallest of
@@ -102,18 +104,19 @@ def checked_sizes(red, model, want, make_stepper, scene, report, log, limits, on
     difference to the next smaller one. ``on_run(results, seconds, full states)`` receives
     the estimate's run of the chosen sizes (the run itself: same model, stepper and initial
     state, stepped to ``t_end`` with ``limits``; its states at the estimate's checkpoints,
-    reconstructed).
+    reconstructed). ``reuse_run = False``: the caller steps the scene's run again (e.g. to
+    write VTK frames as it steps), so every run here is only compared (recorded lean).
     """
     t0 = time.perf_counter()
     tol, t_end = scene["reduction"]["tolerance"], scene["scheme"]["t_end"]
     window = lobe_passage(scene)
     most = (red.n_uv, red.n_theta)
     # a run that carries a history outside X (wear, casing heat) is stepped again as the
-    # scene's run (whose stepper keeps the history the results folder writes): every run
-    # here recorded lean (only what estimate() reads, so that the runs it holds together
-    # stay small, and none of the checks of a run's own verdict); otherwise those that are
-    # never the run
-    whole = model.contact is None or not model.contact.carried_state
+    # scene's run (whose stepper keeps the history the results folder writes), as is one
+    # the caller does not reuse: every run here recorded lean (only what estimate() reads,
+    # so that the runs it holds together stay small, and none of the checks of a run's own
+    # verdict); otherwise those that are never the run
+    whole = reuse_run and (model.contact is None or not model.contact.carried_state)
     cands = [want] if want is not None else ladder(most)
     lean = int(not whole or (want is not None and want != most))  # the reference
     *ref, ref_wall = _timed(red, most, make_stepper, t_end, limits=limits, lean=lean)
@@ -151,6 +154,7 @@ def reduce_checked(
     limits=None,
     on_run=None,
     stiffness=None,
+    reuse_run=True,
 ):
     """Reduce ``model`` as ``scene["reduction"]`` asks; return ``(model, reductor, report)``.
 
@@ -164,13 +168,14 @@ def reduce_checked(
     model's sizes (its :class:`~femrub.output.results.Results`, judged without the reduction
     rule, and its wall time), which is the scene's run: the caller need not step it again
     (lean, and to be stepped again, when the contact carries state outside ``X``:
-    :attr:`~femrub.contact.gap.Contact.carried_state`).
+    :attr:`~femrub.contact.gap.Contact.carried_state`, or when ``reuse_run`` is false: the
+    caller steps the run again).
     """
     if make_stepper is None or scene["reduction"]["method"] == "none":
         return reduce_model(model, scene, log, reductor, stiffness)
     prepared = prepare(model, scene, log, reductor, stiffness, reference=True)
     red, report = prepared.reductor, prepared.report
     sizes = checked_sizes(
-        red, model, prepared.want, make_stepper, scene, report, log, limits, on_run
+        red, model, prepared.want, make_stepper, scene, report, log, limits, on_run, reuse_run
     )
     return finish(prepared, sizes), red, report

@@ -88,7 +88,7 @@ def _simulate(stepper, t_end, every, limits, fields, lean=0):
     return res, fields(res.states)
 
 
-def check_step(scene, model, full, make_stepper, limits, run=None):
+def check_step(scene, model, full, make_stepper, limits, run=None, reuse_run=True):
     """The run's time-step error estimate (``summary.json["time_step_error"]``).
 
     Parameters
@@ -100,6 +100,8 @@ def check_step(scene, model, full, make_stepper, limits, run=None):
     limits : the run's stop limits.
     run : ``(results, full states at checkpoints)`` of the run at ``h`` when already stepped
         (the reduction error estimate's run of these sizes), else ``None``: stepped here.
+    reuse_run : whether the caller may keep the run at ``h`` stepped here as the scene's run
+        (``False``: it is only compared, recorded lean).
 
     Returns
     -------
@@ -120,7 +122,8 @@ def check_step(scene, model, full, make_stepper, limits, run=None):
     if run is None:
         with phase(f"time-step check: run at h = {h:g} s"):
             w0 = time.perf_counter()
-            run = _simulate(make_stepper(model, h), t_end, every, limits, fields)  # may be the run
+            lean = 0 if reuse_run else 1  # whole when it may be the run
+            run = _simulate(make_stepper(model, h), t_end, every, limits, fields, lean)
             wall = time.perf_counter() - w0
     with phase(f"time-step check: run at h/2 = {fine_h:g} s") as p:
         fine = _simulate(st, t_end, 2 * every, limits, fields, lean=2)  # = coarsen(res, 2)
