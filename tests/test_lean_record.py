@@ -139,6 +139,102 @@ def test_a_lean_record_does_not_allocate_the_rows_it_drops():
     assert full_peak > 5 * lean_peak
 
 
+@pytest.mark.parametrize("chunk", [512, 7])
+@pytest.mark.parametrize("k", [1, 2])
+def test_a_compared_run_keeps_the_signals_of_its_whole_record(blade, monkeypatch, k, chunk):
+    """A run only compared (``compared=True``) keeps, bit for bit, what its whole record
+    coarsened keeps (times, signals, impulses, checkpoint states, status), and no checks."""
+    monkeypatch.setattr("femrub.output.recorder.CHUNK_STEPS", chunk)
+    h = blade[1]["h"] / 2
+    full = _blade_run(blade, h, store_every=2 * 50)
+    compared = _blade_run(blade, h, store_every=2 * 50, lean=k, compared=True)
+    assert full.status == "ok" and int((full.contact_state == 2).sum()) > 50  # slides
+    _same_as_coarsened(compared, full, k)
+    assert compared.checks == {} and np.isnan(compared.energy_error())
+
+
+def test_a_compared_run_stops_where_its_whole_record_stops():
+    """The stop checks stay: a stop limit ends a compared run at the same row, for the
+    θ-method and the exponential stepper (whose works of each step are not measured)."""
+    model = fr.bar_model(alpha=3.0)
+    limits = {"tip_temperature": 0.5}
+    for st in (lambda: fr.ThetaMethod(model, 1e-4), lambda: fr.ExponentialMoreau(model, 2e-4)):
+        full = st().run(0.1, limits=limits, store_every=30)
+        compared = st().run(0.1, limits=limits, store_every=30, lean=2, compared=True)
+        assert full.status == "diverged-physically" and 10 < full.steps < 499
+        _same_as_coarsened(compared, full, 2)
+    with pytest.raises(ValueError, match="compared = True needs lean >= 1"):
+        fr.ThetaMethod(model, 1e-4).run(0.1, compared=True)
+
+
+class _UnreadableForms:
+    """Energy forms that fail when read: a recorder that meters the balance fails."""
+
+    def _read(self):
+        raise AssertionError("an energy form was read")
+
+    Qk = Qe = Pth = Pd = heat_content = heat_outflow = Wth = property(_read)
+
+
+def test_a_compared_run_evaluates_no_balance_coulomb_check_or_gap_rows(blade, monkeypatch):
+    """No energy form is read, no Coulomb check made, no gaps or slip velocities of the
+    recorded rows computed; the same run judged (lean, not compared) reads the forms."""
+    model, scheme, opts = blade
+    unreadable = model.with_(energy=_UnreadableForms())
+
+    from femrub.output import kept_rows
+
+    rows = []  # Coulomb checks, and the contact's rows evaluated on blocks of recorded states
+
+    def check(*args, _original=kept_rows.coulomb_check_rows):
+        rows.append("coulomb")
+        return _original(*args)
+
+    monkeypatch.setattr(kept_rows, "coulomb_check_rows", check)
+    cls = type(model.contact)
+
+    def spy(name):
+        original = getattr(cls, name)
+
+        def rows_of(self, *args):
+            if np.ndim(args[-1]) == 2 and len(args[-1]) > 1:
+                rows.append(name)
+            return original(self, *args)
+
+        return rows_of
+
+    for name in ("gap", "slip_velocity"):
+        monkeypatch.setattr(cls, name, spy(name))
+
+    def run(**kw):
+        st = make_stepper(scheme["name"], unreadable, scheme["h"], **opts)
+        return st.run(scheme["t_end"], store_every=50, **kw)
+
+    res = run(lean=1, compared=True)
+    assert res.status == "ok" and res.steps > 100 and not rows
+    with pytest.raises(AssertionError, match="energy form"):
+        run(lean=1)
+    assert run(lean=1, energy=False).status == "ok"  # not metered, still judged
+    assert {"coulomb", "slip_velocity"} <= set(rows) and "gap" not in rows
+    run(energy=False)  # a whole record keeps the gaps
+    assert "gap" in rows
+
+
+def count_meters(monkeypatch) -> list:
+    """The sizes of the models whose runs meter their energy balance, as they start."""
+    from femrub.output import recorder
+
+    metered = []
+
+    class Meter(recorder.EnergyMeter):
+        def __init__(self, model, capacity):
+            metered.append(model.n_dofs)
+            super().__init__(model, capacity)
+
+    monkeypatch.setattr(recorder, "EnergyMeter", Meter)
+    return metered
+
+
 def _recorded_whole(monkeypatch, module):
     """``module._simulate`` recording every row and coarsening afterwards, as before lean
     records (the step check: ``coarsen(res, 2)``; the estimate: ``res.lean()``)."""
@@ -157,13 +253,16 @@ def _recorded_whole(monkeypatch, module):
 
 def test_the_step_check_and_the_estimate_are_those_of_whole_records(blade, monkeypatch):
     """The time-step error (fine run and twin recorded lean at k = 2) and the reduction
-    estimate (its runs recorded lean) equal, bit for bit, what whole records coarsened
-    afterwards gave, with the same statuses."""
+    estimate (its runs recorded lean), all runs only compared, equal, bit for bit, what
+    whole records coarsened afterwards gave, with the same statuses; of these runs only the
+    step check's run at h, which may be the scene's run, meters its energy balance."""
     from femrub.analysis import reduction_check as est
     from femrub.analysis import step_check as sc
     from femrub.app import build
     from femrub.app.scheme import bare_stepper
     from femrub.scene import load_scene
+
+    metered = count_meters(monkeypatch)
 
     # a step tolerance low enough that the round-off twin is stepped too
     changes = {**SCENE, "scheme.step_check": True, "scheme.step_tolerance": 1e-6}
@@ -187,13 +286,16 @@ def test_the_step_check_and_the_estimate_are_those_of_whole_records(blade, monke
 
     lean = check()
     assert "sensitivity" in lean and lean["status_reference"] == "ok"
+    assert len(metered) == 1  # the run at h; not the run at h/2 nor its twin
     with monkeypatch.context() as mp:
         _recorded_whole(mp, sc)
         assert check() == lean
     with monkeypatch.context() as mp:
         _recorded_whole(mp, est)
         whole = estimate()
+    metered.clear()
     assert estimate() == whole and whole["status_reference"] == "ok"
+    assert not metered  # the coating: the scene's run is stepped again, all these compared
 
 
 @pytest.mark.parametrize("lean", [0, 1])

@@ -236,3 +236,24 @@ def test_a_coated_reduced_run_is_estimated_on_lean_runs_and_stepped_again():
     err = sim.report["time_step"]
     assert err["status_reference"] == "ok" and np.isfinite(err["estimate"])
     assert any("time-step check: run at h/2" in line for line in kept)
+
+
+def test_a_run_that_writes_frames_is_stepped_again_and_its_checks_only_compared(monkeypatch):
+    """With VTK frames the scene's run is stepped again (its frames written as it steps): the
+    reduction estimate's and the time-step check's runs are then all only compared (no
+    energy meter), with the estimates of a build whose run is reused (two builds: the same
+    to round-off; bit for bit on one model: tests/test_lean_record.py)."""
+    from test_lean_record import count_meters
+
+    metered = count_meters(monkeypatch)
+    scene = load_scene("twisted-naca", {**SMALL, "scheme.step_check": True})
+    reused = build(scene)
+    assert reused.ran is not None and len(metered) == 1  # the run; its checks' runs compared
+    metered.clear()
+    framed = build(scene.with_changes({"outputs.vtk_stride": 5}))
+    assert framed.fields is not None and framed.ran is None and not metered
+    for key in ("reduction", "time_step"):
+        a = reused.report[key].get("error", reused.report[key])
+        b = framed.report[key].get("error", framed.report[key])
+        assert a["status_reference"] == b["status_reference"] == "ok"
+        assert b["estimate"] == pytest.approx(a["estimate"], rel=1e-6)

@@ -36,6 +36,13 @@ class RunOptions:
         step with the impulses summed over each ``k`` steps (``h`` of the results ``k h``);
         the verdict reads its measures of the rest taken as the steps were recorded
         (:mod:`femrub.output.kept_rows`, ``Results.checks``).
+    compared : a lean run held only to be compared with another (needs ``lean >= 1``): the
+        recorder evaluates neither the energy and heat balance (nor the stepper's own works
+        of each step) nor the Coulomb check, nor the gaps and slip velocities; the stop
+        checks that end a run (non-finite state, stop limits) stay, so the rows kept are the
+        same. Its status says how it ended: the balance and Coulomb rules are not applied
+        (``Results.checks`` is empty) and, without the balance, a numerical blow-up ends it
+        at its first non-finite state or stop limit rather than at the energy it created.
     """
 
     progress: bool = False
@@ -49,6 +56,14 @@ class RunOptions:
     tolerances: Mapping | None = None
     merge_time: float | None = None
     lean: int = 0
+    compared: bool = False
+
+    def __post_init__(self):
+        if self.compared and self.lean < 1:
+            raise ValueError(
+                f"RunOptions.compared = True needs lean >= 1 (a run only compared is a lean "
+                f"record); got lean = {self.lean!r}: pass lean=1 too"
+            )
 
     @classmethod
     def of(cls, options: RunOptions | None = None, **changes) -> RunOptions:

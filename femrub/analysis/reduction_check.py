@@ -47,7 +47,8 @@ def simulate(reductor, sizes, make_stepper, t_end, checkpoints=5, limits=None, t
     itself can reach, not past a physical stop. ``twin``: the initial state perturbed
     (:func:`~femrub.reduction.estimate.perturbed`). ``lean = 1``: a run that is only
     compared, recorded with what :func:`~femrub.reduction.estimate.estimate` reads
-    (``RunOptions.lean``).
+    (``RunOptions.lean`` and ``compared``: no balance, Coulomb check, gaps or slip rows;
+    stopped by the stop limits as the run is).
     """
     what = "twin" if twin else "run"
     with phase(f"reduction error estimate: {what} of sizes {list(sizes)} to {t_end:g} s") as p:
@@ -69,7 +70,7 @@ def simulate(reductor, sizes, make_stepper, t_end, checkpoints=5, limits=None, t
 def _simulate(m, reductor, sizes, make_stepper, t_end, checkpoints, limits, lean):
     st = make_stepper(m)
     every = max(1, st.steps_to(t_end) // checkpoints)
-    res = st.run(t_end, store_every=every, limits=limits, lean=lean)
+    res = st.run(t_end, store_every=every, limits=limits, lean=lean, compared=lean > 0)
     return res, reductor.reconstruct(res.states, *sizes)
 
 
@@ -96,7 +97,9 @@ def _largest(err, tried) -> dict:
     )
 
 
-def checked_sizes(red, model, want, make_stepper, scene, report, log, limits, on_run=None):
+def checked_sizes(
+    red, model, want, make_stepper, scene, report, log, limits, on_run=None, reuse_run=True
+):
     """Sizes to run and their a-posteriori estimate (``report["error"]``).
 
     ``want``: the sizes asked for (``None`` for ``"auto"``: the smallest of
@@ -105,17 +108,19 @@ def checked_sizes(red, model, want, make_stepper, scene, report, log, limits, on
     difference to the next smaller one. ``on_run(results, seconds, full states)`` receives
     the estimate's run of the chosen sizes (the run itself: same model, stepper and initial
     state, stepped to ``t_end`` with ``limits``; its states at the estimate's checkpoints,
-    reconstructed).
+    reconstructed). ``reuse_run = False``: the caller steps the scene's run again (e.g. to
+    write VTK frames as it steps), so every run here is only compared (recorded lean).
     """
     t0 = time.perf_counter()
     tol, t_end = scene["reduction"]["tolerance"], scene["scheme"]["t_end"]
     window = lobe_passage(scene)
     most = (red.n_uv, red.n_theta)
     # a run that carries a history outside X (wear, casing heat) is stepped again as the
-    # scene's run (whose stepper keeps the history the results folder writes): every run
-    # here recorded lean (only what estimate() reads, so that the runs it holds together
-    # stay small); otherwise those that are never the run
-    whole = model.contact is None or not model.contact.carried_state
+    # scene's run (whose stepper keeps the history the results folder writes), as is one
+    # the caller does not reuse: every run here recorded lean (only what estimate() reads,
+    # so that the runs it holds together stay small, and none of the checks of a run's own
+    # verdict); otherwise those that are never the run
+    whole = reuse_run and (model.contact is None or not model.contact.carried_state)
     cands = [want] if want is not None else ladder(most)
     lean = int(not whole or (want is not None and want != most))  # the reference
     *ref, ref_wall = _timed(red, most, make_stepper, t_end, limits=limits, lean=lean)
@@ -153,6 +158,7 @@ def reduce_checked(
     limits=None,
     on_run=None,
     stiffness=None,
+    reuse_run=True,
 ):
     """Reduce ``model`` as ``scene["reduction"]`` asks; return ``(model, reductor, report)``.
 
@@ -166,13 +172,14 @@ def reduce_checked(
     model's sizes (its :class:`~femrub.output.results.Results`, judged without the reduction
     rule, and its wall time), which is the scene's run: the caller need not step it again
     (lean, and to be stepped again, when the contact carries state outside ``X``:
-    :attr:`~femrub.contact.gap.Contact.carried_state`).
+    :attr:`~femrub.contact.gap.Contact.carried_state`, or when ``reuse_run`` is false: the
+    caller steps the run again).
     """
     if make_stepper is None or scene["reduction"]["method"] == "none":
         return reduce_model(model, scene, log, reductor, stiffness)
     prepared = prepare(model, scene, log, reductor, stiffness, reference=True)
     red, report = prepared.reductor, prepared.report
     sizes = checked_sizes(
-        red, model, prepared.want, make_stepper, scene, report, log, limits, on_run
+        red, model, prepared.want, make_stepper, scene, report, log, limits, on_run, reuse_run
     )
     return finish(prepared, sizes), red, report

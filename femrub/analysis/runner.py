@@ -41,7 +41,7 @@ def run(stepper, t_end: float, options: RunOptions | None = None) -> Results:
     :class:`~femrub.output.results.Results` (see the module docstring)."""
     o = options or RunOptions()
     t0 = stepper.t
-    stepper.measure_works(o.energy)
+    stepper.measure_works(o.energy and not o.compared)
     try:
         recorder = Recorder(
             stepper.model,
@@ -57,6 +57,7 @@ def run(stepper, t_end: float, options: RunOptions | None = None) -> Results:
             label=o.label,
             blowup_check=stepper.blowup_check,
             lean=o.lean,
+            compared=o.compared,
         )
         res = recorder.record(
             stepper.state, stepper.advance, progress=o.progress, block=stepper.block_writer()

@@ -6,8 +6,9 @@ difference with a richer run, here the run's own model at half the step, from th
 initial state to the same end time and stop limits. The fine run is recorded coarsened to
 the run's steps (``RunOptions.lean = 2``, the rows :func:`coarsen` would keep: its impulses
 summed over each pair of steps, its signals at the run's times; fields at the same
-checkpoints; its per-step gaps, friction rows and energy balance never stored, its verdict
-measured on them as they pass: :mod:`femrub.output.kept_rows`) and both are compared with
+checkpoints: :mod:`femrub.output.kept_rows`) as a run only compared
+(``RunOptions.compared``: its gaps, friction rows, energy balance and Coulomb check never
+evaluated; its status, ``status_reference``, says how it ended) and both are compared with
 the estimate's measures
 (contact impulse per lobe passage, contact temperature history, displacement and
 temperature fields; a round-off twin of the fine run splits a sensitive response into a
@@ -83,11 +84,11 @@ def full_states(model, full):
 def _simulate(stepper, t_end, every, limits, fields, lean=0):
     """Run ``stepper`` to ``t_end``, full states stored every ``every`` steps (``lean``:
     :class:`~femrub.analysis.options.RunOptions`')."""
-    res = stepper.run(t_end, store_every=every, limits=limits, lean=lean)
+    res = stepper.run(t_end, store_every=every, limits=limits, lean=lean, compared=lean > 0)
     return res, fields(res.states)
 
 
-def check_step(scene, model, full, make_stepper, limits, run=None):
+def check_step(scene, model, full, make_stepper, limits, run=None, reuse_run=True):
     """The run's time-step error estimate (``summary.json["time_step_error"]``).
 
     Parameters
@@ -99,6 +100,8 @@ def check_step(scene, model, full, make_stepper, limits, run=None):
     limits : the run's stop limits.
     run : ``(results, full states at checkpoints)`` of the run at ``h`` when already stepped
         (the reduction error estimate's run of these sizes), else ``None``: stepped here.
+    reuse_run : whether the caller may keep the run at ``h`` stepped here as the scene's run
+        (``False``: it is only compared, recorded lean).
 
     Returns
     -------
@@ -119,7 +122,8 @@ def check_step(scene, model, full, make_stepper, limits, run=None):
     if run is None:
         with phase(f"time-step check: run at h = {h:g} s"):
             w0 = time.perf_counter()
-            run = _simulate(make_stepper(model, h), t_end, every, limits, fields)  # may be the run
+            lean = 0 if reuse_run else 1  # whole when it may be the run
+            run = _simulate(make_stepper(model, h), t_end, every, limits, fields, lean)
             wall = time.perf_counter() - w0
     with phase(f"time-step check: run at h/2 = {fine_h:g} s") as p:
         fine = _simulate(st, t_end, 2 * every, limits, fields, lean=2)  # = coarsen(res, 2)

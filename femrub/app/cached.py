@@ -262,18 +262,20 @@ class Stages:
         self.kept.model_key = (parts, key)
         return key
 
-    def reduce(self, model, scene, log=None, make_stepper=None, limits=None, on_run=None):
+    def reduce(
+        self, model, scene, log=None, make_stepper=None, limits=None, on_run=None, reuse_run=True
+    ):
         """:func:`~femrub.analysis.reduction_check.reduce_checked`: ``(reduced, reductor,
         report)``.
 
         ``make_stepper`` (for the reduction error estimate, which steps the run itself)
         puts the scene's ``scheme``, ``loads`` and ``contact`` and the stop ``limits`` it
-        applies to its runs into the key. ``on_run``: see ``reduce_checked`` (not called on a
-        cache hit: nothing is stepped). Builds in a row reuse the kept reductor of the same
-        matrices, with or without a cache.
+        applies to its runs into the key. ``on_run``, ``reuse_run``: see ``reduce_checked``
+        (``on_run`` is not called on a cache hit: nothing is stepped). Builds in a row reuse
+        the kept reductor of the same matrices, with or without a cache.
         """
         stiffness, self._stiffness = self._stiffness, None
-        kw = {"limits": limits, "on_run": on_run, "stiffness": stiffness}
+        kw = {"limits": limits, "on_run": on_run, "stiffness": stiffness, "reuse_run": reuse_run}
         opts = dict(scene["reduction"])
         stored = self.cache is not None and self._mats_key is not None
         if opts["method"] == "none" or not (stored or self.in_a_row):

@@ -17,7 +17,9 @@ blade's size), so a runaway is reported as ``diverged-physically``, never as ``o
 the seconds spent meshing, assembling and reducing. The reduction error estimate steps the
 reduced model of the chosen sizes to ``scheme.t_end`` with the scene's stepper: those results
 are the run's (``ran``), and :func:`femrub.app.run.run_scene` writes them instead of stepping
-the model a second time. The paper's bar and a 3D blade go through the same path.
+the model a second time (unless the run writes VTK frames: then, as when the contact carries
+a history outside ``X``, the run is stepped again and the checks' runs are only
+compared). The paper's bar and a 3D blade go through the same path.
 """
 
 from __future__ import annotations
@@ -127,7 +129,8 @@ class Simulation:
     report: dict = field(default_factory=dict)
     timings: dict = field(default_factory=dict)
     #: ``(results, wall seconds)`` of the scene's run of ``model`` to ``scheme.t_end``, stepped
-    #: by the reduction error estimate (:func:`reusable_run`), else ``None``
+    #: by the reduction error estimate or the time-step check (:func:`reused_run`: not with
+    #: VTK frames, which the run writes as it steps), else ``None``
     ran: tuple | None = None
     #: the probes' observation rows on the full model, ``{probe_<name>: (1, n) rows}``
     probes: dict = field(default_factory=dict)
@@ -294,7 +297,10 @@ def _runnable(scene, full: _Full, stages, log, modes, report, clock, with_steppe
     model, limits = _select_signals(scene, full.model, report, full.model.length_scale, full.probes)
     if modes and len(report.get("natural_frequencies_hz", ())) != modes:
         report["natural_frequencies_hz"] = stages.frequencies(model, modes).tolist()
-    reduced, reductor, ran = _reduce(scene, model, full.model, stages, log, limits, report, clock)
+    reuse = reused_run(scene, model, full.fields)
+    reduced, reductor, ran = _reduce(
+        scene, model, full.model, stages, log, limits, report, clock, reuse
+    )
     report["model"] = {"n_dofs": reduced.n_dofs, **_layout(reduced)}
     report["damping"] = damped_modes(reduced)
     stepper = stepper_of(scene, reduced, report) if with_stepper else None
@@ -410,15 +416,16 @@ def _report_full(scene, built: RubBuild, report: dict) -> None:
     )
 
 
-def _reduce(scene, model, full, stages, log, limits, report, clock):
+def _reduce(scene, model, full, stages, log, limits, report, clock, reuse):
     """The reduced model, its reductor and the run the reduction estimate (or the time-step
-    check) stepped when it is the scene's run (:func:`reusable_run`), else ``None``."""
+    check) stepped when it is the scene's run (``reuse``: :func:`reused_run`), else
+    ``None`` (then every run of the checks is only compared)."""
     make = lambda m: bare_stepper(scene, m)  # noqa: E731  (the reduction error estimate)
     chosen = []  # (results, wall seconds, full states) of the estimate's run of the chosen sizes
     reduced, reductor, report["reduction"] = stages.reduce(
-        model, scene, log, make, limits, on_run=lambda *run: chosen.append(run)
+        model, scene, log, make, limits, on_run=lambda *run: chosen.append(run), reuse_run=reuse
     )
-    ran = chosen[0][:2] if chosen and reusable_run(model) else None
+    ran = chosen[0][:2] if chosen and reuse else None
     if ran is not None:  # the run itself: its time is the run's ``stepping``
         clock.exclude(ran[1])
     clock.done("reduction", f"{reduced.n_dofs} dofs")
@@ -429,13 +436,21 @@ def _reduce(scene, model, full, stages, log, limits, report, clock):
         res, _, states = chosen.pop()
         given = (res if ran is not None else res.lean(), states)
     report["time_step"], run_h, wall_h = check_step(
-        scene, reduced, full, lambda m, h: bare_stepper(scene, m, h), limits, run=given
+        scene, reduced, full, lambda m, h: bare_stepper(scene, m, h), limits, given, reuse
     )
-    if ran is None and wall_h is not None and reusable_run(model):
+    if ran is None and wall_h is not None and reuse:
         ran = (run_h[0], wall_h)  # the check stepped the run itself
         clock.exclude(wall_h)
     clock.done("step_check", f"time-step error {100 * report['time_step']['estimate']:.2g} %")
     return reduced, reductor, ran
+
+
+def reused_run(scene, model, fields) -> bool:
+    """Whether the run the checks step of the chosen model is kept as the scene's run: the
+    model allows it (:func:`reusable_run`) and the run writes no VTK frames
+    (:func:`~femrub.app.run.run_scene` steps it again, its frames written as it steps).
+    Otherwise the checks record every run they step as a run only compared."""
+    return reusable_run(model) and not (scene["outputs"]["vtk_stride"] and fields is not None)
 
 
 def reusable_run(model) -> bool:

@@ -17,7 +17,13 @@ the buffers' row 0 being row ``i0``), and the store makes the
   residuals and the scales :meth:`~femrub.output.results.Results.energy_error` and
   :meth:`~femrub.output.results.Results.heat_error` divide them by, and the Coulomb check
   (:func:`~femrub.contact.friction.coulomb_check`). Maxima and sums over rows do not depend
-  on how the rows are cut, so these are the values the whole arrays would give.
+  on how the rows are cut, so these are the values the whole arrays would give. A run only
+  compared (``RunOptions.compared``, ``LeanRows(coulomb=False)`` and no energy meter)
+  measures none of them: its ``Results.checks`` is empty.
+
+What a store reads of the buffers besides times, signals and impulses (``reads_gaps``,
+``reads_slips``) tells the recorder which rows to compute: a lean record never reads the
+gaps, and reads the slip velocities only for its Coulomb check.
 """
 
 from __future__ import annotations
@@ -48,6 +54,8 @@ def _info(rec) -> dict:
 
 class AllRows:
     """Every per-step array of every row, ``n_steps + 1`` rows allocated at once."""
+
+    reads_gaps = reads_slips = True
 
     def __init__(self, rec):
         n1, self.taken = rec.n + 1, -1
@@ -101,9 +109,12 @@ class AllRows:
 
 class LeanRows:
     """Times and signals every ``every``-th row, impulses summed per ``every`` steps, and the
-    verdict's measures of every row (module docstring)."""
+    verdict's measures of every row (module docstring; ``coulomb=False``: no Coulomb check,
+    the balance measured only when the recorder has an energy meter)."""
 
-    def __init__(self, rec, every: int):
+    reads_gaps = False
+
+    def __init__(self, rec, every: int, coulomb: bool = True):
         self.k, self.taken, self.groups = int(every), -1, 0
         if self.k < 1:
             raise ValueError(f"a lean record keeps every k-th row, k >= 1; got {every!r}")
@@ -114,7 +125,8 @@ class LeanRows:
         # Coulomb check parts with the recorded contact states and, while the stepper has
         # written no friction rows, with a frictionless stepper's (AllRows.results)
         c = rec.model.contact
-        self._coulomb = None if c is None or not nc else ([], [])
+        self._coulomb = None if c is None or not nc or not coulomb else ([], [])
+        self.reads_slips = self._coulomb is not None
 
     def take(self, rec, i0: int, last: int) -> None:
         """Keep and measure rows ``taken + 1 .. last`` of the recorder's buffers."""

@@ -72,6 +72,9 @@ class Recorder:
         gives them (row 0 with the first block).
     lean : 0 keeps every per-step array; ``k >= 1`` only what a comparison of runs reads,
         every ``k``-th row, impulses summed per ``k`` steps (:mod:`~femrub.output.kept_rows`).
+    compared : a lean run only compared (``lean >= 1``): no energy meter (``energy`` is
+        ignored), no Coulomb check, no gaps or slip velocities computed
+        (:class:`~femrub.analysis.options.RunOptions`).
     label : name of the run (progress bar and ``Results.info``).
     blowup_check : stop on energy created from nothing (a scheme may turn it off when the
         meter's quadratures, not the scheme, would open its balance).
@@ -93,7 +96,10 @@ class Recorder:
         label: str | None = None,
         blowup_check: bool = True,
         lean: int = 0,
+        compared: bool = False,
     ):
+        if compared and not lean:
+            raise ValueError("a recorder of a run only compared keeps a lean record: lean >= 1")
         self.model, self.h, self.n, self.scheme = model, h, n_steps, scheme
         self.h_lim, self.label = stability_limit, label
         self.store_every, self.on_state, self.on_rows = store_every, on_state, on_rows
@@ -118,7 +124,8 @@ class Recorder:
         self.heat = np.zeros((n + 1, nc))
         self.cstate = np.zeros((n + 1, nc), dtype=np.int8)
         self.has_friction = False
-        self.meter = EnergyMeter(model, n + 1) if (energy and model.energy is not None) else None
+        metered = energy and not compared and model.energy is not None
+        self.meter = EnergyMeter(model, n + 1) if metered else None
         self.limits = dict(limits or {})
         self._lim_idx = _limit_index(self.limits, self.names, self.sizes)
         self._stored: list[np.ndarray] = []
@@ -135,7 +142,8 @@ class Recorder:
             0  # steps done, chunk row, chunk start, last kept
         )
         self.buf = np.empty((self.chunk + 1, N))
-        self.kept = AllRows(self) if not lean else LeanRows(self, lean)
+        self.kept = AllRows(self) if not lean else LeanRows(self, lean, coulomb=not compared)
+        self._slips = self.tangents and self.kept.reads_slips
 
     def buffers(self) -> dict[str, np.ndarray]:
         """The per-step buffers, by name (``energy_*``: the meter's), one chunk's rows."""
@@ -334,10 +342,10 @@ class Recorder:
         O = self._O
         if O is not None:
             self.obs[b] = X[1:] @ O.T if isinstance(O, np.ndarray) else (O @ X[1:].T).T
-        if c is not None:
+        if c is not None and self._gaps_read():
             self.gap[b] = c.gap(t[b], X[1:])
-            if self.tangents:
-                self.slip[b] = c.slip_velocity(X[1:])
+        if self._slips:
+            self.slip[b] = c.slip_velocity(X[1:])
         if self.meter is not None and m:
             friction = (self.imp_t[b], self.heat[b]) if self.has_friction else None
             with np.errstate(all="ignore"):
@@ -361,6 +369,10 @@ class Recorder:
             self._stored_rows.append(r)
             self._stored_t.append(t[r - i0].copy())
         return i0 + m
+
+    def _gaps_read(self) -> bool:
+        """Whether the gaps of the rows are read: kept, or fed to a sink."""
+        return self.kept.reads_gaps or self.on_state is not None or self.on_rows is not None
 
     def _deliver(self, i0: int, last: int) -> None:
         """Hand the checked rows ``i0 + 1 .. last`` of the buffers to what keeps them, then

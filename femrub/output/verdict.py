@@ -22,7 +22,8 @@ The recorder ends a run as ``unstable`` (blow-up), ``diverged-physically`` (a st
 
 A lean record (``RunOptions.lean = k``, :mod:`femrub.output.kept_rows`) keeps neither the
 energy balance nor the friction rows; the balance and Coulomb rules read the same measures
-taken on its rows as they were recorded (``Results.checks``).
+taken on its rows as they were recorded (``Results.checks``). A run only compared
+(``RunOptions.compared``) takes none: both rules pass it (its status says how it ended).
 
 * ``resolution``: contact episodes (impulses less than ``merge_time`` apart form one
   episode) resolved by fewer than :data:`UNRESOLVED_STEPS` steps (median over the
