@@ -197,7 +197,7 @@ def _run(model, scene, limits, lean=0):
     t_end = scene["scheme"]["t_end"]
     every = max(1, stepper.steps_to(t_end) // CHECKPOINTS)
     t0 = time.perf_counter()
-    res = stepper.run(t_end, store_every=every, limits=limits, lean=lean)
+    res = stepper.run(t_end, store_every=every, limits=limits, lean=lean, compared=lean > 0)
     return res, time.perf_counter() - t0
 
 
