@@ -31,7 +31,7 @@ import scipy.sparse as sp
 
 from ..analysis.reduction_check import lobe_passage
 from ..analysis.step_check import check_step
-from ..geometry.rotation_direction import derive_rotation_direction
+from ..geometry.rotation_direction import ROTATION_DIRECTIONS, derive_rotation_direction
 from ..model.casing_waves import casing_harmonics, waves_of
 from ..model.cyclic import cyclic_structure
 from ..model.wheel import WheelConfig, contact_rows_of_sector, tip_contacts, wheel_model
@@ -67,7 +67,7 @@ def _direction(scene, sector) -> float:
     given = scene["loads"]["rotation_direction"]
     if given == "auto":
         return derive_rotation_direction(sector.mesh).sign
-    return 1.0 if given == "counterclockwise" else -1.0
+    return ROTATION_DIRECTIONS[given]
 
 
 def _config(scene, sector) -> WheelConfig:

@@ -50,7 +50,8 @@ ANGLE_POINTS = 16
 
 
 def cylindrical_components(values: np.ndarray, phi: np.ndarray) -> np.ndarray:
-    """``(3, n)`` Cartesian components at angles ``phi`` as (radial, circumferential, axial)."""
+    """``(3, ...)`` Cartesian components at angles ``phi`` (broadcast against ``values[0]``) as
+    (radial, circumferential, axial)."""
     s, c = np.sin(phi), np.cos(phi)
     radial = -s * values[1] + c * values[2]
     circumferential = -c * values[1] - s * values[2]
@@ -87,10 +88,9 @@ def ring_amplitudes(structure, basis, axial: np.ndarray, radius: float) -> np.nd
     full = np.zeros((structure.basis.N, basis.shapes.shape[1]), dtype=complex)
     full[structure.free] = basis.shapes
     values = (probe @ full).reshape(3, x.size, -1)  # (component, point, mode)
-    cyl = np.stack([cylindrical_components(values[:, :, j], ph) for j in range(values.shape[2])])
-    cyl = cyl.reshape(values.shape[2], 3, np.size(axial), phi.size)
+    cyl = cylindrical_components(values, ph[:, None]).reshape(3, np.size(axial), phi.size, -1)
     kernel = w * np.exp(-1j * basis.k * phi)
-    return np.einsum("jcpq,q->jpc", cyl, kernel)
+    return np.einsum("cpqj,q->jpc", cyl, kernel)
 
 
 @dataclass(frozen=True)

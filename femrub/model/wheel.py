@@ -200,6 +200,13 @@ def _frames(contacts: ContactPoints, n_blades: int) -> np.ndarray:
     return np.einsum("sab,pdb->spda", turns, local).reshape(-1, 3, 3)
 
 
+def _contact_angles(contacts: ContactPoints, n_blades: int):
+    """Angles (rad, rotor frame) of the sector's contacts ``(n_c,)`` and of every blade's
+    ``(N n_c,)``, blade by blade."""
+    phi = sector_angle(contacts.points)
+    return phi, (2.0 * math.pi / n_blades * np.arange(n_blades)[:, None] + phi).ravel()
+
+
 def _contact_rows(disk, casing, structure, contacts, n_blades):
     """Normal ``(N n_c, n_u)`` and tangent ``(2 N n_c, n_u)`` rows (blade less casing)."""
     normal, tangent = contact_rows_of_sector(structure, contacts)
@@ -208,8 +215,7 @@ def _contact_rows(disk, casing, structure, contacts, n_blades):
     Dt = disk.sector_rows(tangent).reshape(n_blades * 2 * nc, -1)
     if casing is None:
         return Dn, Dt
-    phi = sector_angle(contacts.points)
-    angles = (2.0 * math.pi / n_blades * np.arange(n_blades)[:, None] + phi).ravel()
+    phi, angles = _contact_angles(contacts, n_blades)
     Cn = casing.rows(
         angles, np.tile(cylindrical_components(contacts.normals, phi).T, (n_blades, 1))
     )
@@ -304,8 +310,7 @@ def wheel_model(
     Nrows, Trows = _contact_rows(disk, casing, structure, contacts, N)
     M, C, K, Ka = _matrices(disk, casing, config, mistuning)
     growth = contacts.normal_displacement(structure.static)
-    phi = sector_angle(contacts.points)
-    angles = (2.0 * math.pi / N * np.arange(N)[:, None] + phi).ravel()
+    _, angles = _contact_angles(contacts, N)
     offsets = np.tile(tip_radius - contacts.radii - growth, N)
     profile = _casing_profile(config)
     omega = float(config.rotation_speed)
