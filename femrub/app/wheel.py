@@ -32,7 +32,7 @@ import scipy.sparse as sp
 from ..analysis.reduction_check import lobe_passage
 from ..analysis.step_check import check_step
 from ..geometry.rotation_direction import ROTATION_DIRECTIONS, derive_rotation_direction
-from ..model.casing_waves import casing_harmonics, waves_of
+from ..model.casing_waves import casing_harmonics, ring_line_loads, waves_of
 from ..model.cyclic import cyclic_structure
 from ..model.wheel import WheelConfig, contact_rows_of_sector, tip_contacts, wheel_model
 from ..reduction.cyclic_ritz import CyclicBasis, cyclic_bases
@@ -144,10 +144,18 @@ def _bases(parts: WheelParts, sizes) -> list:
     if parts.ring is None:
         return [(d, None) for d in disks]
     harmonics = casing_harmonics(parts.ring.n_sectors)
-    rings = cyclic_bases(parts.ring, [c for _, c in sizes], harmonics=harmonics)
     reading = parts.bore * (1.0 + 1e-6)  # just inside the ring's bore
     axial = parts.contacts.points[0]
+    loads = ring_line_loads(parts.ring, np.unique(axial), reading, _band(axial))
+    rings = cyclic_bases(parts.ring, [c for _, c in sizes], loads, harmonics=harmonics)
     return [(d, waves_of(parts.ring, r, axial, reading)) for d, r in zip(disks, rings, strict=True)]
+
+
+def _band(axial: np.ndarray) -> float:
+    """The axial width (m) a contact's load on the ring is spread over: the contacts' axial
+    spacing (0 for a single axial position)."""
+    x = np.unique(axial)
+    return 0.0 if x.size < 2 else float(np.ptp(x)) / (x.size - 1)
 
 
 def _model(parts: WheelParts, disk, waves):

@@ -41,6 +41,7 @@ __all__ = [
     "casing_waves",
     "cylindrical_components",
     "ring_amplitudes",
+    "ring_line_loads",
     "rotating_blocks",
     "waves_of",
 ]
@@ -78,19 +79,81 @@ def ring_amplitudes(structure, basis, axial: np.ndarray, radius: float) -> np.nd
         ``(m, n, 3)`` complex: ``A_j(x_p)`` in (radial, circumferential, axial) components,
         ``(1/α) ∫ W_j(φ) e^{−ikφ} dφ`` over the sector.
     """
-    alpha = 2.0 * math.pi / structure.n_sectors
-    nodes, weights = np.polynomial.legendre.leggauss(ANGLE_POINTS)
-    phi, w = 0.5 * alpha * nodes, 0.5 * weights  # mean over (−α/2, α/2)
-    x = np.repeat(np.asarray(axial, dtype=float), phi.size)
-    ph = np.tile(phi, np.size(axial))
-    points = np.stack([x, -radius * np.sin(ph), radius * np.cos(ph)])
-    probe = sp.csr_matrix(structure.basis.probes(points))
+    probe, phi, w = _bore_probe(structure, axial, radius)
     full = np.zeros((structure.basis.N, basis.shapes.shape[1]), dtype=complex)
     full[structure.free] = basis.shapes
-    values = (probe @ full).reshape(3, x.size, -1)  # (component, point, mode)
+    n = np.size(axial) * phi.size
+    values = (probe @ full).reshape(3, n, -1)  # (component, point, mode)
+    ph = np.tile(phi, np.size(axial))
     cyl = cylindrical_components(values, ph[:, None]).reshape(3, np.size(axial), phi.size, -1)
     kernel = w * np.exp(-1j * basis.k * phi)
     return np.einsum("cpqj,q->jpc", cyl, kernel)
+
+
+def _bore_probe(structure, axial, radius: float):
+    """The probe (``(3 n_x n_φ, N)``, component-major) of the ring's field at the Gauss
+    angles ``φ`` over the sector (its angles and weights of the mean over ``(−α/2, α/2)``)
+    at every axial position ``axial`` (m) and ``radius`` (m)."""
+    alpha = 2.0 * math.pi / structure.n_sectors
+    nodes, weights = np.polynomial.legendre.leggauss(ANGLE_POINTS)
+    phi, w = 0.5 * alpha * nodes, 0.5 * weights
+    x = np.repeat(np.asarray(axial, dtype=float), phi.size)
+    ph = np.tile(phi, np.size(axial))
+    points = np.stack([x, -radius * np.sin(ph), radius * np.cos(ph)])
+    return sp.csr_matrix(structure.basis.probes(points)), phi, w
+
+
+def ring_line_loads(structure, axial: np.ndarray, radius: float, band: float = 0.0):
+    """The ring's loads of the contacts, for the residual shapes of its bases: a function
+    of the nodal diameter ``k`` returning, per axial position and per direction (radial,
+    circumferential), the sector's part of the load ``e^{ikψ}`` spread round the ring.
+
+    Parameters
+    ----------
+    structure : CyclicStructure
+        The ring's sector.
+    axial : numpy.ndarray
+        ``(n,)`` axial positions ``x`` (m) of the contacts.
+    radius : float
+        Radius (m) the loads act at (just inside the ring's bore).
+    band : float
+        Axial width (m) each load is spread over (uniformly, three Gauss points; 0: a line).
+
+    Returns
+    -------
+    callable
+        ``k -> (2 n, n_free)`` complex rows (their scale does not matter: the residual shapes
+        are normalised).
+    """
+    axial = np.asarray(axial, dtype=float)
+    if band > 0.0:
+        g, gw = np.polynomial.legendre.leggauss(3)
+        x = (axial[:, None] + 0.5 * band * g[None, :]).ravel()
+        xw = np.tile(0.5 * gw, axial.size)
+    else:
+        x, xw, g = axial, np.ones(axial.size), np.zeros(1)
+    probe, phi, w = _bore_probe(structure, x, radius)
+    n_x, n_phi = x.size, phi.size
+    s, c = np.sin(phi), np.cos(phi)
+    directions = {  # (component, φ) in global axes (x, y, z) of the bore points
+        "radial": np.stack([np.zeros_like(phi), -s, c]),
+        "circumferential": np.stack([np.zeros_like(phi), -c, -s]),
+    }
+    per_position = g.size
+
+    def rows(k: int) -> sp.csr_matrix:
+        out = []
+        wave = w * np.exp(1j * k * phi)  # (n_phi,)
+        for p in range(axial.size):
+            span = slice(p * per_position, (p + 1) * per_position)
+            weight = np.zeros(n_x)
+            weight[span] = xw[span]
+            for d in directions.values():
+                coeff = d[:, None, :] * weight[None, :, None] * wave[None, None, :]
+                out.append(sp.csr_matrix(coeff.reshape(1, -1)) @ probe)
+        return sp.vstack(out).tocsr()[:, structure.free]
+
+    return rows
 
 
 @dataclass(frozen=True)

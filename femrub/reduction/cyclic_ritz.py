@@ -107,6 +107,8 @@ def _harmonic(structure: CyclicStructure, k: int, n_modes: int, load_rows) -> _H
     solve = hermitian_solver(Kk)
     lam, Q = lowest_hermitian_modes(Kk, Mk, min(n_modes, Kk.shape[0]), solve=solve)
     loads = static = None
+    if callable(load_rows):
+        load_rows = load_rows(k)
     if load_rows is not None and load_rows.shape[0]:
         loads = np.asarray((Th @ sp.csr_matrix(load_rows).T).toarray(), dtype=complex)
         static = np.column_stack([solve(loads[:, j]) for j in range(loads.shape[1])])
@@ -165,9 +167,11 @@ def harmonic_basis(
         Nodal diameter, ``0 <= k <= N/2``.
     n_modes : int
         Modes kept (families).
-    load_rows : scipy.sparse matrix, optional
-        ``(r, n_free)`` real rows where loads act (e.g. contact patch means); their residual
-        shapes join the basis.
+    load_rows : scipy.sparse matrix or callable, optional
+        ``(r, n_free)`` rows of the loads on the sector (e.g. contact patch means), or a
+        function of ``k`` returning them (complex rows: loads ``f_0`` on sector 0 of a load
+        ``f_s = e^{iksα} f_0``, e.g. a line load ``e^{ikψ}``); their residual shapes join the
+        basis.
     """
     return _ritz(_harmonic(structure, k, n_modes, load_rows), n_modes)
 
