@@ -133,7 +133,7 @@ def ring_line_loads(structure, axial: np.ndarray, radius: float, band: float = 0
     else:
         x, xw, g = axial, np.ones(axial.size), np.zeros(1)
     probe, phi, w = _bore_probe(structure, x, radius)
-    n_x, n_phi = x.size, phi.size
+    n_x = x.size
     s, c = np.sin(phi), np.cos(phi)
     directions = {  # (component, φ) in global axes (x, y, z) of the bore points
         "radial": np.stack([np.zeros_like(phi), -s, c]),
