@@ -29,7 +29,7 @@ from ..model.rub import FieldMap
 from .frame_fields import FrameFields
 from .vtu_file import VTK_TETRA, VTUWriter
 
-__all__ = ["FIELD_UNITS", "VTKSeries", "snapshot_png"]
+__all__ = ["FIELD_UNITS", "FrameSink", "VTKSeries", "snapshot_png"]
 
 #: SI units of the point and cell data of every frame
 FIELD_UNITS = {
@@ -47,7 +47,24 @@ _UNITS_COMMENT = (
 )
 
 
-class VTKSeries:
+class FrameSink:
+    """A run's ``on_state`` callback that takes every ``stride``-th state (``take``) and is
+    closed (``close``) on leaving a ``with`` block."""
+
+    stride: int
+
+    def __call__(self, state) -> None:
+        if state.k % self.stride == 0:
+            self.take(state)
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.close()
+
+
+class VTKSeries(FrameSink):
     """Stream a run to ``directory/name_XXXXXX.vtu`` plus ``directory/name.pvd``.
 
     A frame is taken every ``stride`` steps (the initial state included): the call only
@@ -68,7 +85,7 @@ class VTKSeries:
     Parameters
     ----------
     directory : output folder (created).
-    model : the (full or reduced) model run; needs ``model.to_full``.
+    model : the (full or reduced) model run; with a ``FieldMap``, needs ``model.to_full``.
     fields : the :class:`~femrub.model.rub.FieldMap` of the full model, or a frame source of
         another mesh: ``fields.frame_fields(model, h, dtype)`` gives an object with
         ``compact(X, impulse, friction, times=...)``, ``store(compact, b, data)`` and its
@@ -157,16 +174,6 @@ class VTKSeries:
     @property
     def pvd_path(self) -> Path:
         return self.dir / f"{self.name}.pvd"
-
-    def __call__(self, state) -> None:
-        if state.k % self.stride == 0:
-            self.take(state)
-
-    def __enter__(self):
-        return self
-
-    def __exit__(self, *exc) -> None:
-        self.close()
 
     def take(self, state) -> None:
         """Copy the frame of ``state`` (t, X, impulse, friction impulse) for the writer."""

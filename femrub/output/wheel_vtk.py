@@ -47,7 +47,7 @@ import scipy.sparse as sp
 from ..geometry.cyclic_sector import axis_rotation, full_wheel
 from ..model.wheel import WheelMap
 from .frame_fields import _scatter
-from .vtk import VTKSeries
+from .vtk import FrameSink, VTKSeries
 from .vtu_file import VTK_TETRA, VTUWriter
 
 __all__ = ["CasingFrames", "CyclicVertexField", "RotorFrames", "WheelFields", "WheelSeries"]
@@ -343,7 +343,7 @@ class _Source:
         return self.kind(self.fields, model, h, dtype)
 
 
-class WheelSeries:
+class WheelSeries(FrameSink):
     """The rotor's and the casing's :class:`~femrub.output.vtk.VTKSeries` of one run, fed
     together (the ``on_state`` callback of a run): ``rub.pvd`` and ``casing.pvd`` in
     ``directory``, a frame of each every ``stride`` steps at the same times."""
@@ -369,16 +369,6 @@ class WheelSeries:
     snapshot_scalars = property(lambda self: self.rotor.snapshot_scalars)
     seconds = property(lambda self: sum(p.seconds for p in self.parts.values()))
     cpu_seconds = property(lambda self: sum(p.cpu_seconds for p in self.parts.values()))
-
-    def __call__(self, state) -> None:
-        if state.k % self.stride == 0:
-            self.take(state)
-
-    def __enter__(self):
-        return self
-
-    def __exit__(self, *exc) -> None:
-        self.close()
 
     def take(self, state) -> None:
         for part in self.parts.values():
