@@ -230,7 +230,7 @@ def test_run_of_a_wheel_scene_writes_the_whole_wheel_and_its_casing(tmp_path):
     ramped in over an eighth of a revolution), a frame every 150 steps: both series are
     readable, every frame holds the whole structure, and the response, the same on blades
     a lobe apart, is drawn 3-fold symmetric on the rotor and on the casing; the contact
-    forces drawn are the impulses of the frame's step over ``h``."""
+    and friction forces drawn are those of the frame's step."""
     from test_wheel_scene import WHEEL
 
     stride, h = 150, REVOLUTION / 1500
@@ -246,6 +246,7 @@ def test_run_of_a_wheel_scene_writes_the_whole_wheel_and_its_casing(tmp_path):
     assert s["steps"] == 750 and s["vtk"] == "vtk/rub.pvd" and s["vtk_frames"] == 6
     with np.load(out / "history.npz") as history:
         impulses = history["impulse"][::stride]  # at the frames' steps
+        friction = history["friction_force"][::stride]  # (frames, contacts, 3), global axes
     touched = int(impulses.sum(axis=1).argmax())
     assert impulses[touched].sum() > 0.0
     for name in ("rub", "casing"):
@@ -268,5 +269,13 @@ def test_run_of_a_wheel_scene_writes_the_whole_wheel_and_its_casing(tmp_path):
     assert radius.min() == pytest.approx(0.02, rel=1e-6)  # the bore of the whole disk
     assert np.ptp(angles) > 2 * math.pi * 0.99  # all the way round
     assert np.abs(rotor.point_data["static_displacement"]).max() > 0.0
-    drawn = np.linalg.norm(rotor.point_data["contact_force"], axis=1).sum()
-    assert drawn == pytest.approx(impulses[touched].sum() / h, rel=1e-5)
+    normal = np.linalg.norm(rotor.point_data["contact_force"], axis=1)
+    assert normal.sum() == pytest.approx(impulses[touched].sum() / h, rel=1e-5)
+    tangent = rotor.point_data["friction_force"]
+    scale = np.linalg.norm(friction[touched], axis=1).sum()
+    assert np.linalg.norm(tangent, axis=1).sum() == pytest.approx(scale, rel=1e-5)
+    np.testing.assert_allclose(
+        tangent.sum(axis=0), friction[touched].sum(axis=0), rtol=0, atol=1e-6 * scale
+    )
+    slipping = np.linalg.norm(tangent, axis=1)[normal > 0] / normal[normal > 0]
+    assert slipping.max() == pytest.approx(0.02, rel=1e-5)  # μ, on the same vertices
