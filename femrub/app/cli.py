@@ -173,11 +173,10 @@ def _run(args) -> int:
             print(f"  note: {res.message}")
         for w in res.warnings:
             print(f"  warning: {w}")
-        vtk = (
-            " and vtk/rub.pvd (ParaView)"
-            if built.fields is not None and scene["outputs.vtk_stride"]
-            else ""
-        )
+        vtk = ""
+        if built.fields is not None and scene["outputs.vtk_stride"]:
+            series = built.fields.parts() if hasattr(built.fields, "parts") else ("rub",)
+            vtk = " and " + ", ".join(f"vtk/{name}.pvd" for name in series) + " (ParaView)"
         print(f"  results in {out}/: summary.json, history.csv, signals.png{vtk}")
     if args.explain:
         from .explain import format_timings

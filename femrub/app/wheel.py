@@ -35,6 +35,7 @@ from ..geometry.rotation_direction import ROTATION_DIRECTIONS, derive_rotation_d
 from ..model.casing_waves import casing_harmonics, ring_line_loads, waves_of
 from ..model.cyclic import cyclic_structure
 from ..model.wheel import WheelConfig, contact_rows_of_sector, tip_contacts, wheel_model
+from ..output.wheel_vtk import WheelFields
 from ..reduction.cyclic_ritz import CyclicBasis, cyclic_bases
 from ..reduction.estimate import HORIZON_SHARE, estimate, perturbed
 from ..scene.spec import fail
@@ -239,8 +240,9 @@ def _reduction_check(scene, parts, small, rich, model, limits, log):
 
 def build_wheel(scene, log=None):
     """The :class:`~femrub.app.simulation.Simulation` of a bladed-disk scene (module
-    docstring): the wheel's model (also its full model), its stepper, its run (stepped by the
-    reduction error estimate) and the report."""
+    docstring): the wheel's model (also its full model), its fields (the whole wheel's VTK
+    frames, :class:`~femrub.output.wheel_vtk.WheelFields`), its stepper, its run (stepped by
+    the reduction error estimate) and the report."""
     from .simulation import Simulation
 
     timings, t0 = {}, time.perf_counter()
@@ -248,7 +250,7 @@ def build_wheel(scene, log=None):
     timings["assembly"] = time.perf_counter() - t0
     t1 = time.perf_counter()
     small, rich = _bases(parts, _sizes(scene))
-    model, _ = _model(parts, *small)
+    model, wheel = _model(parts, *small)
     timings["reduction"] = time.perf_counter() - t1
     limits = {}
     report = _report(scene, parts, model)
@@ -268,8 +270,10 @@ def build_wheel(scene, log=None):
     timings["checks"] = time.perf_counter() - t2 - wall
     stepper = stepper_of(scene, model, report)
     report["timings"] = timings
+    c = parts.config
+    fields = WheelFields(wheel, parts.disk, parts.ring, c.rotation_speed, c.direction)
     return Simulation(
-        scene, model, model, None, None, stepper, limits, report, timings, (run, wall)
+        scene, model, model, fields, None, stepper, limits, report, timings, (run, wall)
     )
 
 

@@ -75,7 +75,7 @@ OUTPUTS = {
     "modes": ("summary.json", "modes.csv", "modes.png", "coincidences.csv", "campbell.png"),
 }
 #: the files of a run's VTK series (in ``vtk/``)
-VTK_FILES = ("rub_*.vtu", "rub.pvd", "*.tmp")
+VTK_FILES = ("rub_*.vtu", "rub.pvd", "casing_*.vtu", "casing.pvd", "*.tmp")
 _NOFOLLOW = getattr(os, "O_NOFOLLOW", 0)
 
 

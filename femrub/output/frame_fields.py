@@ -156,9 +156,10 @@ class FrameFields:
         self._contact = model.contact
         self.h = float(h)
 
-    def compact(self, X, impulse, friction=None) -> dict[str, np.ndarray | None]:
+    def compact(self, X, impulse, friction=None, times=None) -> dict[str, np.ndarray | None]:
         """Fields of ``B`` frames as computed: states ``X`` (B × N), impulses (B × n_c),
-        friction impulses (B × n_c × 2, or ``None``).
+        friction impulses (B × n_c × 2, or ``None``); ``times`` (s) of the frames is not
+        needed (a blade's fields are those of its state).
 
         Returns ``displacement`` and ``velocity`` (B × n_points × dim), ``temperature``
         (B × n_points, ``None`` without a thermal part), ``von_mises`` (B × n_cells) and

@@ -209,7 +209,10 @@ def _run(  # noqa: PLR0913 (run_to_folder's options passed on)
     if fields is not None and vtk_stride:
         from .vtk import VTKSeries
 
-        series = VTKSeries(out / "vtk", model, fields, h=stepper.h, stride=vtk_stride)
+        if hasattr(fields, "vtk_series"):  # several meshes (a bladed disk and its casing)
+            series = fields.vtk_series(out / "vtk", model, h=stepper.h, stride=vtk_stride)
+        else:
+            series = VTKSeries(out / "vtk", model, fields, h=stepper.h, stride=vtk_stride)
     for stale in ("history.csv", "history.npz", "signals.png", "snapshot.png"):
         (out / stale).unlink(missing_ok=True)  # results of an earlier, unfinished run
     history = HistoryCSV(out / "history.csv", every=csv_stride, units=signal_units(model))
@@ -345,7 +348,11 @@ def _finish(  # noqa: PLR0913 (run_to_folder's options passed on)
         from .vtk import snapshot_png
 
         try:
-            snapshot_png(series.dir / series.frames[-1][1], out / "snapshot.png")
+            snapshot_png(
+                series.dir / series.frames[-1][1],
+                out / "snapshot.png",
+                scalars=series.snapshot_scalars,
+            )
         except Exception as exc:  # rendering is optional (no OpenGL on the machine)
             doc["snapshot_error"] = f"{type(exc).__name__}: {exc}"
             print(

@@ -29,7 +29,7 @@ from ..model.rub import FieldMap
 from .frame_fields import FrameFields
 from .vtu_file import VTK_TETRA, VTUWriter
 
-__all__ = ["FIELD_UNITS", "VTKSeries", "snapshot_png"]
+__all__ = ["FIELD_UNITS", "FrameSink", "VTKSeries", "snapshot_png"]
 
 #: SI units of the point and cell data of every frame
 FIELD_UNITS = {
@@ -47,7 +47,24 @@ _UNITS_COMMENT = (
 )
 
 
-class VTKSeries:
+class FrameSink:
+    """A run's ``on_state`` callback that takes every ``stride``-th state (``take``) and is
+    closed (``close``) on leaving a ``with`` block."""
+
+    stride: int
+
+    def __call__(self, state) -> None:
+        if state.k % self.stride == 0:
+            self.take(state)
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.close()
+
+
+class VTKSeries(FrameSink):
     """Stream a run to ``directory/name_XXXXXX.vtu`` plus ``directory/name.pvd``.
 
     A frame is taken every ``stride`` steps (the initial state included): the call only
@@ -68,8 +85,12 @@ class VTKSeries:
     Parameters
     ----------
     directory : output folder (created).
-    model : the (full or reduced) model run; needs ``model.to_full``.
-    fields : the :class:`~femrub.model.rub.FieldMap` of the full model.
+    model : the (full or reduced) model run; with a ``FieldMap``, needs ``model.to_full``.
+    fields : the :class:`~femrub.model.rub.FieldMap` of the full model, or a frame source of
+        another mesh: ``fields.frame_fields(model, h, dtype)`` gives an object with
+        ``compact(X, impulse, friction, times=...)``, ``store(compact, b, data)`` and its
+        ``writer`` (:class:`~femrub.output.vtu_file.VTUWriter`), and ``fields.snapshot_scalars``
+        names the field ``snapshot.png`` is coloured by (:mod:`femrub.output.wheel_vtk`).
     h : the run's time step (s), to turn contact impulses into forces.
     stride : write every ``stride``-th step (the initial state is always written).
     batch : most frames waiting (then the stepping waits for the writer) and most frames
@@ -97,7 +118,7 @@ class VTKSeries:
         flush_seconds: float = 10.0,
         dtype=np.float32,
     ):
-        if model.to_full is None:
+        if isinstance(fields, FieldMap) and model.to_full is None:
             raise ValueError("this model has no map to the full mesh (model.to_full)")
         if int(stride) < 1:
             raise ValueError(f"VTK output stride must be >= 1, got {stride!r}")
@@ -113,12 +134,24 @@ class VTKSeries:
         self.h = float(h)
         self.frames: list[tuple[float, str]] = []
         self.seconds = self._main_cpu = self._writer_cpu = 0.0
-        self._fields = FrameFields(model, fields, self.h, dtype)
-        point = {"displacement": 3, "velocity": 3, "temperature": 1}
-        point |= {"contact_force": 3, "friction_force": 3}
-        self._vtu = VTUWriter(
-            fields.mesh.p.T, fields.mesh.t.T, VTK_TETRA, point, ["von_mises"], _UNITS_COMMENT, dtype
-        )
+        self._comment, self.snapshot_scalars = _UNITS_COMMENT, "temperature"
+        if isinstance(fields, FieldMap):
+            self._fields = FrameFields(model, fields, self.h, dtype)
+            point = {"displacement": 3, "velocity": 3, "temperature": 1}
+            point |= {"contact_force": 3, "friction_force": 3}
+            self._vtu = VTUWriter(
+                fields.mesh.p.T,
+                fields.mesh.t.T,
+                VTK_TETRA,
+                point,
+                ["von_mises"],
+                _UNITS_COMMENT,
+                dtype,
+            )
+        else:  # a frame source of its own (a part of a bladed disk, :mod:`.wheel_vtk`)
+            self._fields = fields.frame_fields(model, self.h, dtype)
+            self._vtu = self._fields.writer
+            self._comment, self.snapshot_scalars = self._vtu.comment, fields.snapshot_scalars
         self.batch, self.min_batch = int(batch), min(int(min_batch), int(batch))
         self.flush_seconds = float(flush_seconds)
         self._vtu_main: VTUWriter | None = None
@@ -141,16 +174,6 @@ class VTKSeries:
     @property
     def pvd_path(self) -> Path:
         return self.dir / f"{self.name}.pvd"
-
-    def __call__(self, state) -> None:
-        if state.k % self.stride == 0:
-            self.take(state)
-
-    def __enter__(self):
-        return self
-
-    def __exit__(self, *exc) -> None:
-        self.close()
 
     def take(self, state) -> None:
         """Copy the frame of ``state`` (t, X, impulse, friction impulse) for the writer."""
@@ -282,11 +305,12 @@ class VTKSeries:
         for start in range(0, len(frames), self.batch):
             part = frames[start : start + self.batch]
             X, imp = np.stack([f[2] for f in part]), np.stack([f[3] for f in part])
+            times = np.array([f[1] for f in part])
             fi = None
             if any(f[4] is not None for f in part):
                 shape = next(f[4] for f in part if f[4] is not None).shape
                 fi = np.stack([np.zeros(shape) if f[4] is None else f[4] for f in part])
-            c = self._fields.compact(X, imp, fi)
+            c = self._fields.compact(X, imp, fi, times=times)
             for b, f in enumerate(part):
                 fname = f"{self.name}_{f[0]:06d}.vtu"
                 self._fields.store(c, b, vtu.data)
@@ -307,7 +331,7 @@ class VTKSeries:
         lines = [
             '<?xml version="1.0"?>',
             '<VTKFile type="Collection" version="0.1">',
-            _UNITS_COMMENT,
+            self._comment,
             "<Collection>",
         ]
         for t, f in self.frames:

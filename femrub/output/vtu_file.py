@@ -83,6 +83,7 @@ class VTUWriter:
         index = np.int32 if small else np.int64  # fewer bytes per frame
         cells = cells.astype(index)
         self.n_points, self.n_cells = pts.shape[0], cells.shape[0]
+        self.comment = comment
         self.dtype = np.dtype(dtype)
         self.point_fields, self.cell_fields = dict(point_fields), list(cell_fields)
         shapes = {
