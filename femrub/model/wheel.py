@@ -29,11 +29,13 @@ kept, as in component mode mistuning).
 from __future__ import annotations
 
 import math
+from contextlib import nullcontext
 from dataclasses import dataclass, replace
 
 import numpy as np
 import scipy.sparse as sp
 
+from ..blas import SERIAL_SETUP_DOFS, one_blas_thread
 from ..contact.casing import (
     Concentric,
     Lobed,
@@ -184,11 +186,12 @@ def mistuning_stiffness(
     Kb = isotropic_stiffness(structure.basis.with_elements(blade), lam, mu)
     Kb = sp.csr_matrix(Kb)[structure.free][:, structure.free]
     out = np.zeros((disk.size, disk.size))
-    for s, delta in enumerate(factors):
-        if delta == 0.0:
-            continue
-        U = disk.sector_field(np.eye(disk.size), s)  # (n_free, size)
-        out += delta * (U.T @ (Kb @ U))
+    with one_blas_thread if disk.size <= SERIAL_SETUP_DOFS else nullcontext():
+        for s, delta in enumerate(factors):
+            if delta == 0.0:
+                continue
+            U = disk.sector_field(np.eye(disk.size), s)  # (n_free, size)
+            out += delta * (U.T @ (Kb @ U))
     return 0.5 * (out + out.T)
 
 
