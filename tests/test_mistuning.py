@@ -35,7 +35,9 @@ from dataclasses import replace
 import numpy as np
 import pytest
 import scipy.linalg as sla
+import tomli_w
 from scipy.optimize import minimize_scalar
+from small_wheel import scene_tables
 
 from femrub.app.explain import explain
 from femrub.app.wheel import _model, _report, wheel_parts
@@ -47,53 +49,29 @@ N = 6
 ALPHA = 2.0 * math.pi / N
 WHITEHEAD = (1.0 + math.sqrt(N)) / 2.0
 FACTORS = [0.03, -0.02, 0.0, 0.01, -0.04, 0.05]
-SCENE = """
-name = "wheel6-mistuned"
-[geometry]
-kind = "naca"
-code = "0012"
-span = 0.03
-root_chord = 0.015
-tip_chord = 0.012
-twist = 20.0
-n_sections = 3
-h = 0.015
-h_min = 0.01
-[material]
-young = "110 GPa"
-poisson = 0.3
-density = 4500.0
-[rotor]
-sectors = 6
-hub_radius = 0.02
-rim_radius = 0.045
-thickness = 0.015
-families = 3
-contacts = 2
-damping_ratio = 0.001
-{mistuning}
-[casing.ring]
-clearance = "1 mm"
-[loads]
-rotation_speed = 1000.0
-centrifugal = "off"
-[scheme]
-h = 1e-6
-t_end = 1e-3
-[outputs]
-plots = false
-"""
+SCENE = {
+    "name": "wheel6-mistuned",
+    "casing": {"ring": {"clearance": 1e-3}},
+    "loads": {"rotation_speed": 1000.0, "centrifugal": "off"},
+    "scheme": {"h": 1e-6, "t_end": 1e-3},
+    "outputs": {"plots": False},
+}
 
 
-def _scene(mistuning: str):
-    return loads_scene(SCENE.format(mistuning=mistuning))
+def _scene(mistuning=None, sectors=N):
+    """The wheel's scene: 3 families, 2 contacts a blade, damping ratio 0.001, rigid casing."""
+    rotor = dict(families=3, contacts=2, damping_ratio=0.001, mistuning=mistuning)
+    tables = scene_tables(**{k: v for k, v in rotor.items() if v is not None})
+    if sectors is None:
+        del tables["rotor"]["sectors"]
+    return loads_scene(tomli_w.dumps({**SCENE, **tables}))
 
 
 @pytest.fixture(scope="module")
 def wheel():
     """The scene's parts (mistuned by ``FACTORS``), its disk basis and the rows of every
     blade's mean circumferential tip displacement ``(N, n)``."""
-    parts = wheel_parts(_scene(f"mistuning = {FACTORS}"))
+    parts = wheel_parts(_scene(FACTORS))
     disk = cyclic_basis(parts.disk, 3, parts.rows)
     nc = parts.contacts.n
     circumferential = parts.rows[nc + 1 :: 2]  # tangent rows: axial, circumferential per contact
@@ -155,10 +133,10 @@ def _spread(disk) -> float:
 @pytest.mark.parametrize(
     ("mistuning", "says"),
     [
-        ("mistuning = [0.01, 0.02]", "rotor.mistuning = [0.01, 0.02]: give one factor δ_s per"),
-        ("mistuning = [0.0, 0.0, -1.0, 0.0, 0.0, 0.0]", "rotor.mistuning[2] = -1.0: must be > -1"),
-        ('mistuning = [0.0, "stiff", 0, 0, 0, 0]', "rotor.mistuning[1] = 'stiff': expected a"),
-        ("mistuning = 0.03", "rotor.mistuning = 0.03: must be a non-empty list of numbers > -1"),
+        ([0.01, 0.02], "rotor.mistuning = [0.01, 0.02]: give one factor δ_s per blade: 6 numbers"),
+        ([0.0, 0.0, -1.0, 0.0, 0.0, 0.0], "rotor.mistuning[2] = -1.0: must be > -1"),
+        ([0.0, "stiff", 0, 0, 0, 0], "rotor.mistuning[1] = 'stiff': expected a number"),
+        (0.03, "rotor.mistuning = 0.03: must be a non-empty list of numbers > -1"),
     ],
 )
 def test_bad_mistuning_is_refused_in_one_line_when_loaded(mistuning, says):
@@ -168,9 +146,8 @@ def test_bad_mistuning_is_refused_in_one_line_when_loaded(mistuning, says):
 
 
 def test_mistuning_of_a_single_blade_is_refused():
-    text = SCENE.format(mistuning="mistuning = [0.01]").replace("sectors = 6\n", "")
     with pytest.raises(SceneError, match=r"rotor.mistuning = \[0.01\]: .* set rotor.sectors"):
-        loads_scene(text)
+        _scene([0.01], sectors=None)
 
 
 def test_the_scenes_mistuning_reaches_the_model_and_its_report(wheel):
@@ -182,7 +159,7 @@ def test_the_scenes_mistuning_reaches_the_model_and_its_report(wheel):
     difference = (mistuned.blocks.K - tuned.blocks.K).toarray()
     np.testing.assert_allclose(difference, added, rtol=0, atol=1e-12 * np.abs(added).max())
     assert np.abs(added).max() > 1e-3 * disk.omega.min() ** 2
-    report = _report(_scene(f"mistuning = {FACTORS}"), parts, mistuned)
+    report = _report(_scene(FACTORS), parts, mistuned)
     assert report["bladed_disk"]["mistuning"] == {"factors": FACTORS, "max_abs": 0.05}
     report["reduction"] = {"error": {"estimate": 0.0, "reference_sizes": [], "tolerance": 0.0}}
     report["scheme"] = {"name": "theta", "h": 1e-6, "steps": 1000}
