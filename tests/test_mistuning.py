@@ -40,9 +40,9 @@ from scipy.optimize import minimize_scalar
 from small_wheel import scene_tables
 
 from femrub.app.explain import explain
-from femrub.app.wheel import _model, _report, wheel_parts
+from femrub.app.wheel import _model, _report, transfer, wheel_parts
 from femrub.model.wheel import mistuning_stiffness
-from femrub.reduction.cyclic_ritz import cyclic_basis
+from femrub.reduction.cyclic_ritz import cyclic_bases
 from femrub.scene import SceneError, loads_scene
 
 N = 6
@@ -69,14 +69,15 @@ def _scene(mistuning=None, sectors=N):
 
 @pytest.fixture(scope="module")
 def wheel():
-    """The scene's parts (mistuned by ``FACTORS``), its disk basis and the rows of every
-    blade's mean circumferential tip displacement ``(N, n)``."""
+    """The scene's parts (mistuned by ``FACTORS``), its disk basis (3 modes per nodal
+    diameter), the rows of every blade's mean circumferential tip displacement ``(N, n)``
+    and the richer basis of the reduction error estimate (``3 + 2`` modes)."""
     parts = wheel_parts(_scene(FACTORS))
-    disk = cyclic_basis(parts.disk, 3, parts.rows)
+    disk, richer = cyclic_bases(parts.disk, [3, 5], parts.rows)
     nc = parts.contacts.n
     circumferential = parts.rows[nc + 1 :: 2]  # tangent rows: axial, circumferential per contact
     rows = disk.sector_rows(circumferential).mean(axis=1)
-    return parts, disk, rows
+    return parts, disk, rows, richer
 
 
 def _with(parts, factors=None, damping=None):
@@ -151,7 +152,7 @@ def test_mistuning_of_a_single_blade_is_refused():
 
 
 def test_the_scenes_mistuning_reaches_the_model_and_its_report(wheel):
-    parts, disk, _ = wheel
+    parts, disk, _, richer = wheel
     assert parts.mistuning == tuple(FACTORS)
     added = mistuning_stiffness(parts.disk, disk, FACTORS, parts.material, 0.045)
     mistuned, _ = _model(parts, disk, None)
@@ -159,6 +160,13 @@ def test_the_scenes_mistuning_reaches_the_model_and_its_report(wheel):
     difference = (mistuned.blocks.K - tuned.blocks.K).toarray()
     np.testing.assert_allclose(difference, added, rtol=0, atol=1e-12 * np.abs(added).max())
     assert np.abs(added).max() > 1e-3 * disk.omega.min() ** 2
+    # the reduction estimate's richer wheel, mistuned alike: on the run's coordinates (which
+    # its basis spans) its stiffness is the run's
+    reference, _ = _model(parts, richer, None)
+    T = transfer(disk, richer, parts.disk.M)
+    K = mistuned.blocks.K.toarray()
+    restricted = T.T @ reference.blocks.K.toarray() @ T
+    np.testing.assert_allclose(restricted, K, rtol=0, atol=1e-9 * np.abs(K).max())
     report = _report(_scene(FACTORS), parts, mistuned)
     assert report["bladed_disk"]["mistuning"] == {"factors": FACTORS, "max_abs": 0.05}
     report["reduction"] = {"error": {"estimate": 0.0, "reference_sizes": [], "tolerance": 0.0}}
@@ -171,7 +179,7 @@ def test_the_scenes_mistuning_reaches_the_model_and_its_report(wheel):
 
 @pytest.mark.parametrize("k", [1, 2])
 def test_tuned_wheel_responds_alike_on_every_blade_up_to_the_travelling_phase(wheel, k):
-    parts, disk, rows = wheel
+    parts, disk, rows, _ = wheel
     model, _ = _model(_with(parts), disk, None)
     _, _, blades = _peak(model, rows, k, parts.config.disk_damping)
     np.testing.assert_allclose(np.abs(blades), np.abs(blades[0]), rtol=1e-9)
@@ -183,7 +191,7 @@ def test_uniform_mistuning_only_shifts_the_frequency(wheel):
     """``δ_s = δ`` on every blade keeps the wheel cyclic: the tuned response's shape, its
     peak at the stiffer family's frequency, its amplitude that of the tuned peak scaled by
     the frequencies' ratio (the damping kept: ``|x| = f / (c ω)``)."""
-    parts, disk, rows = wheel
+    parts, disk, rows, _ = wheel
     delta, k, zeta = 0.04, 2, parts.config.disk_damping
     tuned, _ = _model(_with(parts), disk, None)
     stiffer, _ = _model(_with(parts, [delta] * N), disk, None)
@@ -200,7 +208,7 @@ def test_mistuned_peak_stays_under_whiteheads_bound(wheel):
     tenth of it (the premise of the module docstring): every pattern's peak over the tuned
     peak is at most ``(1 + √N) / 2``, and mistuning amplifies the response (by far more than
     the blades' own stiffness changes, below 1e-3)."""
-    parts, disk, rows = wheel
+    parts, disk, rows, _ = wheel
     spread = _spread(disk)
     assert spread < 1e-3  # the weak coupling of the module docstring
     second = min(h.omega[1] for h in disk.harmonics)
@@ -224,7 +232,7 @@ def test_large_mistuning_of_a_weakly_coupled_wheel_localises(wheel):
     the half-power width: every blade vibrates alone, the largest peak is the softest
     blade's, ``ω̄ / ω_s`` times the tuned one to 1 % (the damping fixed; the shape of the
     blade's mode changes it a little), far under the bound."""
-    parts, disk, rows = wheel
+    parts, disk, rows, _ = wheel
     zeta = parts.config.disk_damping
     tuned, _ = _model(_with(parts), disk, None)
     a0, w0, _ = _peak(tuned, rows, 1, zeta)
