@@ -22,8 +22,9 @@ the tangential relative displacement is the blade's less the casing's.
 
 Mistuning: blade ``s`` has its stiffness scaled by ``1 + δ_s``. With ``K_b`` the stiffness of
 the elements above the disk's rim on the sector and ``U_s`` the disk coordinates' field in
-sector ``s``, the disk's reduced stiffness gains ``Σ_s δ_s U_sᵀ K_b U_s`` (the tuned basis
-kept, as in component mode mistuning).
+sector ``s``, the disk's reduced stiffness gains ``Σ_s δ_s U_sᵀ K_b U_s`` (Eq. 5 of
+docs/bladed-disk.md; the tuned basis kept: the mistuning projected on the tuned wheel's
+modes and residual shapes, as in the subset-of-nominal-modes method).
 """
 
 from __future__ import annotations
@@ -175,8 +176,26 @@ def mistuning_stiffness(
 ) -> np.ndarray:
     """``Σ_s δ_s U_sᵀ K_b U_s`` (module docstring) on the disk's coordinates.
 
-    ``K_b``: the elastic stiffness (``material``) of the sector's elements whose vertices all
-    lie outside ``rim_radius`` (m): the blade, without the disk or the prestress.
+    Parameters
+    ----------
+    structure : CyclicStructure
+        The disk's sector (its mesh, basis and free dofs).
+    disk : CyclicBasis
+        The disk's coordinates; ``U_s`` is their field in sector ``s``.
+    factors : array_like
+        ``(N,)`` δ_s (dimensionless, each > −1): blade ``s``'s stiffness times ``1 + δ_s``.
+    material : Material
+        The blades' material; ``K_b`` is the elastic stiffness (N/m) of the sector's
+        elements whose vertices all lie outside ``rim_radius`` (m): the blade above the rim,
+        without the disk or the prestress.
+    rim_radius : float
+        The disk's rim radius (m).
+
+    Returns
+    -------
+    numpy.ndarray
+        ``(disk.size, disk.size)`` symmetric stiffness (rad²/s²: the coordinates are
+        mass-normalised) to add to the disk's ``diag(ω̂²)``.
     """
     factors = np.asarray(factors, dtype=float)
     mesh = structure.sector.mesh.mesh
