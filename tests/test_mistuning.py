@@ -40,7 +40,9 @@ from scipy.optimize import minimize_scalar
 from small_wheel import scene_tables
 
 from femrub.app.explain import explain
+from femrub.app.modes import ModesResult, write_modes_folder
 from femrub.app.wheel import _model, _report, transfer, wheel_parts
+from femrub.model.cyclic import ModeTable
 from femrub.model.wheel import mistuning_stiffness
 from femrub.reduction.cyclic_ritz import cyclic_bases
 from femrub.scene import SceneError, loads_scene
@@ -172,6 +174,14 @@ def test_the_scenes_mistuning_reaches_the_model_and_its_report(wheel):
     report["reduction"] = {"error": {"estimate": 0.0, "reference_sizes": [], "tolerance": 0.0}}
     report["scheme"] = {"name": "theta", "h": 1e-6, "steps": 1000}
     assert "mistuned: blade s's stiffness times 1 + δ_s, max |δ_s| = 5 %" in explain(report)
+
+
+def test_modes_say_the_mistuning_is_not_applied(tmp_path):
+    """``femrub modes`` gives the tuned wheel's modes by nodal diameter: its summary says so."""
+    table = ModeTable(np.arange(4), np.ones(4, dtype=int), np.full(4, 1120.0), 1000.0)
+    summary = write_modes_folder(ModesResult({"disk": table}), tmp_path, _scene(FACTORS))
+    assert summary["mistuning"].startswith("not applied: the modes by nodal diameter are the tuned")
+    assert "mistuning" not in write_modes_folder(ModesResult({"disk": table}), tmp_path, _scene())
 
 
 # -- the forced response ------------------------------------------------------------------
