@@ -209,8 +209,8 @@ def test_uniform_mistuning_only_shifts_the_frequency(wheel):
     a1, w1, blades = _peak(stiffer, rows, k, zeta)
     travelling = blades * np.exp(-1j * k * ALPHA * np.arange(N))
     np.testing.assert_allclose(travelling, travelling[0], rtol=1e-6)  # round-off, Q = 500
-    assert 1.0 + 0.4 * delta < (w1 / w0) ** 2 < 1.0 + delta
-    assert a1 * w1 == pytest.approx(a0 * w0, rel=1e-2)
+    assert 1.0 + 0.8 * delta < (w1 / w0) ** 2 < 1.0 + delta  # the blade's share of the energy
+    assert a1 * w1 == pytest.approx(a0 * w0, rel=2e-3)
 
 
 def test_mistuned_peak_stays_under_whiteheads_bound(wheel):
@@ -240,7 +240,7 @@ def test_mistuned_peak_stays_under_whiteheads_bound(wheel):
 def test_large_mistuning_of_a_weakly_coupled_wheel_localises(wheel):
     """About 3 % mistuning, a hundred times the coupling, its factors apart by more than
     the half-power width: every blade vibrates alone, the largest peak is the softest
-    blade's, ``ω̄ / ω_s`` times the tuned one to 1 % (the damping fixed; the shape of the
+    blade's, ``ω̄ / ω_s`` times the tuned one to 0.5 % (the damping fixed; the shape of the
     blade's mode changes it a little), far under the bound."""
     parts, disk, rows, _ = wheel
     zeta = parts.config.disk_damping
@@ -251,6 +251,6 @@ def test_large_mistuning_of_a_weakly_coupled_wheel_localises(wheel):
         a, _, blades = _peak(model, rows, 1, zeta)
         softest = _family(model).min()
         assert np.argmax(np.abs(blades)) == np.argmin(factors)
-        assert np.sort(np.abs(blades))[-2] < 0.3 * a
-        assert a / a0 == pytest.approx(w0 / softest, rel=1e-2)
+        assert np.sort(np.abs(blades))[-2] < 0.2 * a
+        assert a / a0 == pytest.approx(w0 / softest, rel=5e-3)
         assert 1.0 < a / a0 <= WHITEHEAD
