@@ -83,6 +83,7 @@ def wheel():
 
 
 def _with(parts, factors=None, damping=None):
+    """``parts`` mistuned by ``factors`` (``None``: tuned), with the disk's damping ratio."""
     config = parts.config if damping is None else replace(parts.config, disk_damping=damping)
     factors = None if factors is None else tuple(factors)
     return replace(parts, mistuning=factors, config=config)
