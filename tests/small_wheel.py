@@ -18,3 +18,18 @@ def disk_sector():
     return bladed_disk_sector(
         N, d["hub_radius"], d["rim_radius"], d["thickness"], BLADE, h=d["h"], h_min=d["h_min"]
     )
+
+
+def scene_tables(**rotor) -> dict:
+    """The wheel as the ``geometry``, ``material`` and ``rotor`` tables of a scene (SI), with
+    more ``rotor`` keys."""
+    d = DISK
+    return {
+        "geometry": {"kind": "naca", **BLADE, "h": d["h"], "h_min": d["h_min"]},
+        "material": {"young": TITANIUM.young, "poisson": TITANIUM.poisson, "density": TITANIUM.rho},
+        "rotor": {
+            "sectors": N,
+            **{k: d[k] for k in ("hub_radius", "rim_radius", "thickness")},
+            **rotor,
+        },
+    }

@@ -327,6 +327,7 @@ def _wheel_rows(report: dict) -> list:
             f"{w['sector_free_dofs']} free dofs per sector; casing: {w['casing']}; "
             f"direction {'counterclockwise' if w['direction'] > 0 else 'clockwise'}",
         ),
+        ("blades", _mistuning_text(w.get("mistuning"))),
         (
             "model",
             f"{w['disk_coordinates']} disk and {w['casing_coordinates']} casing coordinates "
@@ -346,3 +347,13 @@ def _wheel_rows(report: dict) -> list:
         ("outputs", "no VTK for a bladed disk yet"),
         ("timings", format_timings(report.get("timings", {}))),
     ]
+
+
+def _mistuning_text(mistuning) -> str:
+    """A bladed disk's blades: tuned, or mistuned by ``rotor.mistuning``."""
+    if not mistuning:
+        return "tuned (identical blades)"
+    return (
+        f"mistuned: blade s's stiffness times 1 + δ_s, max |δ_s| = "
+        f"{100 * mistuning['max_abs']:.3g} % (rotor.mistuning)"
+    )

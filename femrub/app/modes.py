@@ -327,5 +327,10 @@ def write_modes_folder(
         "coincidence_rule": "k Ω = ω_disk,k + ω_casing,k (disk backward wave, casing forward)",
         "timings": timings,
     }
+    if scene["rotor"].get("mistuning"):
+        summary["mistuning"] = (
+            "not applied: the modes by nodal diameter are the tuned wheel's (femrub run applies "
+            "rotor.mistuning)"
+        )
     write_json(out / "summary.json", summary)
     return summary

@@ -4,7 +4,9 @@ The scene's disk sector (``rotor.*``, the NACA blade of ``geometry.*``) is prest
 ``loads.rotation_speed`` (``loads.centrifugal``) and reduced per nodal diameter with the
 residual shapes of ``rotor.contacts`` contacts on each blade's tip; the casing ring
 (``casing.ring.*``, when it has a ``thickness``; a rigid round casing otherwise) enters as
-waves of the rotating frame (:mod:`femrub.model.wheel`). The model is its own full model:
+waves of the rotating frame (:mod:`femrub.model.wheel`); ``rotor.mistuning`` scales
+blade ``s``'s elastic stiffness by ``1 + δ_s`` (:func:`~femrub.model.wheel.mistuning_stiffness`
+on each model's disk basis: the run's and the reference's alike). The model is its own full model:
 its coordinates are mass-normalised, so the mass norm of the wheel's displacement is the
 norm of its displacement coordinates.
 
@@ -34,7 +36,13 @@ from ..analysis.step_check import check_step
 from ..geometry.rotation_direction import ROTATION_DIRECTIONS, derive_rotation_direction
 from ..model.casing_waves import casing_harmonics, ring_line_loads, waves_of
 from ..model.cyclic import cyclic_structure
-from ..model.wheel import WheelConfig, contact_rows_of_sector, tip_contacts, wheel_model
+from ..model.wheel import (
+    WheelConfig,
+    contact_rows_of_sector,
+    mistuning_stiffness,
+    tip_contacts,
+    wheel_model,
+)
 from ..output.wheel_vtk import WheelFields
 from ..reduction.cyclic_ritz import CyclicBasis, cyclic_bases
 from ..reduction.estimate import HORIZON_SHARE, estimate, perturbed
@@ -62,6 +70,8 @@ class WheelParts:
     bore: float
     tip_radius: float
     config: WheelConfig
+    mistuning: tuple | None = None  # δ_s per blade (rotor.mistuning); None: tuned
+    material: object = None  # the blades' material (their stiffness scaled by 1 + δ_s)
 
 
 def _direction(scene, sector) -> float:
@@ -117,7 +127,15 @@ def wheel_parts(scene, log=None) -> WheelParts:
         bore,
         tip_radius,
         _config(scene, sector),
+        _mistuning(scene),
+        material,
     )
+
+
+def _mistuning(scene) -> tuple | None:
+    """``rotor.mistuning`` as a tuple, ``None`` for a tuned wheel (no factor or all zero)."""
+    factors = scene["rotor"].get("mistuning")
+    return tuple(factors) if factors and any(factors) else None
 
 
 def _check_start(scene, disk, contacts, tip_radius: float) -> None:
@@ -160,7 +178,13 @@ def _band(axial: np.ndarray) -> float:
 
 
 def _model(parts: WheelParts, disk, waves):
-    blade = parts.tip_radius - parts.disk.sector.info["rim_radius"]
+    """The wheel's model on the bases ``disk`` and ``waves``, the blades' mistuning projected
+    on ``disk`` (the run's model and the reference's alike)."""
+    rim = parts.disk.sector.info["rim_radius"]
+    blade = parts.tip_radius - rim
+    extra = None
+    if parts.mistuning is not None:
+        extra = mistuning_stiffness(parts.disk, disk, parts.mistuning, parts.material, rim)
     return wheel_model(
         parts.config,
         parts.disk,
@@ -169,6 +193,7 @@ def _model(parts: WheelParts, disk, waves):
         waves,
         tip_radius=parts.tip_radius,
         blade_size=blade,
+        mistuning=extra,
     )
 
 
@@ -294,6 +319,14 @@ def _report(scene, parts: WheelParts, model) -> dict:
             "tip_radius": parts.tip_radius,
             "direction": c.direction,
             "ramp": c.ramp,
+            "mistuning": _mistuning_report(parts.mistuning),
         },
         "model": {"n_dofs": model.n_dofs},
     }
+
+
+def _mistuning_report(factors) -> dict | None:
+    """``None`` for a tuned wheel, else the factors δ_s and their largest magnitude."""
+    if factors is None:
+        return None
+    return {"factors": list(factors), "max_abs": float(np.abs(factors).max())}

@@ -21,19 +21,23 @@ with the casing sliding at ``−σ Ω r_p`` (:func:`~femrub.contact.casing.slidi
 the tangential relative displacement is the blade's less the casing's.
 
 Mistuning: blade ``s`` has its stiffness scaled by ``1 + δ_s``. With ``K_b`` the stiffness of
-the elements above the disk's rim on the sector and ``U_s`` the disk coordinates' field in
-sector ``s``, the disk's reduced stiffness gains ``Σ_s δ_s U_sᵀ K_b U_s`` (the tuned basis
-kept, as in component mode mistuning).
+the blade's elements on the sector (centroid outside the disk's rim) and ``U_s`` the disk
+coordinates' field in sector ``s``, the disk's reduced stiffness gains
+``Σ_s δ_s U_sᵀ K_b U_s`` (Eq. 5 of docs/bladed-disk.md; the tuned basis kept: the mistuning
+projected on the tuned wheel's modes and residual shapes, as in the subset-of-nominal-modes
+method).
 """
 
 from __future__ import annotations
 
 import math
+from contextlib import nullcontext
 from dataclasses import dataclass, replace
 
 import numpy as np
 import scipy.sparse as sp
 
+from ..blas import SERIAL_SETUP_DOFS, one_blas_thread
 from ..contact.casing import (
     Concentric,
     Lobed,
@@ -173,22 +177,43 @@ def mistuning_stiffness(
 ) -> np.ndarray:
     """``Σ_s δ_s U_sᵀ K_b U_s`` (module docstring) on the disk's coordinates.
 
-    ``K_b``: the elastic stiffness (``material``) of the sector's elements whose vertices all
-    lie outside ``rim_radius`` (m): the blade, without the disk or the prestress.
+    Parameters
+    ----------
+    structure : CyclicStructure
+        The disk's sector (its mesh, basis and free dofs).
+    disk : CyclicBasis
+        The disk's coordinates; ``U_s`` is their field in sector ``s``.
+    factors : array_like
+        ``(N,)`` δ_s (dimensionless, each > −1): blade ``s``'s stiffness times ``1 + δ_s``.
+    material : Material
+        The blades' material; ``K_b`` is the elastic stiffness (N/m) of the sector's
+        elements whose centroid lies outside ``rim_radius`` (m): the blade, without the disk
+        (whose vertices all lie inside the rim) or the prestress. The blade's root elements,
+        which reach below the rim where the root is sunk into the disk, are the blade's:
+        on a coarse mesh they hold much of a bending mode's strain energy.
+    rim_radius : float
+        The disk's rim radius (m).
+
+    Returns
+    -------
+    numpy.ndarray
+        ``(disk.size, disk.size)`` symmetric stiffness (rad²/s²: the coordinates are
+        mass-normalised) to add to the disk's ``diag(ω̂²)``.
     """
     factors = np.asarray(factors, dtype=float)
     mesh = structure.sector.mesh.mesh
     radius = np.hypot(mesh.p[1], mesh.p[2])
-    blade = np.flatnonzero(np.all(radius[mesh.t] > rim_radius * (1.0 + 1e-9), axis=0))
+    blade = np.flatnonzero(radius[mesh.t].mean(axis=0) > rim_radius * (1.0 + 1e-9))
     lam, mu = lame_parameters(material.young, material.poisson, 3)
     Kb = isotropic_stiffness(structure.basis.with_elements(blade), lam, mu)
     Kb = sp.csr_matrix(Kb)[structure.free][:, structure.free]
     out = np.zeros((disk.size, disk.size))
-    for s, delta in enumerate(factors):
-        if delta == 0.0:
-            continue
-        U = disk.sector_field(np.eye(disk.size), s)  # (n_free, size)
-        out += delta * (U.T @ (Kb @ U))
+    with one_blas_thread if disk.size <= SERIAL_SETUP_DOFS else nullcontext():
+        for s, delta in enumerate(factors):
+            if delta == 0.0:
+                continue
+            U = disk.sector_field(np.eye(disk.size), s)  # (n_free, size)
+            out += delta * (U.T @ (Kb @ U))
     return 0.5 * (out + out.T)
 
 

@@ -44,11 +44,11 @@ PHYSICAL_BOUNDS: dict[str, tuple[float, float]] = {
 def check_physical(key: str, spec: Spec, value) -> None:
     """Raise a one-line ``SceneError`` when a dimensional ``value`` of ``key`` is out of bounds.
 
-    ``value`` is the normalised (SI) value of a float, pair or vec3 key; words (``"auto"``)
+    ``value`` is the normalised (SI) value of a float, pair, vec3 or floats key; words (``"auto"``)
     and dimensionless keys pass.
     """
     bounds = PHYSICAL_BOUNDS.get(spec.dim)
-    if bounds is None or spec.kind not in ("float", "pair", "vec3"):
+    if bounds is None or spec.kind not in ("float", "pair", "vec3", "floats"):
         return
     items = value if isinstance(value, list) else [value]
     for i, x in enumerate(items):

@@ -37,6 +37,14 @@ ROTOR = {
     "damping_ratio": _f(
         0.01, "none", "modal damping ratio of the disk's modes (time integration)", lo=0.0, hi=1.0
     ),
+    "mistuning": Spec(
+        "floats",
+        None,
+        lo=-1.0,
+        lo_open=True,
+        doc="per-blade stiffness factors δ_s: blade s's elastic stiffness times 1 + δ_s "
+        "(unset: tuned)",
+    ),
 }
 
 CASING_RING = {
@@ -78,6 +86,7 @@ CASING_SECTION = {"ring": CASING_RING}
 def check_rotor(d: dict) -> None:
     """Refuse a bladed disk or casing ring whose keys contradict each other (one line)."""
     rotor, ring = d["rotor"], d["casing"]["ring"]
+    _check_mistuning(rotor)
     if rotor.get("sectors") is None:
         if ring.get("thickness") is not None:
             fail(
@@ -105,4 +114,25 @@ def check_rotor(d: dict) -> None:
             "casing.ring.distortion",
             ring["distortion"],
             "an out-of-roundness needs its order: set casing.ring.lobes >= 1",
+        )
+
+
+def _check_mistuning(rotor: dict) -> None:
+    """``rotor.mistuning``: one factor per blade of a bladed disk."""
+    factors, n = rotor.get("mistuning"), rotor.get("sectors")
+    if factors is None:
+        return
+    if n is None:
+        fail(
+            "rotor.mistuning",
+            factors,
+            "per-blade stiffness factors need a bladed disk; set rotor.sectors (the number of "
+            "blades) or remove rotor.mistuning",
+        )
+    if len(factors) != n:
+        fail(
+            "rotor.mistuning",
+            factors,
+            f"give one factor δ_s per blade: {n} numbers (rotor.sectors = {n}), not "
+            f"{len(factors)}; 0 for a blade as designed",
         )

@@ -69,8 +69,9 @@ class Spec:
     Parameters
     ----------
     kind : ``"float"``, ``"int"``, ``"bool"``, ``"str"``, ``"choice"``, ``"vec3"``,
-        ``"pair"`` (two floats), ``"ints"`` (list of int), ``"strs"`` (list of str),
-        ``"tables"`` (an array of tables, each checked against ``items``).
+        ``"pair"`` (two floats), ``"ints"`` (list of int), ``"floats"`` (a non-empty list
+        of numbers, each within the bounds), ``"strs"`` (list of str), ``"tables"`` (an
+        array of tables, each checked against ``items``).
     default : value used when the key is absent (``REQUIRED``: must be given; ``None``:
         left to the builder).
     dim : unit dimension of a float (:mod:`femrub.scene.units`).
@@ -94,7 +95,9 @@ class Spec:
 
     @property
     def unit(self) -> str:
-        return SI_LABEL.get(self.dim, "-") if self.kind in ("float", "pair", "vec3") else "-"
+        return (
+            SI_LABEL.get(self.dim, "-") if self.kind in ("float", "pair", "vec3", "floats") else "-"
+        )
 
     def _bounds(self, key, value, x):
         if not math.isfinite(x):
@@ -179,6 +182,16 @@ class Spec:
         if not ok or any(isinstance(v, bool) or not isinstance(v, int) for v in value):
             fail(key, value, "must be a non-empty list of integers")
         return [int(v) for v in value]
+
+    def _check_floats(self, key, value) -> list:
+        """Each number checked as a float key ``key[i]`` of the same unit and bounds; an error
+        also says what the list means (``doc``)."""
+        if not isinstance(value, list) or not value:
+            fail(key, value, f"must be a non-empty list of numbers{self._range()}: {self.doc}")
+        try:
+            return [self._number(f"{key}[{i}]", v) for i, v in enumerate(value)]
+        except SceneError as exc:
+            raise SceneError(f"{exc} ({key}: {self.doc})") from None
 
     def _check_tables(self, key, value) -> list:
         """Each table's keys checked (unknown, required, defaults); absent keys left out."""
