@@ -292,6 +292,7 @@ OTHER_PAGES = {
     "speed-map-costs.md": "A 40-speed interaction map: where a sweep point's time goes",
     "prestress-campbell-costs.md": "Centrifugal prestress and Campbell diagrams",
     "periodic-rotor37.md": "Periodic orbits of reduced Rotor 37: cost and time runs",
+    "bladed-disk.md": "The built-in bladed disk: cost and its sweep against the coincidence",
 }
 
 #: the full tables the studies write (linked from the overview)
