@@ -19,6 +19,7 @@ import tomli_w
 from small_wheel import N, scene_tables
 
 from femrub.app.cli import main
+from femrub.app.probes import probe_points, wheel_probes
 from femrub.app.scheme import bare_stepper
 from femrub.app.sweep import _write_csv, point_metrics
 from femrub.app.wheel import _bases, _model, wheel_parts
@@ -236,3 +237,26 @@ def test_run_writes_the_probes_of_every_blade(tmp_path):
     assert float(written["max_probe_tip_y_m"]) == pytest.approx(
         metrics["probes"]["max_probe_tip_y_m"]
     )
+
+
+def test_a_node_number_is_the_sector_meshs_node_tag(wheel):
+    """``node`` names the sector mesh's gmsh node tag: the same rows as ``point`` there; an
+    unknown number is refused by key (``wheel_parts`` asks right after meshing the sector,
+    before assembling it)."""
+    _, parts, _, _, _ = wheel
+    mesh = parts.disk.sector.mesh
+    tip = int(mesh.require("tip")[0])
+    tag = int(mesh.vertex_ids[tip])
+    position = mesh.mesh.p[:, tip].tolist()
+    probes = [
+        {"name": "by_node", "node": tag, "component": "z", "blade": "all"},
+        {"name": "by_point", "point": position, "component": "z", "blade": "all"},
+    ]
+    scene = _scene(probes)
+    at = probe_points(scene, mesh)
+    (a, b), entries, _ = wheel_probes(scene, parts.disk, at)
+    assert entries[0]["distance"] == 0.0 and entries[1]["distance"] < 1e-12
+    assert (a.rows != b.rows).nnz == 0 and np.array_equal(a.direction, b.direction)
+    bad = _scene([{"name": "far", "node": 10**7, "component": "x"}])
+    with pytest.raises(SceneError, match=r"^outputs.probes\[0\].node = 10000000: no such node"):
+        probe_points(bad, mesh)
