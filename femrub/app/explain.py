@@ -260,10 +260,22 @@ def _probe_text(probe: dict) -> str:
     if "point" in probe:
         asked %= tuple([*probe["point"], 0.0, 0.0][:3])
     at = ", ".join(f"{x:.6g}" for x in probe["position"])
-    return (
+    text = (
         f"probe_{probe['name']}: {what} ({probe['unit']}) at {asked}; "
         f"mesh node at ({at}) m, {probe['distance']:.3g} m away"
     )
+    return text + _blade_text(probe)
+
+
+def _blade_text(probe: dict) -> str:
+    """Which blade of a bladed disk a probe reads (its node is the sector's: blade 0's)."""
+    blade = probe.get("blade")
+    if blade is None:
+        return ""
+    if blade == "all":
+        keys = probe["keys"]
+        return f"; read on every blade ({keys[0]} .. {keys[-1]})"
+    return f"; read on blade {blade} (the sector's node turned by {blade} sectors)"
 
 
 def _output_rows(report: dict) -> list[tuple[str, str]]:
@@ -344,6 +356,7 @@ def _wheel_rows(report: dict) -> list:
             f"(tolerance {100 * step.get('tolerance', 0.0):.3g} %)",
         ),
         ("scheme", f"{scheme.get('name')} h = {scheme.get('h'):g} s, {scheme.get('steps')} steps"),
+        *[("probe", _probe_text(p)) for p in report.get("probes", [])],
         ("outputs", "no VTK for a bladed disk yet"),
         ("timings", format_timings(report.get("timings", {}))),
     ]

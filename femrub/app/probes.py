@@ -4,7 +4,10 @@
 into coordinates right after the mesh is read, so an unknown node number is refused before
 any assembly. :func:`probe_observations` then finds each probe's mesh node, its direction
 and its observation row (:mod:`femrub.model.probes`) on the full model, named
-``probe_<name>``; the reduction projects these rows like the model's other signals.
+``probe_<name>``; the reduction projects these rows like the model's other signals. On a
+bladed disk (``rotor.sectors``) :func:`wheel_probes` finds the node on the sector's mesh
+and the probe reads it on the blade ``blade`` (or on every blade), as an observation of the
+wheel's coordinates (:mod:`femrub.model.wheel_probes`).
 
 Node numbers: a CalculiX/Abaqus deck's node numbers (mid-side nodes included), a gmsh file's
 node tags (corner nodes); a blade femrub builds (box, naca, sections) has the node tags of
@@ -17,13 +20,14 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..model.probes import FIELDS, direction, mesh_nodes, probe_rows
+from ..model.probes import FIELDS, direction, mesh_nodes, node_rows, probe_rows
+from ..model.wheel_probes import GLOBAL_AXES, WheelProbe
 from ..output.results import PROBE_PREFIX
-from ..scene.schema_run import PROBE_QUANTITIES
+from ..scene.schema_run import PROBE_QUANTITIES, probe_names
 from ..scene.spec import SceneError, fail
 from ..scene.units import SI_LABEL
 
-__all__ = ["probe_observations", "probe_points", "probe_unit"]
+__all__ = ["probe_observations", "probe_points", "probe_unit", "wheel_probes"]
 #: distance from a node number's own position to the model's node, relative to the mean edge
 #: length, above which it is no node of the model (a node no element uses); a quadratic
 #: deck's mid-side node is exact with P2 displacements and within this of the straight
@@ -126,27 +130,79 @@ def probe_observations(scene, built, points):
                 f"{key}.quantity = 'temperature': {exc} ({built.thermal[1]}); probe a "
                 "displacement, or set physics.thermal = 'on'"
             ) from None
-        name = probe["name"]
-        obs[PROBE_PREFIX + name] = row
-        entry = {
-            "name": name,
-            "quantity": quantity,
-            "component": component,
-            "unit": probe_unit(quantity),
-            **({"node": probe["node"]} if "node" in probe else {"point": list(map(float, x))}),
-            "position": site["position"].tolist(),
-            "distance": site["distance"],
-            "direction": None if d is None else d.tolist(),
-        }
-        report.append(entry)
-        if site["distance"] > spacing:
-            warnings.append(
-                f"{key} ({name!r}): the nearest node is {site['distance']:.3g} m away, more "
-                f"than the mesh's mean edge length {spacing:.3g} m; check the point's unit"
-            )
-        if row.nnz == 0:
-            warnings.append(f"{key} ({name!r}): the node is clamped, the probe reads 0")
+        obs[PROBE_PREFIX + probe["name"]] = row
+        report.append(_entry(probe, x, site, d))
+        warnings += _warnings(key, probe["name"], site, spacing, row.nnz == 0)
     return obs, report, warnings
+
+
+def _entry(probe, x, site, d) -> dict:
+    """What a probe reads and where (the build's report, ``--explain``)."""
+    quantity = probe["quantity"]
+    return {
+        "name": probe["name"],
+        "quantity": quantity,
+        "component": probe.get("component"),
+        "unit": probe_unit(quantity),
+        **({"node": probe["node"]} if "node" in probe else {"point": list(map(float, x))}),
+        "position": site["position"].tolist(),
+        "distance": site["distance"],
+        "direction": None if d is None else d.tolist(),
+    }
+
+
+def _warnings(key, name, site, spacing, clamped) -> list[str]:
+    """A probe far from its node (a point in the wrong unit?) or on a clamped node."""
+    out = []
+    if site["distance"] > spacing:
+        out.append(
+            f"{key} ({name!r}): the nearest node is {site['distance']:.3g} m away, more "
+            f"than the mesh's mean edge length {spacing:.3g} m; check the point's unit"
+        )
+    if clamped:
+        out.append(f"{key} ({name!r}): the node is clamped, the probe reads 0")
+    return out
+
+
+def wheel_probes(scene, structure, points):
+    """The probes of a bladed disk's scene on its sector (:mod:`femrub.model.wheel_probes`)
+    and what to report of them.
+
+    Parameters
+    ----------
+    scene : Scene
+        Its ``outputs.probes`` (checked when loaded: a displacement or velocity, ``blade``
+        below ``rotor.sectors``).
+    structure : CyclicStructure
+        The disk's sector (:mod:`femrub.model.cyclic`): its mesh is blade 0's, in the
+        sector's axes.
+    points : list of numpy.ndarray
+        Each probe's position on the sector (:func:`probe_points`).
+
+    Returns
+    -------
+    tuple
+        ``(probes, report, warnings)``: a :class:`~femrub.model.wheel_probes.WheelProbe` per
+        probe, one dict per probe as :func:`probe_observations` reports (its position on the
+        sector, blade 0's) with its ``blade`` (an integer or ``"all"``) and the history
+        ``keys`` it writes, and the warnings.
+    """
+    disc, n = structure.disc, structure.n_sectors
+    nodes, spacing = mesh_nodes(disc), _mean_edge(disc)
+    probes, report, warnings = [], [], []
+    for i, (probe, x) in enumerate(zip(scene["outputs"]["probes"], points, strict=True)):
+        key = f"outputs.probes[{i}]"
+        site = _site(probe, x, nodes, spacing, key)
+        component, blade = probe["component"], probe.get("blade", 0)
+        d = direction(disc.blade, site["position"], component)
+        rows = node_rows(structure.basis, nodes, site["node"], np.eye(3))[:, structure.free]
+        keys = tuple(PROBE_PREFIX + name for name in probe_names(probe, n))
+        blades = tuple(range(n)) if blade == "all" else (blade,)
+        field = FIELDS[probe["quantity"]]
+        probes.append(WheelProbe(keys, blades, field, rows, d, component in GLOBAL_AXES))
+        report.append({**_entry(probe, x, site, d), "blade": blade, "keys": list(keys)})
+        warnings += _warnings(key, probe["name"], site, spacing, rows.nnz == 0)
+    return tuple(probes), report, warnings
 
 
 def _mean_edge(disc) -> float:

@@ -48,7 +48,9 @@ from ..reduction.cyclic_ritz import CyclicBasis, cyclic_bases
 from ..reduction.estimate import HORIZON_SHARE, estimate, perturbed
 from ..scene.spec import fail
 from . import translate as tr
+from .build_warnings import warn
 from .modes import casing_sector, ring_material, rotor_sector
+from .probes import probe_points, wheel_probes
 from .scheme import bare_stepper, stepper_of
 
 __all__ = ["WheelParts", "build_wheel", "transfer", "wheel_parts"]
@@ -72,6 +74,8 @@ class WheelParts:
     config: WheelConfig
     mistuning: tuple | None = None  # δ_s per blade (rotor.mistuning); None: tuned
     material: object = None  # the blades' material (their stiffness scaled by 1 + δ_s)
+    probes: tuple = ()  # WheelProbe per outputs.probes (femrub.model.wheel_probes)
+    probe_report: tuple = ()  # (report entries, warnings) of the probes (app.probes)
 
 
 def _direction(scene, sector) -> float:
@@ -105,6 +109,7 @@ def _config(scene, sector) -> WheelConfig:
 def wheel_parts(scene, log=None) -> WheelParts:
     """Mesh and assemble the scene's sectors, prestress the disk, place the contacts."""
     sector = rotor_sector(scene)
+    probe_at = probe_points(scene, sector.mesh)  # node numbers checked before any assembly
     material = tr.material_of(scene)
     method = tr.centrifugal_of(scene) or "off"
     omega = float(scene["loads"]["rotation_speed"])
@@ -119,6 +124,7 @@ def wheel_parts(scene, log=None) -> WheelParts:
     if scene["casing"]["ring"].get("thickness") is not None:
         ring = cyclic_structure(casing_sector(scene, tip_radius), ring_material(scene))
     _check_start(scene, disk, contacts, tip_radius)
+    probes, entries, warnings = wheel_probes(scene, disk, probe_at)
     return WheelParts(
         disk,
         contacts,
@@ -129,6 +135,8 @@ def wheel_parts(scene, log=None) -> WheelParts:
         _config(scene, sector),
         _mistuning(scene),
         material,
+        probes,
+        (entries, warnings),
     )
 
 
@@ -194,6 +202,7 @@ def _model(parts: WheelParts, disk, waves):
         tip_radius=parts.tip_radius,
         blade_size=blade,
         mistuning=extra,
+        probes=parts.probes,
     )
 
 
@@ -279,6 +288,9 @@ def build_wheel(scene, log=None):
     timings["reduction"] = time.perf_counter() - t1
     limits = {}
     report = _report(scene, parts, model)
+    report["probes"], probe_warnings = parts.probe_report or ([], [])
+    for msg in probe_warnings:
+        warn(msg, report, log)
     t2 = time.perf_counter()
     err, run, wall = _reduction_check(scene, parts, small, rich, model, limits, log)
     report["reduction"] = {"method": "cyclic", "error": err}

@@ -32,7 +32,7 @@ from scipy.spatial import cKDTree
 from ..contact.points import _component_of
 from .build import _observations
 
-__all__ = ["FIELDS", "MeshNodes", "direction", "mesh_nodes", "probe_rows"]
+__all__ = ["FIELDS", "MeshNodes", "direction", "mesh_nodes", "node_rows", "probe_rows"]
 
 #: the state block of each probed quantity
 FIELDS = {"displacement": "u", "velocity": "v", "temperature": "theta"}
@@ -111,13 +111,21 @@ def _node_dofs(basis, nodes: MeshNodes, node: int):
     return np.column_stack([_node_dofs(basis, nodes, int(v))[0][:, 0] for v in verts]), weights
 
 
+def node_rows(basis, nodes: MeshNodes, node: int, directions) -> sp.csr_matrix:
+    """``(r, basis.N)`` rows ``d_iᵀ u(x_node)`` on every displacement dof of ``basis``, one
+    per direction of ``directions`` ``(r, dim)`` (the global axes ``np.eye(dim)``: the
+    node's displacement vector)."""
+    d = np.atleast_2d(np.asarray(directions, dtype=float))
+    dofs, weights = _node_dofs(basis, nodes, node)  # (dim, m), (m,)
+    vals = (d[:, :, None] * weights[None, None, :]).reshape(d.shape[0], -1)
+    rows = np.repeat(np.arange(d.shape[0]), vals.shape[1])
+    cols = np.tile(dofs.ravel(), d.shape[0])
+    return sp.csr_matrix((vals.ravel(), (rows, cols)), shape=(d.shape[0], basis.N))
+
+
 def _displacement_row(disc, mats, nodes: MeshNodes, node: int, d: np.ndarray) -> sp.csr_matrix:
     """(1, n_u) row ``dᵀ u(x_node)`` on the free displacement dofs."""
-    dofs, weights = _node_dofs(disc.basis_u, nodes, node)  # (dim, m), (m,)
-    vals = (d[:, None] * weights[None, :]).ravel()
-    full = sp.csr_matrix(
-        (vals, (np.zeros(vals.size, dtype=int), dofs.ravel())), shape=(1, mats.n_u_all)
-    )
+    full = node_rows(disc.basis_u, nodes, node, d)
     return sp.csr_matrix(full @ mats.prolongation_u())
 
 

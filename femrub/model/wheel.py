@@ -55,6 +55,8 @@ from ..reduction.cyclic_ritz import CyclicBasis
 from .build import ContactSpec, first_order_model
 from .casing_waves import CasingWaves, cylindrical_components, rotating_blocks
 from .first_order import CasingSweep, FirstOrderModel, Parameters
+from .wheel_probes import UNITS as PROBE_UNITS
+from .wheel_probes import wheel_probe_rows
 
 __all__ = [
     "WheelConfig",
@@ -284,16 +286,23 @@ def _as_matrices(M, C, K) -> ThermoelasticMatrices:
     )
 
 
-def _observations(Dn: np.ndarray, n_blades: int, nc: int, n_u: int) -> dict:
-    """Mean normal tip displacement of blade 0 and of every blade (the blade alone), rows
-    on the ``n_u`` displacement coordinates (``Dn`` on the disk's)."""
-    Dn = np.hstack([Dn, np.zeros((Dn.shape[0], n_u - Dn.shape[1]))])
+def _observations(Dn: np.ndarray, n_blades: int, nc: int, n_u: int, probes=None) -> dict:
+    """Mean normal tip displacement of blade 0 and of every blade (the blade alone), and the
+    probes' rows (``{key: (field, row)}`` on the disk's coordinates,
+    :func:`~femrub.model.wheel_probes.wheel_probe_rows`), rows on the ``n_u`` displacement
+    coordinates (``Dn`` on the disk's)."""
+
+    def padded(rows):
+        return np.hstack([rows, np.zeros((rows.shape[0], n_u - rows.shape[1]))])
+
+    Dn = padded(Dn)
     per_blade = Dn.reshape(n_blades, nc, -1).mean(axis=1)
     return {
         "tip_displacement": ("u", per_blade[:1]),
         "tip_velocity": ("v", per_blade[:1]),
         "blade_tip_displacement": ("u", per_blade),
         "contact_displacement": ("u", Dn),
+        **{key: (field, padded(row)) for key, (field, row) in (probes or {}).items()},
     }
 
 
@@ -307,6 +316,7 @@ def wheel_model(
     tip_radius: float,
     blade_size: float,
     mistuning=None,
+    probes=(),
 ) -> tuple[FirstOrderModel, WheelMap]:
     """The first-order model of the wheel against the casing (module docstring).
 
@@ -330,6 +340,9 @@ def wheel_model(
     mistuning : numpy.ndarray, optional
         ``(n_disk, n_disk)`` stiffness added to the disk's coordinates
         (:func:`mistuning_stiffness`).
+    probes : sequence of WheelProbe, optional
+        Probes observed on the blades they read (:mod:`femrub.model.wheel_probes`), with
+        their units in ``info["signal_units"]``.
     """
     N, nc = disk.n_sectors, contacts.n
     Nrows, Trows = _contact_rows(disk, casing, structure, contacts, N)
@@ -361,10 +374,12 @@ def wheel_model(
         **friction,
     )
     n_disk = disk.size
+    observed = {k: v for p in probes for k, v in wheel_probe_rows(p, disk).items()}
+    units = {key: PROBE_UNITS[field] for key, (field, _) in observed.items()}
     model = first_order_model(
         _as_matrices(M, C, K),
         contact=spec,
-        observe=_observations(Nrows[:, :n_disk], N, nc, Nrows.shape[1]),
+        observe=_observations(Nrows[:, :n_disk], N, nc, Nrows.shape[1], observed),
         thermal=False,
         info=dict(
             kind="bladed-disk",
@@ -374,6 +389,7 @@ def wheel_model(
             casing_coordinates=0 if casing is None else casing.size,
             rotation_speed=omega,
             rotation_direction=float(config.direction),
+            **({"signal_units": units} if units else {}),
         ),
         length_scale=float(blade_size),
         parameters=Parameters(rotation_speed=omega),

@@ -44,6 +44,9 @@ STAGES = ("mesh", "assembly", "reduction", "stepping", "output")
 OPTIONAL_STAGES = ("step_check",)
 
 
+#: most probe panels of signals.png (the first probes; every probe is in history.npz/.csv):
+#: a bladed disk's probe on every blade has a history per blade
+MAX_PROBE_PANELS = 12
 #: what each curve of signals.png is, for several contact points
 SIGNAL_TITLES = {
     "tip_displacement": "mean normal displacement of the contact points",
@@ -326,7 +329,7 @@ def _finish(  # noqa: PLR0913 (run_to_folder's options passed on)
     with naming(out / "history.npz"):
         res.save_npz(out / "history.npz")
     panels = [k for k in ("tip_displacement", "tip_temperature") if k in res.signals]
-    panels += [k for k in res.signals if k.startswith(PROBE_PREFIX)]
+    panels += [k for k in res.signals if k.startswith(PROBE_PREFIX)][:MAX_PROBE_PANELS]
     if plots:
         savefig(
             tip_panels(

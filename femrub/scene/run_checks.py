@@ -84,7 +84,6 @@ _WHEEL_REFUSALS = (
     ("contact.abradable.thickness", lambda v: v > 0, "no abradable coating on the ring yet"),
     ("contact.casing_heat.thickness", lambda v: v > 0, "no casing heat model on the ring yet"),
     ("loads.tip_force.law", lambda v: v != "none", "no tip force on a bladed disk"),
-    ("outputs.probes", lambda v: bool(v), "no node probes on a bladed disk yet"),
     ("scheme.name", lambda v: v != "theta", "a bladed disk runs the θ-method"),
 )
 

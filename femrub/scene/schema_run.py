@@ -17,6 +17,7 @@ __all__ = [
     "PROBE_COMPONENTS",
     "PROBE_QUANTITIES",
     "REDUCTION",
+    "probe_names",
     "SCHEME",
     "SIGNALS",
 ]
@@ -167,7 +168,26 @@ PROBE = {
         "circumferential (axis × radial) about the machine axis at the node; none for "
         "temperature",
     ),
+    "blade": Spec(
+        I,
+        None,
+        lo=0,
+        choices=("all",),
+        doc="a bladed disk (rotor.sectors): the blade s (0 to N - 1) whose node is read, the "
+        "sector's node turned by s 2π/N about the axis (unset: blade 0), or 'all': one "
+        "history per blade, probe_<name>_blade<s>",
+    ),
 }
+
+
+def probe_names(probe: dict, n_blades: int | None = None) -> list[str]:
+    """The names a probe table records under (``probe_<name>``): its ``name``, or with
+    ``blade = "all"`` on a wheel of ``n_blades`` blades ``<name>_blade<s>`` for
+    ``s = 0 .. n_blades − 1``."""
+    if probe.get("blade") != "all":
+        return [probe["name"]]
+    return [f"{probe['name']}_blade{s}" for s in range(n_blades)]
+
 
 OUTPUTS = {
     "signals": Spec("strs", "all", choices=("all",), doc="history signals kept"),

@@ -132,7 +132,8 @@ class Spec:
             if value in self.choices:
                 return value
             if self.kind != "float":
-                fail(key, value, f"use one of {', '.join(map(repr, self.choices))} or a list")
+                other = "an integer" if self.kind == "int" else "a list"
+                fail(key, value, f"use one of {', '.join(map(repr, self.choices))} or {other}")
         check = getattr(self, f"_check_{self.kind}", None)
         if check is None:  # pragma: no cover
             raise AssertionError(self.kind)
@@ -147,7 +148,7 @@ class Spec:
 
     def _check_int(self, key, value) -> int:
         if isinstance(value, bool) or not isinstance(value, int):
-            fail(key, value, f"must be an integer{self._range()}")
+            fail(key, value, f"must be an integer{self._range()}{self._words(', or ')}")
         self._bounds(key, value, value)
         return int(value)
 

@@ -17,7 +17,7 @@ from .activation import check_activation
 from .bounds import check_physical
 from .schema import SCHEMA, TOP
 from .schema_rotor import check_rotor
-from .schema_run import PROBE_COMPONENTS
+from .schema_run import PROBE_COMPONENTS, probe_names
 from .spec import REQUIRED, SceneError, Variant, fail, unknown_key
 
 __all__ = ["normalize", "check_files", "signals_for", "MAX_STEPS"]
@@ -273,15 +273,50 @@ def _check_probe(key: str, probe: dict, d: dict) -> None:
         fail(f"{key}.component", component, "the 1D bar moves along x only; use 'x' or 'radial'")
 
 
+def _check_wheel_probe(key: str, probe: dict, d: dict) -> None:
+    """``blade`` only on a bladed disk (``rotor.sectors``), one of its blades; no
+    temperature there (a wheel has no temperature dofs)."""
+    n, blade = d["rotor"].get("sectors"), probe.get("blade")
+    if n is None:
+        if blade is not None:
+            fail(
+                f"{key}.blade",
+                blade,
+                "a single-blade scene has one blade; remove the key, or set rotor.sectors "
+                "for a bladed disk",
+            )
+        return
+    if probe["quantity"] == "temperature":
+        fail(
+            f"{key}.quantity",
+            "temperature",
+            "a bladed disk (rotor.sectors) has no temperature dofs; probe a displacement or "
+            "a velocity",
+        )
+    if blade != "all" and blade is not None and blade >= n:
+        fail(
+            f"{key}.blade",
+            blade,
+            f"the wheel has {n} blades (rotor.sectors = {n}); give 0 to {n - 1}, or 'all'",
+        )
+
+
 def _check_probes(d: dict) -> None:
-    """``outputs.probes``: each table (:func:`_check_probe`), names used once."""
-    seen = set()
+    """``outputs.probes``: each table (:func:`_check_wheel_probe`, :func:`_check_probe`),
+    the names each records under (``blade = "all"``: one per blade) used once."""
+    seen = {}
     for i, probe in enumerate(d["outputs"]["probes"]):
         key = f"outputs.probes[{i}]"
+        _check_wheel_probe(key, probe, d)
         _check_probe(key, probe, d)
-        if probe["name"] in seen:
-            fail(f"{key}.name", probe["name"], "another probe has this name; name each once")
-        seen.add(probe["name"])
+        for name in probe_names(probe, d["rotor"].get("sectors")):
+            if name in seen:
+                fail(
+                    f"{key}.name",
+                    probe["name"],
+                    f"another probe ({seen[name]}) records probe_{name}; name each probe once",
+                )
+            seen[name] = key
 
 
 def _check_scheme(d: dict) -> None:
