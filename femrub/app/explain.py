@@ -287,9 +287,7 @@ def _output_rows(report: dict) -> list[tuple[str, str]]:
         rows.append(("limits", ", ".join(f"{k} <= {v:g}" for k, v in report["limits"].items())))
     rows += [("ignored", note) for note in report.get("ignored", [])]
     rows += [("probe", _probe_text(p)) for p in report.get("probes", [])]
-    o = report["outputs"]
-    vtk = f"VTK every {o['vtk_stride']} steps" if o["vtk_stride"] else None
-    rows.append(("outputs", vtk or "no VTK (outputs.vtk_stride = 0)"))
+    rows.append(("outputs", _vtk_text(report["outputs"]["vtk_stride"])))
     if report.get("natural_frequencies_hz"):
         rows.append(
             ("modes", ", ".join(f"{x:.4g}" for x in report["natural_frequencies_hz"]) + " Hz")
@@ -357,9 +355,13 @@ def _wheel_rows(report: dict) -> list:
         ),
         ("scheme", f"{scheme.get('name')} h = {scheme.get('h'):g} s, {scheme.get('steps')} steps"),
         *[("probe", _probe_text(p)) for p in report.get("probes", [])],
-        ("outputs", "no VTK for a bladed disk yet"),
+        ("outputs", _vtk_text(report.get("outputs", {}).get("vtk_stride", 0))),
         ("timings", format_timings(report.get("timings", {}))),
     ]
+
+
+def _vtk_text(stride: int) -> str:
+    return f"VTK every {stride} steps" if stride else "no VTK (outputs.vtk_stride = 0)"
 
 
 def _mistuning_text(mistuning) -> str:

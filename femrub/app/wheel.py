@@ -334,6 +334,7 @@ def _report(scene, parts: WheelParts, model) -> dict:
             "mistuning": _mistuning_report(parts.mistuning),
         },
         "model": {"n_dofs": model.n_dofs},
+        "outputs": {"vtk_stride": scene["outputs"]["vtk_stride"]},
     }
 
 
