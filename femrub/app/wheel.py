@@ -173,16 +173,16 @@ def _bases(parts: WheelParts, sizes) -> list:
     harmonics = casing_harmonics(parts.ring.n_sectors)
     reading = parts.bore * (1.0 + 1e-6)  # just inside the ring's bore
     axial = parts.contacts.points[0]
-    loads = ring_line_loads(parts.ring, np.unique(axial), reading, _band(axial))
+    positions = np.unique(axial)
+    loads = ring_line_loads(parts.ring, positions, reading, _band(positions))
     rings = cyclic_bases(parts.ring, [c for _, c in sizes], loads, harmonics=harmonics)
     return [(d, waves_of(parts.ring, r, axial, reading)) for d, r in zip(disks, rings, strict=True)]
 
 
-def _band(axial: np.ndarray) -> float:
-    """The axial width (m) a contact's load on the ring is spread over: the contacts' axial
-    spacing (0 for a single axial position)."""
-    x = np.unique(axial)
-    return 0.0 if x.size < 2 else float(np.ptp(x)) / (x.size - 1)
+def _band(positions: np.ndarray) -> float:
+    """The axial width (m) a contact's load on the ring is spread over: the mean spacing of
+    the contacts' distinct axial ``positions`` (0 for a single one)."""
+    return 0.0 if positions.size < 2 else float(np.ptp(positions)) / (positions.size - 1)
 
 
 def _model(parts: WheelParts, disk, waves):

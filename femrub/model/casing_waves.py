@@ -128,30 +128,22 @@ def ring_line_loads(structure, axial: np.ndarray, radius: float, band: float = 0
     axial = np.asarray(axial, dtype=float)
     if band > 0.0:
         g, gw = np.polynomial.legendre.leggauss(3)
-        x = (axial[:, None] + 0.5 * band * g[None, :]).ravel()
-        xw = np.tile(0.5 * gw, axial.size)
     else:
-        x, xw, g = axial, np.ones(axial.size), np.zeros(1)
+        g, gw = np.zeros(1), np.full(1, 2.0)
+    x = (axial[:, None] + 0.5 * band * g[None, :]).ravel()  # (n_pos × n_g,) position-major
     probe, phi, w = _bore_probe(structure, x, radius)
-    n_x = x.size
     s, c = np.sin(phi), np.cos(phi)
-    directions = {  # (component, φ) in global axes (x, y, z) of the bore points
-        "radial": np.stack([np.zeros_like(phi), -s, c]),
-        "circumferential": np.stack([np.zeros_like(phi), -c, -s]),
-    }
-    per_position = g.size
+    zero = np.zeros_like(phi)
+    # (direction, component, φ): radial and circumferential in global axes (x, y, z)
+    directions = np.stack([np.stack([zero, -s, c]), np.stack([zero, -c, -s])])
+    # (position, point): each position's weights on its own axial Gauss points
+    weights = np.kron(np.eye(axial.size), 0.5 * gw[None, :])
 
     def rows(k: int) -> sp.csr_matrix:
-        out = []
-        wave = w * np.exp(1j * k * phi)  # (n_phi,)
-        for p in range(axial.size):
-            span = slice(p * per_position, (p + 1) * per_position)
-            weight = np.zeros(n_x)
-            weight[span] = xw[span]
-            for d in directions.values():
-                coeff = d[:, None, :] * weight[None, :, None] * wave[None, None, :]
-                out.append(sp.csr_matrix(coeff.reshape(1, -1)) @ probe)
-        return sp.vstack(out).tocsr()[:, structure.free]
+        wave = w * np.exp(1j * k * phi)  # (n_φ,)
+        coeff = np.einsum("dcq,px,q->pdcxq", directions, weights, wave)
+        coeff = coeff.reshape(2 * axial.size, -1)  # rows (position, direction) as probe's
+        return sp.csr_matrix(coeff @ probe)[:, structure.free]
 
     return rows
 
