@@ -34,6 +34,7 @@ __all__ = [
     "full_wheel",
     "set_periodic",
     "sector_angle",
+    "sector_turns",
 ]
 
 
@@ -41,6 +42,12 @@ def axis_rotation(beta: float) -> np.ndarray:
     """``R(β)``: the turn by ``β`` (rad) about the machine axis ``+x``, shape ``(3, 3)``."""
     c, s = np.cos(beta), np.sin(beta)
     return np.array([[1.0, 0.0, 0.0], [0.0, c, -s], [0.0, s, c]])
+
+
+def sector_turns(n_sectors: int) -> np.ndarray:
+    """``(N, 3, 3)``: ``R(sα)`` of every sector ``s`` of ``N`` (``α = 2π/N``)."""
+    alpha = 2.0 * np.pi / n_sectors
+    return np.stack([axis_rotation(s * alpha) for s in range(n_sectors)])
 
 
 def sector_angle(points: np.ndarray) -> np.ndarray:

@@ -50,7 +50,7 @@ from ..contact.points import ContactPoints, locate_contacts
 from ..fem.assembly import ThermoelasticMatrices
 from ..fem.elasticity import isotropic_stiffness
 from ..fem.forms import lame_parameters
-from ..geometry.cyclic_sector import axis_rotation, sector_angle
+from ..geometry.cyclic_sector import sector_angle, sector_turns
 from ..reduction.cyclic_ritz import CyclicBasis
 from .build import ContactSpec, first_order_model
 from .casing_waves import CasingWaves, cylindrical_components, rotating_blocks
@@ -222,9 +222,7 @@ def mistuning_stiffness(
 def _frames(contacts: ContactPoints, n_blades: int) -> np.ndarray:
     """``(N n_c, 3, 3)``: normal, axial and circumferential directions in global axes."""
     local = contacts.frames()  # (n_c, 3, 3) in the sector's axes
-    alpha = 2.0 * math.pi / n_blades
-    turns = np.stack([axis_rotation(s * alpha) for s in range(n_blades)])
-    return np.einsum("sab,pdb->spda", turns, local).reshape(-1, 3, 3)
+    return np.einsum("sab,pdb->spda", sector_turns(n_blades), local).reshape(-1, 3, 3)
 
 
 def _contact_angles(contacts: ContactPoints, n_blades: int):

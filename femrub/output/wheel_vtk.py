@@ -44,7 +44,7 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.sparse as sp
 
-from ..geometry.cyclic_sector import axis_rotation, full_wheel
+from ..geometry.cyclic_sector import full_wheel, sector_turns
 from ..model.wheel import WheelMap
 from .frame_fields import _scatter
 from .vtk import FrameSink, VTKSeries
@@ -65,12 +65,6 @@ WHEEL_FIELD_UNITS = {
 def _comment(frame: str, names) -> str:
     units = ", ".join(f"{k} [{WHEEL_FIELD_UNITS[k]}]" for k in names)
     return f"<!-- femrub units: {units} ; time in s ; {frame} -->"
-
-
-def _turns(n_sectors: int) -> np.ndarray:
-    """``(N, 3, 3)``: ``R(sα)`` of every copy."""
-    alpha = 2.0 * math.pi / n_sectors
-    return np.stack([axis_rotation(s * alpha) for s in range(n_sectors)])
 
 
 class CyclicVertexField:
@@ -100,7 +94,7 @@ class CyclicVertexField:
         self.points = np.ascontiguousarray(mesh.mesh.p.T)
         self.cells = np.ascontiguousarray(mesh.mesh.t.T)
         self.n_sectors = basis.n_sectors
-        self.turns = _turns(self.n_sectors)
+        self.turns = sector_turns(self.n_sectors)
         self.vertex_rows = _vertex_rows(structure)
         self._blocks, ks = [], []
         for h, start, m, pair in basis.blocks():
