@@ -52,6 +52,7 @@ friction = 0.02
 rotation_speed = {SPEED}
 centrifugal = "linear"
 [scheme]
+step_check = true
 h = {REVOLUTION / 1500!r}
 t_end = {3 * REVOLUTION!r}
 [outputs]
@@ -72,6 +73,7 @@ def test_run_writes_every_blade_and_both_checks(scene_file, tmp_path):
     s = json.loads((out / "summary.json").read_text())
     assert s["status"] in ("ok", "inaccurate"), s["message"]
     assert s["steps"] == 4500
+    assert s["timings"]["step_check"] > 0.0 and s["timings"]["reduction"] > 0.0
     for check in ("reduction_error", "time_step_error"):
         assert 0.0 <= s[check]["estimate"] < 1.0 and s[check]["tolerance"] > 0.0
     with np.load(out / "history.npz") as h:

@@ -343,6 +343,8 @@ def _wheel_rows(report: dict) -> list:
             f"{w['disk_coordinates']} disk and {w['casing_coordinates']} casing coordinates "
             "(per nodal diameter: modes and the tip contacts' residual shapes)",
         ),
+        *_casing_rows(report),
+        *_blade_heat_rows(report),
         (
             "reduction",
             f"estimated error {100 * err['estimate']:.3g} % against the richer wheel "
@@ -350,14 +352,25 @@ def _wheel_rows(report: dict) -> list:
         ),
         (
             "time step",
-            f"estimated error {100 * step.get('estimate', 0.0):.3g} % "
-            f"(tolerance {100 * step.get('tolerance', 0.0):.3g} %)",
+            f"estimated error {100 * step['estimate']:.3g} % "
+            f"(tolerance {100 * step['tolerance']:.3g} %)"
+            if step
+            else "not checked (scheme.step_check = false)",
         ),
         ("scheme", f"{scheme.get('name')} h = {scheme.get('h'):g} s, {scheme.get('steps')} steps"),
         *[("probe", _probe_text(p)) for p in report.get("probes", [])],
         ("outputs", _vtk_text(report.get("outputs", {}).get("vtk_stride", 0))),
         ("timings", format_timings(report.get("timings", {}))),
     ]
+
+
+def _blade_heat_rows(report: dict) -> list:
+    """A bladed disk's blades take their share of the frictional heat out of the run."""
+    ch = report.get("casing_heat")
+    if not ch:
+        return []
+    share = f"{100 * ch['partition']:.3g} %"
+    return [("blade heat", f"the blades' share ({share}) leaves the run: no temperature dofs")]
 
 
 def _vtk_text(stride: int) -> str:

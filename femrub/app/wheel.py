@@ -10,7 +10,7 @@ on each model's disk basis: the run's and the reference's alike). The model is i
 its coordinates are mass-normalised, so the mass norm of the wheel's displacement is the
 norm of its displacement coordinates.
 
-Checks, as for a single blade, both stepping the scene's scheme to ``scheme.t_end``:
+Checks, as for a single blade, stepping the scene's scheme to ``scheme.t_end``:
 
 * the *reduction error estimate*: the run against the same wheel with richer bases
   (``rotor.families + 2`` modes per nodal diameter on the disk, ``casing.ring.families + 1``
@@ -19,14 +19,18 @@ Checks, as for a single blade, both stepping the scene's scheme to ``scheme.t_en
   (:func:`transfer`) and compared there by :func:`~femrub.reduction.estimate.estimate`
   (contact impulses per lobe passage, the wheel's displacement in the mass norm; with the
   round-off twin of the richer model when the response is sensitive);
-* the *time-step check* (:func:`~femrub.analysis.step_check.check_step`).
+* the *time-step check* (:func:`~femrub.analysis.step_check.check_step`), when
+  ``scheme.step_check`` asks for it (as for a single blade).
+
+``timings``: ``assembly``, ``reduction`` (the bases and the estimate's runs other than the
+run itself) and ``step_check``.
 """
 
 from __future__ import annotations
 
 import math
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 import scipy.sparse as sp
@@ -34,13 +38,16 @@ import scipy.sparse as sp
 from ..analysis.reduction_check import lobe_passage
 from ..analysis.step_check import check_step
 from ..geometry.rotation_direction import ROTATION_DIRECTIONS, derive_rotation_direction
+from ..model.builder import casing_heat_of, coating_of, heat_choice
 from ..model.casing_waves import casing_harmonics, ring_line_loads, waves_of
 from ..model.cyclic import cyclic_structure
 from ..model.wheel import (
+    CasingSurface,
     WheelConfig,
     contact_rows_of_sector,
     mistuning_stiffness,
     tip_contacts,
+    wheel_casing_grid,
     wheel_model,
 )
 from ..output.wheel_vtk import WheelFields
@@ -76,6 +83,7 @@ class WheelParts:
     material: object = None  # the blades' material (their stiffness scaled by 1 + δ_s)
     probes: tuple = ()  # WheelProbe per outputs.probes (femrub.model.wheel_probes)
     probe_report: tuple = ()  # (report entries, warnings) of the probes (app.probes)
+    surface: CasingSurface | None = None  # the casing's coating and wall heat
 
 
 def _direction(scene, sector) -> float:
@@ -125,6 +133,7 @@ def wheel_parts(scene, log=None) -> WheelParts:
         ring = cyclic_structure(casing_sector(scene, tip_radius), ring_material(scene))
     _check_start(scene, disk, contacts, tip_radius)
     probes, entries, warnings = wheel_probes(scene, disk, probe_at)
+    config = _config(scene, sector)
     return WheelParts(
         disk,
         contacts,
@@ -132,12 +141,29 @@ def wheel_parts(scene, log=None) -> WheelParts:
         ring,
         bore,
         tip_radius,
-        _config(scene, sector),
+        config,
         _mistuning(scene),
         material,
         probes,
         (entries, warnings),
+        _surface(scene, config, disk, contacts),
     )
+
+
+def _surface(scene, config: WheelConfig, disk, contacts) -> CasingSurface | None:
+    """The casing's abradable coating (``contact.abradable``) and wall heat
+    (``contact.casing_heat``) on the cells the blades sweep, or ``None`` without either."""
+    contact = tr.contact_config(scene)
+    cells = contact.abradable or contact.casing_heat
+    if cells is None:
+        return None
+    n_blades = disk.n_sectors
+    footprint = contact.abradable.footprint if contact.abradable is not None else 0.0
+    grid = wheel_casing_grid(config, disk, contacts, n_blades, cells, footprint)
+    heat = heat_choice(contact, contacts, 3)
+    heat = replace(heat, alpha=np.tile(heat.alpha, n_blades))
+    casing_heat = casing_heat_of(contact, grid, heat)  # its inputs checked by check_run
+    return CasingSurface(coating_of(contact, grid), casing_heat, heat.law, heat.eta, heat.alpha)
 
 
 def _mistuning(scene) -> tuple | None:
@@ -203,6 +229,7 @@ def _model(parts: WheelParts, disk, waves):
         blade_size=blade,
         mistuning=extra,
         probes=parts.probes,
+        surface=parts.surface,
     )
 
 
@@ -277,7 +304,7 @@ def build_wheel(scene, log=None):
     docstring): the wheel's model (also its full model), its fields (the whole wheel's VTK
     frames, :class:`~femrub.output.wheel_vtk.WheelFields`), its stepper, its run (stepped by
     the reduction error estimate) and the report."""
-    from .simulation import Simulation
+    from .simulation import Simulation, reusable_run
 
     timings, t0 = {}, time.perf_counter()
     parts = wheel_parts(scene, log)
@@ -294,24 +321,18 @@ def build_wheel(scene, log=None):
     t2 = time.perf_counter()
     err, run, wall = _reduction_check(scene, parts, small, rich, model, limits, log)
     report["reduction"] = {"method": "cyclic", "error": err}
-    states = run.states
-    step, _, _ = check_step(
-        scene,
-        model,
-        model,
-        lambda m, h: bare_stepper(scene, m, h=h),
-        limits,
-        run=(run, states),
-    )
-    report["time_step"] = step
-    timings["checks"] = time.perf_counter() - t2 - wall
+    timings["reduction"] += time.perf_counter() - t2 - wall  # the estimate, without the run
+    if scene["scheme"]["step_check"]:
+        t3 = time.perf_counter()
+        make = lambda m, h: bare_stepper(scene, m, h=h)  # noqa: E731
+        report["time_step"], _, _ = check_step(scene, model, model, make, limits, (run, run.states))
+        timings["step_check"] = time.perf_counter() - t3
     stepper = stepper_of(scene, model, report)
     report["timings"] = timings
     c = parts.config
     fields = WheelFields(wheel, parts.disk, parts.ring, c.rotation_speed, c.direction)
-    return Simulation(
-        scene, model, model, fields, None, stepper, limits, report, timings, (run, wall)
-    )
+    ran = (run, wall) if reusable_run(model) else None  # a coating's run: its wear is output
+    return Simulation(scene, model, model, fields, None, stepper, limits, report, timings, ran)
 
 
 def _report(scene, parts: WheelParts, model) -> dict:
@@ -335,7 +356,25 @@ def _report(scene, parts: WheelParts, model) -> dict:
         },
         "model": {"n_dofs": model.n_dofs},
         "outputs": {"vtk_stride": scene["outputs"]["vtk_stride"]},
+        **_surface_report(parts.surface),
     }
+
+
+def _surface_report(surface: CasingSurface | None) -> dict:
+    """The report's ``abradable`` and ``casing_heat`` entries (as a single blade's)."""
+    wear = surface.wear if surface is not None else None
+    heat = surface.casing_heat if surface is not None else None
+    out = {"abradable": wear.as_dict() if wear is not None else None, "casing_heat": None}
+    if heat is not None:
+        out["casing_heat"] = {
+            "thickness": heat.b,
+            "tau": heat.tau,
+            "partition": surface.heat_partition,
+            "expansion": heat.expansion,
+        }
+    if surface is not None:
+        out["friction"] = {"heat_law": surface.heat_law, "heat_partition": surface.heat_partition}
+    return out
 
 
 def _mistuning_report(factors) -> dict | None:

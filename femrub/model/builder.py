@@ -32,7 +32,7 @@ from ..fem.discretisation import assemble, discretise
 from ..fem.eigen import angular_frequencies
 from ..fem.prestress import centrifugal_prestress
 from ..geometry.rotation_direction import RotationDirection, derive_rotation_direction
-from .config import RubConfig
+from .config import ContactConfig, RubConfig
 from .rub import FieldMap, rub_model, tip_load
 
 __all__ = [
@@ -40,6 +40,9 @@ __all__ = [
     "HeatChoice",
     "RubBuild",
     "build_rub",
+    "casing_heat_of",
+    "coating_of",
+    "heat_choice",
     "length_scale",
     "rotation_direction",
 ]
@@ -169,9 +172,9 @@ def _reach(config: RubConfig, mats, candidates, loads, growth) -> Reach:
     )
 
 
-def heat_choice(config: RubConfig, points: ContactPoints, dim: int) -> HeatChoice:
+def heat_choice(contact: ContactConfig, points: ContactPoints, dim: int) -> HeatChoice:
     """The heat law of the kept ``points`` (Coulomb μ only on a 3D blade)."""
-    c = config.contact
+    c = contact
     mu = float(c.friction) if dim == 3 else 0.0
     eta = float(c.heat_partition)
     if c.heat_law == "power":
@@ -239,13 +242,17 @@ def casing_grid(config: RubConfig, blade, points, growth, sign=1.0) -> CasingGri
     )
 
 
-def _abradable(config: RubConfig, grid):
-    a = config.contact.abradable
+def coating_of(contact: ContactConfig, grid):
+    """The abradable coating ``contact.abradable`` on the casing cells ``grid``, or ``None``."""
+    a = contact.abradable
     return None if grid is None or a is None else Abradable(a.thickness, a.yield_force, grid)
 
 
-def _casing_heat(config: RubConfig, grid, heat: HeatChoice):
-    h = config.contact.casing_heat
+def casing_heat_of(contact: ContactConfig, grid, heat: HeatChoice):
+    """The casing wall's heat model ``contact.casing_heat`` on the casing cells ``grid``
+    heated by the casing's share of ``heat``, or ``None``; refused when no frictional heat
+    reaches the casing."""
+    h = contact.casing_heat
     if grid is None or h is None:
         return None
     mu = heat.mu if heat.law == "power" else 0.0
@@ -324,7 +331,7 @@ def build_rub(blade, config: RubConfig, *, stages=None, log=None) -> RubBuild:
     loads = _tip_loads(config, disc, mats, candidates)
     reach = _reach(config, mats, candidates, loads, growth)
     points = candidates.restrict(reach.keep)
-    heat = heat_choice(config, points, blade.dim)
+    heat = heat_choice(config.contact, points, blade.dim)
     thermal = thermal_choice(config, heat.heated, points.n > 0, blade.dim)
     rotation = rotation_direction(config, blade)
     grid = casing_grid(config, blade, points, growth[reach.keep], rotation.sign)
@@ -344,8 +351,8 @@ def build_rub(blade, config: RubConfig, *, stages=None, log=None) -> RubBuild:
         friction=heat.mu,
         heat_law=heat.law,
         heat_partition=heat.eta,
-        wear=_abradable(config, grid),
-        casing_heat=_casing_heat(config, grid, heat),
+        wear=coating_of(config.contact, grid),
+        casing_heat=casing_heat_of(config.contact, grid, heat),
         damping=damping,
         length_scale=length_scale(blade),
         direction=rotation.sign,

@@ -38,6 +38,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from ..blas import SERIAL_SETUP_DOFS, one_blas_thread
+from ..contact.abradable import CasingGrid
 from ..contact.casing import (
     Concentric,
     Lobed,
@@ -59,11 +60,13 @@ from .wheel_probes import UNITS as PROBE_UNITS
 from .wheel_probes import wheel_probe_rows
 
 __all__ = [
+    "CasingSurface",
     "WheelConfig",
     "WheelMap",
     "contact_rows_of_sector",
     "mistuning_stiffness",
     "tip_contacts",
+    "wheel_casing_grid",
     "wheel_model",
 ]
 
@@ -104,6 +107,55 @@ class WheelConfig:
     disk_damping: float = 0.0
     casing_damping: float = 0.0
     ramp: float = 0.0
+
+
+@dataclass(frozen=True)
+class CasingSurface:
+    """What the casing's surface carries besides its shape: the abradable coating and the
+    wall's heat, both on the cells every blade's contacts sweep (:func:`wheel_casing_grid`).
+
+    Attributes
+    ----------
+    wear : :class:`~femrub.contact.abradable.Abradable` or None
+        The coating (its wear map in the casing's fixed frame).
+    casing_heat : :class:`~femrub.contact.casing_heat.CasingHeat` or None
+        The wall's lumped temperatures and the clearance their expansion takes.
+    heat_law : str
+        ``"power"`` (the casing takes ``(1 − η)`` of the friction power) or ``"alpha"``.
+    heat_partition : float
+        η, the share of the frictional power that enters the blades.
+    alpha : numpy.ndarray
+        ``(N n_c,)`` heat coefficients (m/s) of the ``"alpha"`` law, blade by blade.
+    """
+
+    wear: object = None
+    casing_heat: object = None
+    heat_law: str = "alpha"
+    heat_partition: float = 1.0
+    alpha: np.ndarray | float = 0.0
+
+
+def wheel_casing_grid(
+    config: WheelConfig, structure, contacts: ContactPoints, n_blades: int, cells, footprint=0.0
+) -> CasingGrid:
+    """The casing cells swept by the tip contacts of all ``n_blades`` blades.
+
+    Contact ``(s, p)`` sits at casing angle ``σ Ω t + φ_sp`` (Eq. 1) and axial position
+    ``x_p`` (the sector's axis); the grid's radius is the largest tip radius grown at Ω.
+    ``cells``: the coating's or the casing heat's configuration (``n_angle``, ``n_axial``);
+    ``footprint``: the circumferential width (m) a contact reads the coating over.
+    """
+    _, angles = _contact_angles(contacts, n_blades)
+    growth = contacts.normal_displacement(structure.static)
+    return CasingGrid(
+        angles,
+        np.tile(contacts.points[0], n_blades),
+        float(np.max(contacts.radii + growth)),
+        config.direction * float(config.rotation_speed),
+        n_angle=cells.n_angle,
+        n_axial=cells.n_axial,
+        footprint=footprint,
+    )
 
 
 @dataclass(frozen=True)
@@ -225,6 +277,19 @@ def _frames(contacts: ContactPoints, n_blades: int) -> np.ndarray:
     return np.einsum("sab,pdb->spda", sector_turns(n_blades), local).reshape(-1, 3, 3)
 
 
+def _surface_terms(surface: CasingSurface | None) -> dict:
+    """The contact specification's terms of the casing's coating and heat."""
+    if surface is None:
+        return {}
+    return dict(
+        wear=surface.wear,
+        casing_heat=surface.casing_heat,
+        heat_law=surface.heat_law,
+        heat_partition=surface.heat_partition,
+        heat_coefficient=surface.alpha,
+    )
+
+
 def _contact_angles(contacts: ContactPoints, n_blades: int):
     """Angles (rad, rotor frame) of the sector's contacts ``(n_c,)`` and of every blade's
     ``(N n_c,)``, blade by blade."""
@@ -315,6 +380,7 @@ def wheel_model(
     blade_size: float,
     mistuning=None,
     probes=(),
+    surface: CasingSurface | None = None,
 ) -> tuple[FirstOrderModel, WheelMap]:
     """The first-order model of the wheel against the casing (module docstring).
 
@@ -341,6 +407,8 @@ def wheel_model(
     probes : sequence of WheelProbe, optional
         Probes observed on the blades they read (:mod:`femrub.model.wheel_probes`), with
         their units in ``info["signal_units"]``.
+    surface : CasingSurface, optional
+        The casing's coating and wall heat (none when ``None``).
     """
     N, nc = disk.n_sectors, contacts.n
     Nrows, Trows = _contact_rows(disk, casing, structure, contacts, N)
@@ -370,6 +438,7 @@ def wheel_model(
         restitution=config.restitution,
         names=[f"blade{s}_contact{p}" for s in range(N) for p in range(nc)],
         **friction,
+        **_surface_terms(surface),
     )
     n_disk = disk.size
     observed = {k: v for p in probes for k, v in wheel_probe_rows(p, disk).items()}

@@ -25,7 +25,9 @@ dissipation::
 (``w_t,m = Gvtᵀ X_m − v_c``, the mid-step slip velocity; a scheme that integrates the
 tangential work ``∫ λ_t · Gvtᵀ X dt`` itself hands it as ``tangential_work``).
 ``friction_heat`` is then the heat the stepper put into the blade and
-``heat_to_casing = friction_work − friction_heat``.
+``heat_to_casing = friction_work − friction_heat``; on a model without blade temperatures
+(a bladed disk, a blade run with ``physics.thermal = "off"``) nothing enters the blade and
+``heat_to_casing`` is the casing's share ``Σ_i (1 − η_i)`` of each contact's friction work.
 """
 
 from __future__ import annotations
@@ -45,6 +47,19 @@ BLOWUP_FACTOR = 1e3
 
 _WORKS = ("external_work", "thermal_work", "damping_work", "contact_work")
 _HEATS = ("friction_heat", "heat_load", "heat_outflow")
+
+
+def _heat_to_casing(contact, inc: dict, Pt: np.ndarray, Xm: np.ndarray) -> np.ndarray:
+    """The casing's share of each step's friction work under the ``"power"`` law: what the
+    blade did not take (``friction_work − friction_heat``), or, on a model without blade
+    temperatures (no heat enters a blade dof), ``Σ_i (1 − η_i) (−P_t,i · w_t,m,i)``: the
+    blade's share ``η`` then leaves the model's bookkeeping instead of being counted as the
+    casing's."""
+    if contact.has_heat or not Pt.shape[1]:
+        return inc.get("friction_work", 0.0) - inc["friction_heat"]
+    slip = (Xm @ contact.Gvt).reshape(Pt.shape) - contact.casing_velocity
+    per_contact = -np.einsum("kij,kij->ki", Pt, slip)
+    return per_contact @ (1.0 - contact.heat_partition)
 
 
 class EnergyMeter:
@@ -146,7 +161,7 @@ class EnergyMeter:
                     inc["impact_dissipation"] = -dwc
                 inc["friction_heat"] = heat.sum(axis=1)
                 if c.heat_law == "power":
-                    inc["heat_to_casing"] = inc.get("friction_work", 0.0) - inc["friction_heat"]
+                    inc["heat_to_casing"] = _heat_to_casing(c, inc, Pt, Xm)
         inc["heat_outflow"] = h * (Xm @ f.heat_outflow)
         for k in WORK_KEYS[1:6]:  # the stepper's own, where it gave them
             if k in own:

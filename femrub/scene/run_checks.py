@@ -81,8 +81,6 @@ def check_friction(scene) -> None:
 #: what a bladed-disk run does not model, as ``(key, refused when, the value's meaning)``
 _WHEEL_REFUSALS = (
     ("physics.thermal", lambda v: v == "on", "a bladed disk runs without temperature dofs"),
-    ("contact.abradable.thickness", lambda v: v > 0, "no abradable coating on the ring yet"),
-    ("contact.casing_heat.thickness", lambda v: v > 0, "no casing heat model on the ring yet"),
     ("loads.tip_force.law", lambda v: v != "none", "no tip force on a bladed disk"),
     ("scheme.name", lambda v: v != "theta", "a bladed disk runs the θ-method"),
 )
@@ -97,6 +95,36 @@ def check_bladed_disk(scene) -> None:
         value = scene.get(key)
         if value is not None and refused(value):
             fail(key, value, f"{why}; remove it, or remove rotor.sectors to run one blade")
+    _check_casing_heat(scene)
+
+
+def _check_casing_heat(scene) -> None:
+    """A bladed disk's casing heat needs frictional heat that reaches the casing: Coulomb
+    friction (heat law ``"power"``, a blade's default) or a heat coefficient (``"alpha"``),
+    and a blade share ``contact.heat_partition`` below 1."""
+    if not (scene.get("contact.casing_heat.thickness") or 0.0) > 0.0:
+        return
+    law = scene.get("contact.heat_law") or "auto"
+    if law == "alpha" and not scene.get("contact.heat_coefficient"):
+        fail(
+            "contact.heat_coefficient",
+            scene.get("contact.heat_coefficient"),
+            "no frictional heat reaches the casing (contact.casing_heat); give α > 0",
+        )
+    if law != "alpha" and not scene.get("contact.friction"):
+        fail(
+            "contact.friction",
+            scene.get("contact.friction"),
+            "no frictional heat reaches the casing (contact.casing_heat); give μ > 0",
+        )
+    eta = scene.get("contact.heat_partition")
+    if isinstance(eta, (int, float)) and eta >= 1.0:
+        fail(
+            "contact.heat_partition",
+            eta,
+            "the blades take all the frictional heat, none reaches contact.casing_heat; "
+            "give a share below 1, or 'effusivity'",
+        )
 
 
 def check_run(scene) -> None:
