@@ -68,7 +68,7 @@ def wheel():
     every state stored."""
     scene = _scene()
     parts = wheel_parts(scene)
-    ((disk, _),) = _bases(parts, [(3, 0)])
+    ((disk, _, _),) = _bases(parts, [(3, 0)])
     model, _ = _model(parts, disk, None)
     res = bare_stepper(scene, model).run(REVOLUTION, store_every=1)
     return scene, parts, disk, model, res
@@ -178,8 +178,8 @@ def test_a_load_on_one_blade_shows_on_its_probe_turned_with_the_blade(wheel):
         ({"blade": "every"}, "outputs.probes[0].blade = 'every': use one of 'all' or an integer"),
         (
             {"quantity": "temperature", "component": None},
-            "outputs.probes[0].quantity = 'temperature': a bladed disk (rotor.sectors) has no "
-            "temperature dofs",
+            "outputs.probes[0].quantity = 'temperature': a bladed disk (rotor.sectors) probes "
+            "displacements and velocities",
         ),
     ],
 )

@@ -87,17 +87,25 @@ def test_run_writes_every_blade_and_both_checks(scene_file, tmp_path):
 
 def test_the_richer_wheel_holds_the_runs_fields_exactly(scene_file):
     parts = wheel_parts(load_scene(str(scene_file)))
-    small, rich = _bases(parts, [(3, 2), (5, 3)])
+    assert parts.thermal is not None  # friction heats the blades: temperature dofs
+    small, rich = _bases(parts, [(3, 2, 2), (5, 3, 3)])
     T = _state_transfer(parts, small, rich)
     n_disk_small, n_disk_rich = small[0].size, rich[0].size
     x = np.random.default_rng(1).standard_normal(T.shape[1])
     carried = T @ x
+    n_t_small, n_t_rich = small[2].size, rich[2].size
     for s in (0, 1, 3):
         a = small[0].sector_field(x[:n_disk_small], s)
         b = rich[0].sector_field(carried[:n_disk_rich], s)
         assert np.abs(a - b).max() <= 1e-9 * np.abs(a).max()
-    # the mass norm is kept: both coordinate sets are mass-normalised
-    half = T.shape[1] // 2
-    assert np.linalg.norm(carried[: T.shape[0] // 2]) == pytest.approx(
-        np.linalg.norm(x[:half]), rel=1e-9
+        a = small[2].sector_field(x[-n_t_small:], s)  # the temperature, last in the state
+        b = rich[2].sector_field(carried[-n_t_rich:], s)
+        assert np.abs(a - b).max() <= 1e-9 * np.abs(a).max()
+    # the mass norm and the heat-capacity norm are kept: every coordinate set is normalised
+    n_u_small, n_u_rich = (T.shape[1] - n_t_small) // 2, (T.shape[0] - n_t_rich) // 2
+    assert np.linalg.norm(carried[:n_u_rich]) == pytest.approx(
+        np.linalg.norm(x[:n_u_small]), rel=1e-9
+    )
+    assert np.linalg.norm(carried[-n_t_rich:]) == pytest.approx(
+        np.linalg.norm(x[-n_t_small:]), rel=1e-9
     )

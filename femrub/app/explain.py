@@ -365,8 +365,17 @@ def _wheel_rows(report: dict) -> list:
 
 
 def _blade_heat_rows(report: dict) -> list:
-    """A bladed disk's blades take their share of the frictional heat out of the run."""
-    ch = report.get("casing_heat")
+    """The blades' temperature, or where their share of the frictional heat goes without
+    it."""
+    ch, w = report.get("casing_heat"), report["bladed_disk"]
+    if w.get("temperature_coordinates"):
+        return [
+            (
+                "temperature",
+                f"{w['temperature_coordinates']} coordinates of the blades' temperature (per "
+                "nodal diameter: thermal modes and the tip contacts' static heat shapes)",
+            )
+        ]
     if not ch:
         return []
     share = f"{100 * ch['partition']:.3g} %"

@@ -41,17 +41,25 @@ from ..geometry.rotation_direction import ROTATION_DIRECTIONS, derive_rotation_d
 from ..model.builder import casing_heat_of, coating_of, heat_choice
 from ..model.casing_waves import casing_harmonics, ring_line_loads, waves_of
 from ..model.cyclic import cyclic_structure
+from ..model.cyclic_thermal import (
+    ThermalSector,
+    expansion_rows,
+    heat_rows_with_content,
+    thermal_sector,
+)
 from ..model.wheel import (
     CasingSurface,
     WheelConfig,
+    contact_heat_rows,
     contact_rows_of_sector,
     mistuning_stiffness,
     tip_contacts,
     wheel_casing_grid,
     wheel_model,
+    wheel_thermal,
 )
 from ..output.wheel_vtk import WheelFields
-from ..reduction.cyclic_ritz import CyclicBasis, cyclic_bases
+from ..reduction.cyclic_ritz import CyclicBasis, cross_matrix, cyclic_bases
 from ..reduction.estimate import HORIZON_SHARE, estimate, perturbed
 from ..scene.spec import fail
 from . import translate as tr
@@ -62,8 +70,9 @@ from .scheme import bare_stepper, stepper_of
 
 __all__ = ["WheelParts", "build_wheel", "transfer", "wheel_parts"]
 
-#: Modes per nodal diameter the reference model adds on the disk and on the casing.
-REFERENCE_EXTRA = (2, 1)
+#: Modes per nodal diameter the reference model adds on the disk, on the casing and on the
+#: blades' temperature.
+REFERENCE_EXTRA = (2, 1, 1)
 #: States stored per run for the field comparison.
 CHECKPOINTS = 5
 
@@ -83,7 +92,9 @@ class WheelParts:
     material: object = None  # the blades' material (their stiffness scaled by 1 + δ_s)
     probes: tuple = ()  # WheelProbe per outputs.probes (femrub.model.wheel_probes)
     probe_report: tuple = ()  # (report entries, warnings) of the probes (app.probes)
-    surface: CasingSurface | None = None  # the casing's coating and wall heat
+    surface: CasingSurface | None = None  # the casing's coating and wall heat, the heat law
+    thermal: ThermalSector | None = None  # the blades' temperature (physics.thermal)
+    heat_rows: sp.csr_matrix | None = None  # the contacts' temperature rows on the sector
 
 
 def _direction(scene, sector) -> float:
@@ -134,6 +145,7 @@ def wheel_parts(scene, log=None) -> WheelParts:
     _check_start(scene, disk, contacts, tip_radius)
     probes, entries, warnings = wheel_probes(scene, disk, probe_at)
     config = _config(scene, sector)
+    thermal = _thermal(scene, disk, material)
     return WheelParts(
         disk,
         contacts,
@@ -146,22 +158,46 @@ def wheel_parts(scene, log=None) -> WheelParts:
         material,
         probes,
         (entries, warnings),
-        _surface(scene, config, disk, contacts),
+        _surface(scene, config, disk, contacts, thermal is not None),
+        thermal,
+        None if thermal is None else contact_heat_rows(thermal, contacts),
     )
 
 
-def _surface(scene, config: WheelConfig, disk, contacts) -> CasingSurface | None:
+def heated(scene) -> bool:
+    """Whether the scene's frictional heat enters the blades: a share ``η > 0`` of a power
+    (Coulomb μ > 0 under the ``"power"`` law, α > 0 under ``"alpha"``)."""
+    c = scene["contact"]
+    if tr.heat_partition_of(scene) <= 0.0:
+        return False
+    return c["friction"] > 0.0 if tr.heat_law_of(scene) == "power" else c["heat_coefficient"] > 0
+
+
+def _thermal(scene, disk, material):
+    """The blades' temperature (:func:`~femrub.model.cyclic_thermal.thermal_sector`) when
+    ``physics.thermal`` keeps it (``"auto"``: when frictional heat enters the blades)."""
+    mode = scene["physics"]["thermal"]
+    if mode == "off" or (mode == "auto" and not heated(scene)):
+        return None
+    coupling = "none" if scene["physics"]["coupling"] == "none" else "physical"
+    return thermal_sector(disk, material, coupling)
+
+
+def _surface(scene, config: WheelConfig, disk, contacts, thermal: bool) -> CasingSurface | None:
     """The casing's abradable coating (``contact.abradable``) and wall heat
-    (``contact.casing_heat``) on the cells the blades sweep, or ``None`` without either."""
+    (``contact.casing_heat``) on the cells the blades sweep, and the heat law; ``None``
+    without either and without the blades' temperature (``thermal``)."""
     contact = tr.contact_config(scene)
     cells = contact.abradable or contact.casing_heat
-    if cells is None:
+    if cells is None and not thermal:
         return None
     n_blades = disk.n_sectors
-    footprint = contact.abradable.footprint if contact.abradable is not None else 0.0
-    grid = wheel_casing_grid(config, disk, contacts, n_blades, cells, footprint)
     heat = heat_choice(contact, contacts, 3)
     heat = replace(heat, alpha=np.tile(heat.alpha, n_blades))
+    if cells is None:
+        return CasingSurface(None, None, heat.law, heat.eta, heat.alpha)
+    footprint = contact.abradable.footprint if contact.abradable is not None else 0.0
+    grid = wheel_casing_grid(config, disk, contacts, n_blades, cells, footprint)
     casing_heat = casing_heat_of(contact, grid, heat)  # its inputs checked by check_run
     return CasingSurface(coating_of(contact, grid), casing_heat, heat.law, heat.eta, heat.alpha)
 
@@ -191,18 +227,36 @@ def _check_start(scene, disk, contacts, tip_radius: float) -> None:
 
 
 def _bases(parts: WheelParts, sizes) -> list:
-    """``(disk basis, casing waves)`` for each ``(disk modes, casing modes)`` of ``sizes``
-    (one factorisation and eigen-solve per nodal diameter for them all)."""
-    disks = cyclic_bases(parts.disk, [d for d, _ in sizes], parts.rows)
+    """``(disk basis, casing waves, temperature basis)`` for each ``(disk modes, casing
+    modes[, temperature modes])`` of ``sizes`` (one factorisation and eigen-solve per nodal
+    diameter for them all). With the blades' temperature the disk's bases hold the static
+    responses to the thermal stresses of the richest temperature basis, so the thermal
+    expansion of every temperature basis is exact."""
+    thermal = [None] * len(sizes)
+    rows = parts.rows
+    if parts.thermal is not None:
+        loads = heat_rows_with_content(parts.thermal, parts.heat_rows)
+        thermal = cyclic_bases(parts.thermal.structure, [s[2] for s in sizes], loads)
+        richest = thermal[int(np.argmax([s[2] for s in sizes]))]
+        expansion = expansion_rows(parts.thermal, richest)
+        rows = lambda k: sp.vstack([parts.rows, expansion(k)]).tocsr()  # noqa: E731
+    disks = cyclic_bases(parts.disk, [s[0] for s in sizes], rows)
+    waves = _casing_bases(parts, [s[1] for s in sizes])
+    return list(zip(disks, waves, thermal, strict=True))
+
+
+def _casing_bases(parts: WheelParts, sizes) -> list:
+    """The casing's waves (:func:`~femrub.model.casing_waves.waves_of`) for each number of
+    ring modes of ``sizes``; ``None`` each for a rigid casing."""
     if parts.ring is None:
-        return [(d, None) for d in disks]
+        return [None] * len(sizes)
     harmonics = casing_harmonics(parts.ring.n_sectors)
     reading = parts.bore * (1.0 + 1e-6)  # just inside the ring's bore
     axial = parts.contacts.points[0]
     positions = np.unique(axial)
     loads = ring_line_loads(parts.ring, positions, reading, _band(positions))
-    rings = cyclic_bases(parts.ring, [c for _, c in sizes], loads, harmonics=harmonics)
-    return [(d, waves_of(parts.ring, r, axial, reading)) for d, r in zip(disks, rings, strict=True)]
+    rings = cyclic_bases(parts.ring, sizes, loads, harmonics=harmonics)
+    return [waves_of(parts.ring, r, axial, reading) for r in rings]
 
 
 def _band(positions: np.ndarray) -> float:
@@ -211,9 +265,9 @@ def _band(positions: np.ndarray) -> float:
     return 0.0 if positions.size < 2 else float(np.ptp(positions)) / (positions.size - 1)
 
 
-def _model(parts: WheelParts, disk, waves):
-    """The wheel's model on the bases ``disk`` and ``waves``, the blades' mistuning projected
-    on ``disk`` (the run's model and the reference's alike)."""
+def _model(parts: WheelParts, disk, waves, temperature=None):
+    """The wheel's model on the bases ``disk``, ``waves`` and ``temperature``, the blades'
+    mistuning projected on ``disk`` (the run's model and the reference's alike)."""
     rim = parts.disk.sector.info["rim_radius"]
     blade = parts.tip_radius - rim
     extra = None
@@ -230,36 +284,31 @@ def _model(parts: WheelParts, disk, waves):
         mistuning=extra,
         probes=parts.probes,
         surface=parts.surface,
+        thermal=None
+        if temperature is None
+        else wheel_thermal(parts.thermal, temperature, disk, parts.contacts),
     )
 
 
 def transfer(small: CyclicBasis, rich: CyclicBasis, mass) -> np.ndarray:
     """``(rich.size, small.size)``: the coordinates in ``rich`` of the fields of ``small``'s
     coordinates, ``W_richᴴ M W_small`` per nodal diameter (exact when ``rich``'s span holds
-    ``small``'s), as real coordinates (:class:`~femrub.reduction.cyclic_ritz.CyclicBasis`)."""
-    out = np.zeros((rich.size, small.size))
-    blocks = {h.k: (h, start, m, pair) for h, start, m, pair in rich.blocks()}
-    for h, start, m, pair in small.blocks():
-        hr, rs, mr, _ = blocks[h.k]
-        P = hr.shapes.conj().T @ (mass @ h.shapes)  # (mr, m)
-        if pair:
-            out[rs : rs + mr, start : start + m] = P.real
-            out[rs : rs + mr, start + m : start + 2 * m] = -P.imag
-            out[rs + mr : rs + 2 * mr, start : start + m] = P.imag
-            out[rs + mr : rs + 2 * mr, start + m : start + 2 * m] = P.real
-        else:
-            out[rs : rs + mr, start : start + m] = P.real
-    return out
+    ``small``'s), as real coordinates (:func:`~femrub.reduction.cyclic_ritz.cross_matrix`)."""
+    return cross_matrix(rich, small, mass)
 
 
 def _state_transfer(parts, small, rich) -> np.ndarray:
-    """States ``[u, v]`` of the small wheel into the rich wheel's (displacement and velocity
-    alike)."""
-    (disk_s, waves_s), (disk_r, waves_r) = small, rich
+    """States ``[u, v(, θ)]`` of the small wheel into the rich wheel's (displacement and
+    velocity alike; the temperature by its own basis)."""
+    (disk_s, waves_s, temp_s), (disk_r, waves_r, temp_r) = small[:3], rich[:3]
     T = transfer(disk_s, disk_r, parts.disk.M)
     if waves_s is not None:
         T = sp.block_diag([T, transfer(waves_s.basis, waves_r.basis, parts.ring.M)]).toarray()
-    return np.kron(np.eye(2), T)
+    T = np.kron(np.eye(2), T)
+    if temp_s is not None:
+        Tt = transfer(temp_s, temp_r, parts.thermal.structure.M)
+        T = sp.block_diag([T, Tt]).toarray()
+    return T
 
 
 def _run(model, scene, limits, lean=0):
@@ -271,15 +320,18 @@ def _run(model, scene, limits, lean=0):
     return res, time.perf_counter() - t0
 
 
-def _sizes(scene) -> tuple:
-    """The run's ``(disk, casing)`` modes per nodal diameter and the reference's."""
-    sizes = (scene["rotor"]["families"], scene["casing"]["ring"]["families"])
-    return sizes, tuple(a + b for a, b in zip(sizes, REFERENCE_EXTRA, strict=True))
+def _sizes(scene, thermal: bool) -> tuple:
+    """The run's ``(disk, casing[, temperature])`` modes per nodal diameter and the
+    reference's (``thermal``: with the blades' temperature)."""
+    r = scene["rotor"]
+    sizes = (r["families"], scene["casing"]["ring"]["families"])
+    sizes += (r["thermal_families"],) if thermal else ()
+    return sizes, tuple(a + b for a, b in zip(sizes, REFERENCE_EXTRA[: len(sizes)], strict=True))
 
 
 def _reduction_check(scene, parts, small, rich, model, limits, log):
     """The run and the estimate of its reduction error against the richer wheel."""
-    sizes, rich_sizes = _sizes(scene)
+    sizes, rich_sizes = _sizes(scene, parts.thermal is not None)
     rich_model, _ = _model(parts, *rich)
     T = _state_transfer(parts, small, rich)
     if log:
@@ -310,7 +362,7 @@ def build_wheel(scene, log=None):
     parts = wheel_parts(scene, log)
     timings["assembly"] = time.perf_counter() - t0
     t1 = time.perf_counter()
-    small, rich = _bases(parts, _sizes(scene))
+    small, rich = _bases(parts, _sizes(scene, parts.thermal is not None))
     model, wheel = _model(parts, *small)
     timings["reduction"] = time.perf_counter() - t1
     limits = {}
@@ -349,6 +401,7 @@ def _report(scene, parts: WheelParts, model) -> dict:
             "casing_coordinates": model.info["casing_coordinates"],
             "sector_free_dofs": int(parts.disk.free.size),
             "casing": "flexible ring" if parts.ring is not None else "rigid",
+            "temperature_coordinates": model.info["temperature_coordinates"],
             "tip_radius": parts.tip_radius,
             "direction": c.direction,
             "ramp": c.ramp,

@@ -77,7 +77,8 @@ class CyclicStructure:
         Free displacement dofs (the basis's numbering).
     left, right : numpy.ndarray
         ``(n_face_nodes, 3)``: positions in ``free`` of the three components of each free
-        node of the left face and of its image on the right face.
+        node of the left face and of its image on the right face (``(n, 1)`` for a scalar
+        field: :mod:`femrub.model.cyclic_thermal`).
     omega : float
         Rotation speed Ω (rad/s) of the prestress (0: none).
     prestress : str
@@ -172,10 +173,11 @@ def cyclic_projection(structure: CyclicStructure, k: int) -> sp.csr_matrix:
     phase = np.exp(1j * k * structure.sector.angle)
     if abs(phase.imag) < 1e-12:
         phase = phase.real
-    R = structure.sector.rotation
+    c = structure.left.shape[1]  # 3: a displacement, turned by R(α); 1: a scalar field
+    R = structure.sector.rotation if c == 3 else np.eye(c)
     # row right[j, c] = phase Σ_c' R[c, c'] q[left[j, c']]
-    rows = np.repeat(structure.right, 3, axis=1).ravel()
-    cols = column[np.tile(structure.left, (1, 3))].ravel()
+    rows = np.repeat(structure.right, c, axis=1).ravel()
+    cols = column[np.tile(structure.left, (1, c))].ravel()
     vals = np.tile((phase * R).ravel(), structure.left.shape[0])
     rows = np.concatenate([independent, rows])
     cols = np.concatenate([np.arange(independent.size), cols])

@@ -52,7 +52,7 @@ from ..fem.assembly import ThermoelasticMatrices
 from ..fem.elasticity import isotropic_stiffness
 from ..fem.forms import lame_parameters
 from ..geometry.cyclic_sector import sector_angle, sector_turns
-from ..reduction.cyclic_ritz import CyclicBasis
+from ..reduction.cyclic_ritz import CyclicBasis, cross_matrix
 from .build import ContactSpec, first_order_model
 from .casing_waves import CasingWaves, cylindrical_components, rotating_blocks
 from .first_order import CasingSweep, FirstOrderModel, Parameters
@@ -63,11 +63,14 @@ __all__ = [
     "CasingSurface",
     "WheelConfig",
     "WheelMap",
+    "WheelThermal",
     "contact_rows_of_sector",
     "mistuning_stiffness",
     "tip_contacts",
+    "contact_heat_rows",
     "wheel_casing_grid",
     "wheel_model",
+    "wheel_thermal",
 ]
 
 
@@ -133,6 +136,68 @@ class CasingSurface:
     heat_law: str = "alpha"
     heat_partition: float = 1.0
     alpha: np.ndarray | float = 0.0
+
+
+@dataclass(frozen=True)
+class WheelThermal:
+    """The blades' temperature on the wheel's coordinates
+    (:mod:`femrub.model.cyclic_thermal`, reduced by :mod:`femrub.reduction.cyclic_ritz`).
+
+    Attributes
+    ----------
+    basis : CyclicBasis
+        The temperature's harmonic bases (``C^θθ``-orthonormal: reduced heat capacity ``I``,
+        conductivity ``diag(μ)``, ``μ = basis.omega²`` in 1/s).
+    Kut : numpy.ndarray
+        ``(n_disk, n_θ)`` thermal-stress coupling ``K^uθ`` on the disk's and the
+        temperature's coordinates (N/K per unit coordinates).
+    Ctu : numpy.ndarray
+        ``(n_θ, n_disk)`` thermoelastic heating ``C^θu``.
+    heat_rows : numpy.ndarray
+        ``(N n_c, n_θ)``: the temperature at contact ``(s, p)`` (and where its frictional
+        heat enters), blade by blade.
+    heat_content : numpy.ndarray
+        ``(n_θ,)``: the whole wheel's heat content ``Σ_s 1ᵀ C^θθ θ_s`` (J) per coordinate.
+    heat_outflow : tuple of numpy.ndarray
+        ``(n_disk,)`` and ``(n_θ,)``: the heat flow out of the wheel ``Σ_s 1ᵀ (C^θu u̇_s +
+        K^θθ θ_s)`` (W) per velocity and per temperature coordinate (the root is held at
+        ambient).
+    """
+
+    basis: CyclicBasis
+    Kut: np.ndarray
+    Ctu: np.ndarray
+    heat_rows: np.ndarray
+    heat_content: np.ndarray
+    heat_outflow: tuple
+
+
+def wheel_thermal(thermal, basis: CyclicBasis, disk: CyclicBasis, contacts: ContactPoints):
+    """:class:`WheelThermal` of the sector's temperature ``thermal``
+    (:class:`~femrub.model.cyclic_thermal.ThermalSector`) on ``basis``, coupled to the disk's
+    coordinates ``disk`` (:func:`~femrub.reduction.cyclic_ritz.cross_matrix` of ``K^uθ``
+    and ``C^θu``), with the tip ``contacts``' temperature rows."""
+    rows = contact_heat_rows(thermal, contacts)
+    t = thermal.structure
+    ones = np.ones(t.free.size)
+
+    def whole(b: CyclicBasis, row) -> np.ndarray:  # Σ over the sectors of a sector row
+        return b.sector_rows(np.atleast_2d(row)).sum(axis=(0, 1))
+
+    return WheelThermal(
+        basis,
+        cross_matrix(disk, basis, thermal.Kut),
+        cross_matrix(basis, disk, thermal.Ctu),
+        basis.sector_rows(rows).reshape(basis.n_sectors * contacts.n, -1),
+        whole(basis, t.M.T @ ones),
+        (whole(disk, thermal.Ctu.T @ ones), whole(basis, t.K.T @ ones)),
+    )
+
+
+def contact_heat_rows(thermal, contacts: ContactPoints) -> sp.csr_matrix:
+    """``(n_c, n_free_θ)``: each tip contact's temperature (and heat input) weights on the
+    sector's free temperature dofs."""
+    return sp.csr_matrix(contacts.heat[:, thermal.structure.free])
 
 
 def wheel_casing_grid(
@@ -330,22 +395,31 @@ def _matrices(disk, casing, config, extra_stiffness):
     return (*blocks, sp.block_diag([zero, Ka], format="csr"))
 
 
-def _as_matrices(M, C, K) -> ThermoelasticMatrices:
+def _as_matrices(M, C, K, thermal: WheelThermal | None = None) -> ThermoelasticMatrices:
+    """The wheel's blocks of Eq. (2): ``M``, ``C``, ``K`` of the displacement coordinates
+    and, with ``thermal``, the temperature's (capacity ``I``, conductivity ``diag(μ)``) and
+    the couplings (zero on the casing's coordinates)."""
     n = M.shape[0]
-    empty = sp.csr_matrix((0, 0))
+    nt = 0 if thermal is None else thermal.basis.size
+    Kut = np.zeros((n, nt))
+    Ctu = np.zeros((nt, n))
+    if thermal is not None:
+        n_disk = thermal.Kut.shape[0]
+        Kut[:n_disk], Ctu[:, :n_disk] = thermal.Kut, thermal.Ctu
+    mu = np.zeros(0) if thermal is None else thermal.basis.omega**2
     return ThermoelasticMatrices(
         M=sp.csr_matrix(M),
         C=sp.csr_matrix(C),
         K=sp.csr_matrix(K),
-        Kut=sp.csr_matrix((n, 0)),
-        Ctu=sp.csr_matrix((0, n)),
-        Ctt=empty,
-        Ktt=empty,
+        Kut=sp.csr_matrix(Kut),
+        Ctu=sp.csr_matrix(Ctu),
+        Ctt=sp.identity(nt, format="csr"),
+        Ktt=sp.diags(mu).tocsr(),
         free_u=np.arange(n),
-        free_t=np.zeros(0, dtype=int),
+        free_t=np.arange(nt),
         n_u_all=n,
-        n_t_all=0,
-        info={"coupling": None},
+        n_t_all=nt,
+        info={"coupling": None if thermal is None else "physical"},
     )
 
 
@@ -369,6 +443,30 @@ def _observations(Dn: np.ndarray, n_blades: int, nc: int, n_u: int, probes=None)
     }
 
 
+def _heat_forms(thermal: WheelThermal, layout, n: int) -> dict:
+    """The whole wheel's heat content and outflow on the state (the reduced ``C^θθ = I``
+    and ``K^θθ`` alone would weigh every coordinate alike)."""
+    content, outflow = np.zeros(n), np.zeros(n)
+    content[layout.t] = thermal.heat_content
+    v_disk, t_part = thermal.heat_outflow
+    outflow[layout.v.start : layout.v.start + v_disk.size] = v_disk
+    outflow[layout.t] = t_part
+    return {"heat_content": content, "heat_outflow": outflow}
+
+
+def _thermal_observations(thermal: WheelThermal | None, n_blades: int, nc: int) -> dict:
+    """Mean tip temperature of blade 0 and of every blade, and every contact's (K)."""
+    if thermal is None:
+        return {}
+    Q = thermal.heat_rows
+    per_blade = Q.reshape(n_blades, nc, -1).mean(axis=1)
+    return {
+        "tip_temperature": ("theta", per_blade[:1]),
+        "blade_tip_temperature": ("theta", per_blade),
+        "contact_temperature": ("theta", Q),
+    }
+
+
 def wheel_model(
     config: WheelConfig,
     structure,
@@ -381,6 +479,7 @@ def wheel_model(
     mistuning=None,
     probes=(),
     surface: CasingSurface | None = None,
+    thermal: WheelThermal | None = None,
 ) -> tuple[FirstOrderModel, WheelMap]:
     """The first-order model of the wheel against the casing (module docstring).
 
@@ -408,7 +507,10 @@ def wheel_model(
         Probes observed on the blades they read (:mod:`femrub.model.wheel_probes`), with
         their units in ``info["signal_units"]``.
     surface : CasingSurface, optional
-        The casing's coating and wall heat (none when ``None``).
+        The casing's coating and wall heat, and the heat law (none when ``None``).
+    thermal : WheelThermal, optional
+        The blades' temperature: the frictional heat enters it at the contacts (their share
+        η, ``surface.heat_partition``); without it the wheel has no temperature dofs.
     """
     N, nc = disk.n_sectors, contacts.n
     Nrows, Trows = _contact_rows(disk, casing, structure, contacts, N)
@@ -439,21 +541,24 @@ def wheel_model(
         names=[f"blade{s}_contact{p}" for s in range(N) for p in range(nc)],
         **friction,
         **_surface_terms(surface),
+        **({} if thermal is None else {"heat_dofs": thermal.heat_rows}),
     )
     n_disk = disk.size
     observed = {k: v for p in probes for k, v in wheel_probe_rows(p, disk).items()}
     units = {key: PROBE_UNITS[field] for key, (field, _) in observed.items()}
+    observe = _observations(Nrows[:, :n_disk], N, nc, Nrows.shape[1], observed)
     model = first_order_model(
-        _as_matrices(M, C, K),
+        _as_matrices(M, C, K, thermal),
         contact=spec,
-        observe=_observations(Nrows[:, :n_disk], N, nc, Nrows.shape[1], observed),
-        thermal=False,
+        observe=observe | _thermal_observations(thermal, N, nc),
+        thermal=thermal is not None,
         info=dict(
             kind="bladed-disk",
             n_blades=N,
             n_contacts=N * nc,
             disk_coordinates=n_disk,
             casing_coordinates=0 if casing is None else casing.size,
+            temperature_coordinates=0 if thermal is None else thermal.basis.size,
             rotation_speed=omega,
             rotation_direction=float(config.direction),
             **({"signal_units": units} if units else {}),
@@ -465,5 +570,10 @@ def wheel_model(
     energy = model.energy
     n_u = model.layout.n_u
     circulatory = sp.bmat([[None, sp.csr_matrix((n_u, n_u))], [-Ka, None]], format="csr")
-    model = model.with_(energy=replace(energy, Pd=sp.csr_matrix(energy.Pd + circulatory)))
+    n_t = model.n_dofs - 2 * n_u
+    circulatory = sp.block_diag([circulatory, sp.csr_matrix((n_t, n_t))], format="csr")
+    energy = replace(energy, Pd=sp.csr_matrix(energy.Pd + circulatory))
+    if thermal is not None:
+        energy = replace(energy, **_heat_forms(thermal, model.layout, model.n_dofs))
+    model = model.with_(energy=energy)
     return model, WheelMap(disk, casing, contacts, N)

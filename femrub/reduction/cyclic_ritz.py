@@ -41,6 +41,7 @@ __all__ = [
     "CyclicBasis",
     "HarmonicBasis",
     "cyclic_bases",
+    "cross_matrix",
     "cyclic_basis",
     "harmonic_basis",
 ]
@@ -285,3 +286,30 @@ def cyclic_basis(
     """:func:`harmonic_basis` of every nodal diameter in ``harmonics`` (default all,
     ``0 .. ⌊N/2⌋``), as one :class:`CyclicBasis`."""
     return cyclic_bases(structure, [n_modes], load_rows, harmonics)[0]
+
+
+def cross_matrix(rows: CyclicBasis, cols: CyclicBasis, operator) -> np.ndarray:
+    """``(rows.size, cols.size)``: the whole structure's bilinear form of a sector
+    ``operator`` between the real coordinates of two bases of the same sectors.
+
+    For a sector operator ``A`` (``(n_rows_free, n_cols_free)``, real, the same in every
+    sector, e.g. a mass, a coupling ``K^uθ``) and fields of coordinates ``x`` (``rows``) and
+    ``y`` (``cols``), ``Σ_s u_sᵀ A w_s = xᵀ B y`` (Eq. 1): harmonics of different ``k`` do
+    not couple, and with ``P = W_kᴴ A V_k`` a pair's block is
+    ``[[Re P, −Im P], [Im P, Re P]]`` (``ξ = a + i b``), a real harmonic's ``Re P``. With
+    ``A = M`` and ``cols`` spanned by ``rows`` it carries ``cols``' coordinates into
+    ``rows``' exactly.
+    """
+    out = np.zeros((rows.size, cols.size))
+    blocks = {h.k: (h, start, m) for h, start, m, _ in rows.blocks()}
+    for h, start, m, pair in cols.blocks():
+        if h.k not in blocks:
+            continue
+        hr, rs, mr = blocks[h.k]
+        P = hr.shapes.conj().T @ (operator @ h.shapes)  # (mr, m)
+        out[rs : rs + mr, start : start + m] = P.real
+        if pair:
+            out[rs : rs + mr, start + m : start + 2 * m] = -P.imag
+            out[rs + mr : rs + 2 * mr, start : start + m] = P.imag
+            out[rs + mr : rs + 2 * mr, start + m : start + 2 * m] = P.real
+    return out

@@ -80,7 +80,6 @@ def check_friction(scene) -> None:
 
 #: what a bladed-disk run does not model, as ``(key, refused when, the value's meaning)``
 _WHEEL_REFUSALS = (
-    ("physics.thermal", lambda v: v == "on", "a bladed disk runs without temperature dofs"),
     ("loads.tip_force.law", lambda v: v != "none", "no tip force on a bladed disk"),
     ("scheme.name", lambda v: v != "theta", "a bladed disk runs the θ-method"),
 )

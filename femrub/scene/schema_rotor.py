@@ -4,9 +4,9 @@ Part of :data:`femrub.scene.schema.SCHEMA`. A scene with ``rotor.sectors = N`` i
 disk of ``N`` blades: the blade is the scene's ``geometry`` (``kind = "naca"``; its
 ``hub_radius`` is replaced by the disk's rim), the disk an annulus clamped at its bore.
 ``casing.ring.thickness`` adds a flexible casing ring around the blades' tips. Both feed
-``femrub modes`` (:mod:`femrub.app.modes`); ``femrub run`` refuses them
-(:func:`femrub.scene.run_checks.check_run`). :func:`check_rotor` is the cross-key check,
-made when the scene is loaded.
+``femrub modes`` (:mod:`femrub.app.modes`) and ``femrub run`` (:mod:`femrub.app.wheel`,
+which refuses what it does not model: :func:`femrub.scene.run_checks.check_run`).
+:func:`check_rotor` is the cross-key check, made when the scene is loaded.
 """
 
 from __future__ import annotations
@@ -34,6 +34,14 @@ ROTOR = {
     ),
     "families": Spec(I, 3, lo=1, hi=30, doc="mode families computed per nodal diameter"),
     "contacts": Spec(I, 3, lo=1, hi=20, doc="contacts on each blade's tip, along its chord"),
+    "thermal_families": Spec(
+        I,
+        2,
+        lo=1,
+        hi=30,
+        doc="thermal modes per nodal diameter of the blades' temperature (with the tip "
+        "contacts' static heat shapes; a run with temperature dofs)",
+    ),
     "damping_ratio": _f(
         0.01, "none", "modal damping ratio of the disk's modes (time integration)", lo=0.0, hi=1.0
     ),

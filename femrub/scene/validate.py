@@ -275,7 +275,7 @@ def _check_probe(key: str, probe: dict, d: dict) -> None:
 
 def _check_wheel_probe(key: str, probe: dict, d: dict) -> None:
     """``blade`` only on a bladed disk (``rotor.sectors``), one of its blades; no
-    temperature there (a wheel has no temperature dofs)."""
+    temperature probe there (the blades' temperatures are read at the contacts)."""
     n, blade = d["rotor"].get("sectors"), probe.get("blade")
     if n is None:
         if blade is not None:
@@ -290,8 +290,8 @@ def _check_wheel_probe(key: str, probe: dict, d: dict) -> None:
         fail(
             f"{key}.quantity",
             "temperature",
-            "a bladed disk (rotor.sectors) has no temperature dofs; probe a displacement or "
-            "a velocity",
+            "a bladed disk (rotor.sectors) probes displacements and velocities; its blades' "
+            "temperatures are read at the tip contacts (history.npz contact_temperature)",
         )
     if blade != "all" and blade is not None and blade >= n:
         fail(
