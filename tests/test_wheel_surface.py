@@ -108,7 +108,8 @@ def test_a_coated_ring_heated_by_friction_through_femrub_run(tmp_path, thermal):
         assert "blade heat" in explain
     else:
         assert blade == pytest.approx(eta * work, rel=1e-2) and s["heat_error"] < 1e-10
-        assert "coordinates of the blades' temperature" in explain and s["max_contact_temperature"] > 0.0
+        assert "coordinates of the blades' temperature" in explain
+        assert s["max_contact_temperature"] > 0.0
     wall = np.loadtxt(out / "casing_temperature.csv", delimiter=",", skiprows=1)
     assert 0.0 < wall[:, 1:].max() <= s["max_casing_temperature"] * (1 + 1e-9)
     hot = _harmonic_angle(np.radians(wall[:, 0]), wall[:, 1:].mean(axis=1))

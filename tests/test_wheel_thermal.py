@@ -15,7 +15,7 @@ import pytest
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 from scipy.spatial import cKDTree
-from small_wheel import N, TITANIUM, disk_sector
+from small_wheel import TITANIUM, N, disk_sector
 from test_cyclic_modes import _located
 
 from femrub.fem.discretisation import assemble, discretise
