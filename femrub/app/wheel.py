@@ -6,16 +6,23 @@ residual shapes of ``rotor.contacts`` contacts on each blade's tip; the casing r
 (``casing.ring.*``, when it has a ``thickness``; a rigid round casing otherwise) enters as
 waves of the rotating frame (:mod:`femrub.model.wheel`); ``rotor.mistuning`` scales
 blade ``s``'s elastic stiffness by ``1 + δ_s`` (:func:`~femrub.model.wheel.mistuning_stiffness`
-on each model's disk basis: the run's and the reference's alike). The model is its own full model:
-its coordinates are mass-normalised, so the mass norm of the wheel's displacement is the
-norm of its displacement coordinates.
+on each model's disk basis: the run's and the reference's alike); ``contact.abradable`` and
+``contact.casing_heat`` put a coating and a wall heat model on the casing
+(:class:`~femrub.model.wheel.CasingSurface`); with frictional heat for the blades
+(``physics.thermal``) the blades' temperature is reduced per nodal diameter too
+(:mod:`femrub.model.cyclic_thermal`, ``rotor.thermal_families`` modes and the contacts'
+static heat shapes) and the disk's bases gain the static responses to its thermal stresses.
+The model is its own full model: its coordinates are mass-normalised (heat-capacity
+normalised for the temperature), so the mass norm of the wheel's displacement is the norm
+of its displacement coordinates.
 
 Checks, as for a single blade, stepping the scene's scheme to ``scheme.t_end``:
 
 * the *reduction error estimate*: the run against the same wheel with richer bases
   (``rotor.families + 2`` modes per nodal diameter on the disk, ``casing.ring.families + 1``
-  on the casing). The richer disk basis spans the run's (modes and residual shapes of the
-  same contacts), so the run's states are carried into the richer coordinates exactly
+  on the casing, ``rotor.thermal_families + 1`` on the temperature). The richer disk basis
+  spans the run's (modes and residual shapes of the same contacts), so the run's states are
+  carried into the richer coordinates exactly
   (:func:`transfer`) and compared there by :func:`~femrub.reduction.estimate.estimate`
   (contact impulses per lobe passage, the wheel's displacement in the mass norm; with the
   round-off twin of the richer model when the response is sensitive);
