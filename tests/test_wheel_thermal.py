@@ -23,11 +23,15 @@ from femrub.geometry.cyclic_sector import axis_rotation, full_wheel
 from femrub.model.cyclic import cyclic_structure
 from femrub.model.cyclic_thermal import expansion_rows, heat_rows_with_content, thermal_sector
 from femrub.model.wheel import (
+    CasingSurface,
+    WheelConfig,
     contact_heat_rows,
     contact_rows_of_sector,
     tip_contacts,
+    wheel_model,
     wheel_thermal,
 )
+from femrub.output.wheel_vtk import WheelFields
 from femrub.reduction.cyclic_ritz import cyclic_bases
 
 HEATED_BLADE, HEATED_CONTACT = 2, 1
@@ -146,3 +150,40 @@ def test_heat_content_and_outflow_are_the_whole_wheels(reduced, whole):
     uniform = wheel.basis.sector_rows(thermal.structure.M @ np.ones(thermal.structure.free.size))
     assert np.allclose(wheel.heat_rows @ wheel.heat_content, 1.0, atol=1e-9)
     assert uniform.shape[0] == N
+
+
+def test_the_rotors_frames_draw_every_blades_temperature(reduced):
+    """The whole wheel's ``temperature`` point data is the temperature coordinates' sector
+    field of copy ``s`` at the sector's vertices (a scalar: no turn)."""
+    sector, structure, thermal, contacts, disk, wheel = reduced
+    config = WheelConfig(rotation_speed=0.0, clearance=1e-4, friction=0.1)
+    surface = CasingSurface(heat_law="power", heat_partition=0.5)
+    tip = sector.info["tip_radius"]
+    model, wheel_map = wheel_model(
+        config,
+        structure,
+        disk,
+        contacts,
+        tip_radius=tip,
+        blade_size=0.03,
+        surface=surface,
+        thermal=wheel,
+    )
+    assert model.layout.n_t == wheel.basis.size and wheel_map.temperature is wheel.basis
+    fields = WheelFields(wheel_map, structure, None, 0.0, 1.0, thermal.structure)
+    frames = fields.parts()["rub"](fields, model, 1e-6, np.float64)
+    X = np.zeros(model.layout.n)
+    eta = np.random.default_rng(5).standard_normal(wheel.basis.size)
+    X[model.layout.t] = eta
+    c = frames.compact(X[None], np.zeros((1, model.n_contacts)))
+    t = thermal.structure
+    vertex = t.basis.nodal_dofs[0]
+    held = np.ones(t.basis.N, dtype=bool)
+    held[t.free] = False
+    for s in range(N):
+        field = np.zeros(t.basis.N)
+        field[t.free] = wheel.basis.sector_field(eta, s)
+        got = c["temperature"][0, frames.map.copies[s], 0]
+        np.testing.assert_allclose(got, field[vertex], rtol=0, atol=1e-10 * np.abs(field).max())
+    assert np.all(c["temperature"][0, frames.map.copies[0][held[vertex]], 0] == 0.0)
+    assert "temperature" in frames.writer.data

@@ -389,7 +389,8 @@ def build_wheel(scene, log=None):
     stepper = stepper_of(scene, model, report)
     report["timings"] = timings
     c = parts.config
-    fields = WheelFields(wheel, parts.disk, parts.ring, c.rotation_speed, c.direction)
+    thermal = None if parts.thermal is None else parts.thermal.structure
+    fields = WheelFields(wheel, parts.disk, parts.ring, c.rotation_speed, c.direction, thermal)
     ran = (run, wall) if reusable_run(model) else None  # a coating's run: its wear is output
     return Simulation(scene, model, model, fields, None, stepper, limits, report, timings, ran)
 

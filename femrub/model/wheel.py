@@ -237,12 +237,16 @@ class WheelMap:
         The tip contacts of the sector's blade (sector axes).
     n_blades : int
         ``N``.
+    temperature : CyclicBasis or None
+        The blades' temperature coordinates (the state's last ``temperature.size``), or
+        ``None`` without temperature dofs.
     """
 
     disk: CyclicBasis
     casing: CasingWaves | None
     contacts: ContactPoints
     n_blades: int
+    temperature: CyclicBasis | None = None
 
     @property
     def n_disk(self) -> int:
@@ -576,4 +580,5 @@ def wheel_model(
     if thermal is not None:
         energy = replace(energy, **_heat_forms(thermal, model.layout, model.n_dofs))
     model = model.with_(energy=energy)
-    return model, WheelMap(disk, casing, contacts, N)
+    temperature = None if thermal is None else thermal.basis
+    return model, WheelMap(disk, casing, contacts, N, temperature)

@@ -17,7 +17,8 @@ of :mod:`femrub.reduction.cyclic_ritz` turned to global axes::
 coordinates); ``static_displacement`` (m): the centrifugal growth at Ω, the same in every
 frame (the total displacement is the sum); ``contact_force`` and ``friction_force`` (N,
 global axes) at the vertex of each tip contact of every blade, ``−λ n / h`` and the
-friction impulse over ``h``.
+friction impulse over ``h``; with the blades' temperature, ``temperature`` (K above
+ambient), Eq. (1) of the temperature's coordinates with one component and no turn.
 
 **The casing ring** (``casing_XXXXXX.vtu``, ``casing.pvd``; with a flexible ring only), in
 the casing's fixed frame: the ring's coordinates are waves of the rotating frame,
@@ -59,6 +60,7 @@ WHEEL_FIELD_UNITS = {
     "static_displacement": "m",
     "contact_force": "N",
     "friction_force": "N",
+    "temperature": "K",
 }
 
 
@@ -68,16 +70,21 @@ def _comment(frame: str, names) -> str:
 
 
 class CyclicVertexField:
-    """Displacement at the vertices of a whole cyclic structure from its coordinates, Eq. (1).
+    """Displacement (or a scalar field) at the vertices of a whole cyclic structure from its
+    coordinates, Eq. (1).
 
     Parameters
     ----------
     structure : CyclicStructure
-        The sector (its mesh, basis and free dofs).
+        The sector (its mesh, basis and free dofs): three components per vertex (a
+        displacement, turned to global axes) or one (a scalar field: the temperature of
+        :mod:`femrub.model.cyclic_thermal`, the same in every axes).
     basis : CyclicBasis
         The coordinates' harmonic bases on that sector.
     dtype : numpy dtype
         Precision of the products (``float32`` for files written in single precision).
+    like : CyclicVertexField, optional
+        A field of the same sector whose whole mesh is taken (not built again).
 
     Attributes
     ----------
@@ -89,10 +96,14 @@ class CyclicVertexField:
         ``(N, n_sector_vertices)``: the whole mesh's vertex of each sector vertex in each copy.
     """
 
-    def __init__(self, structure, basis, dtype=np.float64):
-        mesh, self.copies = full_wheel(structure.sector)
-        self.points = np.ascontiguousarray(mesh.mesh.p.T)
-        self.cells = np.ascontiguousarray(mesh.mesh.t.T)
+    def __init__(self, structure, basis, dtype=np.float64, like=None):
+        if like is None:
+            mesh, self.copies = full_wheel(structure.sector)
+            self.points = np.ascontiguousarray(mesh.mesh.p.T)
+            self.cells = np.ascontiguousarray(mesh.mesh.t.T)
+        else:
+            self.copies, self.points, self.cells = like.copies, like.points, like.cells
+        self.components = structure.left.shape[1]
         self.n_sectors = basis.n_sectors
         self.turns = sector_turns(self.n_sectors)
         self.vertex_rows = _vertex_rows(structure)
@@ -108,7 +119,7 @@ class CyclicVertexField:
             else:
                 re, im, scale = Wr, Wi, 1.0 / math.sqrt(self.n_sectors)
             cols = np.arange(start, start + m * (2 if pair else 1))
-            rows = scale * np.concatenate([re, im], axis=0).T  # (columns, 2 × 3 n_vertices)
+            rows = scale * np.concatenate([re, im], axis=0).T  # (columns, 2 × c n_vertices)
             self._blocks.append((cols, np.ascontiguousarray(rows, dtype=dtype)))
             ks.append(h.k)
         angles = np.outer(np.arange(self.n_sectors), ks) * basis.angle  # (N, H)
@@ -122,20 +133,22 @@ class CyclicVertexField:
         return self.points.shape[0]
 
     def sector_fields(self, x: np.ndarray) -> np.ndarray:
-        """``(B, N, n_sector_vertices, 3)``: the field of every copy in the sector's axes,
+        """``(B, N, n_sector_vertices, c)``: the field of every copy in the sector's axes,
         ``Σ_k c_k Re(e^{iksα} W_k ξ_k)`` at the sector's vertices, for coordinates ``x``
         ``(B, size)``."""
         x = np.atleast_2d(np.asarray(x))
-        B, n3 = x.shape[0], self.vertex_rows.size
+        B, n3, c = x.shape[0], self.vertex_rows.size, self.components
         parts = np.empty((B, 2 * len(self._blocks), n3), dtype=self.dtype)
         for j, (cols, rows) in enumerate(self._blocks):
             parts[:, 2 * j : 2 * j + 2] = (x[:, cols].astype(self.dtype) @ rows).reshape(B, 2, n3)
-        return np.matmul(self._phases, parts).reshape(B, self.n_sectors, n3 // 3, 3)
+        return np.matmul(self._phases, parts).reshape(B, self.n_sectors, n3 // c, c)
 
     def __call__(self, x: np.ndarray) -> np.ndarray:
-        """``(B, n_points, 3)``: the whole structure's displacement (global axes) for
-        coordinates ``x`` ``(B, size)``, Eq. (1)."""
+        """``(B, n_points, c)``: the whole structure's field for coordinates ``x``
+        ``(B, size)``, Eq. (1): a displacement turned to global axes, a scalar as it is."""
         local = self.sector_fields(x)
+        if self.components == 1:
+            return self.place(local)
         return self.place(np.einsum("sij,bsvj->bsvi", self.turns.astype(self.dtype), local))
 
     def place(self, per_copy: np.ndarray) -> np.ndarray:
@@ -147,8 +160,8 @@ class CyclicVertexField:
 
 
 def _vertex_rows(structure) -> np.ndarray:
-    """``(3 n_vertices,)`` vertex-major: the position in ``structure.free`` of each vertex's
-    displacement components (−1 where clamped)."""
+    """``(c n_vertices,)`` vertex-major: the position in ``structure.free`` of each vertex's
+    components (−1 where clamped or held)."""
     where = np.full(structure.basis.N, -1, dtype=np.int64)
     where[structure.free] = np.arange(structure.free.size)
     return where[structure.basis.nodal_dofs.T.ravel()]
@@ -177,6 +190,11 @@ class RotorFrames:
         self.map = CyclicVertexField(fields.disk, wheel.disk, dtype)
         self._u = np.arange(wheel.n_disk)
         self._v = model.layout.n_u + self._u
+        self.temperature = None  # the blades' temperature: its field and state slice
+        if wheel.temperature is not None and fields.thermal is not None:
+            tmap = CyclicVertexField(fields.thermal, wheel.temperature, dtype, like=self.map)
+            self.temperature = (tmap, model.layout.t)
+            self.names = (*self.names, "temperature")
         self.h = float(h)
         N, contacts = wheel.n_blades, wheel.contacts
         turns = self.map.turns
@@ -192,7 +210,7 @@ class RotorFrames:
         static = np.asarray(fields.disk.static)[fields.disk.basis.nodal_dofs.T.ravel()]
         local = np.broadcast_to(static.reshape(1, 1, -1, 3), (1, N, static.size // 3, 3))
         self.static = self.map.place(np.einsum("sij,bsvj->bsvi", turns, local))[0]
-        point = {name: 3 for name in self.names}
+        point = {name: 1 if name == "temperature" else 3 for name in self.names}
         self.writer = _writer(self.map, point, _comment("rotor frame", point), dtype)
         self.writer.data["static_displacement"][:] = self.static
 
@@ -207,6 +225,9 @@ class RotorFrames:
         lam = np.asarray(impulse, dtype=float).reshape(B, -1)
         forces = -(lam[:, :, None] / self.h) * self._normals[None]
         out = {"displacement": both[:B], "velocity": both[B:], "friction_force": None}
+        if self.temperature is not None:
+            tmap, t = self.temperature
+            out["temperature"] = tmap(X[:, t])
         out["contact_force"] = _scatter(self._scatter, forces)
         c = self._contact
         if friction is not None and np.size(friction) and c is not None and c.frames is not None:
@@ -217,8 +238,9 @@ class RotorFrames:
 
     def store(self, compact: dict, b: int, data: dict) -> None:
         """Write frame ``b`` of ``compact`` into the writer's arrays ``data``."""
-        for k in ("displacement", "velocity"):
-            data[k][:] = compact[k][b]
+        drawn = ("displacement", "velocity") + (("temperature",) if self.temperature else ())
+        for k in drawn:
+            data[k][:] = compact[k][b].reshape(data[k].shape)
         cv = self.contact_vertices
         for k in ("contact_force", "friction_force"):
             data[k][cv] = 0.0 if compact[k] is None else compact[k][b]
@@ -304,6 +326,9 @@ class WheelFields:
         Ω (rad/s).
     direction : float
         σ (+1 or −1).
+    thermal : CyclicStructure or None
+        The sector's temperature (:mod:`femrub.model.cyclic_thermal`) when the blades have
+        temperature dofs: the rotor's frames then draw ``temperature`` (K above ambient).
     """
 
     wheel: WheelMap
@@ -311,6 +336,7 @@ class WheelFields:
     ring: object
     rotation_speed: float
     direction: float
+    thermal: object = None
 
     def parts(self) -> dict:
         """``{series name: frame source class}``: ``rub`` (the rotor) and, with a flexible
