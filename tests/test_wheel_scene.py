@@ -82,7 +82,22 @@ def test_run_writes_every_blade_and_both_checks(scene_file, tmp_path):
         assert (
             np.abs(h["energy_energy_error"]).max() < 1e-8 * np.abs(h["energy_contact_work"]).max()
         )
+        assert np.abs(h["energy_heat_error"]).max() < 1e-8 * h["energy_heat_content"].max()
+        impulse = h["impulse"].reshape(4501, 6, 2)
+        tip = h["signal_blade_tip_displacement"]
+        hot = h["signal_blade_tip_temperature"]
     assert "6 blades, 2 tip contacts each" in (out / "explain.txt").read_text()
+    # blades.csv: one row per blade from the histories; a tuned wheel against a 3-lobed
+    # casing treats blades a lobe apart (two blades) alike
+    blades = np.genfromtxt(out / "blades.csv", delimiter=",", names=True)
+    h_step = REVOLUTION / 1500
+    np.testing.assert_allclose(blades["max_normal_force_n"], impulse.max(axis=(0, 2)) / h_step)
+    np.testing.assert_allclose(blades["rms_tip_displacement_m"], np.sqrt((tip**2).mean(axis=0)))
+    np.testing.assert_allclose(blades["max_tip_temperature_k"], hot.max(axis=0))
+    for column in ("max_normal_force_n", "rms_tip_displacement_m", "max_tip_temperature_k"):
+        v = blades[column]
+        np.testing.assert_allclose(v[[2, 3, 4, 5]], v[[0, 1, 2, 3]], rtol=1e-6)
+    assert s["blades"]["n_blades"] == 6 and s["blades"]["hottest_tip"]["blade"] in range(6)
 
 
 def test_the_richer_wheel_holds_the_runs_fields_exactly(scene_file):

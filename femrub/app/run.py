@@ -197,6 +197,11 @@ def _run_claimed(scene, out, progress, log, on_built, modes, make):
             f"stepping done in {t.get('stepping', 0.0):.2f} s ({res.steps} steps, "
             f"{per_step:.0f} µs/step wall), output {t.get('output', 0.0):.2f} s"
         )
+    info = built.model.info
+    if info.get("kind") == "bladed-disk" and res.impulse.size:
+        from ..output.blades import write_blades
+
+        res.info["blades"] = write_blades(res, info["n_blades"], out)
     contact = built.stepper.model.contact  # the run's own history (wear map, casing heat)
     if contact is not None and contact.wear is not None:
         from ..output.wear import write_wear
