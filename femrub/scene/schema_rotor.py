@@ -36,7 +36,7 @@ ROTOR = {
     "contacts": Spec(I, 3, lo=1, hi=20, doc="contacts on each blade's tip, along its chord"),
     "thermal_families": Spec(
         I,
-        2,
+        6,
         lo=1,
         hi=30,
         doc="thermal modes per nodal diameter of the blades' temperature (with the tip "
