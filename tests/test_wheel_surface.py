@@ -95,7 +95,7 @@ def test_a_coated_ring_heated_by_friction_through_femrub_run(tmp_path, thermal):
     assert 0.0 < s["max_wear_depth"] <= THICKNESS and s["worn_volume"] > 0.0
     surface = np.loadtxt(out / "wear_map.csv", delimiter=",", skiprows=1)
     assert surface.shape == (180, 1 + build["abradable"]["n_axial"])
-    assert surface[:, 1:].max() <= s["max_wear_depth"] * (1 + 1e-9)
+    assert surface[:, 1:].max() <= s["max_wear_depth"] * (1 + 1e-7)  # 8 digits in the csv
     # the casing takes its share 1 − η of the friction work (the energy meter's mid-step
     # slip) and the wall's model received as much (its own end-of-step slip); the blades
     # take the rest into their temperature, or, without temperature dofs, nothing
@@ -111,7 +111,7 @@ def test_a_coated_ring_heated_by_friction_through_femrub_run(tmp_path, thermal):
         assert "coordinates of the blades' temperature" in explain
         assert s["max_contact_temperature"] > 0.0
     wall = np.loadtxt(out / "casing_temperature.csv", delimiter=",", skiprows=1)
-    assert 0.0 < wall[:, 1:].max() <= s["max_casing_temperature"] * (1 + 1e-9)
+    assert 0.0 < wall[:, 1:].max() <= s["max_casing_temperature"] * (1 + 1e-7)
     hot = _harmonic_angle(np.radians(wall[:, 0]), wall[:, 1:].mean(axis=1))
     assert abs(hot - TROUGH) < abs(hot - MIRROR)  # heated where it rubs (ahead of the trough)
     assert "yields at 5 N per contact" in explain
