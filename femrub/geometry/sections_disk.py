@@ -16,20 +16,20 @@ Below its root (hub) section the blade is extended into the rim: an extra sectio
 section projected along ``−z`` (radially inwards at ``φ = 0``) onto the plane
 ``z = z_b`` below the rim surface under the root (``z_b = rim_radius cos φ_r − d``, ``φ_r``
 the root's largest ``|φ|``, ``d`` 2 % of the span), is lofted with the files' sections in one
-``addThruSections`` through every section. The loft passes through every given section, so
-the blade between them is the same loft as the single sections blade's but for its
-continuation below the root; its bottom cap is planar, and a planar face cutting through
-the rim's cylinder is the case OpenCASCADE fuses robustly (the NACA disk sinks its planar
-root the same way). A separate shank fused onto the root face would instead have to fuse
-on the root's non-planar filling surface, a face shared exactly by two solids, which
-OpenCASCADE fuses less reliably.
+``addThruSections`` through every section. The loft passes through every given section
+(between the root and the next one its smooth surface differs slightly from the single
+sections blade's, as it continues below the root; a ruled loft does not differ). Its
+bottom cap is planar and cuts through the rim's cylinder, as the NACA disk's sunk root
+does: the fuse meets no coincident faces. A separate shank fused onto the blade would
+share the root's non-planar (filled) face exactly with it, a coincident-face fuse, which
+this construction avoids.
 
 The blade must fit the sector (:func:`fit_problem`): the rim below the root section, the
 root within the disk's thickness, and every section and the extension within the sector,
 ``|φ| <= 0.95 π/N``. A compressor blade of solidity above one, like Rotor 37, spans more
 than its pitch ``2π/N`` about the axis and so does not fit the sector of its own blade
-count (Rotor 37: 36 blades; it fits up to ``N = 27``): such a wheel is refused, not
-altered.
+count (Rotor 37: 36 blades; it fits up to ``N = 24`` on a rim at 17 to 17.5 cm): such a
+wheel is refused, not altered.
 
 Node sets: ``root`` (the hub bore, clamped), ``left`` and ``right`` (cyclic faces, meshed
 periodic), ``tip`` (the blade's tip face, non-planar for a real blade).
