@@ -228,6 +228,13 @@ def test_a_rim_above_the_root_is_refused(folder, tmp_path, monkeypatch):
     assert f"rim_radius < {root:.6g} m" in msg
 
 
+def test_a_disk_thinner_than_the_root_is_refused(folder, tmp_path, monkeypatch):
+    msg = _one_line_refusal(tmp_path, folder, monkeypatch, thickness=0.01)
+    axial = np.ptp(_section(RADII[0], CHORDS[0], TWISTS[0])[0]) / 100  # the root's, in m
+    assert msg.startswith("rotor.thickness = 0.01: ")
+    assert msg.endswith(f"(thickness >= {axial:.6g} m)")
+
+
 def test_sections_too_wide_for_the_sectors_are_refused(folder, tmp_path, monkeypatch):
     blade = place_sections(read_sections(folder, "cm"), "x")
     lo, hi = blade.extent(DISK["rim_radius"])
