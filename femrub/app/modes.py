@@ -2,13 +2,14 @@
 
 A scene with ``rotor.sectors = N`` (:mod:`femrub.scene.schema_rotor`) is meshed as one
 cyclic sector (:func:`~femrub.geometry.bladed_disk.bladed_disk_sector`: the disk sector and
-the scene's NACA blade), assembled with P2 tetrahedra and the centrifugal prestress at
-``loads.rotation_speed`` (``loads.centrifugal``: ``auto`` is nonlinear above rest, ``off``
-none), and solved per nodal diameter ``k = 0 .. ⌊N/2⌋`` (:mod:`femrub.model.cyclic`),
-``rotor.families`` modes each. With ``casing.ring.thickness``, the casing ring around the
-tips (bore radius: the blades' largest tip radius + ``casing.ring.clearance``) is meshed as
-a sector of the same ``N`` and solved likewise, at rest; the rotation speeds of
-``k Ω = ω_disk + ω_casing`` follow (:mod:`femrub.model.coincidence`).
+the scene's NACA blade; :func:`~femrub.geometry.sections_disk.sections_disk_sector`: the
+blade lofted through the scene's section files), assembled with P2 tetrahedra and the
+centrifugal prestress at ``loads.rotation_speed`` (``loads.centrifugal``: ``auto`` is
+nonlinear above rest, ``off`` none), and solved per nodal diameter ``k = 0 .. ⌊N/2⌋``
+(:mod:`femrub.model.cyclic`), ``rotor.families`` modes each. With ``casing.ring.thickness``,
+the casing ring around the tips (bore radius: the blades' largest tip radius +
+``casing.ring.clearance``) is meshed as a sector of the same ``N`` and solved likewise, at
+rest; the rotation speeds of ``k Ω = ω_disk + ω_casing`` follow (:mod:`femrub.model.coincidence`).
 
 With ``speeds`` (``femrub modes --speeds A:B:STEP``, rad/s) the disk's modes are solved at
 every listed speed, the sector assembled once and its prestress solved speed after speed
@@ -38,7 +39,7 @@ import numpy as np
 
 from ..fem.material import Material
 from ..model.cyclic import ModeTable, cyclic_structure, mode_table, mode_tables_over_speeds
-from ..scene.spec import SceneError
+from ..scene.spec import SceneError, fail
 from . import translate as tr
 
 __all__ = [
@@ -90,14 +91,44 @@ def _blade_of(scene) -> dict:
     return {k: g[k] for k in keys} | {"n_points": g["n_points"]}
 
 
+def _sections_sector(scene, h: float):
+    """The sector of a bladed disk whose blade is lofted through the scene's section files;
+    a blade that does not fit the disk sector is refused by the ``rotor`` key at fault
+    before meshing (:func:`~femrub.geometry.sections_disk.fit_problem`)."""
+    from ..geometry.errors import GeometryError
+    from ..geometry.sections import read_sections
+    from ..geometry.sections_disk import fit_problem, place_sections, sections_disk_sector
+
+    r, g = scene["rotor"], scene["geometry"]
+    files = g.get("files")
+    paths = [scene.path(f) for f in files] if files else scene.path(g["path"])
+    try:
+        sections = read_sections(paths, g["length_unit"], g["pattern"])
+        blade = place_sections(sections, g["axis"])
+    except GeometryError as exc:
+        fail("geometry.files" if files else "geometry.path", files or g["path"], str(exc))
+    disk = (r["sectors"], r["hub_radius"], r["rim_radius"], r["thickness"])
+    problem = fit_problem(blade, *disk)
+    if problem is not None:
+        name, value, reason = problem
+        fail(f"rotor.{name}", value, reason)
+    return sections_disk_sector(
+        *disk, blade, h=h, h_min=g.get("h_min"), interpolate=g["interpolate"], ruled=g["ruled"]
+    )
+
+
 def rotor_sector(scene):
-    """The meshed sector of the scene's bladed disk (``rotor`` and ``geometry`` keys)."""
+    """The meshed sector of the scene's bladed disk (``rotor`` and ``geometry`` keys): the
+    NACA blade's (:func:`~femrub.geometry.bladed_disk.bladed_disk_sector`) or the section
+    files' (:func:`~femrub.geometry.sections_disk.sections_disk_sector`)."""
     from ..geometry.bladed_disk import bladed_disk_sector
     from ..geometry.errors import GeometryError
 
     r, g = scene["rotor"], scene["geometry"]
     h = r.get("h") or g.get("h") or r["thickness"] / 3
     try:
+        if g["kind"] == "sections":
+            return _sections_sector(scene, h)
         return bladed_disk_sector(
             r["sectors"],
             r["hub_radius"],

@@ -1,6 +1,6 @@
 """A bladed-disk scene (``rotor.sectors``) as a runnable simulation: every blade against the casing.
 
-The scene's disk sector (``rotor.*``, the NACA blade of ``geometry.*``) is prestressed at
+The scene's disk sector (``rotor.*``, the blade of ``geometry.*``) is prestressed at
 ``loads.rotation_speed`` (``loads.centrifugal``) and reduced per nodal diameter with the
 residual shapes of ``rotor.contacts`` contacts on each blade's tip; the casing ring
 (``casing.ring.*``, when it has a ``thickness``; a rigid round casing otherwise) enters as

@@ -35,7 +35,12 @@ from .mesh_size import MeshSize
 from .naca import naca4_parameters
 from .naca_blade import naca_sections
 
-__all__ = ["bladed_disk_sector", "fitted_blade_sections"]
+__all__ = [
+    "bladed_disk_sector",
+    "disk_sector_solid",
+    "fitted_blade_sections",
+    "mesh_disk_sector",
+]
 
 #: Share of the disk's thickness the blade's root chord may take.
 AXIAL_FILL = 0.9
@@ -102,7 +107,8 @@ def fitted_blade_sections(blade: dict, n_sectors: int, rim_radius: float, thickn
     return sections, scale, depth
 
 
-def _disk_sector(n_sectors, hub_radius, rim_radius, thickness) -> int:
+def disk_sector_solid(n_sectors, hub_radius, rim_radius, thickness) -> int:
+    """The annular disk sector as an OpenCASCADE volume centred on ``φ = 0``; its tag."""
     occ = gmsh.model.occ
     angle = 2.0 * math.pi / n_sectors
     outer = occ.addCylinder(-thickness / 2, 0, 0, thickness, 0, 0, rim_radius, angle=angle)
@@ -160,50 +166,24 @@ def bladed_disk_sector(  # noqa: PLR0913 (keyword options, one per scene key)
     sections, scale, depth = fitted_blade_sections(blade, n_sectors, rim_radius, thickness)
     size = MeshSize(h, h_min)
     occ = gmsh.model.occ
-    half = math.pi / n_sectors
+    z_tip = float(sections[-1][0][2, 0])
+    disk = (n_sectors, hub_radius, rim_radius, thickness)
     with gmsh_session(verbose, "bladed-disk") as session:
-        disk = _disk_sector(n_sectors, hub_radius, rim_radius, thickness)
+        sector = disk_sector_solid(*disk)
         wires = [_add_wire(a, c, True) for a, c in sections]
         loft = [t for d, t in occ.addThruSections(wires, makeSolid=True) if d == 3]
-        fused, _ = occ.fuse([(3, disk)], [(3, t) for t in loft])
-        occ.synchronize()
-        volumes = [t for d, t in fused if d == 3]
-        if len(volumes) != 1:
-            raise GeometryError(
-                f"the blade and the disk sector did not fuse into one solid ({len(volumes)});"
-                " check the blade's span and chords against the rim"
-            )
-        faces = [t for _, t in gmsh.model.getBoundary([(3, volumes[0])], oriented=False)]
-        left, right = cyclic_plane_distance(half)
-        z_tip = float(sections[-1][0][2, 0])
-        groups = classify_faces(
-            faces,
-            {
-                "root": lambda p: np.hypot(p[1], p[2]) - hub_radius,
-                "left": left,
-                "right": right,
-                "tip": lambda p: p[2] - z_tip,
-            },
-            tol=1e-6 * rim_radius,
-        )
-        set_periodic(groups["left"], groups["right"], 2.0 * half)
-        gmsh.model.addPhysicalGroup(3, volumes, name="blade")
-        for name, tags in groups.items():
-            gmsh.model.addPhysicalGroup(2, tags, name=name)
-        size.apply(session)
-        gmsh.model.mesh.generate(3)
-        if not any(len(t) for t in gmsh.model.mesh.getElements(3)[1]):
-            raise GeometryError(
-                f"gmsh could not mesh the bladed disk sector with h = {h:g} m, h_min ="
-                f" {size.h_min:g} m; use a smaller element size (rotor.h, geometry.h_min)"
-            )
-        mesh = to_blade_mesh(
-            "x",
+        mesh = mesh_disk_sector(
+            session,
+            disk,
+            sector,
+            loft,
+            lambda faces: classify_faces(
+                faces, {"tip": lambda p: p[2] - z_tip}, tol=1e-6 * rim_radius
+            )["tip"],
+            size,
             f"bladed_disk_sector(N={n_sectors}, hub={hub_radius}, rim={rim_radius},"
             f" thickness={thickness}, h={h})",
         )
-    for name in ("root", "left", "right", "tip"):
-        mesh.require(name)
     tip_radius = float(mesh.radius(mesh.mesh.p[:, mesh.node_sets["tip"]]).max())
     info = dict(
         hub_radius=hub_radius,
@@ -215,3 +195,66 @@ def bladed_disk_sector(  # noqa: PLR0913 (keyword options, one per scene key)
         h=size.h,
     )
     return SectorMesh(mesh, int(n_sectors), "disk", info)
+
+
+def mesh_disk_sector(  # noqa: PLR0913 (the parts of one gmsh model)
+    session, disk: tuple, sector: int, blade: list[int], tip, size: MeshSize, source: str
+):
+    """Fuse a blade with the disk sector and mesh the sector with periodic cyclic faces.
+
+    Parameters
+    ----------
+    session : GmshSession
+        The open gmsh session holding the disk sector's and the blade's volumes.
+    disk : tuple
+        ``(n_sectors, hub_radius, rim_radius, thickness)`` (lengths in m).
+    sector : int
+        The disk sector's volume tag (:func:`disk_sector_solid`).
+    blade : list of int
+        The blade's volume tags.
+    tip : callable
+        ``faces -> tags``: the fused solid's surfaces that form the blade's tip face.
+    size : MeshSize
+        Element sizes.
+    source : str
+        Description stored in the mesh.
+
+    Returns
+    -------
+    BladeMesh
+        Node sets ``root`` (the bore), ``left``, ``right`` and ``tip``.
+    """
+    n_sectors, hub_radius, rim_radius, thickness = disk
+    occ = gmsh.model.occ
+    half = math.pi / n_sectors
+    fused, _ = occ.fuse([(3, sector)], [(3, t) for t in blade])
+    occ.synchronize()
+    volumes = [t for d, t in fused if d == 3]
+    if len(volumes) != 1:
+        raise GeometryError(
+            f"the blade and the disk sector did not fuse into one solid ({len(volumes)});"
+            " check the blade's span and chords against the rim"
+        )
+    faces = [t for _, t in gmsh.model.getBoundary([(3, volumes[0])], oriented=False)]
+    left, right = cyclic_plane_distance(half)
+    groups = classify_faces(
+        faces,
+        {"root": lambda p: np.hypot(p[1], p[2]) - hub_radius, "left": left, "right": right},
+        tol=1e-6 * rim_radius,
+    )
+    groups["tip"] = tip(faces)
+    set_periodic(groups["left"], groups["right"], 2.0 * half)
+    gmsh.model.addPhysicalGroup(3, volumes, name="blade")
+    for name, tags in groups.items():
+        gmsh.model.addPhysicalGroup(2, tags, name=name)
+    size.apply(session)
+    gmsh.model.mesh.generate(3)
+    if not any(len(t) for t in gmsh.model.mesh.getElements(3)[1]):
+        raise GeometryError(
+            f"gmsh could not mesh the bladed disk sector with h = {size.h:g} m, h_min ="
+            f" {size.h_min:g} m; use a smaller element size (rotor.h, geometry.h_min)"
+        )
+    mesh = to_blade_mesh("x", source)
+    for name in ("root", "left", "right", "tip"):
+        mesh.require(name)
+    return mesh

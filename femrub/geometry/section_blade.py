@@ -11,7 +11,7 @@ from .blade_mesh import BladeMesh
 from .errors import GeometryError
 from .loft import loft_blade
 from .mesh_size import MeshSize
-from .sections import read_section, section_files, split_section
+from .sections import orient_sides, read_section, section_files, split_section
 
 __all__ = ["sections_blade"]
 
@@ -103,6 +103,7 @@ def sections_blade(
             raise GeometryError(
                 f"Section file {str(path)!r}: {exc} Pass pattern=... or only airfoil section files."
             ) from exc
+    sections = orient_sides(sections)
     tip_chord = float(np.linalg.norm(sections[-1][0][:, -1] - sections[-1][0][:, 0]))
     size = MeshSize(tip_chord / 12 if h is None else h, h_min)
     n = estimate_section_tets(raw, size.h)

@@ -10,7 +10,7 @@ import numpy as np
 from .errors import GeometryError
 from .units import length_scale
 
-__all__ = ["read_section", "read_sections", "section_files", "split_section"]
+__all__ = ["orient_sides", "read_section", "read_sections", "section_files", "split_section"]
 
 
 def read_section(path: str | Path, length_unit: str = "cm") -> np.ndarray:
@@ -162,3 +162,41 @@ def split_section(points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     side_a = rolled[:, : k + 1]
     side_b = np.hstack([rolled[:, k:], rolled[:, :1]])[:, ::-1]
     return side_a, side_b
+
+
+def _side_normal(side_a: np.ndarray) -> np.ndarray:
+    """``(TE − LE) × (m − LE)``, ``m`` the middle point of side ``a``: which side it is."""
+    le, te, mid = side_a[:, 0], side_a[:, -1], side_a[:, side_a.shape[1] // 2]
+    return np.cross(te - le, mid - le)
+
+
+def orient_sides(sides: list[tuple[np.ndarray, np.ndarray]]) -> list[tuple[np.ndarray, np.ndarray]]:
+    """Sections' sides (:func:`split_section`) made to match the first section's.
+
+    :func:`split_section` names the leading edge by the sign of the chord's largest
+    component, which can flip from section to section of a twisted blade; a loft between
+    mismatched sections crosses itself. Section ``k`` is turned end for end when its first
+    point lies nearer to the trailing edge of section ``k − 1`` than to its leading edge, and
+    its sides are swapped when side ``a`` lies on the other side of the chord than section
+    ``k − 1``'s side ``a`` (the sign of ``n_k · n_{k−1}``, ``n = (TE − LE) × (m − LE)``,
+    ``m`` the side's middle point; consecutive sections twist by less than 90°).
+
+    Parameters
+    ----------
+    sides : list of (numpy.ndarray, numpy.ndarray)
+        Each section's two sides ``(3, m)``, hub to tip.
+
+    Returns
+    -------
+    list of (numpy.ndarray, numpy.ndarray)
+        The same sides, from the same edge and in the same order as the first section's.
+    """
+    out = [sides[0]]
+    for a, b in sides[1:]:
+        pa = out[-1][0]
+        if np.linalg.norm(a[:, 0] - pa[:, 0]) > np.linalg.norm(a[:, 0] - pa[:, -1]):
+            a, b = b[:, ::-1], a[:, ::-1]
+        if _side_normal(a) @ _side_normal(pa) < 0:
+            a, b = b, a
+        out.append((a, b))
+    return out

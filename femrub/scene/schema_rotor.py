@@ -1,8 +1,10 @@
 """The scene schema of a bladed disk (``rotor``) and a flexible casing ring (``casing.ring``).
 
 Part of :data:`femrub.scene.schema.SCHEMA`. A scene with ``rotor.sectors = N`` is a bladed
-disk of ``N`` blades: the blade is the scene's ``geometry`` (``kind = "naca"``; its
-``hub_radius`` is replaced by the disk's rim), the disk an annulus clamped at its bore.
+disk of ``N`` blades: the blade is the scene's ``geometry`` (``kind = "naca"``, its
+``hub_radius`` replaced by the disk's rim; or ``kind = "sections"``, the section files turned
+about the axis onto the sector and extended into the rim), the disk an annulus clamped at
+its bore.
 ``casing.ring.thickness`` adds a flexible casing ring around the blades' tips. Both feed
 ``femrub modes`` (:mod:`femrub.app.modes`) and ``femrub run`` (:mod:`femrub.app.wheel`,
 which refuses what it does not model: :func:`femrub.scene.run_checks.check_run`).
@@ -104,12 +106,12 @@ def check_rotor(d: dict) -> None:
                 "blades) or remove casing.ring",
             )
         return
-    if d["geometry"]["kind"] != "naca":
+    if d["geometry"]["kind"] not in ("naca", "sections"):
         fail(
             "geometry.kind",
             d["geometry"]["kind"],
-            "the blades of a bladed disk (rotor.sectors) are NACA blades; use geometry.kind = "
-            "'naca'",
+            "the blades of a bladed disk (rotor.sectors) are NACA blades or lofted through "
+            "section files; use geometry.kind = 'naca' or 'sections'",
         )
     if not rotor["rim_radius"] > rotor["hub_radius"]:
         fail(
