@@ -108,11 +108,11 @@ def test_modes_keeps_a_finished_folder_and_run_refuses_what_a_wheel_lacks(modes_
     capsys.readouterr()
     assert main(["modes", str(scene), "-o", str(out), "-q"]) == 2
     assert "--overwrite" in capsys.readouterr().err
-    run = ["run", str(scene), "-o", str(out.parent / "run"), "-q", "--set=physics.thermal=on"]
+    run = ["run", str(scene), "-o", str(out.parent / "run"), "-q", "--set=scheme.name=carpenter"]
     assert main(run) == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1
-    assert "physics.thermal = 'on'" in err and "bladed disk runs without temperature" in err
+    assert "scheme.name = 'carpenter'" in err and "a bladed disk runs the θ-method" in err
     assert not (out.parent / "run").exists()
 
 
