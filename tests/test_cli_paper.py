@@ -150,16 +150,47 @@ DOCUMENTED = ("first_contact_time", "contact_phases", "impacts", "max_contact_fo
 DOCUMENTED += ("tip_temperature_end", "n_dofs", "status", "stability_limit")
 
 
+#: a run with this many impacts or more chatters at the casing (several impacts per contact
+#: phase): its counts and peaks follow round-off
+CHATTER = 100
+#: what round-off moves in a chattering run, and how far it may: a factor on the count of
+#: impacts and the largest force, a relative change of the final tip temperature
+CHATTER_STATISTICS, CHATTER_FACTOR, CHATTER_TEMPERATURE = (
+    ("impacts", "max_contact_force"),
+    1.5,
+    0.01,
+)
+
+
+def _same_run(old: dict, new: dict) -> None:
+    """``new`` reproduces the documented run ``old``: every documented number (to 1e-6);
+    for a chattering run, the numbers round-off cannot move before the chatter (status, first
+    contact, phases, sizes) exactly and its statistics within a band."""
+    chatter = old["impacts"] >= CHATTER
+    for key in DOCUMENTED:
+        label = (old["label"], key)
+        if chatter and key in CHATTER_STATISTICS:
+            assert 1 / CHATTER_FACTOR <= new[key] / old[key] <= CHATTER_FACTOR, label
+        elif chatter and key == "tip_temperature_end":
+            assert new[key] == pytest.approx(old[key], rel=CHATTER_TEMPERATURE), label
+        elif isinstance(old[key], float):
+            assert new[key] == pytest.approx(old[key], rel=1e-6), label
+        else:
+            assert new[key] == old[key], label
+
+
 def test_documented_numbers_are_current(summary):
     """docs/paper-reproduction.md renders its numbers from docs/paper/summary.json: a fresh
-    run must reproduce that file (else copy the new ``femrub paper`` summary.json there)."""
+    run must reproduce that file (else copy the new ``femrub paper`` summary.json there).
+
+    The θ-method's runs at 1e-5 s and 1e-6 s chatter at the casing (hundreds of impacts in
+    0.4 s): a trajectory that the last bits of the arithmetic steer, so another machine's
+    floating point (its BLAS, its vector instructions) gives other counts and peaks of the
+    same size. Those are compared within a band; everything else to 1e-6."""
     path = Path(__file__).resolve().parents[1] / "docs" / "paper" / "summary.json"
     documented = json.loads(path.read_text())["runs"]
     assert len(documented) == len(summary)
+    assert sum(r["impacts"] >= CHATTER for r in documented) <= len(documented) // 3
     for old, new in zip(documented, summary, strict=True):
         assert (old["figure"], old["label"]) == (new["figure"], new["label"])
-        for key in DOCUMENTED:
-            if isinstance(old[key], float):
-                assert new[key] == pytest.approx(old[key], rel=1e-6), (old["label"], key)
-            else:
-                assert new[key] == old[key], (old["label"], key)
+        _same_run(old, new)
