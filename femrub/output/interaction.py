@@ -126,4 +126,5 @@ def _campbell(ax, rows, scene, axes) -> None:
     ax.set_ylim(0.0, top)
     ax.set_ylabel("frequency (Hz)", fontsize=8)
     ax.grid(True, lw=0.3, alpha=0.6)
-    ax.legend(fontsize=7, loc="upper left")
+    if ax.get_legend_handles_labels()[0]:  # a bladed disk's points carry no frequencies
+        ax.legend(fontsize=7, loc="upper left")
