@@ -81,6 +81,7 @@ def _run(model, scheme, opts, blocks, **run):
             "volume": w.worn_volume,
             "last_t": w._last[0],
             "last_r": w._last[1].copy(),
+            "incursion": w.incursion.copy(),
         }
     return res, st, coat
 
@@ -127,6 +128,11 @@ def test_power_heat_and_wear_blocks_equal_the_steps(blade):
     assert ca["volume"] == pytest.approx(cb["volume"], rel=1e-9)
     assert ca["last_t"] == cb["last_t"]
     _close(ca["last_r"], cb["last_r"], 1e-9)
+    # each contact's incursion below the unworn surface: the surface is no deeper than what
+    # the contacts reached, and the cutting contacts reached into the coating
+    _close(ca["incursion"], cb["incursion"], 1e-9)
+    assert ca["max"] <= ca["incursion"].max() * (1 + 1e-9)
+    assert ca["incursion"].max() < w.thickness
 
 
 def test_footprint_blocks_equal_the_steps(blade):

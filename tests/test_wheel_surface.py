@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import json
 import math
+import re
 
 import numpy as np
 import pytest
@@ -67,6 +68,11 @@ def test_every_blade_cuts_the_coating_under_the_narrow_bore(tmp_path, direction)
     assert model.contact.wear is not wear  # the run's own coating; the model's stays unworn
     assert not model.contact.wear.depth.any()
     assert 5e-6 < wear.max_depth < THICKNESS and wear.depth.min() >= 0.0
+    # every blade's tips went into the coating, none deeper than it, the surface no deeper
+    # than what they reached
+    incursion = wear.incursion.reshape(6, -1).max(axis=1)
+    assert np.all(incursion > 0.0) and incursion.max() <= THICKNESS
+    assert wear.max_depth <= incursion.max() * (1 + 1e-9)
     assert (
         abs(_harmonic_angle(wear.angle_centres(), wear.surface.mean(axis=1)) - TROUGH) < 5
     )  # the mirror angle is 20° off
@@ -115,6 +121,16 @@ def test_a_coated_ring_heated_by_friction_through_femrub_run(tmp_path, thermal):
     hot = _harmonic_angle(np.radians(wall[:, 0]), wall[:, 1:].mean(axis=1))
     assert abs(hot - TROUGH) < abs(hot - MIRROR)  # heated where it rubs (ahead of the trough)
     assert "yields at 5 N per contact" in explain
+    # the coating is read at points: the warning names one blade's contact spacing (a few
+    # mm on a 12 mm tip), not the blades' pitch (78 mm at the tips)
+    (footprint,) = [w for w in build["warnings"] if w.startswith("contact.abradable.footprint")]
+    assert "each of the 12 contacts" in footprint
+    assert 0.5 < float(re.search(r"about ([0-9.]+) mm", footprint).group(1)) < 12.0
+    blades = np.genfromtxt(out / "blades.csv", delimiter=",", names=True)
+    deepest = blades["max_incursion_m"]
+    assert np.all(deepest > 0.0) and deepest.max() == pytest.approx(s["max_incursion"])
+    assert s["max_wear_depth"] <= s["max_incursion"] * (1 + 1e-9) <= THICKNESS * (1 + 1e-9)
+    assert s["blades"]["deepest_incursion"]["max_incursion_m"] == pytest.approx(deepest.max())
     # scheme.step_check = false: no time-step check, and its cost is not in the timings
     assert "time step  not checked (scheme.step_check = false)" in explain
     assert s.get("time_step_error") is None and "step_check" not in s["timings"]

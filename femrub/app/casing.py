@@ -9,13 +9,15 @@ import numpy as np
 __all__ = ["footprint_warning"]
 
 
-def footprint_warning(scene, grid) -> str | None:
+def footprint_warning(scene, grid, per_blade: int | None = None) -> str | None:
     """A one-line warning when several contacts read a coating at points
     (``contact.abradable.footprint = 0``), naming the width each stands for: their span
-    around the casing (the shortest arc holding them all) over their number less one."""
+    around the casing (the shortest arc holding them all) over their number less one; on a
+    bladed disk (``per_blade`` contacts on each blade, blade by blade) the span of one
+    blade's contacts."""
     if grid is None or scene["contact"]["abradable"]["thickness"] <= 0.0 or grid.footprint:
         return None
-    phi = np.unique(np.mod(grid.angles, 2 * np.pi))
+    phi = np.unique(np.mod(grid.angles[:per_blade], 2 * np.pi))
     if phi.size < 2:
         return None
     span = 2 * np.pi - np.diff(np.r_[phi, phi[0] + 2 * np.pi]).max()

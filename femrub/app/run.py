@@ -198,11 +198,13 @@ def _run_claimed(scene, out, progress, log, on_built, modes, make):
             f"{per_step:.0f} µs/step wall), output {t.get('output', 0.0):.2f} s"
         )
     info = built.model.info
+    contact = built.stepper.model.contact  # the run's own history (wear map, casing heat)
     if info.get("kind") == "bladed-disk" and res.impulse.size:
         from ..output.blades import write_blades
 
-        res.info["blades"] = write_blades(res, info["n_blades"], out)
-    contact = built.stepper.model.contact  # the run's own history (wear map, casing heat)
+        wear = contact.wear if contact is not None else None
+        incursion = None if wear is None else wear.incursion
+        res.info["blades"] = write_blades(res, info["n_blades"], out, incursion)
     if contact is not None and contact.wear is not None:
         from ..output.wear import write_wear
 

@@ -71,6 +71,7 @@ from ..reduction.estimate import HORIZON_SHARE, estimate, perturbed
 from ..scene.spec import fail
 from . import translate as tr
 from .build_warnings import warn
+from .casing import footprint_warning
 from .modes import casing_sector, ring_material, rotor_sector
 from .probes import probe_points, wheel_probes
 from .scheme import bare_stepper, stepper_of
@@ -377,6 +378,8 @@ def build_wheel(scene, log=None):
     report["probes"], probe_warnings = parts.probe_report or ([], [])
     for msg in probe_warnings:
         warn(msg, report, log)
+    if parts.surface is not None and parts.surface.wear is not None:
+        warn(footprint_warning(scene, parts.surface.wear.grid, parts.contacts.n), report, log)
     t2 = time.perf_counter()
     err, run, wall = _reduction_check(scene, parts, small, rich, model, limits, log)
     report["reduction"] = {"method": "cyclic", "error": err}

@@ -36,7 +36,9 @@ and never deeper than ``e``.
 
 The wear map is casing state that evolves during a run: a stepper calls :meth:`reset` when
 it starts. ``history`` keeps ``(t, deepest point of the surface)`` at every step that
-removed material. The cut is :func:`femrub.contact.wear_map.cut_sweeps` (compiled), which
+removed material; ``incursion`` each contact's largest reach ``r_i = w − g_i`` so far (m):
+how deep below the unworn surface its tip went, cutting or riding in a groove another
+contact (another blade) cut. The cut is :func:`femrub.contact.wear_map.cut_sweeps` (compiled), which
 the θ-method's blocks of steps also call (:mod:`femrub.contact.rub_block`).
 """
 
@@ -174,6 +176,7 @@ class Abradable:
         self.h = h
         self._last = None  # (t, reach) of the previous update: the start of the next sweep
         self._bound = None  # (t, bounds) of the last step's impulse_cap
+        self.incursion = np.zeros(self.grid.angles.size)  # each contact's largest reach (m)
 
     def cells(self, t: float) -> np.ndarray:
         return self.grid.cells(t)
@@ -232,6 +235,7 @@ class Abradable:
         depth = self.depth_at(t)
         reach = depth - np.asarray(gap, dtype=float)
         last, self._last = self._last, (float(t), reach)
+        self.incursion = np.maximum(self.incursion, reach)
         cut = np.asarray(yielded, dtype=bool) & (reach > depth)
         if not np.any(cut):
             return

@@ -375,7 +375,7 @@ def _compile_rub() -> None:
             ints,
             np.ones(5),
             np.ones(2, dtype=np.int64),
-            z.copy(),
+            np.zeros((2, 1)),
             np.zeros(3),
         ),
         (*rows, E(0)),

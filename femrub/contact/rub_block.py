@@ -47,9 +47,10 @@ WEAR_GRID = ("omega", "scale", "thickness", "cap", "footprint")
 def _wear_cut(depth, GT, X, P, t, g0, angles, axial_cell, grid, dims, last_r, wstate, U):
     """``Abradable.update`` at ``t`` after a step (``g0`` (n,): the casing profile's gap at
     ``t``): the contacts that yielded (at their bound ``U`` of the step) cut the map;
-    ``last_r``/``wstate`` carry the previous call's reach and ``(called before, its time,
-    deepest wear)``. Returns the deepest wear
-    after the cut, or ``nan`` when nothing was cut."""
+    ``last_r`` ``(2, n)`` carries the previous call's reach (row 0) and each contact's
+    largest reach so far, its incursion (row 1), ``wstate`` ``(called before, its time,
+    deepest wear)``. Returns the deepest wear after the cut, or ``nan`` when nothing was
+    cut."""
     omega, scale, thickness = grid[0], grid[1], grid[2]
     n_angle, n_axial = dims[0], dims[1]
     n = angles.size
@@ -67,13 +68,15 @@ def _wear_cut(depth, GT, X, P, t, g0, angles, axial_cell, grid, dims, last_r, ws
         r1, xe, r0, x0 = reach[idx], x1[idx], reach[idx], x1[idx]
         if wstate[0] > 0.0 and t > wstate[1]:
             x0 = positions(wstate[1], angles, omega, scale)[idx]
-            r0 = last_r[idx]
+            r0 = last_r[0][idx]
         deepest = cut_sweeps(
             depth, axial_cell[idx], x0, xe, r0, r1, thickness, n_angle, n_axial, grid[4]
         )
         wstate[2] = max(wstate[2], deepest)
         out = wstate[2]
-    last_r[:] = reach
+    last_r[0, :] = reach
+    for i in range(n):
+        last_r[1, i] = max(last_r[1, i], reach[i])
     wstate[0], wstate[1] = 1.0, t
     return out
 

@@ -32,10 +32,11 @@ BLADE_COLUMNS = {
     "rms_tip_displacement_m": "m",
     "max_abs_tip_displacement_m": "m",
     "max_tip_temperature_k": "K",
+    "max_incursion_m": "m",
 }
 
 
-def blade_table(res, n_blades: int) -> dict[str, np.ndarray]:
+def blade_table(res, n_blades: int, incursion=None) -> dict[str, np.ndarray]:
     """``{column: (N,) values}`` of :data:`BLADE_COLUMNS` from the run ``res``
     (:class:`~femrub.output.results.Results`) of a wheel of ``n_blades`` blades.
 
@@ -43,7 +44,9 @@ def blade_table(res, n_blades: int) -> dict[str, np.ndarray]:
     ``P / h`` (N) and friction force ``|P_t| / h`` (N); the share of the steps in which any
     of its contacts carried an impulse; the total normal impulse (N s); the RMS and largest
     ``|.|`` of its mean normal tip displacement (m); its largest mean tip temperature rise
-    (K; ``nan`` without temperature dofs).
+    (K; ``nan`` without temperature dofs); with an abradable coating, ``incursion`` ``(N n_c,)``
+    (:attr:`~femrub.contact.abradable.Abradable.incursion`), the deepest its contacts went
+    below the unworn coating (m; ``nan`` without a coating).
     """
     N = int(n_blades)
     impulse = np.asarray(res.impulse, dtype=float).reshape(res.impulse.shape[0], N, -1)
@@ -65,17 +68,22 @@ def blade_table(res, n_blades: int) -> dict[str, np.ndarray]:
     table["max_tip_temperature_k"] = (
         np.full(N, np.nan) if hot is None else np.asarray(hot, dtype=float).max(axis=0)
     )
+    table["max_incursion_m"] = (
+        np.full(N, np.nan)
+        if incursion is None
+        else np.clip(np.asarray(incursion, dtype=float).reshape(N, -1), 0.0, None).max(axis=1)
+    )
     return table
 
 
-def write_blades(res, n_blades: int, out) -> dict:
+def write_blades(res, n_blades: int, out, incursion=None) -> dict:
     """Write ``blades.csv`` (one row per blade, :data:`BLADE_COLUMNS`) into ``out`` and add
     ``blades`` to ``out/summary.json``: the blade with the largest normal force, the largest
     tip displacement and (with temperatures) the hottest tip, with those values, and the
     largest-to-smallest ratio of the blades' RMS tip displacements (1 for identical
-    blades); return that entry."""
+    blades), with a coating the blade that went deepest into it; return that entry."""
     out = Path(out)
-    table = blade_table(res, n_blades)
+    table = blade_table(res, n_blades, incursion)
     columns = list(BLADE_COLUMNS)
     data = np.column_stack([table[c] for c in columns])
     header = ",".join(columns)
@@ -90,6 +98,8 @@ def write_blades(res, n_blades: int, out) -> dict:
     }
     if np.all(np.isfinite(table["max_tip_temperature_k"])):
         entry["hottest_tip"] = _extreme(table, "max_tip_temperature_k")
+    if incursion is not None:
+        entry["deepest_incursion"] = _extreme(table, "max_incursion_m")
     summary = read_json(out / "summary.json")
     summary["blades"] = entry
     write_json(out / "summary.json", summary)

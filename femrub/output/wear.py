@@ -17,7 +17,9 @@ __all__ = ["write_casing_heat", "write_wear"]
 
 def write_wear(wear, out) -> dict:
     """Write ``wear_map.csv``, ``wear_map.png`` and ``wear_history.csv`` into ``out``, add
-    ``max_wear_depth`` (m) and ``worn_volume`` (m³) to ``out/summary.json``; return them.
+    ``max_wear_depth`` (m), ``worn_volume`` (m³) and ``max_incursion`` (m: the deepest any
+    contact reached below the unworn surface, :attr:`Abradable.incursion
+    <femrub.contact.abradable.Abradable.incursion>`) to ``out/summary.json``; return them.
 
     ``wear_map.csv``: one row per casing-angle cell (``angle_deg`` = its centre), one column
     per axial cell (``z=<centre in m>``): the worn surface's depth at the cell centres
@@ -65,7 +67,11 @@ def write_wear(wear, out) -> dict:
     fig.tight_layout()
     fig.savefig(out / "wear_map.png", dpi=110)
     plt.close(fig)
-    keys = {"max_wear_depth": wear.max_depth, "worn_volume": wear.worn_volume}
+    keys = {
+        "max_wear_depth": wear.max_depth,
+        "worn_volume": wear.worn_volume,
+        "max_incursion": float(np.clip(wear.incursion, 0.0, None).max(initial=0.0)),
+    }
     _add_to_summary(out / "summary.json", keys)
     return keys
 

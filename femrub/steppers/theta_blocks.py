@@ -245,12 +245,15 @@ def _rub(st, sig, t1, off, warm, use_warm, X, P, Pt, heat, state) -> tuple:
     ta = st.t0 + np.arange(st.k + 1, st.k + m + 1) * h  # the per-step path's after_step times
     hist = np.empty(m)
     if w is None:
-        depth, g0a, last_r, wstate = np.zeros(1), np.zeros((m, c.n)), np.zeros(c.n), np.zeros(3)
+        depth, g0a, wstate = np.zeros(1), np.zeros((m, c.n)), np.zeros(3)
+        last_r = np.zeros((2, c.n))
     else:
         depth = w.depth.reshape(-1)  # a view: cut in place
         g0a = np.ascontiguousarray(_profile_gap(c, ta))
         last = w._last
-        last_r = np.zeros(c.n) if last is None else np.array(last[1], dtype=float)
+        last_r = np.zeros((2, c.n))  # the last reach and the incursion so far
+        last_r[0] = 0.0 if last is None else np.asarray(last[1], dtype=float)
+        last_r[1] = w.incursion
         wstate = np.array(
             [last is not None, 0.0 if last is None else last[0], w.history[-1][1]], dtype=float
         )
@@ -291,5 +294,6 @@ def _rub(st, sig, t1, off, warm, use_warm, X, P, Pt, heat, state) -> tuple:
     if w is not None and done:
         cut = np.flatnonzero(~np.isnan(hist[:done]))
         w.history.extend(zip(ta[cut].tolist(), hist[cut].tolist(), strict=True))
-        w._last = (float(ta[done - 1]), last_r.copy())
+        w._last = (float(ta[done - 1]), last_r[0].copy())
+        w.incursion = last_r[1].copy()
     return done, status, res, warm
