@@ -19,6 +19,7 @@ from scipy.sparse.csgraph import connected_components
 from scipy.spatial.distance import pdist
 from small_wheel import TITANIUM, N
 from test_cyclic_modes import Whole, _check_against_whole
+from test_wheel_scene import WHEEL
 
 from femrub.app.cli import main
 from femrub.app.modes import rotor_sector
@@ -176,19 +177,10 @@ def test_sections_disk_cyclic_modes_match_the_whole_wheel(sector):
     assert cyclic[0] > 0
 
 
-RING = """
-[casing.ring]
-thickness = 0.004
-axial_length = 0.03
-clearance = "20 um"
-lobes = 3
-distortion = "200 um"
-h = 0.01
-families = 2
-[loads]
-rotation_speed = 1000.0
-centrifugal = "linear"
-"""
+#: the 6-blade wheel's casing ring (test_wheel_scene.py), at its speed
+RING = WHEEL[WHEEL.index("[casing.ring]") : WHEEL.index("[contact]")] + (
+    '[loads]\nrotation_speed = 1000.0\ncentrifugal = "linear"\n'
+)
 
 
 def test_the_wheel_run_takes_the_sector_its_contacts_on_the_tip(folder, tmp_path):
