@@ -74,6 +74,8 @@ def test_run_writes_every_blade_and_both_checks(scene_file, tmp_path):
     assert s["status"] in ("ok", "inaccurate"), s["message"]
     assert s["steps"] == 4500
     assert s["timings"]["step_check"] > 0.0 and s["timings"]["reduction"] > 0.0
+    seconds = s["inputs"]["build"]["reduction"]["seconds"]  # the bases, the estimate's runs
+    assert s["timings"]["reduction"] == pytest.approx(seconds["bases"] + seconds["estimate"])
     for check in ("reduction_error", "time_step_error"):
         assert 0.0 <= s[check]["estimate"] < 1.0 and s[check]["tolerance"] > 0.0
     with np.load(out / "history.npz") as h:

@@ -382,8 +382,10 @@ def build_wheel(scene, log=None):
         warn(footprint_warning(scene, parts.surface.wear.grid, parts.contacts.n), report, log)
     t2 = time.perf_counter()
     err, run, wall = _reduction_check(scene, parts, small, rich, model, limits, log)
-    report["reduction"] = {"method": "cyclic", "error": err}
-    timings["reduction"] += time.perf_counter() - t2 - wall  # the estimate, without the run
+    estimate_seconds = time.perf_counter() - t2 - wall  # the estimate, without the run
+    seconds = {"bases": timings["reduction"], "estimate": estimate_seconds}
+    report["reduction"] = {"method": "cyclic", "error": err, "seconds": seconds}
+    timings["reduction"] += estimate_seconds
     if scene["scheme"]["step_check"]:
         t3 = time.perf_counter()
         make = lambda m, h: bare_stepper(scene, m, h=h)  # noqa: E731
