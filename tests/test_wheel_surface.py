@@ -106,13 +106,14 @@ def test_a_coated_ring_heated_by_friction_through_femrub_run(tmp_path, thermal):
     # slip) and the wall's model received as much (its own end-of-step slip); the blades
     # take the rest into their temperature, or, without temperature dofs, nothing
     work, blade, casing = s["friction_work"], s["heat_to_blade"], s["heat_to_casing"]
-    assert work > 0.0 and blade + casing == pytest.approx(work, rel=1e-9) or thermal == "off"
+    assert work > 0.0
     assert s["casing_heat_in"] == pytest.approx(casing, rel=1e-2)
     explain = (out / "explain.txt").read_text()
     if thermal == "off":
         assert blade == 0.0 and casing == pytest.approx((1 - eta) * work, rel=1e-9)
         assert "blade heat" in explain
     else:
+        assert blade + casing == pytest.approx(work, rel=1e-9)
         assert blade == pytest.approx(eta * work, rel=1e-2) and s["heat_error"] < 1e-10
         assert "coordinates of the blades' temperature" in explain
         assert s["max_contact_temperature"] > 0.0
