@@ -102,7 +102,6 @@ class WheelParts:
     probe_report: tuple = ()  # (report entries, warnings) of the probes (app.probes)
     surface: CasingSurface | None = None  # the casing's coating and wall heat, the heat law
     thermal: ThermalSector | None = None  # the blades' temperature (physics.thermal)
-    heat_rows: sp.csr_matrix | None = None  # the contacts' temperature rows on the sector
 
 
 def _direction(scene, sector) -> float:
@@ -168,11 +167,10 @@ def wheel_parts(scene, log=None) -> WheelParts:
         (entries, warnings),
         _surface(scene, config, disk, contacts, thermal is not None),
         thermal,
-        None if thermal is None else contact_heat_rows(thermal, contacts),
     )
 
 
-def heated(scene) -> bool:
+def _heated(scene) -> bool:
     """Whether the scene's frictional heat enters the blades: a share ``η > 0`` of a power
     (Coulomb μ > 0 under the ``"power"`` law, α > 0 under ``"alpha"``)."""
     c = scene["contact"]
@@ -185,7 +183,7 @@ def _thermal(scene, disk, material):
     """The blades' temperature (:func:`~femrub.model.cyclic_thermal.thermal_sector`) when
     ``physics.thermal`` keeps it (``"auto"``: when frictional heat enters the blades)."""
     mode = scene["physics"]["thermal"]
-    if mode == "off" or (mode == "auto" and not heated(scene)):
+    if mode == "off" or (mode == "auto" and not _heated(scene)):
         return None
     coupling = "none" if scene["physics"]["coupling"] == "none" else "physical"
     return thermal_sector(disk, material, coupling)
@@ -243,7 +241,8 @@ def _bases(parts: WheelParts, sizes) -> list:
     thermal = [None] * len(sizes)
     rows = parts.rows
     if parts.thermal is not None:
-        loads = heat_rows_with_content(parts.thermal, parts.heat_rows)
+        heat = contact_heat_rows(parts.thermal, parts.contacts)
+        loads = heat_rows_with_content(parts.thermal, heat)
         thermal = cyclic_bases(parts.thermal.structure, [s[2] for s in sizes], loads)
         richest = thermal[int(np.argmax([s[2] for s in sizes]))]
         expansion = expansion_rows(parts.thermal, richest)
@@ -308,7 +307,7 @@ def transfer(small: CyclicBasis, rich: CyclicBasis, mass) -> np.ndarray:
 def _state_transfer(parts, small, rich) -> np.ndarray:
     """States ``[u, v(, θ)]`` of the small wheel into the rich wheel's (displacement and
     velocity alike; the temperature by its own basis)."""
-    (disk_s, waves_s, temp_s), (disk_r, waves_r, temp_r) = small[:3], rich[:3]
+    (disk_s, waves_s, temp_s), (disk_r, waves_r, temp_r) = small, rich
     T = transfer(disk_s, disk_r, parts.disk.M)
     if waves_s is not None:
         T = sp.block_diag([T, transfer(waves_s.basis, waves_r.basis, parts.ring.M)]).toarray()

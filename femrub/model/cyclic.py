@@ -51,6 +51,7 @@ __all__ = [
     "ModeTable",
     "cyclic_projection",
     "cyclic_structure",
+    "face_dof_map",
     "harmonic_modes",
     "mode_table",
     "mode_tables_over_speeds",
@@ -113,21 +114,22 @@ class CyclicStructure:
         return np.arange(self.n_sectors // 2 + 1)
 
 
-def _dof_components(basis) -> np.ndarray:
-    """Component (0, 1, 2) of every dof of a vector basis (``ElementVector`` order)."""
+def _dof_components(basis, n_components: int = 3) -> np.ndarray:
+    """Component (0 .. ``n_components − 1``) of every dof of a basis (``ElementVector``
+    order; all 0 for a scalar field)."""
     comp = np.empty(basis.N, dtype=np.int64)
     dofs = np.asarray(basis.element_dofs)
-    comp[dofs] = (np.arange(dofs.shape[0]) % 3)[:, None]
+    comp[dofs] = (np.arange(dofs.shape[0]) % n_components)[:, None]
     return comp
 
 
-def _face_nodes(basis, on_face, comp, tol) -> np.ndarray:
-    """``(n, 3)`` dofs of the three components at each dof location on a face."""
+def _face_nodes(basis, on_face, comp, tol, n_components: int) -> np.ndarray:
+    """``(n, n_components)`` dofs of the components at each dof location on a face."""
     locs = basis.doflocs
     dofs = np.flatnonzero(np.abs(on_face(locs)) <= tol)
     first = dofs[comp[dofs] == 0]
     out = [first]
-    for c in (1, 2):
+    for c in range(1, n_components):
         cand = dofs[comp[dofs] == c]
         dist, idx = cKDTree(locs[:, cand].T).query(locs[:, first].T)
         if dist.size and dist.max() > tol:
@@ -136,14 +138,16 @@ def _face_nodes(basis, on_face, comp, tol) -> np.ndarray:
     return np.column_stack(out)
 
 
-def _face_map(basis, sector: SectorMesh, free: np.ndarray):
-    """Left-face dofs and their right images as positions in ``free`` (free nodes only)."""
+def face_dof_map(basis, sector: SectorMesh, free: np.ndarray, n_components: int = 3):
+    """Left-face dofs and their right images as positions in ``free`` (free nodes only),
+    ``(n, n_components)`` each: the three components of a displacement, or the one of a
+    scalar field (the temperature, :mod:`femrub.model.cyclic_thermal`)."""
     scale = float(np.ptp(basis.mesh.p, axis=1).max())
     tol = 1e-8 * scale
-    comp = _dof_components(basis)
+    comp = _dof_components(basis, n_components)
     on_left, on_right = cyclic_plane_distance(sector.angle / 2)
-    left = _face_nodes(basis, on_left, comp, tol)
-    right_all = _face_nodes(basis, on_right, comp, tol)
+    left = _face_nodes(basis, on_left, comp, tol, n_components)
+    right_all = _face_nodes(basis, on_right, comp, tol, n_components)
     locs = basis.doflocs
     right0 = face_pairs(locs, left[:, 0], right_all[:, 0], sector.rotation, tol)
     row = {d: i for i, d in enumerate(right_all[:, 0])}
@@ -152,7 +156,9 @@ def _face_map(basis, sector: SectorMesh, free: np.ndarray):
     position[free] = np.arange(free.size)
     keep = np.all(position[left] >= 0, axis=1)
     if np.any(position[right[keep]] < 0) or np.any(position[right[~keep]] >= 0):
-        raise ValueError("the clamped dofs of the sector are not cyclic-symmetric")
+        raise ValueError(
+            "the held (clamped or ambient) dofs of the sector are not cyclic-symmetric"
+        )
     return position[left[keep]], position[right[keep]]
 
 
@@ -245,7 +251,7 @@ def cyclic_structure(
     disc = discretise(sector.mesh, order=2)
     mats = assemble(disc, material)
     free = np.asarray(mats.free_u)
-    left, right = _face_map(disc.basis_u, sector, free)
+    left, right = face_dof_map(disc.basis_u, sector, free)
     static = np.zeros(disc.basis_u.N)
     rest = CyclicStructure(
         sector, mats.K, mats.M, free, left, right, 0.0, prestress, static, disc.basis_u, disc

@@ -22,8 +22,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from ..fem.discretisation import assemble
-from ..geometry.cyclic_sector import cyclic_plane_distance, face_pairs
-from .cyclic import CyclicStructure
+from .cyclic import CyclicStructure, face_dof_map
 
 __all__ = ["ThermalSector", "expansion_rows", "heat_rows_with_content", "thermal_sector"]
 
@@ -51,24 +50,6 @@ class ThermalSector:
     coupling: str = "physical"
 
 
-def _scalar_face_map(basis, sector, free: np.ndarray):
-    """Positions in ``free`` of the free temperature dofs of the left face and of their
-    images on the right face, ``(n, 1)`` each."""
-    scale = float(np.ptp(basis.mesh.p, axis=1).max())
-    tol = 1e-8 * scale
-    on_left, on_right = cyclic_plane_distance(sector.angle / 2)
-    locs = basis.doflocs
-    left = np.flatnonzero(np.abs(on_left(locs)) <= tol)
-    right_all = np.flatnonzero(np.abs(on_right(locs)) <= tol)
-    right = face_pairs(locs, left, right_all, sector.rotation, tol)
-    position = -np.ones(basis.N, dtype=np.int64)
-    position[free] = np.arange(free.size)
-    keep = position[left] >= 0
-    if np.any(position[right[keep]] < 0) or np.any(position[right[~keep]] >= 0):
-        raise ValueError("the sector's ambient (root) temperature dofs are not cyclic-symmetric")
-    return position[left[keep]][:, None], position[right[keep]][:, None]
-
-
 def thermal_sector(structure: CyclicStructure, material, coupling: str = "physical"):
     """The temperature of ``structure``'s sector (its mesh and displacement dofs) with
     ``material``'s heat capacity ``ρc`` (J/m³/K), conductivity (W/m/K) and expansion (1/K).
@@ -81,7 +62,7 @@ def thermal_sector(structure: CyclicStructure, material, coupling: str = "physic
     if not np.array_equal(mats.free_u, structure.free):
         raise ValueError("the thermal assembly's displacement dofs differ from the structure's")
     free = np.asarray(mats.free_t)
-    left, right = _scalar_face_map(disc.basis_t, structure.sector, free)
+    left, right = face_dof_map(disc.basis_t, structure.sector, free, n_components=1)
     temperature = CyclicStructure(
         structure.sector,
         sp.csr_matrix(mats.Ktt),
