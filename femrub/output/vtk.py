@@ -301,7 +301,8 @@ class VTKSeries(FrameSink):
 
     def _write_frames(self, frames: list[tuple], vtu: VTUWriter) -> None:
         """Reconstruct the frames, ``batch`` at once, write their files with ``vtu``, then
-        the ``.pvd`` (the frames complete on disk, in order)."""
+        the ``.pvd`` (the frames complete on disk, in order): ``frames`` lists a frame only
+        once the ``.pvd`` names it."""
         for start in range(0, len(frames), self.batch):
             part = frames[start : start + self.batch]
             X, imp = np.stack([f[2] for f in part]), np.stack([f[3] for f in part])
@@ -311,15 +312,15 @@ class VTKSeries(FrameSink):
                 shape = next(f[4] for f in part if f[4] is not None).shape
                 fi = np.stack([np.zeros(shape) if f[4] is None else f[4] for f in part])
             c = self._fields.compact(X, imp, fi, times=times)
+            written = []
             for b, f in enumerate(part):
                 fname = f"{self.name}_{f[0]:06d}.vtu"
                 self._fields.store(c, b, vtu.data)
                 vtu.write(self.dir / fname)
-                with self._pvd_lock:
-                    self.frames.append((f[1], fname))
-        with self._pvd_lock:
-            self.frames.sort(key=lambda tf: tf[1])
-            self._write_pvd()
+                written.append((f[1], fname))
+            with self._pvd_lock:
+                self.frames = sorted([*self.frames, *written], key=lambda tf: tf[1])
+                self._write_pvd()
 
     def _raise_error(self) -> None:
         """Raise the writer's error here, once (the writer writes nothing after it)."""
