@@ -10,7 +10,7 @@ from test_cache import SMALL as CACHE_SMALL
 
 from femrub.app.run import run_scene
 from femrub.app.scheme import bare_stepper
-from femrub.app.simulation import build, reusable_run
+from femrub.app.simulation import build
 from femrub.output.run_folder import run_to_folder
 from femrub.scene import load_scene
 
@@ -40,7 +40,7 @@ def _write(sim, out, ran, csv_stride=1):
 
 
 def test_the_estimate_run_is_the_run(sim, tmp_path):
-    assert sim.ran is not None and reusable_run(sim.full)
+    assert sim.ran is not None
     res, wall = sim.ran
     assert wall > 0 and res.steps == sim.stepper.steps_to(sim.scene["scheme"]["t_end"])
     a = _write(sim, tmp_path / "reused", sim.ran)
@@ -223,19 +223,31 @@ def test_a_point_the_model_cannot_take_as_a_parameter_is_built_in_full():
     assert other.full.parameters["rotation_speed"] == 1400.0
 
 
-def test_a_coated_reduced_run_is_estimated_on_lean_runs_and_stepped_again():
-    """A run that carries state outside X (a coating) is not reused: the estimate keeps its
-    runs lean (times, impulses, signals), and the time-step check compares them."""
+def test_a_coated_reduced_run_is_the_estimates_run_with_the_coating_it_cut(tmp_path):
+    """A run that carries state outside X (a coating) is the estimate's run too: stepped
+    once, with the wear map it cut; the time-step check steps only the run at h/2. Its
+    folder's wear map and history equal those of the same model stepped afresh."""
     from test_rub_blocks import SCENE
 
     scene = load_scene("twisted-naca", {**SCENE, "scheme.step_check": True})
     kept = []
     sim = build(scene, log=kept.append)
-    assert not reusable_run(sim.full) and sim.ran is None
-    assert sim.report["reduction"]["error"]["estimate"] < 1.0
+    assert sim.ran is not None and sim.report["reduction"]["error"]["estimate"] < 1.0
     err = sim.report["time_step"]
     assert err["status_reference"] == "ok" and np.isfinite(err["estimate"])
     assert any("time-step check: run at h/2" in line for line in kept)
+    assert not any("time-step check: run at h =" in line for line in kept)
+    wear = sim.ran[0].contact_history.wear
+    assert wear.surface.max() > 1e-7  # the run cut the coating
+    assert sim.model.contact.wear.surface.max() == 0.0  # the model's own coating is unworn
+
+    res = _write(sim, tmp_path / "reused", sim.ran)
+    fresh = _write(sim, tmp_path / "fresh", None)
+    assert res.contact_history.wear is wear and fresh.contact_history.wear is not wear
+    np.testing.assert_allclose(
+        fresh.contact_history.wear.surface, wear.surface, rtol=0, atol=1e-12 * wear.surface.max()
+    )
+    np.testing.assert_allclose(fresh.impulse, res.impulse, rtol=0, atol=1e-9 * res.impulse.max())
 
 
 def test_a_run_that_writes_frames_is_stepped_again_and_its_checks_only_compared(monkeypatch):

@@ -115,12 +115,12 @@ def checked_sizes(
     tol, t_end = scene["reduction"]["tolerance"], scene["scheme"]["t_end"]
     window = lobe_passage(scene)
     most = (red.n_uv, red.n_theta)
-    # a run that carries a history outside X (wear, casing heat) is stepped again as the
-    # scene's run (whose stepper keeps the history the results folder writes), as is one
-    # the caller does not reuse: every run here recorded lean (only what estimate() reads,
-    # so that the runs it holds together stay small, and none of the checks of a run's own
-    # verdict); otherwise those that are never the run
-    whole = reuse_run and (model.contact is None or not model.contact.carried_state)
+    # a run the caller does not reuse (it steps the scene's run again): every run here
+    # recorded lean (only what estimate() reads, so that the runs it holds together stay
+    # small, and none of the checks of a run's own verdict); otherwise those that are never
+    # the run. A run that carries a history outside X (wear, casing heat) hands it on with
+    # its results (``Results.contact_history``).
+    whole = reuse_run
     cands = [want] if want is not None else ladder(most)
     lean = int(not whole or (want is not None and want != most))  # the reference
     *ref, ref_wall = _timed(red, most, make_stepper, t_end, limits=limits, lean=lean)
@@ -170,10 +170,9 @@ def reduce_checked(
     again). ``limits``: the run's stop limits, applied to the estimate's runs.
     ``on_run(results, seconds, states)``: called with the estimate's run of the returned
     model's sizes (its :class:`~femrub.output.results.Results`, judged without the reduction
-    rule, and its wall time), which is the scene's run: the caller need not step it again
-    (lean, and to be stepped again, when the contact carries state outside ``X``:
-    :attr:`~femrub.contact.gap.Contact.carried_state`, or when ``reuse_run`` is false: the
-    caller steps the run again).
+    rule, with the history its contact carried outside ``X``, and its wall time), which is
+    the scene's run: the caller need not step it again (lean, and to be stepped again, when
+    ``reuse_run`` is false: the caller steps the run again).
     """
     if make_stepper is None or scene["reduction"]["method"] == "none":
         return reduce_model(model, scene, log, reductor, stiffness)

@@ -65,6 +65,9 @@ def run(stepper, t_end: float, options: RunOptions | None = None) -> Results:
     finally:
         stepper.measure_works(False)
     del recorder  # its per-step arrays that the results do not hold: before the checks
+    c = stepper.model.contact
+    if c is not None and c.carried_state:  # the wear map and casing heat this run left
+        res.contact_history = c
     merge_time = None if stepper.locates_events else o.merge_time
     res = assess(res, tolerances=o.tolerances, merge_time=merge_time)
     short = whole_steps_warning(t0, stepper.h, t_end)

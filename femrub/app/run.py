@@ -198,7 +198,7 @@ def _run_claimed(scene, out, progress, log, on_built, modes, make):
             f"{per_step:.0f} µs/step wall), output {t.get('output', 0.0):.2f} s"
         )
     info = built.model.info
-    contact = built.stepper.model.contact  # the run's own history (wear map, casing heat)
+    contact = res.contact_history  # the run's own history (wear map, casing heat)
     if info.get("kind") == "bladed-disk" and res.impulse.size:
         from ..output.blades import write_blades
 

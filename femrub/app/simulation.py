@@ -16,10 +16,10 @@ blade's size), so a runaway is reported as ``diverged-physically``, never as ``o
 ``report`` says what was built and why (``femrub run SCENE --explain``); ``timings`` holds
 the seconds spent meshing, assembling and reducing. The reduction error estimate steps the
 reduced model of the chosen sizes to ``scheme.t_end`` with the scene's stepper: those results
-are the run's (``ran``), and :func:`femrub.app.run.run_scene` writes them instead of stepping
-the model a second time (unless the run writes VTK frames: then, as when the contact carries
-a history outside ``X``, the run is stepped again and the checks' runs are only
-compared). The paper's bar and a 3D blade go through the same path.
+are the run's (``ran``, with the wear map and casing heat its contact carried), and
+:func:`femrub.app.run.run_scene` writes them instead of stepping the model a second time
+(unless the run writes VTK frames: then the run is stepped again and the checks' runs are
+only compared). The paper's bar and a 3D blade go through the same path.
 """
 
 from __future__ import annotations
@@ -56,7 +56,6 @@ __all__ = [
     "blade_size",
     "build",
     "default_limits",
-    "reusable_run",
 ]
 
 #: largest casing clearance (or lobe depth) relative to the blade's size
@@ -447,20 +446,12 @@ def _reduce(scene, model, full, stages, log, limits, report, clock, reuse):
 
 def reused_run(scene, model, fields) -> bool:
     """Whether the run the checks step of the chosen model is kept as the scene's run: the
-    model allows it (:func:`reusable_run`) and the run writes no VTK frames
-    (:func:`~femrub.app.run.run_scene` steps it again, its frames written as it steps).
-    Otherwise the checks record every run they step as a run only compared."""
-    return reusable_run(model) and not (scene["outputs"]["vtk_stride"] and fields is not None)
-
-
-def reusable_run(model) -> bool:
-    """Whether the reduction error estimate's run of the chosen sizes can be the run.
-
-    It is the same model, stepper, initial state, end time and stop limits; its results are
-    kept unless the contact carries state across runs that a later run of the estimate (its
-    reference's twin) would overwrite: an abradable coating's wear or the casing's heat.
-    """
-    return model.contact is None or not model.contact.carried_state
+    same model, stepper, initial state, end time and stop limits, and the history its
+    contact carried outside ``X`` (wear map, casing heat: ``Results.contact_history``), unless
+    the run writes VTK frames (:func:`~femrub.app.run.run_scene` steps it again, its frames
+    written as it steps). Otherwise the checks record every run they step as a run only
+    compared."""
+    return not (scene["outputs"]["vtk_stride"] and fields is not None)
 
 
 def _centrifugal_report(scene, prestress, growth, reach) -> dict:

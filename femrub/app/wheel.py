@@ -363,7 +363,7 @@ def build_wheel(scene, log=None):
     docstring): the wheel's model (also its full model), its fields (the whole wheel's VTK
     frames, :class:`~femrub.output.wheel_vtk.WheelFields`), its stepper, its run (stepped by
     the reduction error estimate) and the report."""
-    from .simulation import Simulation, reusable_run
+    from .simulation import Simulation
 
     timings, t0 = {}, time.perf_counter()
     parts = wheel_parts(scene, log)
@@ -395,7 +395,7 @@ def build_wheel(scene, log=None):
     c = parts.config
     thermal = None if parts.thermal is None else parts.thermal.structure
     fields = WheelFields(wheel, parts.disk, parts.ring, c.rotation_speed, c.direction, thermal)
-    ran = (run, wall) if reusable_run(model) else None  # a coating's run: its wear is output
+    ran = (run, wall)  # the run, with the history it carried (Results.contact_history)
     return Simulation(scene, model, model, fields, None, stepper, limits, report, timings, ran)
 
 

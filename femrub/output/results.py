@@ -213,6 +213,9 @@ class Results:
     extra: dict[str, np.ndarray] = field(default_factory=dict)
     warnings: list[str] = field(default_factory=list)
     checks: dict = field(default_factory=dict)
+    #: the run's contact with the history it carried outside ``X`` at the run's end (an
+    #: abradable coating's wear map, the casing's heat: ``Contact.carried_state``), or ``None``
+    contact_history: object = None
 
     @property
     def force(self) -> np.ndarray:
