@@ -336,3 +336,31 @@ def cli_scene(name: str, sets: list[str]):
         return None
     changes = {k: _value(v) for k, v in (s.split("=", 1) for s in sets)}
     return load_scene(name, {"outputs.vtk_stride": 0, **changes})
+
+
+#: runs ``femrub ARGS`` in this child and reports its own peak resident memory last
+_FEMRUB_CHILD = (
+    "import resource, sys; from femrub.app.cli import main; code = main(sys.argv[1:]); "
+    "sys.stderr.write(f'\\nmaxrss_kib {resource.getrusage(resource.RUSAGE_SELF).ru_maxrss}\\n'); "
+    "sys.exit(code)"
+)
+
+
+def femrub_process(*args) -> dict:
+    """Wall seconds and peak resident memory (MiB) of ``femrub ARGS`` in its own process
+    (exit 0 or 1: a run whose status is not ``ok`` exits 1; anything else raises)."""
+    import subprocess
+
+    t0 = time.perf_counter()
+    cmd = [sys.executable, "-c", _FEMRUB_CHILD, *args]
+    done = subprocess.run(cmd, cwd=ROOT, capture_output=True, text=True)
+    wall = time.perf_counter() - t0
+    if done.returncode not in (0, 1):
+        raise RuntimeError(f"femrub {' '.join(args)} failed:\n{done.stderr[-2000:]}")
+    peak = float(done.stderr.rsplit("maxrss_kib", 1)[1].split()[0]) / 1024.0
+    return {
+        "command": "femrub " + " ".join(args),
+        "exit": done.returncode,
+        "wall_s": wall,
+        "peak_mib": peak,
+    }

@@ -21,10 +21,7 @@ from __future__ import annotations
 
 import argparse
 import json
-import subprocess
-import sys
 import tempfile
-import time
 from pathlib import Path
 
 import numpy as np
@@ -43,41 +40,18 @@ RATIO_TARGET = 2.0
 ERROR_TARGET = 0.005
 
 
-#: runs ``femrub ARGS`` in this child and reports its own peak resident memory last
-_CHILD = (
-    "import resource, sys; from femrub.app.cli import main; code = main(sys.argv[1:]); "
-    "sys.stderr.write(f'\\nmaxrss_kib {resource.getrusage(resource.RUSAGE_SELF).ru_maxrss}\\n'); "
-    "sys.exit(code)"
-)
-
-
-def _femrub(*args) -> dict:
-    """Wall seconds and peak memory (MiB) of ``femrub ARGS`` in its own process."""
-    t0 = time.perf_counter()
-    cmd = [sys.executable, "-c", _CHILD, *args]
-    done = subprocess.run(cmd, cwd=C.ROOT, capture_output=True, text=True)
-    wall = time.perf_counter() - t0
-    if done.returncode not in (0, 1):
-        raise RuntimeError(f"femrub {' '.join(args)} failed:\n{done.stderr[-2000:]}")
-    peak = float(done.stderr.rsplit("maxrss_kib", 1)[1].split()[0]) / 1024.0
-    return {
-        "command": "femrub " + " ".join(args),
-        "exit": done.returncode,
-        "wall_s": wall,
-        "peak_mib": peak,
-    }
-
-
 def measure() -> dict:
     with tempfile.TemporaryDirectory(prefix="femrub-campbell-") as tmp:
         tmp = Path(tmp)
-        run = _femrub("run", "rotor37", "--no-cache", "-q", "-o", str(tmp / "run"))
-        diagram = _femrub("campbell", "rotor37", "--speeds", SPEEDS, "-q", "-o", str(tmp / "cb"))
+        run = C.femrub_process("run", "rotor37", "--no-cache", "-q", "-o", str(tmp / "run"))
+        diagram = C.femrub_process(
+            "campbell", "rotor37", "--speeds", SPEEDS, "-q", "-o", str(tmp / "cb")
+        )
         doc = json.loads((tmp / "cb" / "campbell.json").read_text())
         table = np.loadtxt(tmp / "cb" / "campbell.csv", delimiter=",", skiprows=1, ndmin=2)
         held = [w for w in HELD_OUT if w not in doc["sample_speeds"]]
         listed = ",".join(f"{w:g}" for w in held)
-        exact = _femrub(
+        exact = C.femrub_process(
             "campbell", "rotor37", "--speeds", listed, "--exact", "-q", "-o", str(tmp / "ex")
         )
         ex = np.loadtxt(tmp / "ex" / "campbell.csv", delimiter=",", skiprows=1, ndmin=2)
