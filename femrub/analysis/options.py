@@ -36,6 +36,9 @@ class RunOptions:
         step with the impulses summed over each ``k`` steps (``h`` of the results ``k h``);
         the verdict reads its measures of the rest taken as the steps were recorded
         (:mod:`femrub.output.kept_rows`, ``Results.checks``).
+    snapshots : steps of the run after which its whole state is kept
+        (``Results.snapshots``: the time, ``X`` and the history the contact carries outside
+        ``X``): a stepper restarted from one continues the run.
     compared : a lean run held only to be compared with another (needs ``lean >= 1``): the
         recorder evaluates neither the energy and heat balance (nor the stepper's own works
         of each step) nor the Coulomb check, nor the gaps and slip velocities; the stop
@@ -57,6 +60,7 @@ class RunOptions:
     merge_time: float | None = None
     lean: int = 0
     compared: bool = False
+    snapshots: tuple = ()
 
     def __post_init__(self):
         if self.compared and self.lean < 1:

@@ -14,9 +14,11 @@ starts (the memory of its histories).
 
 from __future__ import annotations
 
+import numpy as np
+
 from ..output.limits import run_limits
 from ..output.recorder import Recorder
-from ..output.results import Results
+from ..output.results import Results, Snapshot
 from ..output.verdict import assess
 from ..scene.run_checks import fractional_steps
 from ..scene.validate import MAX_STEPS
@@ -58,6 +60,8 @@ def run(stepper, t_end: float, options: RunOptions | None = None) -> Results:
             blowup_check=stepper.blowup_check,
             lean=o.lean,
             compared=o.compared,
+            snapshots=o.snapshots,
+            take_snapshot=lambda step: _snapshot(stepper, step),
         )
         res = recorder.record(
             stepper.state, stepper.advance, progress=o.progress, block=stepper.block_writer()
@@ -74,6 +78,13 @@ def run(stepper, t_end: float, options: RunOptions | None = None) -> Results:
     if short:
         res.warnings.append(short)
     return res
+
+
+def _snapshot(stepper, step: int) -> Snapshot:
+    """The stepper's whole state after the run's step ``step``."""
+    c = stepper.model.contact
+    history = c.history_snapshot() if c is not None else ()
+    return Snapshot(step, float(stepper.t), np.array(stepper.X, dtype=float), history)
 
 
 def whole_steps_warning(t0: float, h: float, t_end: float) -> str | None:

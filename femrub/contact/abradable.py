@@ -178,6 +178,18 @@ class Abradable:
         self._bound = None  # (t, bounds) of the last step's impulse_cap
         self.incursion = np.zeros(self.grid.angles.size)  # each contact's largest reach (m)
 
+    #: what a run changes (:meth:`snapshot`, :meth:`restore`)
+    _STATE = ("depth", "history", "_last", "_bound", "incursion")
+
+    def snapshot(self) -> dict:
+        """This coating's state now (wear map, history, where the next sweep starts), copied."""
+        return copy.deepcopy({k: getattr(self, k) for k in self._STATE})
+
+    def restore(self, snapshot: dict) -> None:
+        """Take the state :meth:`snapshot` gave (a copy of it: the snapshot serves again)."""
+        for k, v in copy.deepcopy(snapshot).items():
+            setattr(self, k, v)
+
     def cells(self, t: float) -> np.ndarray:
         return self.grid.cells(t)
 

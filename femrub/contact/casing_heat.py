@@ -93,6 +93,18 @@ class CasingHeat:
         self.heat_in = 0.0  # J
         self.history = [(0.0, 0.0)]
 
+    #: what a run changes (:meth:`snapshot`, :meth:`restore`)
+    _STATE = ("T", "t_last", "q", "h", "heat_in", "history")
+
+    def snapshot(self) -> dict:
+        """This casing's state now (cell temperatures, heat received, history), copied."""
+        return copy.deepcopy({k: getattr(self, k) for k in self._STATE})
+
+    def restore(self, snapshot: dict) -> None:
+        """Take the state :meth:`snapshot` gave (a copy of it: the snapshot serves again)."""
+        for k, v in copy.deepcopy(snapshot).items():
+            setattr(self, k, v)
+
     def _cool_to(self, cells, t) -> np.ndarray:
         dt = t - self.t_last[cells]
         return self.T[cells] * np.exp(-np.maximum(dt, 0.0) / self.tau)

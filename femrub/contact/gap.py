@@ -251,6 +251,16 @@ class Contact:
         casing's heat); a stepper runs its own copy (:meth:`with_fresh_history`)."""
         return [s for s in (self.wear, self.casing_heat) if s is not None]
 
+    def history_snapshot(self) -> tuple:
+        """The state of the history this contact carries now (:attr:`carried_state`), copied:
+        what :meth:`restore_history` takes back."""
+        return tuple(s.snapshot() for s in self.carried_state)
+
+    def restore_history(self, snapshot: tuple) -> None:
+        """Put the history this contact carries back to :meth:`history_snapshot`'s state."""
+        for s, state in zip(self.carried_state, snapshot, strict=True):
+            s.restore(state)
+
     def with_fresh_history(self, h: float) -> Contact:
         """This contact with a history of its own, started afresh (an unworn coating, a cold
         casing) for a run of step ``h`` (s): the run's state. The contact it is copied from

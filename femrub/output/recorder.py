@@ -97,6 +97,8 @@ class Recorder:
         blowup_check: bool = True,
         lean: int = 0,
         compared: bool = False,
+        snapshots: tuple = (),
+        take_snapshot: Callable | None = None,
     ):
         if compared and not lean:
             raise ValueError("a recorder of a run only compared keeps a lean record: lean >= 1")
@@ -144,6 +146,9 @@ class Recorder:
         self.buf = np.empty((self.chunk + 1, N))
         self.kept = AllRows(self) if not lean else LeanRows(self, lean, coulomb=not compared)
         self._slips = self.tangents and self.kept.reads_slips
+        #: the steps after which ``take_snapshot(step)`` is kept (blocks end there)
+        self._snap_at = sorted({int(k) for k in snapshots if 0 <= k <= n_steps})
+        self._take_snapshot, self.snapshots = take_snapshot, []
 
     def buffers(self) -> dict[str, np.ndarray]:
         """The per-step buffers, by name (``energy_*``: the meter's), one chunk's rows."""
@@ -181,8 +186,10 @@ class Recorder:
         with one_blas_thread, np.errstate(over="ignore", invalid="ignore"):
             try:
                 self._start(start)
+                self._snapshot()
                 while self._i < self.n:
                     take(block or advance)
+                    self._snapshot()
                     if self._j == self.chunk or self._i == self.n:
                         self._close_chunk(bar)
             except _Stop as stop:
@@ -202,10 +209,18 @@ class Recorder:
         self._end = self._flush(self._i0, self._j)
         return _Stop(status, message, self._end)
 
+    def _snapshot(self) -> None:
+        """Keep the snapshot of the step just done when one is asked for there."""
+        if self._snap_at and self._snap_at[0] == self._i:
+            self.snapshots.append(self._take_snapshot(self._snap_at.pop(0)))
+
     def _take_block(self, block: Callable) -> None:
-        """A block of steps in one call of the stepper's block writer, into the rows."""
+        """A block of steps in one call of the stepper's block writer, into the rows (it ends
+        at the next snapshot's step)."""
         j = self._j
         m = min(self.chunk - j, self.n - self._i)
+        if self._snap_at:
+            m = min(m, self._snap_at[0] - self._i)
         r = slice(j + 1, j + 1 + m)
         done, friction, err = block(
             m, self.buf[r], self.t[r], self.imp[r], self.imp_t[r], self.heat[r], self.cstate[r]
@@ -420,7 +435,7 @@ class Recorder:
             if keep.any():
                 states = np.concatenate(self._stored)[keep]
                 times = np.concatenate(self._stored_t)[keep]
-        return self.kept.results(
+        res = self.kept.results(
             self,
             m,
             status=self.status,
@@ -429,3 +444,5 @@ class Recorder:
             states=states,
             state_times=times,
         )
+        res.snapshots = [s for s in self.snapshots if s.step <= i_end]
+        return res

@@ -29,6 +29,7 @@ import zipfile
 import zlib
 from dataclasses import dataclass, field, replace
 from pathlib import Path
+from typing import NamedTuple
 
 import numpy as np
 
@@ -180,6 +181,19 @@ def _savez(path: Path, arrays: dict) -> None:
                 np.lib.format.write_array(f, a, allow_pickle=False)
 
 
+class Snapshot(NamedTuple):
+    """A run's whole state after its step ``step``: the time ``t`` (s), the state ``X`` and
+    the state of the history its contact carries outside ``X`` (:meth:`Contact.history_snapshot
+    <femrub.contact.gap.Contact.history_snapshot>`, ``()`` without). A stepper restarted
+    from it (:meth:`Stepper.restart(X, t, history) <femrub.steppers.base.Stepper.restart>`)
+    continues the run."""
+
+    step: int
+    t: float
+    X: np.ndarray
+    history: tuple
+
+
 @dataclass
 class Results:
     """What a stepper's ``run()`` returns.
@@ -216,6 +230,8 @@ class Results:
     #: the run's contact with the history it carried outside ``X`` at the run's end (an
     #: abradable coating's wear map, the casing's heat: ``Contact.carried_state``), or ``None``
     contact_history: object = None
+    #: the run's :class:`Snapshot` at the steps ``RunOptions.snapshots`` asked for
+    snapshots: list = field(default_factory=list)
 
     @property
     def force(self) -> np.ndarray:

@@ -162,10 +162,13 @@ class Stepper:
         """Fill the records' ``works`` with the exact energy-balance integrals of each step
         when the stepper can integrate them (``on``); the others ignore it."""
 
-    def restart(self, X, t: float = 0.0) -> None:
+    def restart(self, X, t: float = 0.0, history: tuple | None = None) -> None:
         """Start again from the state ``X`` (N,) at the time ``t`` (s): step ``k = 0``, no
         impulse, the warm starts and carried load signals of the last run dropped, the
-        factorised operators kept.
+        factorised operators kept. ``history``: the state of the history the contact carries
+        outside ``X`` (:meth:`Contact.history_snapshot
+        <femrub.contact.gap.Contact.history_snapshot>`, e.g. of a run's
+        :class:`~femrub.output.results.Snapshot`), needed when it carries one.
 
         Raises
         ------
@@ -173,7 +176,8 @@ class Stepper:
             The stepper does not say how to reset what its step carries (``restartable``).
         ValueError
             ``X`` is not a finite state of the model, or the contact has a history outside
-            ``X`` (an abradable coating, casing heat: not a function of ``X``).
+            ``X`` (an abradable coating, casing heat: not a function of ``X``) and no
+            ``history`` is given.
 
         Notes
         -----
@@ -183,14 +187,17 @@ class Stepper:
         if not self.restartable:
             raise TypeError(f"the {self.name} stepper cannot restart from a given state")
         c = self.model.contact
-        if c is not None and c.carried_state:
+        carried = c is not None and bool(c.carried_state)
+        if carried and history is None:
             raise ValueError(
                 "a contact with a history outside the state (abradable coating, casing heat) "
-                "cannot restart from a state alone"
+                "cannot restart from a state alone: pass history=contact.history_snapshot()"
             )
         X = np.array(X, dtype=float)
         if X.shape != (self.model.n_dofs,) or not np.all(np.isfinite(X)):
             raise ValueError(f"restart state must be a finite vector of length {self.model.n_dofs}")
+        if carried:
+            c.restore_history(history)
         self.k, self.t0, self.t, self.X = 0, float(t), float(t), X
         self.impulse = np.zeros(self.model.n_contacts)
         self.friction = None
