@@ -21,8 +21,9 @@ import numpy as np
 
 from ..contact.casing import lobe_passing_frequency
 from ..progress import phase
-from ..reduction.estimate import estimate, perturbed
+from ..reduction.estimate import estimate, field_norms, perturbed
 from ..reduction.sizes import finish, ladder, prepare, reduce_model
+from .windows import estimate_on_windows, snapshot_steps, step_windows, window_plan
 
 __all__ = ["SAFETY", "lobe_passage", "reduce_checked", "simulate", "twin"]
 
@@ -40,7 +41,17 @@ def lobe_passage(scene) -> float:
     return 2.0 * np.pi / w if w else 0.0
 
 
-def simulate(reductor, sizes, make_stepper, t_end, checkpoints=5, limits=None, twin=False, lean=0):
+def simulate(
+    reductor,
+    sizes,
+    make_stepper,
+    t_end,
+    checkpoints=5,
+    limits=None,
+    twin=False,
+    lean=0,
+    snapshots=(),
+):
     """Step ``reductor.reduce(*sizes)``; return the results and the full states stored.
 
     ``limits``: the run's stop limits: the estimate compares the models over what the run
@@ -48,7 +59,7 @@ def simulate(reductor, sizes, make_stepper, t_end, checkpoints=5, limits=None, t
     (:func:`~femrub.reduction.estimate.perturbed`). ``lean = 1``: a run that is only
     compared, recorded with what :func:`~femrub.reduction.estimate.estimate` reads
     (``RunOptions.lean`` and ``compared``: no balance, Coulomb check, gaps or slip rows;
-    stopped by the stop limits as the run is).
+    stopped by the stop limits as the run is). ``snapshots``: ``RunOptions.snapshots``.
     """
     what = "twin" if twin else "run"
     with phase(f"reduction error estimate: {what} of sizes {list(sizes)} to {t_end:g} s") as p:
@@ -62,15 +73,18 @@ def simulate(reductor, sizes, make_stepper, t_end, checkpoints=5, limits=None, t
             checkpoints,
             limits,
             lean,
+            snapshots,
         )
         p["detail"] = f"{res.steps} steps, {m.n_dofs} coordinates"
     return res, states
 
 
-def _simulate(m, reductor, sizes, make_stepper, t_end, checkpoints, limits, lean):
+def _simulate(m, reductor, sizes, make_stepper, t_end, checkpoints, limits, lean, snapshots=()):
     st = make_stepper(m)
     every = max(1, st.steps_to(t_end) // checkpoints)
-    res = st.run(t_end, store_every=every, limits=limits, lean=lean, compared=lean > 0)
+    res = st.run(
+        t_end, store_every=every, limits=limits, lean=lean, compared=lean > 0, snapshots=snapshots
+    )
     return res, reductor.reconstruct(res.states, *sizes)
 
 
@@ -121,6 +135,15 @@ def checked_sizes(
     # the run. A run that carries a history outside X (wear, casing heat) hands it on with
     # its results (``Results.contact_history``).
     whole = reuse_run
+    plan = None if want is None or want == most else window_plan(scene)
+    if plan is not None:
+        ref_stepper = make_stepper(red.reduce(*most))
+        if ref_stepper.restartable:
+            *kept, err = _on_windows(
+                red, model, want, ref_stepper, make_stepper, scene, limits, whole, plan
+            )
+            tried = [{"sizes": list(want), "estimate": err["estimate"]}]
+            return _chosen(want, err, tried, kept, tol, report, log, on_run, t0)
     cands = [want] if want is not None else ladder(most)
     lean = int(not whole or (want is not None and want != most))  # the reference
     *ref, ref_wall = _timed(red, most, make_stepper, t_end, limits=limits, lean=lean)
@@ -140,6 +163,12 @@ def checked_sizes(
             break
     if chosen == most:
         err = _largest(err, tried)
+    return _chosen(chosen, err, tried, kept, tol, report, log, on_run, t0)
+
+
+def _chosen(chosen, err, tried, kept, tol, report, log, on_run, t0):
+    """Report the estimate of the sizes ``chosen``, hand their run (``kept``: results, wall
+    seconds, full states) to ``on_run``; return the sizes."""
     err.update(tolerance=tol, tried=tried, seconds=time.perf_counter() - t0)
     report["error"] = err
     if on_run is not None:
@@ -147,6 +176,46 @@ def checked_sizes(
     if log:
         log(f"reduction error estimate {100 * err['estimate']:.2g} % at sizes {list(chosen)}")
     return chosen
+
+
+def _on_windows(red, model, sizes, ref_stepper, make_stepper, scene, limits, whole, plan):
+    """The run of ``sizes`` (its snapshots kept at the windows' ends) and its estimate on the
+    windows of ``plan`` against the reductor's largest model (``ref_stepper``):
+    ``(results, wall seconds, full states, estimate)``."""
+    most = (red.n_uv, red.n_theta)
+    t_end = scene["scheme"]["t_end"]
+    res, states, wall = _timed(
+        red,
+        sizes,
+        make_stepper,
+        t_end,
+        limits=limits,
+        lean=int(not whole),
+        snapshots=snapshot_steps(plan),
+    )
+    refs = step_windows(
+        ref_stepper,
+        res,
+        plan,
+        lift=lambda X: red.lift(X, *sizes),
+        limits=limits,
+        label=f"reduction error estimate: sizes {list(most)}, ",
+    )
+    err = estimate_on_windows(
+        res,
+        refs,
+        plan,
+        lambda X: red.reconstruct(X, *sizes),
+        lambda X: red.reconstruct(X, *most),
+        field_norms(model),
+        lobe_passage(scene),
+    )
+    err.update(
+        sizes=list(sizes),
+        reference_sizes=list(most),
+        checkpoints=[float(x) for x in res.state_times],
+    )
+    return res, wall, states, err
 
 
 def reduce_checked(

@@ -35,8 +35,9 @@ import time
 import numpy as np
 
 from ..progress import phase
-from ..reduction.estimate import DECISIVE, estimate, perturbed
+from ..reduction.estimate import DECISIVE, estimate, field_norms, perturbed
 from .reduction_check import SAFETY, lobe_passage
+from .windows import estimate_on_windows, snapshot_steps, step_windows, window_plan
 
 __all__ = ["ORDER", "check_step", "coarsen", "full_states"]
 
@@ -81,10 +82,12 @@ def full_states(model, full):
     return lambda X: np.asarray(P.T @ (T @ np.asarray(X).T)).T
 
 
-def _simulate(stepper, t_end, every, limits, fields, lean=0):
-    """Run ``stepper`` to ``t_end``, full states stored every ``every`` steps (``lean``:
-    :class:`~femrub.analysis.options.RunOptions`')."""
-    res = stepper.run(t_end, store_every=every, limits=limits, lean=lean, compared=lean > 0)
+def _simulate(stepper, t_end, every, limits, fields, lean=0, snapshots=()):
+    """Run ``stepper`` to ``t_end``, full states stored every ``every`` steps (``lean``,
+    ``snapshots``: :class:`~femrub.analysis.options.RunOptions`')."""
+    res = stepper.run(
+        t_end, store_every=every, limits=limits, lean=lean, compared=lean > 0, snapshots=snapshots
+    )
     return res, fields(res.states)
 
 
@@ -118,25 +121,24 @@ def check_step(scene, model, full, make_stepper, limits, run=None, reuse_run=Tru
     fine_h = 0.5 * h
     st = make_stepper(model, fine_h)
     every = max(1, st.steps_to(t_end) // (2 * CHECKPOINTS))  # of the run at h
+    plan = window_plan(scene) if st.restartable else None
     wall = None
     if run is None:
         with phase(f"time-step check: run at h = {h:g} s"):
             w0 = time.perf_counter()
             lean = 0 if reuse_run else 1  # whole when it may be the run
-            run = _simulate(make_stepper(model, h), t_end, every, limits, fields, lean)
+            snaps = snapshot_steps(plan)
+            run = _simulate(make_stepper(model, h), t_end, every, limits, fields, lean, snaps)
             wall = time.perf_counter() - w0
-    with phase(f"time-step check: run at h/2 = {fine_h:g} s") as p:
-        fine = _simulate(st, t_end, 2 * every, limits, fields, lean=2)  # = coarsen(res, 2)
-        fine_status = fine[0].status
-        p["detail"] = f"{fine[0].steps} steps"
-    window, label = lobe_passage(scene), ()
-    err = estimate((label, *run), (label, *fine), full, window=window)
-    if _richardson(err["estimate"]) > SAFETY * tol:  # how sensitive is the response?
-        with phase(f"time-step check: twin at h/2 = {fine_h:g} s"):
-            twin = _simulate(
-                make_stepper(perturbed(model), fine_h), t_end, 2 * every, limits, fields, lean=2
-            )
-        err = estimate((label, *run), (label, *fine), full, window=window, twin=twin, tolerance=tol)
+    window = lobe_passage(scene)
+    if plan is not None and set(snapshot_steps(plan)) <= {s.step for s in run[0].snapshots}:
+        refs = step_windows(
+            st, run[0], plan, factor=2, limits=limits, label="time-step check: h/2, "
+        )
+        err = estimate_on_windows(run[0], refs, plan, fields, fields, field_norms(full), window)
+        fine_status = err["status_reference"]
+    else:
+        err, fine_status = _whole(scene, model, full, st, make_stepper, limits, run, fields, every)
     for key in ("sizes", "reference_sizes", "status_run", "status_reference"):
         err.pop(key, None)
     split = "predictability_horizon" in err
@@ -148,7 +150,7 @@ def check_step(scene, model, full, make_stepper, limits, run=None, reuse_run=Tru
         if split
         else max(measures, key=measures.get, default=""),
         method="Richardson (order 1) on the difference to the same model at h/2"
-        + (f"; {err['method']}" if split else ""),
+        + (f"; {err['method']}" if split or "windows" in err else ""),
         h=h,
         reference_h=fine_h,
         order=ORDER,
@@ -157,6 +159,26 @@ def check_step(scene, model, full, make_stepper, limits, run=None, reuse_run=Tru
         seconds=time.perf_counter() - t0,
     )
     return err, run, wall
+
+
+def _whole(scene, model, full, fine_stepper, make_stepper, limits, run, fields, every):
+    """The estimate of the run against the model stepped at ``h/2`` (``fine_stepper``) over
+    the whole run (and its round-off twin when the difference is large), and how that run
+    ended."""
+    s = scene["scheme"]
+    fine_h, t_end, tol = 0.5 * s["h"], s["t_end"], s["step_tolerance"]
+    with phase(f"time-step check: run at h/2 = {fine_h:g} s") as p:
+        fine = _simulate(fine_stepper, t_end, 2 * every, limits, fields, lean=2)
+        p["detail"] = f"{fine[0].steps} steps"
+    window, label = lobe_passage(scene), ()
+    err = estimate((label, *run), (label, *fine), full, window=window)
+    if _richardson(err["estimate"]) > SAFETY * tol:  # how sensitive is the response?
+        with phase(f"time-step check: twin at h/2 = {fine_h:g} s"):
+            twin = _simulate(
+                make_stepper(perturbed(model), fine_h), t_end, 2 * every, limits, fields, lean=2
+            )
+        err = estimate((label, *run), (label, *fine), full, window=window, twin=twin, tolerance=tol)
+    return err, fine[0].status
 
 
 def _richardson(difference: float) -> float:

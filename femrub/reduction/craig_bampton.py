@@ -366,6 +366,17 @@ class ThermoelasticCraigBampton:
             Xr = full
         return R @ Xr if Xr.ndim == 1 else Xr @ R.T
 
+    def lift(self, Xr: np.ndarray, n_uv=None, n_theta=None) -> np.ndarray:
+        """The largest model's state equal to a state of the model of sizes ``n_uv``,
+        ``n_theta`` (its sub-basis: zero on the columns it leaves out)."""
+        *_, cols, layout = self._columns(n_uv, n_theta)
+        Xr = np.asarray(Xr, dtype=float)
+        if Xr.shape[-1] != layout.n:
+            raise ValueError(f"a reduced state has {layout.n} entries, got {Xr.shape}")
+        out = np.zeros(Xr.shape[:-1] + (self.layout.n,))
+        out[..., cols] = Xr
+        return out
+
     def restrict(self, X: np.ndarray, n_uv=None, n_theta=None) -> np.ndarray:
         """Least-squares reduced state of a full state (exact when ``X`` is in span R).
 

@@ -56,6 +56,7 @@ import scipy.sparse as sp
 __all__ = [
     "QUANTITIES",
     "compare",
+    "compare_windows",
     "estimate",
     "field_norms",
     "perturbed",
@@ -155,6 +156,80 @@ def compare(run, ref, fields_run, fields_ref, norms: dict, window: float) -> dic
         out[name] = _rel(dn.max(), bn.max())
         out[name + "_end"] = _rel(dn[-1], bn[-1])
     return out
+
+
+def compare_windows(run, refs, windows, fields_run, fields_ref, norms: dict, window: float):
+    """Relative differences of ``run`` against references stepped over ``windows`` only.
+
+    Each reference ``refs[j]`` started from the run's own state at the step ``windows[j][0]``
+    (its :class:`~femrub.output.results.Snapshot`) and ran to the step ``windows[j][1]``,
+    its states stored at both ends (on the run's steps: ``lean`` rows). What a window
+    measures is what the models add over it from one state, the error a run makes per
+    window rather than its accumulation: ``contact_force`` the impulse per lobe passage of
+    every window together; ``contact_temperature`` and ``temperature`` the difference over
+    the temperature each window adds (the rise of the reference over it: the temperature of
+    a long run is its whole history's sum); ``displacement`` the fields at the windows' ends;
+    ``displacement_end`` the last window's; ``temperature_end`` the windows' differences
+    summed over what they add (the relative error of the temperature a run sums up).
+    ``fields_*``: full states of rows of reduced states.
+    """
+    snaps = {s.step: s for s in run.snapshots}
+    bins, temp, fields = [], [], []
+    for (k0, k1), ref in zip(windows, refs, strict=False):
+        n = min(k1 - k0, len(ref.t) - 1, len(run.t) - 1 - k0)
+        if n < 1:
+            break
+        a = slice(k0 + 1, k0 + n + 1)
+        bins.append(
+            (
+                _windows(run.t[a], run.impulse[a], window),
+                _windows(ref.t[1 : n + 1], ref.impulse[1 : n + 1], window),
+            )
+        )
+        key = "contact_temperature" if "contact_temperature" in ref.signals else "tip_temperature"
+        if key in ref.signals and key in run.signals:
+            x, y = run.signals[key][k0 : k0 + n + 1], ref.signals[key][: n + 1]
+            temp.append((np.abs(x - y).max(), np.abs(y - y[0]).max()))
+        if n == k1 - k0 and ref.states is not None and len(ref.states) >= 2 and k1 in snaps:
+            start = fields_run(snaps[k0].X[None, :])[0]
+            fields.append(
+                (start, fields_run(snaps[k1].X[None, :])[0], fields_ref(ref.states[-1:])[0])
+            )
+    out = {"contact_force": _binned_error(bins)}
+    if temp:
+        out["contact_temperature"] = _rel(max(d for d, _ in temp), max(r for _, r in temp))
+    for name, field in (("displacement", "u"), ("temperature", "theta")):
+        if field in norms and fields:
+            out.update(_window_fields(name, field, fields, norms[field]))
+    return out
+
+
+def _binned_error(bins) -> float:
+    """``‖ΔI‖_F / ‖I_ref‖_F`` over the lobe passages of every window."""
+    if not bins:
+        return 0.0
+    diff = sum(
+        float(np.sum((a[: min(len(a), len(b))] - b[: min(len(a), len(b))]) ** 2)) for a, b in bins
+    )
+    ref = sum(float(np.sum(b**2)) for _, b in bins)
+    return _rel(np.sqrt(diff), np.sqrt(ref))
+
+
+def _window_fields(name: str, field: str, fields, norm) -> dict:
+    """The field measures of :func:`compare_windows`: at the windows' ends, relative to the
+    field (displacement) or to what the window added to it (temperature)."""
+    sl, W = norm
+    rise = field == "theta"
+
+    def size(v):
+        return float(np.sqrt(v[sl] @ (W @ v[sl])))
+
+    diff = [size(end - ref) for _, end, ref in fields]
+    scale = [size(ref - start) if rise else size(ref) for start, _, ref in fields]
+    # the temperature a run ends with is the sum of what its windows add: their errors
+    # summed over what they add (a window that adds little heat weighs little)
+    end = _rel(sum(diff), sum(scale)) if rise else _rel(diff[-1], scale[-1])
+    return {name: _rel(max(diff), max(scale)), name + "_end": end}
 
 
 def perturbed(model):

@@ -1,0 +1,87 @@
+"""The checks of a long run on windows (femrub.analysis.windows).
+
+A long coated, heated rub (20 revolutions) is checked on five windows of one revolution: the
+reference restarted from the run's own state (and the coating it had cut) at each window.
+The windows must reproduce the run exactly when the reference is the run's own model (no
+misaligned row, lost history or lifted state), cost five revolutions of the reference, and
+see a coarser step as a larger error; a short run is checked whole.
+"""
+
+import math
+
+import numpy as np
+import pytest
+from test_rub_blocks import SCENE
+
+from femrub.analysis import windows
+from femrub.analysis.reduction_check import _on_windows
+from femrub.app import build
+from femrub.app.scheme import bare_stepper
+from femrub.scene import load_scene
+
+#: 42,000 steps of 2 µs at 1500 rad/s: 20.05 revolutions of 2094 steps
+LONG = {**SCENE, "scheme.t_end": 0.084, "scheme.step_check": True}
+
+
+@pytest.fixture(scope="module")
+def long_run(model_cache):
+    scene = load_scene("twisted-naca", LONG)
+    return scene, build(scene, log=lambda s: None, cache=model_cache)
+
+
+def test_a_long_run_is_checked_on_windows_a_short_one_whole():
+    scene = load_scene("twisted-naca", LONG)
+    plan = windows.window_plan(scene)
+    w = round(2 * math.pi / 1500.0 / 2e-6)
+    assert [b - a for a, b in plan] == [w] * windows.N_WINDOWS
+    assert plan[0][0] == 0 and plan[-1][1] == 42000  # from the run's start to its end
+    assert windows.window_plan(scene.with_changes({"scheme.t_end": 0.03})) is None
+    assert windows.window_plan(scene.with_changes({"loads.rotation_speed": 0.0})) is None
+
+
+def test_the_run_and_both_checks_go_by_windows(long_run):
+    scene, sim = long_run
+    red, step = sim.report["reduction"]["error"], sim.report["time_step"]
+    assert "windows" in red["method"] and "windows" in step["method"]
+    assert len(red["windows"]) == len(step["windows"]) == windows.N_WINDOWS
+    assert red["windows"][-1][1] == pytest.approx(0.084, rel=1e-12)
+    assert 0 < red["estimate"] < 1 and 0 < step["estimate"] < 1
+    assert "sensitivity" not in red and "sensitivity" not in step  # no twin
+    res = sim.ran[0]  # the run itself, with the coating it cut
+    assert res.steps == 42000 and res.contact_history.wear.max_depth > 1e-6
+
+
+def test_windows_of_the_runs_own_model_reproduce_the_run(long_run):
+    """The reference restarted from each snapshot with the run's own model: every measure
+    vanishes (a window one step off, a coating not restored, a wrong lift would not)."""
+    scene, sim = long_run
+    red = sim.reductor
+    most = (red.n_uv, red.n_theta)
+    ref = bare_stepper(scene, red.reduce(*most))
+    plan = windows.window_plan(scene)
+    make = lambda m: bare_stepper(scene, m)  # noqa: E731
+    res, _, _, err = _on_windows(red, sim.full, most, ref, make, scene, sim.limits, False, plan)
+    for key in windows.DECISIVE:
+        assert err[key] < 1e-8, (key, err[key])
+    steps = sum(round((b - a) / res.h) for a, b in err["windows"])
+    assert steps == sum(b - a for a, b in plan)  # five revolutions of the reference
+    # row by row: each window's rows are the run's rows of its steps
+    refs = windows.step_windows(ref, res, plan, limits=sim.limits)
+    for (k0, k1), w in zip(plan, refs, strict=True):
+        np.testing.assert_allclose(w.t, res.t[k0 : k1 + 1], rtol=0, atol=1e-12 * res.t[-1])
+        scale = np.abs(res.impulse).max()
+        np.testing.assert_allclose(w.impulse[1:], res.impulse[k0 + 1 : k1 + 1], atol=1e-9 * scale)
+        T, T_run = w.signals["contact_temperature"], res.signals["contact_temperature"]
+        np.testing.assert_allclose(T, T_run[k0 : k1 + 1], rtol=0, atol=1e-9 * np.abs(T_run).max())
+
+
+def test_a_coarser_step_shows_a_larger_windowed_error(long_run, model_cache):
+    scene, sim = long_run
+    coarse = build(
+        scene.with_changes({"scheme.h": 4e-6, "scheme.t_end": 0.084}),
+        log=lambda s: None,
+        cache=model_cache,
+    )
+    fine, rough = sim.report["time_step"], coarse.report["time_step"]
+    assert "windows" in rough["method"]
+    assert rough["estimate"] > 1.3 * fine["estimate"]
