@@ -364,3 +364,28 @@ def femrub_process(*args) -> dict:
         "wall_s": wall,
         "peak_mib": peak,
     }
+
+
+def rotor37_study(argv, description: str, store: Path, page: Path, marker: str, measure, render):
+    """The ``main`` of a Rotor 37 study: ``--render-only`` renders the ``marker`` section of
+    ``page`` from ``store``; otherwise ``measure()`` (skipped with a message without the
+    shared data), its JSON written to ``store`` and its section rendered and printed."""
+    import argparse
+
+    ap = argparse.ArgumentParser(description=description)
+    ap.add_argument("--render-only", action="store_true", help="render the page from the JSON")
+    a = ap.parse_args(argv)
+    if a.render_only:
+        write_between(page, marker, render(read_json(store)))
+        return 0
+    from femrub.geometry.rotor37 import shared_data_dir
+
+    if not (shared_data_dir() / "rotor37-fe-mesh").is_dir():
+        print(f"skipped: no Rotor 37 mesh under {shared_data_dir()} (set FEMRUB_SHARED_DATA)")
+        return 0
+    doc = measure()
+    write_json(store, doc)
+    text = render(doc)
+    write_between(page, marker, text)
+    print(text)
+    return 0

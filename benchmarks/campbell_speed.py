@@ -19,7 +19,6 @@ Run: ``python benchmarks/campbell_speed.py [--render-only]``.
 
 from __future__ import annotations
 
-import argparse
 import json
 import tempfile
 from pathlib import Path
@@ -136,23 +135,9 @@ def render(doc: dict) -> str:
 
 
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--render-only", action="store_true", help="render the page from the JSON")
-    a = ap.parse_args(argv)
-    if a.render_only:
-        C.write_between(PAGE, "campbell_speed", render(C.read_json(JSON)))
-        return 0
-    from femrub.geometry.rotor37 import shared_data_dir
-
-    if not (shared_data_dir() / "rotor37-fe-mesh").is_dir():
-        print(f"skipped: no Rotor 37 mesh under {shared_data_dir()} (set FEMRUB_SHARED_DATA)")
-        return 0
-    doc = measure()
-    C.write_json(JSON, doc)
-    text = render(doc)
-    C.write_between(PAGE, "campbell_speed", text)
-    print(text)
-    return 0
+    return C.rotor37_study(
+        argv, __doc__.splitlines()[0], JSON, PAGE, "campbell_speed", measure, render
+    )
 
 
 if __name__ == "__main__":
