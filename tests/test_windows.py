@@ -60,7 +60,7 @@ def test_windows_of_the_runs_own_model_reproduce_the_run(long_run):
     ref = bare_stepper(scene, red.reduce(*most))
     plan = windows.window_plan(scene)
     make = lambda m: bare_stepper(scene, m)  # noqa: E731
-    res, _, _, err = _on_windows(red, sim.full, most, ref, make, scene, sim.limits, False, plan)
+    res, _, _, err = _on_windows(red, sim.full, most, ref, make, scene, sim.limits, plan)
     for key in windows.DECISIVE:
         assert err[key] < 1e-8, (key, err[key])
     steps = sum(round((b - a) / res.h) for a, b in err["windows"])
@@ -85,3 +85,37 @@ def test_a_coarser_step_shows_a_larger_windowed_error(long_run, model_cache):
     fine, rough = sim.report["time_step"], coarse.report["time_step"]
     assert "windows" in rough["method"]
     assert rough["estimate"] > 1.3 * fine["estimate"]
+
+
+def test_a_windowed_run_with_frames_is_stepped_once_its_frames_from_its_states(tmp_path):
+    """With VTK frames the run the checks stepped is still the run (its states stored at the
+    frames' stride): its frames equal those of the same model stepped with the frames
+    streamed, and the folder holds the coating it cut."""
+    import pyvista
+
+    from femrub.app.run import run_scene
+    from femrub.output.run_folder import run_to_folder
+
+    scene = load_scene("twisted-naca", {**LONG, "outputs.vtk_stride": 4200, "outputs.plots": False})
+    steps = []
+    res, built = run_scene(scene, tmp_path / "once", log=steps.append)
+    assert built.ran is not None and "windows" in built.report["reduction"]["error"]["method"]
+    assert (tmp_path / "once" / "wear_map.csv").exists()
+    fresh = run_to_folder(
+        bare_stepper(scene, built.model),
+        0.084,
+        tmp_path / "streamed",
+        fields=built.fields,
+        vtk_stride=4200,
+        limits=built.limits or None,
+        plots=False,
+        rotation_speed=1500.0,
+    )
+    np.testing.assert_array_equal(fresh.impulse, res.impulse)
+    for k in (0, 5, 10):
+        name = f"vtk/rub_{k:06d}.vtu"
+        a, b = pyvista.read(tmp_path / "once" / name), pyvista.read(tmp_path / "streamed" / name)
+        for field in ("displacement", "temperature", "contact_force"):  # float32 fields
+            scale = 1e-5 * (1e-30 + np.abs(b[field]).max())
+            np.testing.assert_allclose(a[field], b[field], rtol=0, atol=scale)
+    assert len(list((tmp_path / "once" / "vtk").glob("rub_*.vtu"))) == 11

@@ -51,6 +51,7 @@ def simulate(
     twin=False,
     lean=0,
     snapshots=(),
+    store_every=0,
 ):
     """Step ``reductor.reduce(*sizes)``; return the results and the full states stored.
 
@@ -59,7 +60,8 @@ def simulate(
     (:func:`~femrub.reduction.estimate.perturbed`). ``lean = 1``: a run that is only
     compared, recorded with what :func:`~femrub.reduction.estimate.estimate` reads
     (``RunOptions.lean`` and ``compared``: no balance, Coulomb check, gaps or slip rows;
-    stopped by the stop limits as the run is). ``snapshots``: ``RunOptions.snapshots``.
+    stopped by the stop limits as the run is). ``snapshots``: ``RunOptions.snapshots``;
+    ``store_every``: the states stored every that many steps instead of at ``checkpoints``.
     """
     what = "twin" if twin else "run"
     with phase(f"reduction error estimate: {what} of sizes {list(sizes)} to {t_end:g} s") as p:
@@ -74,14 +76,17 @@ def simulate(
             limits,
             lean,
             snapshots,
+            store_every,
         )
         p["detail"] = f"{res.steps} steps, {m.n_dofs} coordinates"
     return res, states
 
 
-def _simulate(m, reductor, sizes, make_stepper, t_end, checkpoints, limits, lean, snapshots=()):
+def _simulate(
+    m, reductor, sizes, make_stepper, t_end, checkpoints, limits, lean, snapshots=(), store_every=0
+):
     st = make_stepper(m)
-    every = max(1, st.steps_to(t_end) // checkpoints)
+    every = store_every or max(1, st.steps_to(t_end) // checkpoints)
     res = st.run(
         t_end, store_every=every, limits=limits, lean=lean, compared=lean > 0, snapshots=snapshots
     )
@@ -140,7 +145,7 @@ def checked_sizes(
         ref_stepper = make_stepper(red.reduce(*most))
         if ref_stepper.restartable:
             *kept, err = _on_windows(
-                red, model, want, ref_stepper, make_stepper, scene, limits, whole, plan
+                red, model, want, ref_stepper, make_stepper, scene, limits, plan
             )
             tried = [{"sizes": list(want), "estimate": err["estimate"]}]
             return _chosen(want, err, tried, kept, tol, report, log, on_run, t0)
@@ -178,20 +183,22 @@ def _chosen(chosen, err, tried, kept, tol, report, log, on_run, t0):
     return chosen
 
 
-def _on_windows(red, model, sizes, ref_stepper, make_stepper, scene, limits, whole, plan):
-    """The run of ``sizes`` (its snapshots kept at the windows' ends) and its estimate on the
-    windows of ``plan`` against the reductor's largest model (``ref_stepper``):
-    ``(results, wall seconds, full states, estimate)``."""
+def _on_windows(red, model, sizes, ref_stepper, make_stepper, scene, limits, plan):
+    """The run of ``sizes`` (its snapshots kept at the windows' ends; recorded whole, its
+    states stored at the scene's VTK stride, so that it is the scene's run even when that
+    writes frames) and its estimate on the windows of ``plan`` against the reductor's largest
+    model (``ref_stepper``): ``(results, wall seconds, full states, estimate)``."""
     most = (red.n_uv, red.n_theta)
-    t_end = scene["scheme"]["t_end"]
+    s = scene["scheme"]
+    stride = scene["outputs"]["vtk_stride"]  # the frames' states: written from the run
     res, states, wall = _timed(
         red,
         sizes,
         make_stepper,
-        t_end,
+        s["t_end"],
         limits=limits,
-        lean=int(not whole),
         snapshots=snapshot_steps(plan),
+        store_every=stride,
     )
     refs = step_windows(
         ref_stepper,

@@ -187,7 +187,7 @@ def _run_claimed(scene, out, progress, log, on_built, modes, make):
         claimed=True,
         reduction_error=built.report["reduction"].get("error"),
         step_error=built.report.get("time_step"),
-        ran=None if stride else built.ran,  # stepped by the error estimate: not twice
+        ran=built.ran,  # stepped by the error estimate: not twice
         csv_stride=o["csv_stride"],
     )
     if log:

@@ -424,7 +424,7 @@ def _reduce(scene, model, full, stages, log, limits, report, clock, reuse):
     reduced, reductor, report["reduction"] = stages.reduce(
         model, scene, log, make, limits, on_run=lambda *run: chosen.append(run), reuse_run=reuse
     )
-    ran = chosen[0][:2] if chosen and reuse else None
+    ran = chosen[0][:2] if chosen and (reuse or holds_frames(chosen[0][0], scene)) else None
     if ran is not None:  # the run itself: its time is the run's ``stepping``
         clock.exclude(ran[1])
     clock.done("reduction", f"{reduced.n_dofs} dofs")
@@ -442,6 +442,16 @@ def _reduce(scene, model, full, stages, log, limits, report, clock, reuse):
         clock.exclude(wall_h)
     clock.done("step_check", f"time-step error {100 * report['time_step']['estimate']:.2g} %")
     return reduced, reductor, ran
+
+
+def holds_frames(res, scene) -> bool:
+    """Whether a run recorded whole holds the states of the scene's VTK frames (every
+    ``outputs.vtk_stride``-th step stored: a run checked on windows), so that it can be
+    the scene's run, its frames written from them."""
+    stride, t = scene["outputs"]["vtk_stride"], res.state_times
+    if not stride or t is None or "lean" in res.info:
+        return False
+    return len(t) == res.steps // stride + 1 and np.allclose(np.diff(t), stride * res.h)
 
 
 def reused_run(scene, model, fields) -> bool:

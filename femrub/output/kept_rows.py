@@ -196,7 +196,7 @@ class LeanRows:
             gap=np.zeros((n + 1, 0)),
             impulse=kept(self.imp),
             steps=max(m - 1, 0),
-            info=_info(rec),
+            info={**_info(rec), "lean": self.k},
             friction_limit=None if c is None else c.friction.copy(),
             checks=self.checks(rec, m),
             **kw,

@@ -27,6 +27,7 @@ from pathlib import Path
 import numpy as np
 
 from .. import __version__
+from ..steppers.record import State
 from .folder import OUTPUTS, ResultExists, claim
 from .history_file import HistoryCSV
 from .interrupts import deferred, interruptible
@@ -152,6 +153,21 @@ def run_to_folder(  # noqa: PLR0913 (keyword-only output options)
         )
 
 
+def _frames_of(res, series, contact) -> None:
+    """Feed ``series`` the frames of a run already stepped: its states stored at every
+    ``series.stride``-th step (``Results.states``), with the impulses of those steps."""
+    if res.states is None or not np.allclose(np.diff(res.state_times), series.stride * res.h):
+        raise ValueError(
+            "run_to_folder: a run already stepped writes VTK frames only from its states "
+            f"stored every vtk_stride = {series.stride} steps"
+        )
+    empty = np.zeros(res.impulse.shape[1])
+    for X, t in zip(res.states, res.state_times, strict=True):
+        k = int(round((t - res.t[0]) / res.h))
+        fi = None if res.friction_force is None else res.friction_force[k] * res.h
+        series(State(k, float(t), X, res.impulse[k], empty, empty, fi))
+
+
 def _judged(ran, tolerances, merge_time):
     """``(results, wall)`` of a run stepped elsewhere, judged as ``femrub.analysis.run`` judges.
 
@@ -163,6 +179,7 @@ def _judged(ran, tolerances, merge_time):
     if res.status == "inaccurate":
         res.status, res.message = "ok", ""
     res.states = res.state_times = None  # the estimate's checkpoints, not the run's output
+    res.snapshots = []
     return assess(res, tolerances=tolerances, merge_time=merge_time), wall
 
 
@@ -207,8 +224,6 @@ def _run(  # noqa: PLR0913 (run_to_folder's options passed on)
         doc["time_step_error"] = step_error
     _write_json(summary_path, doc)
     series = None
-    if ran is not None and fields is not None and vtk_stride:
-        raise ValueError("run_to_folder: a run already stepped has no VTK frames to write")
     if fields is not None and vtk_stride:
         from .vtk import VTKSeries
 
@@ -224,6 +239,8 @@ def _run(  # noqa: PLR0913 (run_to_folder's options passed on)
     try:
         with interruptible():
             if ran is not None:
+                if series is not None:  # its frames, from the states it stored
+                    _frames_of(ran[0], series, stepper.model.contact)
                 res, wall = _judged(ran, tolerances, merge_time)
             else:
                 res = stepper.run(
