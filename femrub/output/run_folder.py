@@ -124,7 +124,8 @@ def run_to_folder(  # noqa: PLR0913 (keyword-only output options)
     ``summary.json["time_step_error"]`` and judged by the ``time_step`` rule. ``ran``: ``(results,
     wall seconds)`` of this very run already stepped (``stepper.model`` from its initial state
     to ``t_end`` with ``limits``, e.g. by the reduction error estimate): it is judged and
-    written instead of stepped again (no VTK: its states were not streamed). ``csv_stride``:
+    written instead of stepped again (its VTK frames from its states, stored every
+    ``vtk_stride`` steps). ``csv_stride``:
     ``history.csv`` at one row every that many steps
     (:meth:`~femrub.output.results.Results.save_csv`'s ``every``; ``history.npz`` keeps every
     step). Returns the :class:`~femrub.output.results.Results`.
