@@ -40,6 +40,7 @@ ERROR_TARGET = 0.005
 
 
 def measure() -> dict:
+    machine = C.machine()  # where and when it starts
     with tempfile.TemporaryDirectory(prefix="femrub-campbell-") as tmp:
         tmp = Path(tmp)
         run = C.femrub_process("run", "rotor37", "--no-cache", "-q", "-o", str(tmp / "run"))
@@ -67,7 +68,7 @@ def measure() -> dict:
             }
         )
     return {
-        "machine": C.machine(),
+        "machine": machine,
         "run": run,
         "campbell": {**diagram, **{k: doc[k] for k in _KEYS if k in doc}},
         "exact": exact,

@@ -44,8 +44,7 @@ SUMMARY_KEYS = (
     "revolutions",
     "n_dofs",
     "timings",
-    "max_tip_temperature",
-    "max_temperature",
+    "max_contact_temperature",
     "max_wear_depth",
     "worn_volume",
     "max_incursion",
@@ -63,7 +62,7 @@ def _checks(summary: dict) -> dict:
 
 
 def measure() -> dict:
-    runs = {}
+    machine, runs = C.machine(), {}  # where and when it starts
     with tempfile.TemporaryDirectory(prefix="femrub-thermal-cost-") as tmp:
         for name in SCENES:
             out = Path(tmp) / name
@@ -74,7 +73,7 @@ def measure() -> dict:
             runs[name] = row
     a, b = (runs[s] for s in SCENES)
     return {
-        "machine": C.machine(),
+        "machine": machine,
         "runs": runs,
         "ratio": b["wall_s"] / a["wall_s"],
         "ratio_target": RATIO_TARGET,
@@ -121,7 +120,7 @@ def render(doc: dict) -> str:
     measures = [
         (key, label, scale)
         for key, label, scale in (
-            ("max_tip_temperature", "hottest tip (K)", 1.0),
+            ("max_contact_temperature", "hottest contact (K above ambient)", 1.0),
             ("max_wear_depth", "deepest wear (mm)", 1e3),
             ("worn_volume", "worn volume (mm³)", 1e9),
         )
