@@ -119,3 +119,14 @@ def test_a_windowed_run_with_frames_is_stepped_once_its_frames_from_its_states(t
             scale = 1e-5 * (1e-30 + np.abs(b[field]).max())
             np.testing.assert_allclose(a[field], b[field], rtol=0, atol=scale)
     assert len(list((tmp_path / "once" / "vtk").glob("rub_*.vtu"))) == 11
+
+
+def test_a_run_stopped_before_its_last_window_is_checked_whole(model_cache):
+    """A stop limit ends the run after its first window: windows would leave its end
+    unchecked, so both checks compare it whole."""
+    scene = load_scene("twisted-naca", {**LONG, "limits.tip_temperature": 35.0})
+    sim = build(scene, log=lambda s: None, cache=model_cache)
+    res = sim.ran[0]
+    assert res.status == "diverged-physically" and 0.005 < res.t[-1] < 0.02
+    for err in (sim.report["reduction"]["error"], sim.report["time_step"]):
+        assert "windows" not in err and np.isfinite(err["estimate"]) and err["estimate"] > 0

@@ -147,8 +147,10 @@ def checked_sizes(
             *kept, err = _on_windows(
                 red, model, want, ref_stepper, make_stepper, scene, limits, plan
             )
-            tried = [{"sizes": list(want), "estimate": err["estimate"]}]
-            return _chosen(want, err, tried, kept, tol, report, log, on_run, t0)
+            if len(err["windows"]) == len(plan):
+                tried = [{"sizes": list(want), "estimate": err["estimate"]}]
+                return _chosen(want, err, tried, kept, tol, report, log, on_run, t0)
+            # the run stopped before its last window (a stop limit): checked whole below
     cands = [want] if want is not None else ladder(most)
     lean = int(not whole or (want is not None and want != most))  # the reference
     *ref, ref_wall = _timed(red, most, make_stepper, t_end, limits=limits, lean=lean)
