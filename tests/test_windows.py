@@ -96,7 +96,7 @@ def test_a_windowed_run_with_frames_is_stepped_once_its_frames_from_its_states(t
     from femrub.app.run import run_scene
     from femrub.output.run_folder import run_to_folder
 
-    scene = load_scene("twisted-naca", {**LONG, "outputs.vtk_stride": 4200, "outputs.plots": False})
+    scene = load_scene("twisted-naca", {**LONG, "outputs.vtk_stride": 600, "outputs.plots": False})
     steps = []
     res, built = run_scene(scene, tmp_path / "once", log=steps.append)
     assert built.ran is not None and "windows" in built.report["reduction"]["error"]["method"]
@@ -106,19 +106,23 @@ def test_a_windowed_run_with_frames_is_stepped_once_its_frames_from_its_states(t
         0.084,
         tmp_path / "streamed",
         fields=built.fields,
-        vtk_stride=4200,
+        vtk_stride=600,
         limits=built.limits or None,
         plots=False,
         rotation_speed=1500.0,
     )
     np.testing.assert_array_equal(fresh.impulse, res.impulse)
-    for k in (0, 5, 10):
+    rubbing = 0
+    for k in range(71):
         name = f"vtk/rub_{k:06d}.vtu"
         a, b = pyvista.read(tmp_path / "once" / name), pyvista.read(tmp_path / "streamed" / name)
-        for field in ("displacement", "temperature", "contact_force"):  # float32 fields
-            scale = 1e-5 * (1e-30 + np.abs(b[field]).max())
+        assert set(a.array_names) == set(b.array_names)
+        for field in b.array_names:  # float32 fields
+            scale = 2e-4 * (1e-30 + np.abs(b[field]).max())
             np.testing.assert_allclose(a[field], b[field], rtol=0, atol=scale)
-    assert len(list((tmp_path / "once" / "vtk").glob("rub_*.vtu"))) == 11
+        rubbing += bool(np.abs(b["friction_force"]).max() > 0)
+    assert rubbing  # a frame with friction forces (read through the contacts' tangents)
+    assert len(list((tmp_path / "once" / "vtk").glob("rub_*.vtu"))) == 71
 
 
 def test_a_run_stopped_before_its_last_window_is_checked_whole(model_cache):

@@ -19,7 +19,8 @@ reduced model of the chosen sizes to ``scheme.t_end`` with the scene's stepper: 
 are the run's (``ran``, with the wear map and casing heat its contact carried), and
 :func:`femrub.app.run.run_scene` writes them instead of stepping the model a second time
 (unless the run writes VTK frames and is checked whole: then the run is stepped again and the
-checks' runs are only compared; a run checked on windows stores its frames' states). The paper's bar and a 3D blade go through the same path.
+checks' runs are only compared; a run checked on windows stores its frames' states). The
+paper's bar and a 3D blade go through the same path.
 """
 
 from __future__ import annotations

@@ -319,6 +319,15 @@ class Contact:
             out = np.concatenate([out, np.zeros((*out.shape[:-1], 3 - dim))], axis=-1)
         return out
 
+    def to_local(self, vectors: np.ndarray) -> np.ndarray:
+        """Global vectors in the contacts' tangent planes ((…, n_c, 3)) on the tangents
+        ((…, n_c, 2)): the inverse of :meth:`to_global` (least squares on ``t₁``, ``t₂``)."""
+        F = self.frames
+        T = F[:, 1:3, :]  # (n_c, 2, dim): t₁, t₂
+        gram = np.einsum("nid,njd->nij", T, T)
+        rhs = np.einsum("nid,...nd->...ni", T, vectors[..., : F.shape[2]])
+        return np.linalg.solve(gram, rhs[..., None])[..., 0]
+
     def project(self, left: np.ndarray, right: np.ndarray) -> Contact:
         """Contact of the model reduced by ``X = right X̄`` and left projection ``leftᵀ``."""
         tang = {}

@@ -165,7 +165,8 @@ def _frames_of(res, series, contact) -> None:
     empty = np.zeros(res.impulse.shape[1])
     for X, t in zip(res.states, res.state_times, strict=True):
         k = int(round((t - res.t[0]) / res.h))
-        fi = None if res.friction_force is None else res.friction_force[k] * res.h
+        ff = res.friction_force
+        fi = None if ff is None or contact.frames is None else contact.to_local(ff[k]) * res.h
         series(State(k, float(t), X, res.impulse[k], empty, empty, fi))
 
 
