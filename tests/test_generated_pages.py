@@ -58,3 +58,17 @@ def test_every_stored_section_is_stamped(load_benchmark):
         for key, entry in data.items():
             m = entry["machine"]
             assert m["date"] and m["commit"] and m["cores"], f"{name}:{key} has no stamp"
+
+
+@pytest.mark.parametrize(
+    ("study", "marker"),
+    [
+        ("campbell_speed", "campbell_speed"),
+        ("thermal_cost", "thermal_cost"),
+        ("thermal_step", "thermal_step"),
+    ],
+)
+def test_rotor37_study_pages_are_their_json(load_benchmark, study, marker):
+    bench = load_benchmark(study)
+    sections = {marker: bench.render(bench.C.read_json(bench.JSON))}
+    _check(bench.PAGE, sections, f"python benchmarks/{study}.py --render-only")
