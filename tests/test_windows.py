@@ -134,3 +134,38 @@ def test_a_run_stopped_before_its_last_window_is_checked_whole(model_cache):
     assert res.status == "diverged-physically" and 0.005 < res.t[-1] < 0.02
     for err in (sim.report["reduction"]["error"], sim.report["time_step"]):
         assert "windows" not in err and np.isfinite(err["estimate"]) and err["estimate"] > 0
+
+
+def test_the_window_comparison_reads_the_runs_rows_of_each_window():
+    """``compare_windows`` on a run whose windows are its own rows gives zero; the same
+    windows read one step late do not (impulses that vary from step to step)."""
+    from types import SimpleNamespace
+
+    from femrub.output.results import Snapshot
+    from femrub.reduction.estimate import compare_windows
+
+    rng = np.random.default_rng(1)
+    n, h, plan = 400, 1e-3, [(0, 50), (170, 220), (350, 400)]
+    t = np.arange(n + 1) * h
+    impulse = rng.random((n + 1, 3))
+    temp = np.cumsum(rng.random((n + 1, 3)), axis=0)
+    snaps = [Snapshot(k, t[k], np.zeros(2), ()) for w in plan for k in w]
+    run = SimpleNamespace(
+        t=t, impulse=impulse, signals={"contact_temperature": temp}, snapshots=snaps
+    )
+
+    def window(k0, k1):
+        rows = slice(k0, k1 + 1)
+        return SimpleNamespace(
+            t=t[rows],
+            impulse=impulse[rows],
+            signals={"contact_temperature": temp[rows]},
+            states=None,
+        )
+
+    same = compare_windows(run, [window(*w) for w in plan], plan, None, None, {}, 10 * h)
+    late = compare_windows(
+        run, [window(a + 1, b + 1) for a, b in plan], plan, None, None, {}, 10 * h
+    )
+    assert same["contact_force"] == 0 and same["contact_temperature"] == 0
+    assert late["contact_force"] > 0.03 and late["contact_temperature"] > 0.01
