@@ -355,16 +355,8 @@ class ThermoelasticCraigBampton:
         ``n_uv``, ``n_theta``: the sizes the reduced model was built with (``reduce``'s
         arguments, also in its ``info``); ``None``: the largest sizes.
         """
-        *_, cols, layout = self._columns(n_uv, n_theta)
-        Xr = np.asarray(Xr, dtype=float)
-        if Xr.shape[-1] != layout.n:
-            raise ValueError(f"a reduced state has {layout.n} entries, got {Xr.shape}")
-        R = self.R
-        if cols.size < R.shape[1]:  # zero coordinates on the columns left out: no copy of R
-            full = np.zeros(Xr.shape[:-1] + (R.shape[1],))
-            full[..., cols] = Xr
-            Xr = full
-        return R @ Xr if Xr.ndim == 1 else Xr @ R.T
+        Xr = self.lift(Xr, n_uv, n_theta)  # zero on the columns left out: no copy of R
+        return self.R @ Xr if Xr.ndim == 1 else Xr @ self.R.T
 
     def lift(self, Xr: np.ndarray, n_uv=None, n_theta=None) -> np.ndarray:
         """The largest model's state equal to a state of the model of sizes ``n_uv``,
@@ -373,6 +365,8 @@ class ThermoelasticCraigBampton:
         Xr = np.asarray(Xr, dtype=float)
         if Xr.shape[-1] != layout.n:
             raise ValueError(f"a reduced state has {layout.n} entries, got {Xr.shape}")
+        if cols.size == self.layout.n:
+            return Xr
         out = np.zeros(Xr.shape[:-1] + (self.layout.n,))
         out[..., cols] = Xr
         return out
