@@ -118,6 +118,11 @@ def _windows(t: np.ndarray, impulse: np.ndarray, window: float) -> np.ndarray:
     return out
 
 
+def _temperature_key(res) -> str:
+    """The contact temperature signal compared: each contact's, else the tip's mean."""
+    return "contact_temperature" if "contact_temperature" in res.signals else "tip_temperature"
+
+
 def _rel(diff: float, ref: float) -> float:
     return float(diff / ref) if ref > 0 else (0.0 if diff == 0 else float("inf"))
 
@@ -140,7 +145,7 @@ def compare(run, ref, fields_run, fields_ref, norms: dict, window: float) -> dic
     m = min(fields_run.shape[0], fields_ref.shape[0])
     fields_run, fields_ref = fields_run[:m], fields_ref[:m]
     out["contact_force"] = _impulse_error(run, ref, window)
-    key = "contact_temperature" if "contact_temperature" in ref.signals else "tip_temperature"
+    key = _temperature_key(ref)
     if key in ref.signals and key in run.signals:
         k = min(len(run.t), len(ref.t))
         a, b = run.signals[key][:k], ref.signals[key][:k]
@@ -186,7 +191,7 @@ def compare_windows(run, refs, windows, fields_run, fields_ref, norms: dict, win
                 _windows(ref.t[1 : n + 1], ref.impulse[1 : n + 1], window),
             )
         )
-        key = "contact_temperature" if "contact_temperature" in ref.signals else "tip_temperature"
+        key = _temperature_key(ref)
         if key in ref.signals and key in run.signals:
             x, y = run.signals[key][k0 : k0 + n + 1], ref.signals[key][: n + 1]
             temp.append((np.abs(x - y).max(), np.abs(y - y[0]).max()))
