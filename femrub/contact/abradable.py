@@ -50,6 +50,7 @@ import math
 import numpy as np
 
 from ..fem.material import check_finite_positive
+from .run_state import RunState
 from .wear_map import cut_sweeps, depth_under, entry_bounds, surface_max
 
 __all__ = ["Abradable", "CasingGrid"]
@@ -142,7 +143,7 @@ class CasingGrid:
         return 0.5 * (self.z_edges[1:] + self.z_edges[:-1])
 
 
-class Abradable:
+class Abradable(RunState):
     """Abradable coating on the cells of a :class:`CasingGrid` (module docstring).
 
     Parameters
@@ -178,17 +179,8 @@ class Abradable:
         self._bound = None  # (t, bounds) of the last step's impulse_cap
         self.incursion = np.zeros(self.grid.angles.size)  # each contact's largest reach (m)
 
-    #: what a run changes (:meth:`snapshot`, :meth:`restore`)
+    #: what a run changes (wear map, history, where the next sweep starts): RunState
     _STATE = ("depth", "history", "_last", "_bound", "incursion")
-
-    def snapshot(self) -> dict:
-        """This coating's state now (wear map, history, where the next sweep starts), copied."""
-        return copy.deepcopy({k: getattr(self, k) for k in self._STATE})
-
-    def restore(self, snapshot: dict) -> None:
-        """Take the state :meth:`snapshot` gave (a copy of it: the snapshot serves again)."""
-        for k, v in copy.deepcopy(snapshot).items():
-            setattr(self, k, v)
 
     def cells(self, t: float) -> np.ndarray:
         return self.grid.cells(t)

@@ -36,6 +36,7 @@ import math
 import numpy as np
 
 from ..fem.material import check_finite_positive
+from .run_state import RunState
 
 __all__ = ["CasingHeat", "effusivity_partition"]
 
@@ -47,7 +48,7 @@ def effusivity_partition(blade: tuple, casing: tuple) -> float:
     return eb / (eb + ec)
 
 
-class CasingHeat:
+class CasingHeat(RunState):
     """Lumped casing-wall temperatures on the cells of ``grid`` (module docstring).
 
     Parameters
@@ -93,17 +94,8 @@ class CasingHeat:
         self.heat_in = 0.0  # J
         self.history = [(0.0, 0.0)]
 
-    #: what a run changes (:meth:`snapshot`, :meth:`restore`)
+    #: what a run changes (cell temperatures, heat received, history): RunState
     _STATE = ("T", "t_last", "q", "h", "heat_in", "history")
-
-    def snapshot(self) -> dict:
-        """This casing's state now (cell temperatures, heat received, history), copied."""
-        return copy.deepcopy({k: getattr(self, k) for k in self._STATE})
-
-    def restore(self, snapshot: dict) -> None:
-        """Take the state :meth:`snapshot` gave (a copy of it: the snapshot serves again)."""
-        for k, v in copy.deepcopy(snapshot).items():
-            setattr(self, k, v)
 
     def _cool_to(self, cells, t) -> np.ndarray:
         dt = t - self.t_last[cells]
