@@ -27,7 +27,7 @@ from ..scene.run_checks import check_run
 from ..scene.scene import Scene
 from .cache import source_version
 from .inputs import inputs_digest
-from .simulation import build, holds_frames
+from .simulation import build
 
 __all__ = ["FINISHED", "folder_status", "merge_time", "run_scene", "scene_hash", "versions"]
 
@@ -148,15 +148,6 @@ def _check_not_the_scene(scene: Scene, out: Path) -> None:
         )
 
 
-def _reusable(built, stride: int):
-    """The run the checks stepped, unless the run writes VTK frames and it did not store
-    their states (then the run is stepped again, its frames written as it steps)."""
-    ran = built.ran
-    if ran is not None and stride and not holds_frames(ran[0], built.scene):
-        return None
-    return ran
-
-
 def _run_claimed(scene, out, progress, log, on_built, modes, make):
     try:
         built = make(scene, log=log, modes=modes)
@@ -196,7 +187,7 @@ def _run_claimed(scene, out, progress, log, on_built, modes, make):
         claimed=True,
         reduction_error=built.report["reduction"].get("error"),
         step_error=built.report.get("time_step"),
-        ran=_reusable(built, stride),  # stepped by the error estimate: not twice
+        ran=built.ran,  # stepped by the error estimate: not twice
         csv_stride=o["csv_stride"],
     )
     if log:

@@ -130,7 +130,8 @@ class Simulation:
     timings: dict = field(default_factory=dict)
     #: ``(results, wall seconds)`` of the scene's run of ``model`` to ``scheme.t_end``, stepped
     #: by the reduction error estimate or the time-step check (:func:`reused_run`: not with
-    #: VTK frames, which the run writes as it steps), else ``None``
+    #: VTK frames, which the run writes as it steps, unless it stored their states:
+    #: :func:`holds_frames`), else ``None``
     ran: tuple | None = None
     #: the probes' observation rows on the full model, ``{probe_<name>: (1, n) rows}``
     probes: dict = field(default_factory=dict)

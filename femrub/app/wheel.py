@@ -363,7 +363,7 @@ def build_wheel(scene, log=None):
     docstring): the wheel's model (also its full model), its fields (the whole wheel's VTK
     frames, :class:`~femrub.output.wheel_vtk.WheelFields`), its stepper, its run (stepped by
     the reduction error estimate) and the report."""
-    from .simulation import Simulation
+    from .simulation import Simulation, holds_frames, reused_run
 
     timings, t0 = {}, time.perf_counter()
     parts = wheel_parts(scene, log)
@@ -395,7 +395,9 @@ def build_wheel(scene, log=None):
     c = parts.config
     thermal = None if parts.thermal is None else parts.thermal.structure
     fields = WheelFields(wheel, parts.disk, parts.ring, c.rotation_speed, c.direction, thermal)
-    ran = (run, wall)  # the run, with the history it carried (Results.contact_history)
+    # the run, with the history it carried (Results.contact_history), unless the run writes
+    # VTK frames whose states it did not store: then it is stepped again, writing them
+    ran = (run, wall) if reused_run(scene, model, fields) or holds_frames(run, scene) else None
     return Simulation(scene, model, model, fields, None, stepper, limits, report, timings, ran)
 
 
