@@ -53,23 +53,40 @@ def _info(rec) -> dict:
 
 
 class AllRows:
-    """Every per-step array of every row, ``n_steps + 1`` rows allocated at once."""
+    """Every per-step array of every row, ``n_steps + 1`` rows allocated at once; the
+    tangential impulses and slip velocities in global axes (``friction_force``,
+    ``slip_velocity``: ``(rows, n_c, 3)``), turned chunk by chunk as the rows arrive (the
+    local rows are not kept beside them)."""
 
     reads_gaps = reads_slips = True
+    #: the recorder's buffers kept in global axes, by the name they take in the results
+    _GLOBAL = {"imp_t": "friction_force", "slip": "slip_velocity"}
 
     def __init__(self, rec):
         n1, self.taken = rec.n + 1, -1
-        self.rows = {k: np.zeros((n1, *a.shape[1:]), a.dtype) for k, a in rec.buffers().items()}
+        c = rec.model.contact
+        self._turns = rec.tangents and c.frames is not None
+        kept = {k: a for k, a in rec.buffers().items() if k not in self._GLOBAL}
+        self.rows = {k: np.zeros((n1, *a.shape[1:]), a.dtype) for k, a in kept.items()}
+        nc = rec.model.n_contacts
+        for name in self._GLOBAL.values():  # zeros without tangents (untouched: no memory)
+            self.rows[name] = np.zeros((n1, nc, 3))
         self.extra: dict[str, np.ndarray] = {}
 
     def take(self, rec, i0: int, last: int) -> None:
-        """Copy rows ``taken + 1 .. last`` from the recorder's buffers."""
+        """Copy rows ``taken + 1 .. last`` from the recorder's buffers (tangential rows turned
+        to global axes, friction impulses over ``h`` as forces)."""
         first = self.taken + 1
         if last < first:
             return
         a, b = slice(first, last + 1), slice(first - i0, last + 1 - i0)
         for k, v in rec.buffers().items():
-            self.rows[k][a] = v[b]
+            if k not in self._GLOBAL:
+                self.rows[k][a] = v[b]
+        if self._turns:
+            c = rec.model.contact
+            self.rows["friction_force"][a] = c.to_global(rec.imp_t[b] / rec.h)
+            self.rows["slip_velocity"][a] = c.to_global(rec.slip[b])
         for k, v in rec.extra.items():
             self.extra.setdefault(k, np.zeros((rec.n + 1, *v.shape[1:]), v.dtype))[a] = v[b]
         self.taken = last
@@ -81,24 +98,21 @@ class AllRows:
         def reached(a):  # the rows reached; no copy of a complete run's arrays (not reused)
             return a[:m] if m == a.shape[0] else a[:m].copy()
 
-        c, nc, h = rec.model.contact, rec.model.n_contacts, rec.h
+        c = rec.model.contact
         if not rec.has_friction:  # frictionless stepper: open or (frictionless) sliding
             r["cstate"][:m] = np.where(r["imp"][:m] > 0.0, 2, 0)
-        ff, sv = np.zeros((m, nc, 3)), np.zeros((m, nc, 3))
-        if rec.tangents and c.frames is not None:
-            ff, sv = c.to_global(r["imp_t"][:m] / h), c.to_global(r["slip"][:m])
         energy = {k[7:]: reached(v) for k, v in r.items() if k.startswith("energy_")}
         return Results(
             scheme=rec.scheme,
-            h=h,
+            h=rec.h,
             t=reached(r["t"]),
             signals=_signals(rec, reached(r["obs"])),
             gap=reached(r["gap"]),
             impulse=reached(r["imp"]),
             energy=energy,
             steps=m - 1,
-            friction_force=ff,
-            slip_velocity=sv,
+            friction_force=reached(r["friction_force"]),
+            slip_velocity=reached(r["slip_velocity"]),
             contact_state=reached(r["cstate"]),
             friction_limit=None if c is None else c.friction.copy(),
             info=_info(rec),
