@@ -125,6 +125,23 @@ def test_a_windowed_run_with_frames_is_stepped_once_its_frames_from_its_states(t
     assert len(list((tmp_path / "once" / "vtk").glob("rub_*.vtu"))) == 71
 
 
+def test_with_its_estimate_cached_the_step_checks_run_is_the_run(tmp_path, model_cache):
+    """A second run of the scene finds its reduction (and its estimate) in the cache: the
+    time-step check steps the run at ``h``, its states at the frames' stride, and that run
+    is the scene's run (it is not stepped again for its frames)."""
+    from femrub.app.run import run_scene
+
+    scene = load_scene("twisted-naca", {**LONG, "outputs.vtk_stride": 600, "outputs.plots": False})
+    first, _ = run_scene(scene, tmp_path / "first", cache=model_cache)
+    lines = []
+    res, built = run_scene(scene, tmp_path / "second", cache=model_cache, log=lines.append)
+    assert any("cache: reduction loaded" in line for line in lines)
+    assert "windows" in built.report["time_step"]["method"]
+    assert built.ran is not None and built.ran[0] is res
+    np.testing.assert_array_equal(res.impulse, first.impulse)
+    assert len(list((tmp_path / "second" / "vtk").glob("rub_*.vtu"))) == 71
+
+
 def test_a_run_stopped_before_its_last_window_is_checked_whole(model_cache):
     """A stop limit ends the run after its first window: windows would leave its end
     unchecked, so both checks compare it whole."""

@@ -126,9 +126,12 @@ def check_step(scene, model, full, make_stepper, limits, run=None, reuse_run=Tru
     if run is None:
         with phase(f"time-step check: run at h = {h:g} s"):
             w0 = time.perf_counter()
-            lean = 0 if reuse_run else 1  # whole when it may be the run
+            # checked on windows, its states at the VTK frames' stride: it may be the run
+            stride = scene["outputs"]["vtk_stride"] if plan is not None else 0
+            lean = 0 if reuse_run or stride else 1  # whole when it may be the run
             snaps = snapshot_steps(plan)
-            run = _simulate(make_stepper(model, h), t_end, every, limits, fields, lean, snaps)
+            st_h = make_stepper(model, h)
+            run = _simulate(st_h, t_end, stride or every, limits, fields, lean, snaps)
             wall = time.perf_counter() - w0
     window = lobe_passage(scene)
     if plan is not None and set(snapshot_steps(plan)) <= {s.step for s in run[0].snapshots}:
@@ -138,6 +141,7 @@ def check_step(scene, model, full, make_stepper, limits, run=None, reuse_run=Tru
         err = estimate_on_windows(run[0], refs, plan, fields, fields, field_norms(full), window)
         fine_status = err["status_reference"]
     else:
+        every = _stored_every(run[0], every)
         err, fine_status = _whole(scene, model, full, st, make_stepper, limits, run, fields, every)
     for key in ("sizes", "reference_sizes", "status_run", "status_reference"):
         err.pop(key, None)
@@ -159,6 +163,15 @@ def check_step(scene, model, full, make_stepper, limits, run=None, reuse_run=Tru
         seconds=time.perf_counter() - t0,
     )
     return err, run, wall
+
+
+def _stored_every(res, default: int) -> int:
+    """Every how many steps ``res`` stored its states (``default`` when it stored fewer than
+    two): the reference at ``h/2`` stores its states at the same times."""
+    t = res.state_times
+    if t is None or len(t) < 2:
+        return default
+    return max(1, int(round((t[1] - t[0]) / res.h)))
 
 
 def _whole(scene, model, full, fine_stepper, make_stepper, limits, run, fields, every):

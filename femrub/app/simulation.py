@@ -439,7 +439,7 @@ def _reduce(scene, model, full, stages, log, limits, report, clock, reuse):
     report["time_step"], run_h, wall_h = check_step(
         scene, reduced, full, lambda m, h: bare_stepper(scene, m, h), limits, given, reuse
     )
-    if ran is None and wall_h is not None and reuse:
+    if ran is None and wall_h is not None and (reuse or holds_frames(run_h[0], scene)):
         ran = (run_h[0], wall_h)  # the check stepped the run itself
         clock.exclude(wall_h)
     clock.done("step_check", f"time-step error {100 * report['time_step']['estimate']:.2g} %")
