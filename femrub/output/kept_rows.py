@@ -61,12 +61,14 @@ class AllRows:
     reads_gaps = reads_slips = True
     #: the recorder's buffers kept in global axes, by the name they take in the results
     _GLOBAL = {"imp_t": "friction_force", "slip": "slip_velocity"}
+    #: buffers not kept: the blade's heat per contact and step (the energy meter sums it)
+    _UNKEPT = ("imp_t", "slip", "heat")
 
     def __init__(self, rec):
         n1, self.taken = rec.n + 1, -1
         c = rec.model.contact
         self._turns = rec.tangents and c.frames is not None
-        kept = {k: a for k, a in rec.buffers().items() if k not in self._GLOBAL}
+        kept = {k: a for k, a in rec.buffers().items() if k not in self._UNKEPT}
         self.rows = {k: np.zeros((n1, *a.shape[1:]), a.dtype) for k, a in kept.items()}
         nc = rec.model.n_contacts
         for name in self._GLOBAL.values():  # zeros without tangents (untouched: no memory)
@@ -81,7 +83,7 @@ class AllRows:
             return
         a, b = slice(first, last + 1), slice(first - i0, last + 1 - i0)
         for k, v in rec.buffers().items():
-            if k not in self._GLOBAL:
+            if k not in self._UNKEPT:
                 self.rows[k][a] = v[b]
         if self._turns:
             c = rec.model.contact
