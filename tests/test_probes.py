@@ -11,10 +11,12 @@ import meshio
 import numpy as np
 import pytest
 
+from femrub.app.blade import load_blade
 from femrub.app.run import run_scene
 from femrub.app.simulation import build
 from femrub.app.sweep import _write_csv, point_metrics
 from femrub.contact.points import _component_of
+from femrub.fem.discretisation import discretise
 from femrub.output.results import Results
 from femrub.scene import SceneError, loads_scene
 
@@ -130,8 +132,10 @@ def test_probe_rows_read_an_affine_field_exactly(deck):
     reproduces, each probe reads dᵀ A x_node: the node, its component and direction."""
     node = deck["mid"][tuple(sorted((deck["corner"][NX, 0, 1], deck["corner"][NX, 1, 1])))]
     extra = f'  {{ name = "temp", node = {node}, quantity = "temperature" }},\n'
-    built = build(_scene(deck, thermal="on", extra=extra), stepper=False)
-    model, disc = built.model, built.fields.disc
+    scene = _scene(deck, thermal="on", extra=extra)
+    built = build(scene, stepper=False)
+    model = built.model
+    disc = discretise(load_blade(scene, None), 2)  # the same mesh's bases (not kept by a build)
     A = np.array([[1.0, 2.0, -0.5], [0.3, -1.0, 4.0], [2.5, 0.7, 1.5]])
     c = np.array([3.0, -2.0, 5.0])
     bu = disc.basis_u

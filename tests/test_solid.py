@@ -166,7 +166,7 @@ def test_vtk_series_reads_back(rub, tmp_path):
     assert vm.shape == (fields.mesh.t.shape[1],) and np.all(vm >= 0) and vm.max() > 0
     # the tip temperature in the file is the run's
     tip_T = float(res.signal("tip_temperature")[-1])
-    w = fields.contacts.heat[:, fields.basis_t.nodal_dofs[0]].mean(axis=0).A1
+    w = fields.contacts.heat[:, fields.vertex_dofs_t].mean(axis=0).A1
     assert float(w @ last.point_data["temperature"]) == pytest.approx(tip_T, rel=1e-6)
 
 

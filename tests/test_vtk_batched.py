@@ -36,13 +36,13 @@ def rub():
         rotation_speed=1000.0,
     )
     built = build_rub(blade, config)
-    return built.model, built.fields
+    return built.model, built.fields, built.disc
 
 
-def von_mises(fields, u_all):
+def von_mises(fields, disc, u_all):
     """Von Mises stress (Pa) per tetrahedron from the displacement at the centroid, through
     scikit-fem's interpolation (the way the per-frame writer computed it)."""
-    ui = fields.basis_u.interpolate(u_all)
+    ui = disc.basis_u.interpolate(u_all)
     grad = ui.grad.mean(axis=-1)  # (3, 3, n_elements), mean over quadrature points
     eps = 0.5 * (grad + grad.transpose(1, 0, 2))
     tr = np.einsum("iie->e", eps)
@@ -53,10 +53,10 @@ def von_mises(fields, u_all):
     return np.sqrt(1.5 * np.einsum("ije,ije->e", dev, dev))
 
 
-def _reference(model, fields, X, impulse):
+def _reference(model, fields, disc, X, impulse):
     """The fields of one frame computed the way the per-frame writer did."""
     full = np.asarray(model.to_full @ X).ravel()
-    bu, bt = fields.basis_u, fields.basis_t
+    bu, bt = disc.basis_u, disc.basis_t
     nu, vd = bu.N, bu.nodal_dofs
     u, v = full[:nu], full[nu : 2 * nu]
     c = fields.contacts
@@ -67,7 +67,7 @@ def _reference(model, fields, X, impulse):
         "velocity": v[vd].T,
         "temperature": full[2 * nu : 2 * nu + bt.N][bt.nodal_dofs[0]],
         "contact_force": force,
-        "von_mises": von_mises(fields, u),
+        "von_mises": von_mises(fields, disc, u),
     }
 
 
@@ -85,7 +85,7 @@ def _frames(series):
 
 @pytest.mark.parametrize("dense", [False, True])
 def test_batched_frames_equal_the_per_frame_fields(rub, tmp_path, dense):
-    model, fields = rub
+    model, fields, disc = rub
     if dense:  # a reduced model's map to the mesh is a dense matrix (float32 product)
         model = dataclasses.replace(model, to_full=model.to_full.toarray())
     series = VTKSeries(tmp_path, model, fields, h=H, stride=STRIDE, batch=4, dtype=np.float64)
@@ -98,7 +98,7 @@ def test_batched_frames_equal_the_per_frame_fields(rub, tmp_path, dense):
     hits = 0
     for (t, f), X, r in zip(frames, res.states, rows):
         assert t == pytest.approx(res.t[r])
-        ref = _reference(model, fields, X, res.impulse[r])
+        ref = _reference(model, fields, disc, X, res.impulse[r])
         m = meshio.read(tmp_path / f)
         for k, a in ref.items():
             got = m.cell_data[k][0] if k == "von_mises" else m.point_data[k]
@@ -130,7 +130,7 @@ def test_default_series_reads_in_pyvista_and_equals_the_direct_fields(rub, tmp_p
     """The series as ``femrub run`` writes it (float32, background writer, default
     batches): VTK's own reader opens the .pvd with every frame at its time, and every field
     of every frame equals the direct reconstruction to float32 round-off."""
-    model, fields = rub
+    model, fields, disc = rub
     if dense:
         model = dataclasses.replace(model, to_full=model.to_full.toarray())
     series = VTKSeries(tmp_path, model, fields, h=H, stride=STRIDE)
@@ -148,7 +148,7 @@ def test_default_series_reads_in_pyvista_and_equals_the_direct_fields(rub, tmp_p
         reader.set_active_time_point(i)
         grid = reader.read()[0]
         assert grid.n_points == fields.mesh.p.shape[1] and grid.n_cells == fields.mesh.t.shape[1]
-        ref = _reference(model, fields, X, res.impulse[r])
+        ref = _reference(model, fields, disc, X, res.impulse[r])
         fric = np.zeros((grid.n_points, 3))
         np.add.at(fric, fields.contacts.vertices, res.friction_force[r])
         ref["friction_force"] = fric
@@ -172,7 +172,7 @@ class _Slow(VTKSeries):
 
 
 def test_a_writer_behind_the_stepping_holds_it_back_and_loses_nothing(rub, tmp_path):
-    model, fields = rub
+    model, fields, disc = rub
     series = _Slow(tmp_path, model, fields, h=H, stride=STRIDE, batch=3, min_batch=2)
     res = _run(model, series)
     assert res.status == "ok"
@@ -182,12 +182,12 @@ def test_a_writer_behind_the_stepping_holds_it_back_and_loses_nothing(rub, tmp_p
     assert [t for t, _ in frames] == pytest.approx(res.t[rows], rel=1e-9)
     for (_, f), X in zip(frames, res.states):
         u = meshio.read(tmp_path / f).point_data["displacement"]
-        ref = _reference(model, fields, X, np.zeros(model.n_contacts))["displacement"]
+        ref = _reference(model, fields, disc, X, np.zeros(model.n_contacts))["displacement"]
         assert np.abs(u - ref).max() <= 1e-5 * max(np.abs(ref).max(), 1e-300)
 
 
 def test_an_idle_writer_takes_a_few_frames_after_flush_seconds(rub, tmp_path):
-    model, fields = rub
+    model, fields, disc = rub
     series = VTKSeries(tmp_path, model, fields, h=H, stride=1, min_batch=8, flush_seconds=0.05)
     states = iter(fr.ThetaMethod(model, H).iterate(0.001))
     for _ in range(2):
@@ -216,7 +216,7 @@ class _Interrupted(VTKSeries):
 @pytest.mark.parametrize("background,batch", [(True, 5), (False, 5), (True, 32)])
 def test_interrupted_run_keeps_every_frame_taken(rub, tmp_path, background, batch):
     """Also when the frames taken are fewer than the writer's ``min_batch`` (batch 32)."""
-    model, fields = rub
+    model, fields, disc = rub
     series = _Interrupted(
         tmp_path, model, fields, h=H, stride=STRIDE, batch=batch, background=background
     )
@@ -232,7 +232,7 @@ def test_interrupted_run_keeps_every_frame_taken(rub, tmp_path, background, batc
 
 
 def test_the_background_writers_error_surfaces(rub, tmp_path, monkeypatch):
-    model, fields = rub
+    model, fields, disc = rub
     series = VTKSeries(tmp_path, model, fields, h=H, stride=STRIDE, batch=3)
 
     def full_disk(path, *fields):

@@ -110,7 +110,7 @@ def probe_observations(scene, built, points):
     """
     if not scene["outputs"]["probes"]:
         return {}, [], []
-    disc, mats, model = built.fields.disc, built.mats, built.model
+    disc, mats, model = built.disc, built.mats, built.model
     nodes = mesh_nodes(disc)
     spacing = _mean_edge(disc)
     obs, report, warnings = {}, [], []

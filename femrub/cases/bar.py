@@ -208,7 +208,7 @@ def _bar_build(case: BarCase):
 def _bar_parts(case: BarCase):
     """Discretisation, Eq. (2) blocks and contact point (the tip) of the bar."""
     built = _bar_build(case)
-    return built.fields.disc, built.mats, built.candidates
+    return built.disc, built.mats, built.candidates
 
 
 def _tip_dof(built) -> int:

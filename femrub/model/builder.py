@@ -97,6 +97,9 @@ class RubBuild:
     model: object
     fields: FieldMap
     mats: object
+    #: the finite-element bases the model was assembled on (what later build stages read of
+    #: the mesh: probes); the model and its field map do not keep them
+    disc: object
     candidates: ContactPoints
     reach: Reach
     prestress: object
@@ -321,6 +324,7 @@ def build_rub(blade, config: RubConfig, *, stages=None, log=None) -> RubBuild:
     disc = stages.discretise(blade, config.order if blade.dim == 3 else 1, config.clamped)
     prestress = _prestress(config, disc, stages, log)
     mats = stages.assemble(disc, config.material, **_assembly_options(config, prestress))
+    mats = replace(mats, basis_u=None, basis_t=None)  # the model keeps matrices, not bases
     damping = (
         stages.damping(config.damping_ratio, tuple(config.damping_modes))
         if config.damping_ratio
@@ -360,5 +364,16 @@ def build_rub(blade, config: RubConfig, *, stages=None, log=None) -> RubBuild:
     )
     model = _initial_velocity(_thermal_note(model, thermal), config.initial_velocity)
     return RubBuild(
-        model, fields, mats, candidates, reach, prestress, growth, grid, heat, thermal, rotation
+        model,
+        fields,
+        mats,
+        disc,
+        candidates,
+        reach,
+        prestress,
+        growth,
+        grid,
+        heat,
+        thermal,
+        rotation,
     )

@@ -27,6 +27,7 @@ from ..contact.points import ContactPoints
 from ..fem.discretisation import Discretisation
 from ..fem.forms import lame_parameters
 from ..fem.material import Material
+from ..fem.strain import centroid_strain
 from .build import ContactSpec, Load, contact_boundary, first_order_model
 from .first_order import CasingSweep, FirstOrderModel, Parameters
 
@@ -38,24 +39,43 @@ DEFAULT_CLEARANCE = 1e-4
 
 @dataclass(frozen=True)
 class FieldMap:
-    """What output needs to turn a state into fields on the mesh (VTK, plots)."""
+    """What output needs to turn a state into fields on the mesh (VTK, plots): the mesh, the
+    displacement and temperature dofs at its vertices, the strain at each element's centroid
+    as an operator on the displacement dofs, the contacts and the Lamé parameters (Pa).
 
-    disc: Discretisation
+    It holds no finite-element basis (their values at every quadrature point are an
+    assembly's, and the largest arrays of a 3D build): :meth:`of` takes what it needs from
+    a :class:`~femrub.fem.discretisation.Discretisation` once.
+    """
+
+    mesh: object
     contacts: ContactPoints
     lam: float
     mu: float
+    #: displacement dofs at the vertices, ``(dim, n_vertices)``; ``n_u``: displacement dofs
+    vertex_dofs_u: np.ndarray
+    #: temperature dofs at the vertices, ``(n_vertices,)``
+    vertex_dofs_t: np.ndarray
+    n_u: int
+    #: ``(G u)[c n_e + e] = ε_ab`` at the centroid of element ``e``, ``c`` over ``pairs``
+    strain: sp.csr_matrix
+    pairs: tuple
 
-    @property
-    def mesh(self):
-        return self.disc.mesh
-
-    @property
-    def basis_u(self) -> fem.Basis:
-        return self.disc.basis_u
-
-    @property
-    def basis_t(self) -> fem.Basis:
-        return self.disc.basis_t
+    @classmethod
+    def of(cls, disc: Discretisation, contacts: ContactPoints, lam: float, mu: float):
+        """The map of ``disc``'s mesh (:func:`~femrub.fem.strain.centroid_strain`)."""
+        G, pairs = centroid_strain(disc.basis_u)
+        return cls(
+            disc.mesh,
+            contacts,
+            lam,
+            mu,
+            disc.basis_u.nodal_dofs,
+            disc.basis_t.nodal_dofs[0],
+            int(disc.basis_u.N),
+            G,
+            tuple(pairs),
+        )
 
 
 def tip_load(disc: Discretisation, mats, force, signal) -> Load:
@@ -217,7 +237,7 @@ def rub_model(  # noqa: PLR0913 (the parts of a rub model, all keyword-only but 
         sweep=sweep,
     )
     lam, mu = lame_parameters(material.young, material.poisson, disc.dim)
-    return model, FieldMap(disc, points, lam, mu)
+    return model, FieldMap.of(disc, points, lam, mu)
 
 
 def solid_model(  # noqa: PLR0913 (the Python preset: keyword-only options, one per scene key)

@@ -32,34 +32,7 @@ import scipy.sparse as sp
 
 from ..model.rub import FieldMap
 
-__all__ = ["FrameFields", "strain_operator", "deviator_root"]
-
-
-def strain_operator(fields: FieldMap) -> tuple[sp.csr_matrix, list[tuple[int, int]]]:
-    """Sparse ``G`` with ``(G u)[c n_e + e] = ε_ab`` at the centroid of element ``e``.
-
-    ``c`` runs over the pairs ``(a, b)``, ``a ≤ b`` (returned); ``ε_ab`` is the mean over
-    the element's quadrature points of ``(∂_b u_a + ∂_a u_b) / 2``.
-    """
-    bu = fields.basis_u
-    dim = fields.mesh.p.shape[0]
-    pairs = [(a, b) for a in range(dim) for b in range(a, dim)]
-    n_e = bu.element_dofs.shape[1]
-    rows, cols, vals = [], [], []
-    for i, phi in enumerate(bu.basis):
-        g = phi[0].grad.mean(axis=-1)  # (dim, dim, n_e): ∂_b φ_a at the centroid
-        for c, (a, b) in enumerate(pairs):
-            v = 0.5 * (g[a, b] + g[b, a])
-            keep = v != 0.0
-            if keep.any():
-                rows.append(c * n_e + np.flatnonzero(keep))
-                cols.append(bu.element_dofs[i, keep])
-                vals.append(v[keep])
-    G = sp.coo_matrix(
-        (np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
-        shape=(len(pairs) * n_e, bu.N),
-    ).tocsr()
-    return G, pairs
+__all__ = ["FrameFields", "deviator_root"]
 
 
 def deviator_root(pairs: list[tuple[int, int]], mu: float) -> np.ndarray:
@@ -92,13 +65,12 @@ class FrameFields:
 
     def __init__(self, model, fields: FieldMap, h: float, dtype=np.float64):
         T = model.to_full
-        bu, bt = fields.basis_u, fields.basis_t
-        nu = bu.N
-        vd = bu.nodal_dofs.T.ravel()  # vertex-major: (n_vertices, dim) flattened
-        self.n_points, self.dim = bu.nodal_dofs.shape[1], bu.nodal_dofs.shape[0]
+        nu, du = fields.n_u, fields.vertex_dofs_u
+        vd = du.T.ravel()  # vertex-major: (n_vertices, dim) flattened
+        self.n_points, self.dim = du.shape[1], du.shape[0]
         self.n_cells = fields.mesh.t.shape[1]
-        self._has_t, self._nt_points = model.layout.n_t > 0, bt.nodal_dofs.shape[1]
-        G, self.pairs = strain_operator(fields)
+        self._has_t, self._nt_points = model.layout.n_t > 0, fields.vertex_dofs_t.size
+        G, self.pairs = fields.strain, list(fields.pairs)
         Q = deviator_root(self.pairs, float(fields.mu))
         n_e = self.n_cells
         # ‖Q ε_e‖ for every element: rows (i n_e + e) of the k n_e × n_u operator Q ⊗ G
@@ -116,7 +88,7 @@ class FrameFields:
         # blocks (name, rows of to_full or None for the stress, columns of X they need)
         blocks = [("displacement", vd), ("velocity", nu + vd)]
         if self._has_t:
-            blocks.append(("temperature", 2 * nu + bt.nodal_dofs[0]))
+            blocks.append(("temperature", 2 * nu + fields.vertex_dofs_t))
         self._sparse = sp.issparse(T)
         self._ops = []  # (names, sizes, columns of X or None, operator)
         if self._sparse:
