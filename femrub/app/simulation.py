@@ -273,12 +273,18 @@ def _build(scene, log, modes, stages, with_stepper=True) -> Simulation:
     report["geometry"] = blade.summary()
     report["blade_size"] = size
     clock.done("mesh", f"{blade.n_vertices} vertices")
+    full = _assembled(scene, blade, stages, log, report, clock, probe_at)
+    return _runnable(scene, full, stages, log, modes, report, clock, with_stepper)
+
+
+def _assembled(scene, blade, stages, log, report, clock, probe_at) -> _Full:
+    """The full model, its fields and probes, reported; what only the assembly needed (the
+    finite-element bases) is released when this returns, before the reduction."""
     built = _full_model(scene, blade, stages, log, report)
     clock.done("assembly", f"{built.model.n_dofs} state dofs")
     _report_full(scene, built, report)
     probes = _probes(scene, built, probe_at, report, log)
-    full = _Full(built.model, built.fields, probes)
-    return _runnable(scene, full, stages, log, modes, report, clock, with_stepper)
+    return _Full(built.model, built.fields, probes)
 
 
 @dataclass(frozen=True)

@@ -181,6 +181,7 @@ class ThermoelasticCraigBampton:
             )
         self.timings = {}
         self._largest = None  # the largest reduced operators, projected on first use
+        self._models = {}  # the reduced models made, by sizes: each made once
         t0 = time.perf_counter()
         self.solver = solver = InteriorSolver(blocks, mi, ti, stiffness)
         self._bnd = np.r_[mb, nu + mb, 2 * nu + tb].astype(int)
@@ -276,8 +277,17 @@ class ThermoelasticCraigBampton:
         (class docstring), so this only projects: ``Ā = R̃ᵀ A R``, ``B̄ = R̃ᵀ B R``. The
         largest model is projected once (on the first call) and every size is then a block
         of it (:mod:`femrub.reduction.truncation`), unless its elastic-energy basis depends
-        on the size (then that size is projected).
+        on the size (then that size is projected). A size asked again is the model made the
+        first time (a model is immutable; a stepper runs its own copy of its contact's
+        history).
         """
+        key = (n_uv, n_theta)
+        if key not in self._models:
+            self._models[key] = self._reduced(n_uv, n_theta)
+        return self._models[key]
+
+    def _reduced(self, n_uv, n_theta) -> FirstOrderModel:
+        """The reduced model of ``n_uv``, ``n_theta`` (:meth:`reduce`), made."""
         n_uv, n_theta, cols, layout = self._columns(n_uv, n_theta)
         t0 = time.perf_counter()
         m = self.fom
@@ -395,6 +405,7 @@ class ThermoelasticCraigBampton:
             raise ValueError("for_model: the model's layout or operators differ from the bases'")
         new = copy.copy(self)
         new.fom, new.timings = fom, {}  # nothing built: the reduced model's info says so
+        new._models = {}  # the models of ``fom``
         return new
 
     def detached(self) -> ThermoelasticCraigBampton:
@@ -402,7 +413,7 @@ class ThermoelasticCraigBampton:
         :meth:`for_model` without holding the model it was built for (about 1 GB for a
         Rotor 37 blade); its factorisations must be released (:meth:`InteriorSolver.free`)."""
         new = copy.copy(self)
-        new.fom = None
+        new.fom, new._models = None, {}
         return new
 
 
