@@ -65,6 +65,23 @@ def test_api_errors_and_reconstruct(paper):
         red.reconstruct(np.zeros(paper.n_dofs))
 
 
+def test_a_size_is_made_once_and_a_released_reductor_gives_what_was_made(paper):
+    """``reduce`` of a size asked again is the model made the first time; ``released()``
+    keeps those models, lifts and reconstructs as before, holds no left basis, and refuses
+    to project what it did not make (its message says so)."""
+    red = ThermoelasticCraigBampton(paper, 8, 6)
+    with pytest.raises(ValueError, match="released"):
+        red.released().reduce(4, 3)  # nothing projected yet
+    small = red.reduce(4, 3)
+    assert red.reduce(4, 3) is small and red.reduce(8, 6) is red.reduce(8, 6)
+    rel = red.released()
+    assert rel.left is None and red.left is not None  # the build's reductor keeps its own
+    assert rel.reduce(4, 3) is small
+    Xr = np.random.default_rng(2).standard_normal((3, small.n_dofs))
+    np.testing.assert_array_equal(rel.reconstruct(Xr, 4, 3), red.reconstruct(Xr, 4, 3))
+    np.testing.assert_array_equal(rel.reduce(6, 3).A.toarray(), red.reduce(6, 3).A.toarray())
+
+
 # -- change of variables: all shapes kept ---------------------------------------------------
 @pytest.mark.parametrize("projection", PROJECTIONS)
 def test_full_basis_theta_method_reproduces_full_model(paper, projection):

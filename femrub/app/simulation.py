@@ -432,6 +432,7 @@ def _reduce(scene, model, full, stages, log, limits, report, clock, reuse):
     reduced, reductor, report["reduction"] = stages.reduce(
         model, scene, log, make, limits, on_run=lambda *run: chosen.append(run), reuse_run=reuse
     )
+    reductor = None if reductor is None else reductor.released()  # its models are made
     ran = chosen[0][:2] if chosen and (reuse or holds_frames(chosen[0][0], scene)) else None
     if ran is not None:  # the run itself: its time is the run's ``stepping``
         clock.exclude(ran[1])

@@ -350,6 +350,12 @@ class ThermoelasticCraigBampton:
         """The operators of the sizes of ``cols`` projected over the full state."""
         every = cols.size == self.R.shape[1]  # the largest sizes: the bases, no copies
         R = self.R if every else np.take(self.R, cols, axis=1)  # C-ordered, as self.R
+        if self.left is None:
+            raise ValueError(
+                f"sizes {layout.n_u + layout.n_v} + {layout.n_t} were not made before this "
+                "reductor was released (released(): it lifts and reconstructs, it no longer "
+                "projects); reduce them with the reductor of the build"
+            )
         Lt = self.left if every else np.take(self.left, cols, axis=1)
         Lt = R if self.projection in ("galerkin", "second-order") else Lt
         return projected(self.fom, R, Lt, layout, self.boundary["u"].size)
@@ -406,6 +412,15 @@ class ThermoelasticCraigBampton:
         new = copy.copy(self)
         new.fom, new.timings = fom, {}  # nothing built: the reduced model's info says so
         new._models = {}  # the models of ``fom``
+        return new
+
+    def released(self) -> ThermoelasticCraigBampton:
+        """This reductor once the build has made its models: it lifts, reconstructs and
+        restricts states and gives the models it made (:meth:`reduce` of those sizes), and
+        holds no left basis (a Petrov–Galerkin projection's: ``n × r``, 0.6 GB for a
+        Rotor 37 blade), so it projects no other size."""
+        new = copy.copy(self)
+        new.left, new._models = None, dict(self._models)
         return new
 
     def detached(self) -> ThermoelasticCraigBampton:
