@@ -83,3 +83,25 @@ def test_npz_stores_what_does_not_deflate_as_it_is(tmp_path):
             np.testing.assert_array_equal(d[key], want)
         assert d["contact_state"].dtype == np.int8 and d["contact_state"].shape == (n + 1, 3)
         np.testing.assert_array_equal(d["signal_tip_displacement"], res.signals["tip_displacement"])
+
+
+def test_friction_magnitude_in_blocks_is_the_norm_of_the_whole(monkeypatch):
+    """``Results.friction_magnitude`` (rows taken a block at a time) equals the norm of the
+    whole array bit for bit, with a short last block; no friction rows give no columns."""
+    monkeypatch.setattr(R, "ROW_BLOCK", 7)
+    rng = np.random.default_rng(3)
+    m, nc = 30, 4
+    res = R.Results(
+        scheme="theta",
+        h=1e-6,
+        t=np.arange(m) * 1e-6,
+        signals={},
+        gap=np.zeros((m, nc)),
+        impulse=np.zeros((m, nc)),
+        friction_force=rng.standard_normal((m, nc, 3)) * 10.0 ** rng.integers(-8, 8, (m, nc, 1)),
+    )
+    np.testing.assert_array_equal(
+        res.friction_magnitude(), np.linalg.norm(res.friction_force, axis=-1)
+    )
+    res.friction_force = None
+    assert res.friction_magnitude().shape == (m, 0)

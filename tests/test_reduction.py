@@ -10,6 +10,7 @@ import femrub as fr
 from femrub.cases.paper_models import paper_reduced_model, paper_reductor
 from femrub.model.build import ContactSpec, Load, first_order_model
 from femrub.reduction import PROJECTIONS, ThermoelasticCraigBampton, craig_bampton_thermal
+from femrub.reduction.truncation import ColumnMap
 
 ALPHA = 3.0
 SIGNALS = ("tip_displacement", "tip_temperature")
@@ -80,6 +81,23 @@ def test_a_size_is_made_once_and_a_released_reductor_gives_what_was_made(paper):
     Xr = np.random.default_rng(2).standard_normal((3, small.n_dofs))
     np.testing.assert_array_equal(rel.reconstruct(Xr, 4, 3), red.reconstruct(Xr, 4, 3))
     np.testing.assert_array_equal(rel.reduce(6, 3).A.toarray(), red.reduce(6, 3).A.toarray())
+
+
+def test_a_size_projected_after_the_largest_shares_its_map_to_the_mesh(paper):
+    """A size projected once the largest model is (a basis that does not nest) takes its map
+    to the mesh as the largest map's columns (no copy of an n × r array) with the products of
+    the map of its own columns."""
+    red = ThermoelasticCraigBampton(paper, 8, 6)
+    red.project()
+    *_, cols, layout = red._columns(4, 3)
+    parts = red._project(cols, layout)
+    shared = parts["to_full"]
+    assert isinstance(shared, ColumnMap) and shared.full is red._largest["to_full"]
+    own = np.asarray(paper.to_full @ red.R[:, cols])
+    Xr = np.random.default_rng(4).standard_normal((5, layout.n))
+    np.testing.assert_allclose(
+        shared @ Xr.T, own @ Xr.T, rtol=1e-13, atol=1e-13 * np.abs(own).max()
+    )
 
 
 # -- change of variables: all shapes kept ---------------------------------------------------

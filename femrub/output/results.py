@@ -158,6 +158,8 @@ NPZ_LEVEL = 1
 NPZ_DEFLATE_BELOW = 0.8
 #: the samples: this many slices of :data:`NPZ_SAMPLE_BYTES`, spread over an array's bytes
 NPZ_SAMPLES, NPZ_SAMPLE_BYTES = 16, 1 << 14
+#: rows of a per-step array reduced at a time (bounds the temporaries of a long run's measures)
+ROW_BLOCK = 65536
 
 
 def _deflates(a: np.ndarray) -> bool:
@@ -237,6 +239,18 @@ class Results:
     def force(self) -> np.ndarray:
         """Mean contact force over each step, ``impulse / h`` (N)."""
         return self.impulse / self.h
+
+    def friction_magnitude(self) -> np.ndarray:
+        """``|λ_t| / h`` per row and contact (N), ``(rows, n_c)``: the norms of
+        ``friction_force`` taken :data:`ROW_BLOCK` rows at a time (no ``(rows, n_c, 3)``
+        temporaries on a long run); ``(rows, 0)`` without friction rows."""
+        ff = self.friction_force
+        if ff is None:
+            return np.zeros((len(self.t), 0))
+        out = np.empty(ff.shape[:-1])
+        for k in range(0, len(ff), ROW_BLOCK):
+            out[k : k + ROW_BLOCK] = np.linalg.norm(ff[k : k + ROW_BLOCK], axis=-1)
+        return out
 
     def signal(self, name: str, component: int | None = None) -> np.ndarray:
         """An observed signal, e.g. ``signal("tip_displacement")``: ``(rows,)`` for a signal

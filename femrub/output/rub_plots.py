@@ -108,7 +108,7 @@ def contact_force_panel(res, omega: float):
     lam = res.force
     total = lam.sum(axis=1)
     ff = res.friction_force
-    friction = None if ff is None or not ff.size else np.linalg.norm(ff, axis=-1).sum(axis=1)
+    friction = None if ff is None or not ff.size else res.friction_magnitude().sum(axis=1)
     steps_per_rev = 2.0 * np.pi / max(omega * res.h, 1e-300)
     n_angle = int(np.clip(steps_per_rev, 1, MAX_ANGLE_CELLS))
     maps = [("normal", total)] + ([("friction", friction)] if friction is not None else [])

@@ -69,7 +69,7 @@ def _friction_summary(res) -> dict:
     e = res.energy
     ff = res.friction_force
     out = {
-        "max_friction_force": float(np.linalg.norm(ff, axis=-1).max())
+        "max_friction_force": float(res.friction_magnitude().max())
         if ff is not None and ff.size
         else 0.0,
         "friction_work": float(e["friction_work"][-1]) if "friction_work" in e else 0.0,

@@ -61,6 +61,7 @@ from .boundary_coordinates import boundary_coordinates, boundary_dofs
 from .interior import InteriorSolver, condensed_solve
 from .operators import projected, sliced
 from .thermal_inputs import input_basis, input_distributions
+from .truncation import ColumnMap
 
 __all__ = ["PROJECTIONS", "ThermoelasticCraigBampton", "craig_bampton_thermal"]
 
@@ -358,7 +359,9 @@ class ThermoelasticCraigBampton:
             )
         Lt = self.left if every else np.take(self.left, cols, axis=1)
         Lt = R if self.projection in ("galerkin", "second-order") else Lt
-        return projected(self.fom, R, Lt, layout, self.boundary["u"].size)
+        largest = None if every or self._largest is None else self._largest["to_full"]
+        shared = None if largest is None else ColumnMap(largest, cols)  # the map, not a copy
+        return projected(self.fom, R, Lt, layout, self.boundary["u"].size, to_full=shared)
 
     def _slice(self, cols, layout) -> dict:
         """The operators of the sizes of ``cols`` as blocks of the largest projected ones,

@@ -29,9 +29,11 @@ from .truncation import ColumnMap, sliced_contact, sliced_energy, sliced_loads
 __all__ = ["projected", "sliced"]
 
 
-def projected(fom, R, left, layout, n_boundary_u: int) -> dict:
+def projected(fom, R, left, layout, n_boundary_u: int, to_full=None) -> dict:
     """Operators of ``fom`` projected on the right basis ``R`` and left basis ``left``
-    (``R̃``; ``R`` itself for a Galerkin projection), of reduced ``layout``."""
+    (``R̃``; ``R`` itself for a Galerkin projection), of reduced ``layout``; ``to_full``:
+    ``fom.to_full @ R`` when already at hand (the largest model's columns, a
+    :class:`~femrub.reduction.truncation.ColumnMap`), else computed."""
     L = fom.layout
     parts = [0, L.u.stop, L.v.stop, L.n]  # the u, v, θ rows of the bases
     Ar = project(left, fom.A, R, parts=parts)
@@ -51,7 +53,9 @@ def projected(fom, R, left, layout, n_boundary_u: int) -> dict:
         "observations": {k: np.asarray(O @ R) for k, O in fom.observations.items()},
         "energy": energy,
         "growth": growth,
-        "to_full": None if fom.to_full is None else np.asarray(fom.to_full @ R),
+        "to_full": to_full
+        if to_full is not None or fom.to_full is None
+        else np.asarray(fom.to_full @ R),
     }
 
 
