@@ -4,7 +4,7 @@ Each command in its own process, with the model cache off (every build from the 
 
 1. ``femrub run rotor37 --no-cache`` (50 revolutions at 1000 steps per revolution, the
    reduction error estimate on);
-2. ``femrub run rotor37-thermal --no-cache`` (50 revolutions at 32,000 steps per revolution,
+2. ``femrub run rotor37-thermal --no-cache`` (50 revolutions at 16,000 steps per revolution,
    frictional heat, thermal stresses, the abradable coating, the reduction error estimate and
    the time-step check on).
 
@@ -16,7 +16,7 @@ round-off twin, and the coated run's hottest tip, deepest wear and worn volume. 
 of ``docs/performance/rotor37-costs.md`` (``--render-only``: from the JSON, no run). Skips
 with a message when the shared data is absent.
 
-Run: ``python benchmarks/thermal_cost.py [--render-only]`` (about 20 minutes on a quiet
+Run: ``python benchmarks/thermal_cost.py [--render-only]`` (about 4 minutes on a quiet
 2-core machine; run it alone).
 """
 
