@@ -186,3 +186,22 @@ def test_the_window_comparison_reads_the_runs_rows_of_each_window():
     )
     assert same["contact_force"] == 0 and same["contact_temperature"] == 0
     assert late["contact_force"] > 0.03 and late["contact_temperature"] > 0.01
+
+
+def test_the_estimates_runs_hold_a_released_reductor(model_cache):
+    """With given sizes, the reductor's bases are handed on (to be stored) before any run,
+    then the checks and the build keep it released: no left basis through the runs, and the
+    model returned is the one the reductor made for those sizes."""
+    from femrub.analysis.reduction_check import reduce_checked
+
+    scene = load_scene("twisted-naca", SCENE)
+    sim = build(scene, log=lambda s: None, cache=model_cache)
+    handed = []
+    model, red, report = reduce_checked(
+        sim.full, scene, None, lambda m: bare_stepper(scene, m), on_bases=handed.append
+    )
+    (bases,) = handed
+    assert bases.left is not None and red.left is None
+    sizes = (report["n_uv"], report["n_theta"])
+    assert red.reduce(*sizes) is model
+    assert "error" in report and report["error"]["estimate"] < 1

@@ -15,6 +15,7 @@ a sensitive response is measured by a round-off twin of the reference (:func:`tw
 
 from __future__ import annotations
 
+import dataclasses
 import time
 
 import numpy as np
@@ -237,6 +238,7 @@ def reduce_checked(
     on_run=None,
     stiffness=None,
     reuse_run=True,
+    on_bases=None,
 ):
     """Reduce ``model`` as ``scene["reduction"]`` asks; return ``(model, reductor, report)``.
 
@@ -250,13 +252,31 @@ def reduce_checked(
     model's sizes (its :class:`~femrub.output.results.Results`, judged without the reduction
     rule, with the history its contact carried outside ``X``, and its wall time), which is
     the scene's run: the caller need not step it again (lean, and to be stepped again, when
-    ``reuse_run`` is false: the caller steps the run again).
+    ``reuse_run`` is false: the caller steps the run again). ``on_bases(reductor)``: called
+    with the reductor once its bases are built, before any run (e.g. to store them: with
+    given sizes the reductor is then released for the checks).
     """
     if make_stepper is None or scene["reduction"]["method"] == "none":
         return reduce_model(model, scene, log, reductor, stiffness)
     prepared = prepare(model, scene, log, reductor, stiffness, reference=True)
+    if on_bases is not None:
+        on_bases(prepared.reductor)
+    prepared = _models_made(prepared)
     red, report = prepared.reductor, prepared.report
     sizes = checked_sizes(
         red, model, prepared.want, make_stepper, scene, report, log, limits, on_run, reuse_run
     )
     return finish(prepared, sizes), red, report
+
+
+def _models_made(prepared):
+    """Given sizes: their model and the reference's made, the reductor released
+    (:meth:`~femrub.reduction.craig_bampton.ThermoelasticCraigBampton.released`: the left
+    basis, a Petrov–Galerkin projection's, is not held through the estimate's runs). The
+    ``"auto"`` ladder projects as it goes: kept as it is."""
+    red, want = prepared.reductor, prepared.want
+    if want is None:
+        return prepared
+    red.reduce(*want)
+    red.reduce(red.n_uv, red.n_theta)
+    return dataclasses.replace(prepared, reductor=red.released())

@@ -296,16 +296,21 @@ class Stages:
         kept = self.kept.reductor.get(bases)
         if kept is None and bases is not None and stored:  # built by another process
             kept = self._fetch("bases", bases)
-        reduced, reductor, report = reduce_checked(
-            model, scene, log, make_stepper, reductor=kept, **kw
-        )
-        _say_phases(self._say, reduced.info.get("timings", {}))
-        if bases is not None:
+
+        def keep_bases(reductor) -> None:  # before the estimate's runs (they may release it)
+            if bases is None:
+                return
             detached = reductor.detached()  # not the model of this point
-            Kept.last(self.kept.reductor, bases, detached)
+            if self.in_a_row:
+                Kept.last(self.kept.reductor, bases, detached)
             if kept is None and stored:
                 shapes = f"{reductor.n_uv} + {reductor.n_theta} shapes on {model.n_dofs} dofs"
                 self._keep("bases", bases, detached, shapes)
+
+        reduced, reductor, report = reduce_checked(
+            model, scene, log, make_stepper, reductor=kept, on_bases=keep_bases, **kw
+        )
+        _say_phases(self._say, reduced.info.get("timings", {}))
         if stored:
             self._store_reduction(key, map_key, reduced, reductor, report)
         return reduced, reductor, report
