@@ -59,7 +59,7 @@ from ..model.first_order import FirstOrderModel, Layout
 from .basis import assemble_basis, left_static_shapes, velocity_static_shapes
 from .boundary_coordinates import boundary_coordinates, boundary_dofs
 from .interior import InteriorSolver, condensed_solve
-from .operators import projected, sliced
+from .operators import left_projected, right_projected, sliced
 from .thermal_inputs import input_basis, input_distributions
 from .truncation import ColumnMap
 
@@ -348,20 +348,28 @@ class ThermoelasticCraigBampton:
         return not np.any(self.R[L.u, Lr.v.start : Lr.v.start + nb])
 
     def _project(self, cols, layout) -> dict:
-        """The operators of the sizes of ``cols`` projected over the full state."""
+        """The operators of the sizes of ``cols`` projected over the full state (the columns
+        of the left basis taken for this call only: released before the energy forms copy
+        the right basis)."""
         every = cols.size == self.R.shape[1]  # the largest sizes: the bases, no copies
         R = self.R if every else np.take(self.R, cols, axis=1)  # C-ordered, as self.R
+        parts = left_projected(self.fom, R, self._left_columns(cols, R, every, layout))
+        largest = None if every or self._largest is None else self._largest["to_full"]
+        shared = None if largest is None else ColumnMap(largest, cols)  # the map, not a copy
+        nb = self.boundary["u"].size
+        return {**parts, **right_projected(self.fom, R, parts, layout, nb, to_full=shared)}
+
+    def _left_columns(self, cols, R, every, layout) -> np.ndarray:
+        """The left basis on ``cols`` (``R`` itself for a Galerkin projection)."""
+        if self.projection in ("galerkin", "second-order"):
+            return R
         if self.left is None:
             raise ValueError(
                 f"sizes {layout.n_u + layout.n_v} + {layout.n_t} were not made before this "
                 "reductor was released (released(): it lifts and reconstructs, it no longer "
                 "projects); reduce them with the reductor of the build"
             )
-        Lt = self.left if every else np.take(self.left, cols, axis=1)
-        Lt = R if self.projection in ("galerkin", "second-order") else Lt
-        largest = None if every or self._largest is None else self._largest["to_full"]
-        shared = None if largest is None else ColumnMap(largest, cols)  # the map, not a copy
-        return projected(self.fom, R, Lt, layout, self.boundary["u"].size, to_full=shared)
+        return self.left if every else np.take(self.left, cols, axis=1)
 
     def _slice(self, cols, layout) -> dict:
         """The operators of the sizes of ``cols`` as blocks of the largest projected ones,

@@ -26,30 +26,43 @@ from ..model.first_order import LoadTerm
 from .energy_forms import energy_rates, reduced_energy
 from .truncation import ColumnMap, sliced_contact, sliced_energy, sliced_loads
 
-__all__ = ["projected", "sliced"]
+__all__ = ["left_projected", "projected", "right_projected", "sliced"]
 
 
 def projected(fom, R, left, layout, n_boundary_u: int, to_full=None) -> dict:
     """Operators of ``fom`` projected on the right basis ``R`` and left basis ``left``
     (``R̃``; ``R`` itself for a Galerkin projection), of reduced ``layout``; ``to_full``:
     ``fom.to_full @ R`` when already at hand (the largest model's columns, a
-    :class:`~femrub.reduction.truncation.ColumnMap`), else computed."""
+    :class:`~femrub.reduction.truncation.ColumnMap`), else computed. The two halves
+    :func:`left_projected` and :func:`right_projected`: a caller that makes ``left`` for
+    this call only passes it to the first, so that it is released before the second."""
+    parts = left_projected(fom, R, left)
+    return {**parts, **right_projected(fom, R, parts, layout, n_boundary_u, to_full)}
+
+
+def left_projected(fom, R, left) -> dict:
+    """What the left basis projects: ``A``, ``B``, the loads, the contact (:func:`projected`)."""
     L = fom.layout
     parts = [0, L.u.stop, L.v.stop, L.n]  # the u, v, θ rows of the bases
-    Ar = project(left, fom.A, R, parts=parts)
-    Br = project(left, fom.B, R, parts=parts)
-    loads = [
-        LoadTerm(left.T @ t.vector, t.signal, power=R.T @ t.power, heat=t.heat, name=t.name)
-        for t in fom.loads
-    ]
+    return {
+        "A": project(left, fom.A, R, parts=parts),
+        "B": project(left, fom.B, R, parts=parts),
+        "loads": [
+            LoadTerm(left.T @ t.vector, t.signal, power=R.T @ t.power, heat=t.heat, name=t.name)
+            for t in fom.loads
+        ],
+        "contact": None if fom.contact is None else fom.contact.project(left, R),
+    }
+
+
+def right_projected(fom, R, left_parts: dict, layout, n_boundary_u: int, to_full=None) -> dict:
+    """What ``R`` alone projects, given :func:`left_projected`'s ``A`` and ``B``: the energy
+    forms and growth rate, the observations, the map to the mesh (:func:`projected`)."""
     energy, growth = None, 0.0
     if fom.energy is not None:
+        Ar, Br = left_parts["A"], left_parts["B"]
         energy, growth = reduced_energy(fom, n_boundary_u, R, Ar, Br, layout)
     return {
-        "A": Ar,
-        "B": Br,
-        "loads": loads,
-        "contact": None if fom.contact is None else fom.contact.project(left, R),
         "observations": {k: np.asarray(O @ R) for k, O in fom.observations.items()},
         "energy": energy,
         "growth": growth,
