@@ -76,7 +76,7 @@ class Kept:
     """What builds of one blade in a row keep in memory, the last of each, ``{key: value}``.
 
     ``discretisation``: the finite-element bases of the mesh; ``assembly``: the Eq. (2)
-    blocks without their bases (``assembly_key``: its key); ``reductor``: the last reductor
+    blocks (``assembly_key``: its key); ``reductor``: the last reductor
     built or loaded, detached from its full model (its bases are speed-free); ``map``: the
     map to the mesh of the largest reduced model (the same for every speed); ``model_key``:
     the last full model's hashed arrays and their key (``(parts, key)``).
@@ -177,12 +177,11 @@ class Stages:
             mats = self._fetch("assembly", key)
         if mats is None:
             mats = assemble(disc, material, **kw)
-            mats = dataclasses.replace(mats, basis_u=None, basis_t=None)
             self._keep("assembly", key, mats, f"{mats.n_u} + {mats.n_t} FE dofs")
         if self.in_a_row:  # the next build on this blade: the same blocks
             Kept.last(self.kept.assembly, key, mats)
             self.kept.assembly_key = key
-        return dataclasses.replace(mats, basis_u=disc.basis_u, basis_t=disc.basis_t)
+        return mats
 
     def damping(self, zeta: float, modes: tuple[int, int]):
         """``(mats, boundary) -> mats`` with the modal Rayleigh damping of ratio ``zeta`` at

@@ -52,8 +52,6 @@ class ThermoelasticMatrices:
         Free dofs in the bases' numbering (Dirichlet dofs removed).
     n_u_all, n_t_all : int
         Sizes before the Dirichlet dofs are removed.
-    basis_u, basis_t : skfem.Basis or None
-        The scikit-fem bases, to map back to the mesh.
     info : dict
         What the assembly reports (sizes, timings).
     """
@@ -69,8 +67,6 @@ class ThermoelasticMatrices:
     free_t: np.ndarray
     n_u_all: int
     n_t_all: int
-    basis_u: Basis | None = None
-    basis_t: Basis | None = None
     info: dict = field(default_factory=dict)
 
     @property
@@ -264,8 +260,6 @@ def assemble_thermoelastic(  # noqa: PLR0913 (keyword-only options, one per scen
         free_t=ft,
         n_u_all=basis_u.N,
         n_t_all=basis_t.N,
-        basis_u=basis_u,
-        basis_t=basis_t,
         info={
             "dim": dim,
             "lumping": lumping,

@@ -324,7 +324,6 @@ def build_rub(blade, config: RubConfig, *, stages=None, log=None) -> RubBuild:
     disc = stages.discretise(blade, config.order if blade.dim == 3 else 1, config.clamped)
     prestress = _prestress(config, disc, stages, log)
     mats = stages.assemble(disc, config.material, **_assembly_options(config, prestress))
-    mats = replace(mats, basis_u=None, basis_t=None)  # the model keeps matrices, not bases
     damping = (
         stages.damping(config.damping_ratio, tuple(config.damping_modes))
         if config.damping_ratio

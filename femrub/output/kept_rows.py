@@ -61,8 +61,9 @@ class AllRows:
     reads_gaps = reads_slips = True
     #: the recorder's buffers kept in global axes, by the name they take in the results
     _GLOBAL = {"imp_t": "friction_force", "slip": "slip_velocity"}
-    #: buffers not kept: the blade's heat per contact and step (the energy meter sums it)
-    _UNKEPT = ("imp_t", "slip", "heat")
+    #: buffers not kept as they are: those turned, and the blade's heat per contact and
+    #: step (the energy meter sums it)
+    _UNKEPT = (*_GLOBAL, "heat")
 
     def __init__(self, rec):
         n1, self.taken = rec.n + 1, -1

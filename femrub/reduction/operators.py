@@ -2,10 +2,10 @@
 
 Two ways to the same operators of a reduced model of the columns ``c`` of the bases:
 
-* :func:`projected`: the projection over the full state, ``Ā = R̃_cᵀ A R_c``,
-  ``B̄ = R̃_cᵀ B R_c``, the loads ``R̃_cᵀ F``, the contact rows (``Contact.project``), the
-  observations ``O R_c``, the energy forms (:func:`~.energy_forms.reduced_energy`) and the
-  map to the mesh ``to_full R_c``;
+* the projection over the full state, in two halves: :func:`left_projected` (``Ā = R̃_cᵀ A
+  R_c``, ``B̄ = R̃_cᵀ B R_c``, the loads ``R̃_cᵀ F``, the contact rows, ``Contact.project``)
+  and :func:`right_projected` (the observations ``O R_c``, the energy forms,
+  :func:`~.energy_forms.reduced_energy`, and the map to the mesh ``to_full R_c``);
 * :func:`sliced`: the same as blocks of the largest model's projected operators
   (:mod:`femrub.reduction.truncation`), with the full model's gap, heat and load functions;
   only the energy rates, which are not projections, are recomputed; the map to the mesh is
@@ -26,22 +26,14 @@ from ..model.first_order import LoadTerm
 from .energy_forms import energy_rates, reduced_energy
 from .truncation import ColumnMap, sliced_contact, sliced_energy, sliced_loads
 
-__all__ = ["left_projected", "projected", "right_projected", "sliced"]
-
-
-def projected(fom, R, left, layout, n_boundary_u: int, to_full=None) -> dict:
-    """Operators of ``fom`` projected on the right basis ``R`` and left basis ``left``
-    (``R̃``; ``R`` itself for a Galerkin projection), of reduced ``layout``; ``to_full``:
-    ``fom.to_full @ R`` when already at hand (the largest model's columns, a
-    :class:`~femrub.reduction.truncation.ColumnMap`), else computed. The two halves
-    :func:`left_projected` and :func:`right_projected`: a caller that makes ``left`` for
-    this call only passes it to the first, so that it is released before the second."""
-    parts = left_projected(fom, R, left)
-    return {**parts, **right_projected(fom, R, parts, layout, n_boundary_u, to_full)}
+__all__ = ["left_projected", "right_projected", "sliced"]
 
 
 def left_projected(fom, R, left) -> dict:
-    """What the left basis projects: ``A``, ``B``, the loads, the contact (:func:`projected`)."""
+    """Operators of ``fom`` projected with the left basis ``left`` (``R̃``; ``R`` itself for a
+    Galerkin projection) on the right basis ``R``: ``A``, ``B``, the loads, the contact; the
+    rest is :func:`right_projected`'s (a caller that makes ``left`` for this call only has it
+    released before the energy forms copy ``R``)."""
     L = fom.layout
     parts = [0, L.u.stop, L.v.stop, L.n]  # the u, v, θ rows of the bases
     return {
@@ -56,8 +48,10 @@ def left_projected(fom, R, left) -> dict:
 
 
 def right_projected(fom, R, left_parts: dict, layout, n_boundary_u: int, to_full=None) -> dict:
-    """What ``R`` alone projects, given :func:`left_projected`'s ``A`` and ``B``: the energy
-    forms and growth rate, the observations, the map to the mesh (:func:`projected`)."""
+    """What ``R`` alone projects, given :func:`left_projected`'s ``A`` and ``B``, of reduced
+    ``layout``: the energy forms and growth rate, the observations, the map to the mesh
+    (``to_full``: ``fom.to_full @ R`` when already at hand, e.g. the largest model's columns
+    as a :class:`~femrub.reduction.truncation.ColumnMap`; else computed)."""
     energy, growth = None, 0.0
     if fom.energy is not None:
         Ar, Br = left_parts["A"], left_parts["B"]
@@ -74,7 +68,7 @@ def right_projected(fom, R, left_parts: dict, layout, n_boundary_u: int, to_full
 
 def sliced(largest: dict, fom, cols, layout) -> dict:
     """The operators of the columns ``cols`` as blocks of the ``largest`` model's
-    (:func:`projected` on every column), with ``fom``'s gap, heat and load functions."""
+    (projected on every column), with ``fom``'s gap, heat and load functions."""
     A, B = largest["A"][np.ix_(cols, cols)], largest["B"][np.ix_(cols, cols)]
     every = cols.size == A.shape[0] == largest["A"].shape[0] and np.array_equal(
         cols, np.arange(cols.size)
