@@ -31,6 +31,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from ..model.rub import FieldMap
+from ..reduction.truncation import column_source
 
 __all__ = ["FrameFields", "deviator_root"]
 
@@ -97,26 +98,7 @@ class FrameFields:
                 self._ops.append(((name,), (rows.size,), None, T[rows]))
             self._ops.append((("von_mises",), (QG.shape[0],), None, (QG @ T[:nu]).tocsr()))
         else:
-            T = np.asarray(T)
-            used = lambda A: np.flatnonzero(np.any(A != 0.0, axis=0))  # noqa: E731
-            Tu = T[:nu]
-            cu = used(Tu)
-            # displacement and stress share the displacement columns: one GEMM
-            S = np.asarray(QG @ Tu[:, cu])
-            U = np.concatenate([T[vd][:, cu], S], axis=0)
-            self._ops.append(
-                (
-                    ("displacement", "von_mises"),
-                    (vd.size, S.shape[0]),
-                    cu,
-                    np.ascontiguousarray(U.T, dtype=dtype),
-                )
-            )
-            for name, rows in blocks[1:]:
-                c = used(T[rows])
-                self._ops.append(
-                    ((name,), (rows.size,), c, np.ascontiguousarray(T[rows][:, c].T, dtype=dtype))
-                )
+            self._ops += _dense_ops(T, QG, blocks, nu, dtype)
         c = fields.contacts
         #: the vertices that carry a contact (sorted, unique); forces are zero elsewhere
         self.contact_vertices, which = np.unique(np.asarray(c.vertices), return_inverse=True)
@@ -218,6 +200,53 @@ class FrameFields:
 
 
 _VECTORS = ("displacement", "velocity", "contact_force", "friction_force")
+
+#: columns of a dense map read at once while the operators are built (bounds the copies)
+COLUMN_BLOCK = 32
+
+
+def _dense_ops(T, QG, blocks, nu: int, dtype) -> list:
+    """The operators of :class:`FrameFields` for a dense map ``T`` (an array or a
+    :class:`~femrub.reduction.truncation.ColumnMap`), each the transposed rows of ``T`` a
+    field needs restricted to the columns they use, built :data:`COLUMN_BLOCK` columns at
+    a time (never a copy of ``T``): the displacement and stress ``[T[vd]; QG T[:nu]]``
+    (one GEMM for both), then the velocity and temperature rows."""
+    A, cols = column_source(T)
+    (_, vd), rest = blocks[0], blocks[1:]
+    cu = _used(A, cols, slice(0, nu))
+    k_rows = QG.shape[0]
+    U = np.empty((cu.size, vd.size + k_rows), dtype=dtype)
+    for j in range(0, cu.size, COLUMN_BLOCK):
+        c = cols[cu[j : j + COLUMN_BLOCK]]
+        U[j : j + COLUMN_BLOCK, : vd.size] = _rows(A, vd, c).T
+        U[j : j + COLUMN_BLOCK, vd.size :] = np.asarray(QG @ _rows(A, slice(0, nu), c)).T
+    ops = [(("displacement", "von_mises"), (vd.size, k_rows), cu, U)]
+    for name, rows in rest:
+        c = _used(A, cols, rows)
+        ops.append(
+            (
+                (name,),
+                (rows.size,),
+                c,
+                np.ascontiguousarray(_rows(A, rows, cols[c]).T, dtype=dtype),
+            )
+        )
+    return ops
+
+
+def _rows(A, rows, cols) -> np.ndarray:
+    """``A[rows][:, cols]`` (``rows`` a slice or indices), copying only that block."""
+    return A[rows][:, cols] if isinstance(rows, slice) else A[np.ix_(rows, cols)]
+
+
+def _used(A, cols, rows) -> np.ndarray:
+    """The columns ``j`` of ``A[:, cols]`` with a nonzero in ``rows``, read
+    :data:`COLUMN_BLOCK` columns at a time."""
+    out = [
+        j + np.flatnonzero(np.any(_rows(A, rows, cols[j : j + COLUMN_BLOCK]) != 0.0, axis=0))
+        for j in range(0, cols.size, COLUMN_BLOCK)
+    ]
+    return np.concatenate(out) if out else np.zeros(0, dtype=np.intp)
 
 
 def _scatter(S: sp.csr_matrix, per: np.ndarray) -> np.ndarray:

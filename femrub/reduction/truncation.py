@@ -30,7 +30,14 @@ import scipy.sparse as sp
 
 from ..model.first_order import LoadTerm
 
-__all__ = ["CONTACT_ROWS", "ColumnMap", "sliced_contact", "sliced_energy", "sliced_loads"]
+__all__ = [
+    "CONTACT_ROWS",
+    "ColumnMap",
+    "column_source",
+    "sliced_contact",
+    "sliced_energy",
+    "sliced_loads",
+]
 
 #: the fields of a :class:`~femrub.contact.gap.Contact` that a reduction projects
 CONTACT_ROWS = ("G", "Gv", "Hm", "Ht", "Gvt", "Hmt")
@@ -97,6 +104,15 @@ class ColumnMap:
         if isinstance(key, tuple):  # rows and columns: from the dense copy
             return np.asarray(self)[key]
         return self.full[key][..., self.cols]
+
+
+def column_source(M) -> tuple[np.ndarray, np.ndarray]:
+    """``(A, cols)`` with ``M[:, j] = A[:, cols[j]]``, without a copy: a :class:`ColumnMap`'s
+    shared array and its columns, or a dense array and all of its columns."""
+    if isinstance(M, ColumnMap):
+        return M.full, M.cols
+    A = np.asarray(M)
+    return A, np.arange(A.shape[1])
 
 
 def _block(Q, cols: np.ndarray):
