@@ -119,6 +119,37 @@ def test_run_scene_steps_once(tmp_path, monkeypatch):
     assert s["reduction_error"]["sizes"] == [8, 4] and s["status"] == res.status
 
 
+def test_a_run_that_keeps_no_build_lets_the_full_model_go_before_its_output(tmp_path, monkeypatch):
+    """``femrub run`` (``keep_build=False``): the full model and the reductor are collected
+    before the results are written, and the folder holds what a kept build writes."""
+    import gc
+    import weakref
+
+    from femrub.output import run_folder
+
+    alive, original = {}, run_folder._finish
+
+    def on_built(built):
+        alive.update(full=weakref.ref(built.full), reductor=weakref.ref(built.reductor))
+
+    def finish(*a, **kw):  # the output stage
+        gc.collect()
+        alive["at_output"] = [k for k in ("full", "reductor") if alive[k]() is not None]
+        return original(*a, **kw)
+
+    monkeypatch.setattr(run_folder, "_finish", finish)
+    scene = load_scene("twisted-naca", {**SMALL, "outputs.plots": False})
+    kept, built = run_scene(scene, tmp_path / "kept", on_built=on_built)
+    assert alive["at_output"] == ["full", "reductor"] and built.full is not None
+    res, built = run_scene(scene, tmp_path / "run", on_built=on_built, keep_build=False)
+    assert alive["at_output"] == [] and built.full is None and built.reductor is None
+    a, b = (json.loads((tmp_path / d / "summary.json").read_text()) for d in ("kept", "run"))
+    assert a["n_full"] == b["n_full"] > b["n_dofs"]
+    assert a.keys() == b.keys() and a["status"] == b["status"]
+    # two builds of one scene: the same model up to the eigen-solver's rounding
+    assert np.allclose(kept.impulse, res.impulse, rtol=1e-6, atol=1e-9 * kept.impulse.max())
+
+
 def test_builds_in_a_row_keep_the_assembly(tmp_path):
     """Builds in a row (a sweep worker's points) take the last assembly from memory."""
     from femrub.app.cache import ModelCache

@@ -143,6 +143,7 @@ def _run(args) -> int:
         log=_log(args),
         on_built=on_built,
         cache=_cache(args, _log(args)),
+        keep_build=False,
     )
     where = f"{out}/ (summary.json, history.csv, history.npz)"
     if res.status == "interrupted":

@@ -112,6 +112,7 @@ def run_scene(
     modes=0,
     cache=None,
     builds=None,
+    keep_build=True,
 ):
     """Build and run ``scene`` into the folder ``out``; return ``(results, built)``.
 
@@ -128,13 +129,17 @@ def run_scene(
     cache : a :class:`~femrub.app.cache.ModelCache` of assembled and reduced models.
     builds : a :class:`~femrub.app.simulation.SceneBuilds` that builds the scene (with its
         own cache, in place of ``cache``) from what it built before (the points of a sweep).
+    keep_build : ``False``: ``built`` without its full model and reductor
+        (:meth:`~femrub.app.simulation.Simulation.released`), let go before the run and its
+        output, which do not read them (``femrub run``: on Rotor 37 they are over a
+        gigabyte).
     """
     out = Path(out)
     check_run(scene)
     _check_not_the_scene(scene, out)
     with claim(out, "run", overwrite=overwrite):
         make = builds or functools.partial(build, cache=cache)
-        return _run_claimed(scene, out, progress, log, on_built, modes, make)
+        return _run_claimed(scene, out, progress, log, on_built, modes, make, keep_build)
 
 
 def _check_not_the_scene(scene: Scene, out: Path) -> None:
@@ -148,7 +153,7 @@ def _check_not_the_scene(scene: Scene, out: Path) -> None:
         )
 
 
-def _run_claimed(scene, out, progress, log, on_built, modes, make):
+def _run_claimed(scene, out, progress, log, on_built, modes, make, keep_build=True):
     try:
         built = make(scene, log=log, modes=modes)
     except OSError as exc:  # a read error: the folder says so too
@@ -156,6 +161,9 @@ def _run_claimed(scene, out, progress, log, on_built, modes, make):
         raise
     if on_built is not None:
         on_built(built)
+    n_full = built.full.n_dofs
+    if not keep_build:
+        built = built.released()
     write_atomic(out / "scene.toml", _resolved(scene).dumps())
     write_atomic(out / "explain.txt", built.explain() + "\n")
     o = scene["outputs"]
@@ -181,7 +189,7 @@ def _run_claimed(scene, out, progress, log, on_built, modes, make):
         snapshot=o["plots"],
         plots=o["plots"],
         timings=built.timings,
-        n_full=built.full.n_dofs,
+        n_full=n_full,
         rotation_speed=scene["loads"]["rotation_speed"],
         merge_time=merge_time(scene),
         claimed=True,

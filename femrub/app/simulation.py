@@ -136,6 +136,13 @@ class Simulation:
     #: the probes' observation rows on the full model, ``{probe_<name>: (1, n) rows}``
     probes: dict = field(default_factory=dict)
 
+    def released(self) -> Simulation:
+        """This simulation without its full model and reductor (both ``None``): what a run
+        writing its results folder reads (the reduced model, its stepper, its map to the
+        mesh, the run the checks stepped). A build keeps them for its checks and for the
+        next speed of a sweep; on Rotor 37 they take over a gigabyte."""
+        return replace(self, full=None, reductor=None)
+
     def explain(self) -> str:
         """What was built and why, as text (``femrub run SCENE --explain``)."""
         return explain(self.report)
