@@ -92,7 +92,7 @@ def test_a_size_projected_after_the_largest_shares_its_map_to_the_mesh(paper):
     *_, cols, layout = red._columns(4, 3)
     parts = red._project(cols, layout)
     shared = parts["to_full"]
-    assert isinstance(shared, ColumnMap) and shared.full is red._largest["to_full"]
+    assert isinstance(shared, ColumnMap) and shared.full is red._largest["to_full"].full is red.R
     own = np.asarray(paper.to_full @ red.R[:, cols])
     Xr = np.random.default_rng(4).standard_normal((5, layout.n))
     np.testing.assert_allclose(

@@ -211,9 +211,12 @@ def test_smaller_sizes_share_the_largest_map_to_the_mesh(paper):
     red = ThermoelasticCraigBampton(paper, 20, 12, projection="second-order")
     largest = red.reduce()
     rom = red.reduce(6, 4)
-    assert isinstance(rom.to_full, ColumnMap) and rom.to_full.full is largest.to_full
+    # the largest map is the basis itself with the mesh's constrained rows put back
+    assert isinstance(largest.to_full, ColumnMap) and largest.to_full.full is red.R
+    assert np.array_equal(np.asarray(largest.to_full), paper.to_full @ red.R)
+    assert isinstance(rom.to_full, ColumnMap) and rom.to_full.full is red.R
     *_, cols, _ = red._columns(6, 4)
-    dense = largest.to_full[:, cols]
+    dense = (paper.to_full @ red.R)[:, cols]
     direct = ThermoelasticCraigBampton(paper, 6, 4, projection="second-order").reduce()
     assert _rel(np.asarray(rom.to_full), np.asarray(direct.to_full)) < TOL_DENSE
     rng = np.random.default_rng(5)
@@ -229,6 +232,9 @@ def test_smaller_sizes_share_the_largest_map_to_the_mesh(paper):
     np.testing.assert_array_equal(M[2:7], dense[2:7])
     np.testing.assert_array_equal(M[rows, 1:4], dense[rows, 1:4])
     np.testing.assert_array_equal(np.asarray(M), dense)
+    clamped = np.flatnonzero(np.diff(sp.csr_matrix(paper.to_full).indptr) == 0)
+    assert clamped.size and not np.any(M[clamped]) and M[int(clamped[0])].shape == (cols.size,)
+    np.testing.assert_array_equal(M[int(clamped[0]) + 1], dense[int(clamped[0]) + 1])
     with pytest.raises(ValueError):
         M @ np.ones(cols.size + 1)
     with pytest.raises(ValueError):

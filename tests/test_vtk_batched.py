@@ -248,33 +248,35 @@ def test_the_background_writers_error_surfaces(rub, tmp_path, monkeypatch):
 
 
 def test_fields_of_a_shared_map_are_read_by_column_blocks(rub, monkeypatch):
-    """A reduced model whose map is columns of a wider array (a size of a larger reduction:
-    ``ColumnMap``) gives the fields of that map copied out, bit for bit, the operators read a
-    few columns at a time (never the whole map copied)."""
+    """A reduced model whose map is columns of a wider array with the mesh's constrained rows
+    put back (a size of a larger reduction: ``ColumnMap`` of the basis) gives the fields of
+    that map copied out, bit for bit, its operators read a few columns at a time (never the
+    whole map copied)."""
     from femrub.output import frame_fields
-    from femrub.reduction.truncation import ColumnMap
+    from femrub.reduction.truncation import prolonged
 
     model, fields, _ = rub
-    dense = dataclasses.replace(model, to_full=model.to_full.toarray())
-    T = dense.to_full
+    P = model.to_full  # the full model's prolongation of its free dofs to the mesh
     rng = np.random.default_rng(3)
-    order = rng.permutation(T.shape[1] + 7)
-    wide = rng.standard_normal((T.shape[0], T.shape[1] + 7))
-    wide[:, order[: T.shape[1]]] = T
-    shared = dataclasses.replace(model, to_full=ColumnMap(wide, order[: T.shape[1]]))
-    X = rng.standard_normal((3, T.shape[1]))
+    n = model.n_dofs
+    wide = rng.standard_normal((n, 9))
+    shared = prolonged(P, wide).columns([7, 2, 4, 0, 5])
+    assert np.array_equal(np.asarray(shared), (P @ wide)[:, [7, 2, 4, 0, 5]])
+    sized = dataclasses.replace(model, to_full=shared)
+    dense = dataclasses.replace(sized, to_full=np.asarray(shared))
+    X = rng.standard_normal((3, 5))
     impulse = rng.random((3, model.n_contacts))
     want = frame_fields.FrameFields(dense, fields, H).compact(X, impulse)
-    monkeypatch.setattr(frame_fields, "COLUMN_BLOCK", 3)
-    rows, taken = frame_fields._rows, []
+    monkeypatch.setattr(frame_fields, "COLUMN_BLOCK", 2)
+    rows, taken = frame_fields._rows_of, []
 
-    def counted(A, r, c):
+    def counted(row_of, A, r, c):
         taken.append((r.stop - r.start if isinstance(r, slice) else len(r), len(c)))
-        return rows(A, r, c)
+        return rows(row_of, A, r, c)
 
-    monkeypatch.setattr(frame_fields, "_rows", counted)
-    got = frame_fields.FrameFields(shared, fields, H).compact(X, impulse)
-    # the displacement rows (all of them) are read three columns at a time
-    assert max(c for r, c in taken if r == fields.n_u) == 3
+    monkeypatch.setattr(frame_fields, "_rows_of", counted)
+    got = frame_fields.FrameFields(sized, fields, H).compact(X, impulse)
+    # the displacement rows (all of them) are read two columns at a time
+    assert max(c for r, c in taken if r == fields.n_u) == 2
     for k, a in want.items():
         assert (a is None and got[k] is None) or np.array_equal(a, got[k]), k

@@ -336,8 +336,8 @@ class Stages:
                 self._say("cache: the reduction's map to the mesh is not in the cache; rebuilding")
                 return None
             Kept.last(self.kept.map, map_key, full)
-        cols = hit["map"]["columns"]
-        to_full = full if cols is None else ColumnMap(full, cols)
+        cols, rows = hit["map"]["columns"], hit["map"].get("rows")
+        to_full = full if cols is None else ColumnMap(full, cols, rows)
         return dict(hit, model=hit["model"].with_(to_full=to_full))
 
     def frequencies(self, model, k: int) -> np.ndarray:
@@ -426,7 +426,7 @@ def _detach(reduced, report, largest: int) -> tuple[dict, np.ndarray | None]:
     stored with the model)."""
     n, to_full, shared, ref = reduced.n_dofs, reduced.to_full, None, None
     if isinstance(to_full, ColumnMap):
-        shared, ref = to_full.full, {"columns": to_full.cols}
+        shared, ref = to_full.full, {"columns": to_full.cols, "rows": to_full.rows}
     elif isinstance(to_full, np.ndarray) and to_full.ndim == 2 and to_full.shape[1] == largest:
         shared, ref = to_full, {"columns": None}
     model = dataclasses.replace(reduced, contact=None, loads=[])

@@ -27,6 +27,8 @@ matrix built once.
 
 from __future__ import annotations
 
+from functools import partial
+
 import numpy as np
 import scipy.sparse as sp
 
@@ -211,9 +213,10 @@ def _dense_ops(T, QG, blocks, nu: int, dtype) -> list:
     field needs restricted to the columns they use, built :data:`COLUMN_BLOCK` columns at
     a time (never a copy of ``T``): the displacement and stress ``[T[vd]; QG T[:nu]]``
     (one GEMM for both), then the velocity and temperature rows."""
-    A, cols = column_source(T)
+    A, cols, row_of = column_source(T)
+    _rows = partial(_rows_of, row_of)
     (_, vd), rest = blocks[0], blocks[1:]
-    cu = _used(A, cols, slice(0, nu))
+    cu = _used(_rows, A, cols, slice(0, nu))
     k_rows = QG.shape[0]
     U = np.empty((cu.size, vd.size + k_rows), dtype=dtype)
     for j in range(0, cu.size, COLUMN_BLOCK):
@@ -222,7 +225,7 @@ def _dense_ops(T, QG, blocks, nu: int, dtype) -> list:
         U[j : j + COLUMN_BLOCK, vd.size :] = np.asarray(QG @ _rows(A, slice(0, nu), c)).T
     ops = [(("displacement", "von_mises"), (vd.size, k_rows), cu, U)]
     for name, rows in rest:
-        c = _used(A, cols, rows)
+        c = _used(_rows, A, cols, rows)
         ops.append(
             (
                 (name,),
@@ -234,12 +237,20 @@ def _dense_ops(T, QG, blocks, nu: int, dtype) -> list:
     return ops
 
 
-def _rows(A, rows, cols) -> np.ndarray:
-    """``A[rows][:, cols]`` (``rows`` a slice or indices), copying only that block."""
-    return A[rows][:, cols] if isinstance(rows, slice) else A[np.ix_(rows, cols)]
+def _rows_of(row_of, A, rows, cols) -> np.ndarray:
+    """``M[rows][:, cols]`` (``rows`` a slice or indices) of the map ``M[i, j] =
+    A[row_of[i], j]`` (zero where ``row_of[i] < 0``; ``row_of`` ``None``: ``M = A``), copying
+    only that block."""
+    if row_of is None:
+        return A[rows][:, cols] if isinstance(rows, slice) else A[np.ix_(rows, cols)]
+    src = row_of[rows]
+    out = np.zeros((src.size, np.size(cols)), dtype=A.dtype)
+    has = src >= 0
+    out[has] = A[np.ix_(src[has], cols)]
+    return out
 
 
-def _used(A, cols, rows) -> np.ndarray:
+def _used(_rows, A, cols, rows) -> np.ndarray:
     """The columns ``j`` of ``A[:, cols]`` with a nonzero in ``rows``, read
     :data:`COLUMN_BLOCK` columns at a time."""
     out = [

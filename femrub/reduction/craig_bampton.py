@@ -61,7 +61,7 @@ from .boundary_coordinates import boundary_coordinates, boundary_dofs
 from .interior import InteriorSolver, condensed_solve
 from .operators import left_projected, right_projected, sliced
 from .thermal_inputs import input_basis, input_distributions
-from .truncation import ColumnMap
+from .truncation import columns_of
 
 __all__ = ["PROJECTIONS", "ThermoelasticCraigBampton", "craig_bampton_thermal"]
 
@@ -355,7 +355,7 @@ class ThermoelasticCraigBampton:
         R = self.R if every else np.take(self.R, cols, axis=1)  # C-ordered, as self.R
         parts = left_projected(self.fom, R, self._left_columns(cols, R, every, layout))
         largest = None if every or self._largest is None else self._largest["to_full"]
-        shared = None if largest is None else ColumnMap(largest, cols)  # the map, not a copy
+        shared = None if largest is None else columns_of(largest, cols)  # not a copy
         nb = self.boundary["u"].size
         return {**parts, **right_projected(self.fom, R, parts, layout, nb, to_full=shared)}
 

@@ -34,6 +34,8 @@ __all__ = [
     "CONTACT_ROWS",
     "ColumnMap",
     "column_source",
+    "columns_of",
+    "prolonged",
     "sliced_contact",
     "sliced_energy",
     "sliced_loads",
@@ -44,30 +46,43 @@ CONTACT_ROWS = ("G", "Gv", "Hm", "Ht", "Gvt", "Hmt")
 
 
 class ColumnMap:
-    """The columns ``cols`` of a dense (n, r) array ``full``, without copying them.
+    """The columns ``cols`` of a dense (n, r) array ``full``, without copying them, with its
+    rows placed by ``rows`` when given (a prolongation: row ``i`` is ``full[rows[i]]``, or
+    zero where ``rows[i] < 0``).
 
-    A reduced model's ``to_full`` for the leading columns ``cols`` of the largest bases
+    A reduced model's ``to_full``: the largest model's map to the mesh is its basis ``R``
+    with the mesh's constrained rows put back (:func:`prolonged`: the full model's
+    ``to_full`` is a prolongation), and a smaller size's the leading columns ``cols`` of that
     (module docstring). ``M @ X`` is ``full @ X̂`` with ``X̂`` the rows of ``X`` placed at
     ``cols`` and zeros elsewhere, ``Y @ M`` is ``(Y @ full)[:, cols]``, rows ``M[rows]`` are
-    ``full[rows][:, cols]``; ``np.asarray(M)`` (or any other indexing) makes the copy.
+    ``full[rows][:, cols]`` (through ``rows``); ``np.asarray(M)`` (or any other indexing)
+    makes the copy.
 
     Parameters
     ----------
-    full : (n, r) dense array (the largest model's map, shared).
+    full : (n, r) dense array (the largest model's basis or map, shared).
     cols : (c,) distinct column indices of ``full``.
+    rows : (m,) row of ``full`` of each row of the map (``-1``: a zero row), or ``None``:
+        the rows of ``full``.
     """
 
     __array_priority__ = 20.0  # ``Y @ M`` of an ndarray ``Y`` comes to :meth:`__rmatmul__`
     ndim = 2
 
-    def __init__(self, full, cols):
+    def __init__(self, full, cols, rows=None):
         self.full = np.asarray(full)
         self.cols = np.asarray(cols, dtype=np.intp)
         if self.full.ndim != 2 or self.cols.ndim != 1:
             raise ValueError("ColumnMap needs a 2D array and a 1D array of columns")
         if np.unique(self.cols).size != self.cols.size:
             raise ValueError("ColumnMap: the columns must be distinct")
-        self.shape = (self.full.shape[0], self.cols.size)
+        self.rows = None if rows is None else np.asarray(rows, dtype=np.intp)
+        n = self.full.shape[0] if self.rows is None else self.rows.size
+        self.shape = (n, self.cols.size)
+
+    def columns(self, cols) -> ColumnMap:
+        """The map of the columns ``cols`` of this one (shared, not copied)."""
+        return ColumnMap(self.full, self.cols[np.asarray(cols, dtype=np.intp)], self.rows)
 
     @property
     def dtype(self):
@@ -77,12 +92,22 @@ class ColumnMap:
         return f"ColumnMap({self.shape[0]} x {self.shape[1]} of {self.full.shape[1]} columns)"
 
     def __array__(self, dtype=None, copy=None):
-        out = np.take(self.full, self.cols, axis=1)
+        out = self._placed(np.take(self.full, self.cols, axis=1))
         return out if dtype is None else out.astype(dtype, copy=False)
 
     def toarray(self) -> np.ndarray:
         """The columns as a dense array (a copy)."""
         return self.__array__()
+
+    def _placed(self, Y: np.ndarray, rows=slice(None)) -> np.ndarray:
+        """The rows ``rows`` of the map's row space of ``Y`` (rows of ``full``'s space)."""
+        if self.rows is None:
+            return Y[rows]
+        src = self.rows[rows]
+        out = np.zeros((src.size,) + Y.shape[1:], dtype=Y.dtype)
+        has = src >= 0
+        out[has] = Y[src[has]]
+        return out
 
     def _padded(self, X) -> np.ndarray:
         X = np.asarray(X)
@@ -95,24 +120,58 @@ class ColumnMap:
     def __matmul__(self, X) -> np.ndarray:
         if sp.issparse(X):
             X = X.toarray()
-        return self.full @ self._padded(X)
+        return self._placed(self.full @ self._padded(X))
 
     def __rmatmul__(self, Y) -> np.ndarray:
+        if self.rows is not None:  # Y's columns onto the rows of ``full``
+            has = np.flatnonzero(self.rows >= 0)
+            S = sp.csr_matrix(
+                (np.ones(has.size), (has, self.rows[has])), shape=(self.rows.size, len(self.full))
+            )
+            Y = Y @ S
         return np.asarray(Y @ self.full)[..., self.cols]
 
     def __getitem__(self, key):
         if isinstance(key, tuple):  # rows and columns: from the dense copy
             return np.asarray(self)[key]
-        return self.full[key][..., self.cols]
+        if self.rows is None:
+            return self.full[key][..., self.cols]
+        src = np.atleast_1d(self.rows[key])
+        out = np.zeros((src.size, self.cols.size), dtype=self.full.dtype)
+        has = src >= 0
+        out[has] = self.full[np.ix_(src[has], self.cols)]
+        return out if np.ndim(self.rows[key]) else out[0]
 
 
-def column_source(M) -> tuple[np.ndarray, np.ndarray]:
-    """``(A, cols)`` with ``M[:, j] = A[:, cols[j]]``, without a copy: a :class:`ColumnMap`'s
-    shared array and its columns, or a dense array and all of its columns."""
+def prolonged(P, R) -> ColumnMap | None:
+    """``P R`` as a :class:`ColumnMap` of ``R`` (no copy) when ``P`` is a prolongation (at most
+    one 1 in each row, in distinct columns: the full model's ``to_full``), else ``None``."""
+    if not sp.issparse(P):
+        return None
+    P = sp.csr_matrix(P)
+    per_row = np.diff(P.indptr)
+    if per_row.max(initial=0) > 1 or not np.all(P.data == 1.0):
+        return None
+    rows = np.full(P.shape[0], -1, dtype=np.intp)
+    rows[per_row == 1] = P.indices
+    if np.unique(P.indices).size != P.indices.size or P.shape[1] != len(R):
+        return None
+    return ColumnMap(R, np.arange(np.shape(R)[1]), rows)
+
+
+def columns_of(M, cols) -> ColumnMap:
+    """The columns ``cols`` of a dense map or of a :class:`ColumnMap` (shared, not copied)."""
+    return M.columns(cols) if isinstance(M, ColumnMap) else ColumnMap(M, cols)
+
+
+def column_source(M) -> tuple[np.ndarray, np.ndarray, np.ndarray | None]:
+    """``(A, cols, rows)`` with ``M[i, j] = A[rows[i], cols[j]]`` (zero where ``rows[i] < 0``;
+    ``rows`` ``None``: ``M[:, j] = A[:, cols[j]]``), without a copy: a :class:`ColumnMap`'s
+    shared array, columns and rows, or a dense array with all of its columns."""
     if isinstance(M, ColumnMap):
-        return M.full, M.cols
+        return M.full, M.cols, M.rows
     A = np.asarray(M)
-    return A, np.arange(A.shape[1])
+    return A, np.arange(A.shape[1]), None
 
 
 def _block(Q, cols: np.ndarray):
