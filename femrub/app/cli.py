@@ -24,6 +24,8 @@ import sys
 import time
 from pathlib import Path
 
+from ..heap import map_large_arrays
+
 __all__ = ["main", "build_parser"]
 
 
@@ -517,6 +519,7 @@ def _one_line(exc: BaseException) -> str:
 
 
 def main(argv=None) -> int:
+    map_large_arrays()  # a long build's freed arrays go back to the system (femrub.heap)
     parser = build_parser()
     args = parser.parse_args(argv)
     if args.version:

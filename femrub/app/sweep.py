@@ -29,6 +29,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .. import heap
 from ..output.folder import FINISHED, FolderError, claim, folder_status
 from ..output.jsonfile import write_json
 from ..output.results import PROBE_PREFIX
@@ -172,6 +173,7 @@ def run_points(
     :class:`~femrub.app.cache.ModelCache` shared by the workers; ``done``: called after
     each point (a progress bar).
     """
+    heap.map_large_arrays()  # workers of another scheduler (femrub.heap)
     base = Scene(scene_data, source, Path(base_dir))
     builds = SceneBuilds(cache)
     rows = []
@@ -224,7 +226,12 @@ def _client(scheduler, workers):
         threads_per_worker=1,
         processes=True,
         dashboard_address=None,
-        env={"OMP_NUM_THREADS": "1", "OPENBLAS_NUM_THREADS": "1", "MKL_NUM_THREADS": "1"},
+        env={
+            "OMP_NUM_THREADS": "1",
+            "OPENBLAS_NUM_THREADS": "1",
+            "MKL_NUM_THREADS": "1",
+            heap.ENV: str(heap.LARGE),  # femrub.heap, from the workers' start
+        },
     )
     return Client(cluster), cluster
 
