@@ -194,6 +194,30 @@ def test_smaller_sizes_are_blocks_of_the_largest_projection(paper, projection, m
     assert abs(growth - ref["growth"]) <= 1e-9 * max(1.0, abs(ref["growth"]))
 
 
+@pytest.mark.parametrize("projection", PROJECTIONS)
+def test_a_size_that_does_not_nest_takes_its_projections_from_the_largest(projection):
+    """Once the largest model is projected, a size whose elastic-energy basis is its own
+    (``_nested()`` false) takes its projected operators as blocks of the largest's (no
+    columns of the left basis), equal to that size projected over the full state; a released
+    reductor (no left basis) makes it the same, bit for bit."""
+    damped = fr.bar_model(alpha=ALPHA, rayleigh=(0.0, 1e-6))  # C_ib: the shapes do not nest
+    red = ThermoelasticCraigBampton(damped, 20, 12, projection=projection)
+    if red._nested():
+        pytest.skip("every size nests (a block of the largest model) with this projection")
+    *_, cols, layout = red._columns(6, 4)
+    direct = red._project(cols, layout)  # before the largest: over the full state
+    red.reduce()
+    rel = red.released()
+    rom, again = red.reduce(6, 4), rel.reduce(6, 4)
+    assert rel.left is None and again is not rom
+    for k in ("A", "B"):
+        assert _rel(getattr(rom, k).toarray(), direct[k]) < TOL_DENSE
+        np.testing.assert_array_equal(getattr(again, k).toarray(), getattr(rom, k).toarray())
+    assert _rel(rom.contact.G, direct["contact"].G) < TOL_DENSE
+    assert _rel(rom.energy.Qe.toarray(), direct["energy"].Qe.toarray()) < TOL_DENSE
+    assert _rel(rom.energy.Pd.toarray(), direct["energy"].Pd.toarray()) < 1e-10
+
+
 def test_sliced_models_take_the_gap_functions_of_the_reductors_model(paper):
     """``for_model`` shares the projected operators; the gap and load functions are the new
     model's (a point of a speed sweep)."""

@@ -59,7 +59,7 @@ from ..model.first_order import FirstOrderModel, Layout
 from .basis import assemble_basis, left_static_shapes, velocity_static_shapes
 from .boundary_coordinates import boundary_coordinates, boundary_dofs
 from .interior import InteriorSolver, condensed_solve
-from .operators import left_projected, right_projected, sliced
+from .operators import left_projected, left_sliced, right_projected, sliced
 from .thermal_inputs import input_basis, input_distributions
 from .truncation import columns_of
 
@@ -348,14 +348,19 @@ class ThermoelasticCraigBampton:
         return not np.any(self.R[L.u, Lr.v.start : Lr.v.start + nb])
 
     def _project(self, cols, layout) -> dict:
-        """The operators of the sizes of ``cols`` projected over the full state (the columns
-        of the left basis taken for this call only: released before the energy forms copy
-        the right basis)."""
+        """The operators of the sizes of ``cols`` projected over the full state; once the
+        largest model is projected, those that are projections are blocks of its
+        (:func:`~femrub.reduction.operators.left_sliced`: no columns of the left basis taken)
+        and only the energy forms, which rest on the size's own modes, are projected on
+        ``R``'s columns."""
         every = cols.size == self.R.shape[1]  # the largest sizes: the bases, no copies
         R = self.R if every else np.take(self.R, cols, axis=1)  # C-ordered, as self.R
-        parts = left_projected(self.fom, R, self._left_columns(cols, R, every, layout))
-        largest = None if every or self._largest is None else self._largest["to_full"]
-        shared = None if largest is None else columns_of(largest, cols)  # not a copy
+        largest = None if every else self._largest
+        if largest is None:
+            parts = left_projected(self.fom, R, self._left_columns(cols, R, every, layout))
+        else:  # blocks of the largest model's: no columns of the left basis taken
+            parts = left_sliced(largest, self.fom, cols)
+        shared = None if largest is None else columns_of(largest["to_full"], cols)
         nb = self.boundary["u"].size
         return {**parts, **right_projected(self.fom, R, parts, layout, nb, to_full=shared)}
 
@@ -429,7 +434,8 @@ class ThermoelasticCraigBampton:
         """This reductor once the build has made its models: it lifts, reconstructs and
         restricts states and gives the models it made (:meth:`reduce` of those sizes), and
         holds no left basis (a Petrov–Galerkin projection's: ``n × r``, 0.6 GB for a
-        Rotor 37 blade), so it projects no other size."""
+        Rotor 37 blade): another size is a block of the largest model's when that one is
+        projected, and refused otherwise."""
         new = copy.copy(self)
         new.left, new._models = None, dict(self._models)
         return new

@@ -71,10 +71,23 @@ def _mapped(fom, R):
     return shared if shared is not None else np.asarray(fom.to_full @ R)
 
 
+def left_sliced(largest: dict, fom, cols) -> dict:
+    """:func:`left_projected` of the columns ``cols`` of both bases, as blocks of the
+    ``largest`` model's (``R̃_cᵀ A R_c = (R̃ᵀ A R)[c, c]``, ...: no columns of the bases
+    copied), with ``fom``'s gap, heat and load functions."""
+    return {
+        "A": largest["A"][np.ix_(cols, cols)],
+        "B": largest["B"][np.ix_(cols, cols)],
+        "loads": sliced_loads(largest["loads"], fom.loads, cols),
+        "contact": sliced_contact(largest["contact"], fom.contact, cols),
+    }
+
+
 def sliced(largest: dict, fom, cols, layout) -> dict:
     """The operators of the columns ``cols`` as blocks of the ``largest`` model's
     (projected on every column), with ``fom``'s gap, heat and load functions."""
-    A, B = largest["A"][np.ix_(cols, cols)], largest["B"][np.ix_(cols, cols)]
+    left = left_sliced(largest, fom, cols)
+    A, B = left["A"], left["B"]
     every = cols.size == A.shape[0] == largest["A"].shape[0] and np.array_equal(
         cols, np.arange(cols.size)
     )
@@ -85,10 +98,7 @@ def sliced(largest: dict, fom, cols, layout) -> dict:
     if largest["energy"] is not None:
         energy, growth = energy_rates(fom, sliced_energy(largest["energy"], cols), A, B, layout)
     return {
-        "A": A,
-        "B": B,
-        "loads": sliced_loads(largest["loads"], fom.loads, cols),
-        "contact": sliced_contact(largest["contact"], fom.contact, cols),
+        **left,
         "observations": {k: O[:, cols] for k, O in largest["observations"].items()},
         "energy": energy,
         "growth": growth,
