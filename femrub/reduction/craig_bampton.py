@@ -221,13 +221,17 @@ class ThermoelasticCraigBampton:
             )
             mphi = orient_columns(normalise_columns(solver.M @ phi[:, : self.n_qu]))
             left = (psi_l, mphi, phi, chi, solver.Ctu.T @ chi)
+            del psi_l, mphi
+        B = None  # the shapes are solved: the operator in the boundary coordinates goes
         if not keep_solver:  # no more solves: the factorisations' memory before the bases'
             solver.free()
         at = (self._idx, self._int, nu, fom.n_dofs, self.layout)  # where each shape goes
         self.R = assemble_basis(*at, psi, phi[:, : self.n_qu], phi, chi, phi_ut)
+        del psi, phi, phi_ut  # each shape is in R (or in ``left``) before the left basis
         self.left = self.R if left is None else assemble_basis(*at, *left)
+        del left
         if coords is not None:  # back to the physical coordinates: R = T̃ R', R̃ = L̃ R̃'
-            self.left = self.R if left is None else coords.left(self.left, L)
+            self.left = self.R if self.left is self.R else coords.left(self.left, L)
             self.R = coords.right(self.R, L)
         self.timings["bases"] = time.perf_counter() - t0
 
