@@ -337,3 +337,16 @@ def test_a_lean_record_saved_and_loaded_keeps_its_checks(tmp_path):
     one = fr.ThetaMethod(model, 1e-4).run(0.0, lean=2)  # no step: no balance, NaN
     back = fr.Results.load_npz(one.save_npz(tmp_path / "one.npz"))
     assert np.isnan(one.energy_error()) and np.isnan(back.energy_error())
+
+
+def test_a_whole_record_writes_no_chunk_of_zeros():
+    """A whole record's arrays start as zeros the system maps only when written: a chunk of
+    zero rows (a contact open, no friction) is not written, a chunk with values is."""
+    from femrub.output.kept_rows import _put
+
+    rows = np.zeros((10, 2))
+    rows.flags.writeable = False  # a write would raise
+    _put(rows, slice(2, 5), np.zeros((3, 2)))
+    rows.flags.writeable = True
+    _put(rows, slice(2, 5), np.array([[0.0, 0.0], [0.0, 1.5], [0.0, 0.0]]))
+    np.testing.assert_array_equal(rows[:, 1], [0, 0, 0, 1.5, 0, 0, 0, 0, 0, 0])

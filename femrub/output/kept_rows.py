@@ -52,11 +52,20 @@ def _info(rec) -> dict:
     return {**info, "signal_units": units} if units else info
 
 
+def _put(rows: np.ndarray, at: slice, values: np.ndarray) -> None:
+    """``rows[at] = values`` unless ``values`` are all zero: the record's arrays start as
+    untouched zeros (pages the system maps only when written), and most per-contact arrays
+    of a rub (impulses, friction forces, contact states) are zero most of the time."""
+    if values.any():
+        rows[at] = values
+
+
 class AllRows:
-    """Every per-step array of every row, ``n_steps + 1`` rows allocated at once; the
-    tangential impulses and slip velocities in global axes (``friction_force``,
-    ``slip_velocity``: ``(rows, n_c, 3)``), turned chunk by chunk as the rows arrive (the
-    local rows are not kept beside them)."""
+    """Every per-step array of every row, ``n_steps + 1`` rows allocated at once (as zeros,
+    written only where a chunk's rows are not: :func:`_put`); the tangential impulses and
+    slip velocities in global axes (``friction_force``, ``slip_velocity``:
+    ``(rows, n_c, 3)``), turned chunk by chunk as the rows arrive (the local rows are not
+    kept beside them)."""
 
     reads_gaps = reads_slips = True
     #: the recorder's buffers kept in global axes, by the name they take in the results
@@ -85,13 +94,15 @@ class AllRows:
         a, b = slice(first, last + 1), slice(first - i0, last + 1 - i0)
         for k, v in rec.buffers().items():
             if k not in self._UNKEPT:
-                self.rows[k][a] = v[b]
+                _put(self.rows[k], a, v[b])
         if self._turns:
             c = rec.model.contact
-            self.rows["friction_force"][a] = c.to_global(rec.imp_t[b] / rec.h)
-            self.rows["slip_velocity"][a] = c.to_global(rec.slip[b])
+            if rec.imp_t[b].any():
+                self.rows["friction_force"][a] = c.to_global(rec.imp_t[b] / rec.h)
+            if rec.slip[b].any():
+                self.rows["slip_velocity"][a] = c.to_global(rec.slip[b])
         for k, v in rec.extra.items():
-            self.extra.setdefault(k, np.zeros((rec.n + 1, *v.shape[1:]), v.dtype))[a] = v[b]
+            _put(self.extra.setdefault(k, np.zeros((rec.n + 1, *v.shape[1:]), v.dtype)), a, v[b])
         self.taken = last
 
     def results(self, rec, m: int, **kw) -> Results:
