@@ -263,3 +263,26 @@ def test_smaller_sizes_share_the_largest_map_to_the_mesh(paper):
         M @ np.ones(cols.size + 1)
     with pytest.raises(ValueError):
         ColumnMap(dense, [0, 0])
+
+
+def test_the_elastic_form_on_its_own_basis_without_a_copy_of_the_basis():
+    """The elastic form and the thermal-stress work of a size whose elastic basis ``R_z`` is
+    not ``R`` are the projections on ``R_z`` (``elastic_basis``, a copy of ``R``), computed
+    as the projection on ``R`` plus the terms of the columns that differ."""
+    import scipy.sparse as sp
+
+    from femrub.fem.linalg import project
+    from femrub.reduction.energy_forms import elastic_basis, reduced_energy
+
+    damped = fr.bar_model(alpha=ALPHA, rayleigh=(0.0, 1e-6))
+    red = ThermoelasticCraigBampton(damped, 20, 12, projection="static-mass")
+    assert not red._nested()
+    rom = red.reduce()
+    L, nb = damped.layout, red.boundary["u"].size
+    Rz = elastic_basis(damped, nb, red.R, red.layout)
+    assert Rz is not red.R and not np.array_equal(Rz, red.R)
+    forms, _ = reduced_energy(damped, nb, red.R, rom.A.toarray(), rom.B.toarray(), red.layout)
+    P = sp.csr_matrix(damped.energy.Pth)
+    P_u = sp.vstack([P[L.v], P[L.u], P[L.t]], format="csr")
+    assert _rel(forms.Qe.toarray(), project(Rz, damped.energy.Qe, Rz)) < TOL_DENSE
+    assert _rel(forms.Wth.toarray(), project(Rz, P_u, red.R)) < TOL_DENSE

@@ -17,7 +17,7 @@ from scipy.linalg import eigh
 
 from ..fem.linalg import project
 
-__all__ = ["elastic_basis", "energy_rates", "reduced_energy"]
+__all__ = ["elastic_basis", "elastic_change", "energy_rates", "reduced_energy"]
 
 
 def reduced_energy(fom, n_boundary_u: int, R, Ar, Br, layout):
@@ -46,21 +46,27 @@ def reduced_energy(fom, n_boundary_u: int, R, Ar, Br, layout):
     m = fom
     L = m.layout
     parts = [0, L.u.stop, L.v.stop, L.n]  # the u, v, θ rows of the bases
-    Rz = elastic_basis(fom, n_boundary_u, R, layout)
+    change = elastic_change(fom, n_boundary_u, R, layout)  # R_z = R but on these rows
     # forms rebuilt below are not projected here: the damping power (``energy_rates``, when
     # damped) and the elastic form on ``R_z``
     zero = sp.csr_matrix((L.n, L.n))
     damped = sp.csr_matrix(m.energy.Pd).count_nonzero() > 0
     given = dataclasses.replace(
-        m.energy, Pd=zero if damped else m.energy.Pd, Qe=m.energy.Qe if Rz is R else zero
+        m.energy, Pd=zero if damped else m.energy.Pd, Qe=m.energy.Qe if change is None else zero
     )
     forms = given.project(R, parts)
-    if Rz is not R:  # else the projected Qe is already the elastic energy's
-        forms.Qe = sp.csr_matrix(project(Rz, m.energy.Qe, Rz, parts=parts))
+    if change is not None:  # else the projected Qe is already the elastic energy's
+        Qe = _projected_on_change(R, m.energy.Qe, parts, L.u, change, right_too=True)
+        forms.Qe = sp.csr_matrix(Qe)
     if L.n_t:
         P = sp.csr_matrix(m.energy.Pth)
         P_u = sp.vstack([P[L.v], P[L.u], P[L.t]], format="csr")  # v-rows moved to u-rows
-        forms.Wth = sp.csr_matrix(np.asarray(project(Rz, P_u, R, parts=parts)))
+        W = (
+            project(R, P_u, R, parts=parts)
+            if change is None
+            else _projected_on_change(R, P_u, parts, L.u, change, right_too=False)
+        )
+        forms.Wth = sp.csr_matrix(np.asarray(W))
     return energy_rates(fom, forms, Ar, Br, layout)
 
 
@@ -89,17 +95,45 @@ def energy_rates(fom, forms, Ar, Br, layout):
 
 def elastic_basis(fom, n_boundary_u: int, R, layout):
     """``R`` with the boundary-velocity static shapes' displacement projected on the kept
-    modes (see :func:`reduced_energy`)."""
-    m = fom
-    L = m.layout
-    nb = n_boundary_u
-    n_qu = layout.n_u - nb
-    cv_b = layout.v.start + np.arange(nb)
-    G = R[L.u][:, cv_b]
-    if not np.any(G):
+    modes (see :func:`reduced_energy`): ``R`` itself when they have none, else a copy."""
+    change = elastic_change(fom, n_boundary_u, R, layout)
+    if change is None:
         return R
-    Phi = R[L.u][:, nb : nb + n_qu]
+    cols, new = change
     Rz = R.copy()
-    MPhi = m.blocks.M @ Phi
-    Rz[L.u, cv_b[0] : cv_b[-1] + 1] = Phi @ np.linalg.solve(Phi.T @ MPhi, MPhi.T @ G)
+    Rz[fom.layout.u, cols] = new
     return Rz
+
+
+def elastic_change(fom, n_boundary_u: int, R, layout):
+    """Where :func:`elastic_basis` differs from ``R``: ``(cols, new)``, the displacement rows
+    of the boundary-velocity columns ``cols`` (a slice) of ``R_z`` (``n_u × n_b``:
+    ``Φ (Φᵀ M Φ)⁻¹ Φᵀ M Γ``), or ``None`` (``R_z = R``)."""
+    L, nb = fom.layout, n_boundary_u
+    n_qu = layout.n_u - nb
+    cols = slice(layout.v.start, layout.v.start + nb)
+    G = R[L.u, cols]
+    if not np.any(G):
+        return None
+    Phi = R[L.u, nb : nb + n_qu]
+    MPhi = fom.blocks.M @ Phi
+    return cols, Phi @ np.linalg.solve(Phi.T @ MPhi, MPhi.T @ G)
+
+
+def _projected_on_change(R, Q, parts, rows, change, right_too: bool) -> np.ndarray:
+    """``R_zᵀ Q R_z`` (``right_too``) or ``R_zᵀ Q R`` without a copy of ``R``: ``R_z = R + E``
+    with ``E`` zero but on the rows ``rows`` of the columns ``cols`` (``change = (cols,
+    new)``, ``E[rows, cols] = new − R[rows, cols]``), so the projection on ``R`` plus the
+    terms of ``E``: ``Eᵀ Q R`` (rows ``cols``), ``Rᵀ Q E`` and ``Eᵀ Q E`` (columns
+    ``cols``)."""
+    cols, new = change
+    E = np.zeros((R.shape[0], new.shape[1]))
+    E[rows] = new - R[rows, cols]
+    Q = sp.csr_matrix(Q)
+    out = project(R, Q, R, parts=parts)
+    out[cols, :] += np.asarray(Q.T @ E).T @ R
+    if right_too:
+        QE = np.asarray(Q @ E)
+        out[:, cols] += R.T @ QE
+        out[cols, cols] += E.T @ QE
+    return out
