@@ -355,8 +355,8 @@ class ThermoelasticCraigBampton:
         """The operators of the sizes of ``cols`` projected over the full state; once the
         largest model is projected, those that are projections are blocks of its
         (:func:`~femrub.reduction.operators.left_sliced`: no columns of the left basis taken)
-        and only the energy forms, which rest on the size's own modes, are projected on
-        ``R``'s columns."""
+        and only what the right basis alone projects (the observations, and the energy
+        forms, which rest on the size's own modes) is projected on ``R``'s columns."""
         every = cols.size == self.R.shape[1]  # the largest sizes: the bases, no copies
         R = self.R if every else np.take(self.R, cols, axis=1)  # C-ordered, as self.R
         largest = None if every else self._largest

@@ -101,14 +101,13 @@ class ColumnMap:
         """The columns as a dense array (a copy)."""
         return self.__array__()
 
-    def _placed(self, Y: np.ndarray, rows=slice(None)) -> np.ndarray:
-        """The rows ``rows`` of the map's row space of ``Y`` (rows of ``full``'s space)."""
+    def _placed(self, Y: np.ndarray) -> np.ndarray:
+        """``Y`` (rows of ``full``'s space) on the map's rows (zero where ``rows < 0``)."""
         if self.rows is None:
-            return Y[rows]
-        src = self.rows[rows]
-        out = np.zeros((src.size,) + Y.shape[1:], dtype=Y.dtype)
-        has = src >= 0
-        out[has] = Y[src[has]]
+            return Y
+        out = np.zeros((self.rows.size,) + Y.shape[1:], dtype=Y.dtype)
+        has = self.rows >= 0
+        out[has] = Y[self.rows[has]]
         return out
 
     def _padded(self, X) -> np.ndarray:
