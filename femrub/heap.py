@@ -7,7 +7,7 @@ build allocates and frees many arrays of 1–32 MB (blocks of right-hand sides, 
 blocks, projection chunks): on Rotor 37 about 1 GB of freed heap was still resident when
 the Craig–Bampton bases (0.6 GB each) were made. :func:`map_large_arrays` fixes the threshold
 (``mallopt(M_MMAP_THRESHOLD, ...)``, which also stops the raise); ``femrub``'s command line
-calls it first and a sweep's workers start with it. A Python session may call it before a
+calls it first and a sweep's workers start with it. A Python program may call it before a
 large build. It does nothing where the C library is not glibc, or when the environment
 already sets ``MALLOC_MMAP_THRESHOLD_`` (the user's choice stands).
 """
