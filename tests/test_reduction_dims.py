@@ -253,6 +253,9 @@ def test_smaller_sizes_share_the_largest_map_to_the_mesh(paper):
     assert _rel(Y @ M, Y @ dense) < 1e-14
     rows = np.array([0, 3, 5])
     np.testing.assert_array_equal(M[rows], dense[rows])
+    plain = ColumnMap(paper.to_full @ red.R, cols)  # no row map: the same rows
+    np.testing.assert_array_equal(plain[rows], dense[rows])
+    np.testing.assert_array_equal(plain[3], dense[3])
     np.testing.assert_array_equal(M[2:7], dense[2:7])
     np.testing.assert_array_equal(M[rows, 1:4], dense[rows, 1:4])
     np.testing.assert_array_equal(np.asarray(M), dense)

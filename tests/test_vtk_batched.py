@@ -268,13 +268,13 @@ def test_fields_of_a_shared_map_are_read_by_column_blocks(rub, monkeypatch):
     impulse = rng.random((3, model.n_contacts))
     want = frame_fields.FrameFields(dense, fields, H).compact(X, impulse)
     monkeypatch.setattr(frame_fields, "COLUMN_BLOCK", 2)
-    rows, taken = frame_fields._rows_of, []
+    block, taken = frame_fields._block, []
 
-    def counted(row_of, A, r, c):
+    def counted(T, r, c):
         taken.append((r.stop - r.start if isinstance(r, slice) else len(r), len(c)))
-        return rows(row_of, A, r, c)
+        return block(T, r, c)
 
-    monkeypatch.setattr(frame_fields, "_rows_of", counted)
+    monkeypatch.setattr(frame_fields, "_block", counted)
     got = frame_fields.FrameFields(sized, fields, H).compact(X, impulse)
     # the displacement rows (all of them) are read two columns at a time
     assert max(c for r, c in taken if r == fields.n_u) == 2

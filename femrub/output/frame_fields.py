@@ -27,13 +27,11 @@ matrix built once.
 
 from __future__ import annotations
 
-from functools import partial
-
 import numpy as np
 import scipy.sparse as sp
 
 from ..model.rub import FieldMap
-from ..reduction.truncation import column_source
+from ..reduction.truncation import columns_of
 
 __all__ = ["FrameFields", "deviator_root"]
 
@@ -213,51 +211,36 @@ def _dense_ops(T, QG, blocks, nu: int, dtype) -> list:
     field needs restricted to the columns they use, built :data:`COLUMN_BLOCK` columns at
     a time (never a copy of ``T``): the displacement and stress ``[T[vd]; QG T[:nu]]``
     (one GEMM for both), then the velocity and temperature rows."""
-    A, cols, row_of = column_source(T)
-    _rows = partial(_rows_of, row_of)
     (_, vd), rest = blocks[0], blocks[1:]
-    cu = _used(_rows, A, cols, slice(0, nu))
+    u = slice(0, nu)
+    cu = _used(T, u)
     k_rows = QG.shape[0]
     U = np.empty((cu.size, vd.size + k_rows), dtype=dtype)
     for j in range(0, cu.size, COLUMN_BLOCK):
-        c = cols[cu[j : j + COLUMN_BLOCK]]
-        U[j : j + COLUMN_BLOCK, : vd.size] = _rows(A, vd, c).T
-        U[j : j + COLUMN_BLOCK, vd.size :] = np.asarray(QG @ _rows(A, slice(0, nu), c)).T
+        c = cu[j : j + COLUMN_BLOCK]
+        U[j : j + COLUMN_BLOCK, : vd.size] = _block(T, vd, c).T
+        U[j : j + COLUMN_BLOCK, vd.size :] = np.asarray(QG @ _block(T, u, c)).T
     ops = [(("displacement", "von_mises"), (vd.size, k_rows), cu, U)]
     for name, rows in rest:
-        c = _used(_rows, A, cols, rows)
-        ops.append(
-            (
-                (name,),
-                (rows.size,),
-                c,
-                np.ascontiguousarray(_rows(A, rows, cols[c]).T, dtype=dtype),
-            )
-        )
+        c = _used(T, rows)
+        block = np.ascontiguousarray(_block(T, rows, c).T, dtype=dtype)
+        ops.append(((name,), (rows.size,), c, block))
     return ops
 
 
-def _rows_of(row_of, A, rows, cols) -> np.ndarray:
-    """``M[rows][:, cols]`` (``rows`` a slice or indices) of the map ``M[i, j] =
-    A[row_of[i], j]`` (zero where ``row_of[i] < 0``; ``row_of`` ``None``: ``M = A``), copying
-    only that block."""
-    if row_of is None:
-        return A[rows][:, cols] if isinstance(rows, slice) else A[np.ix_(rows, cols)]
-    src = row_of[rows]
-    out = np.zeros((src.size, np.size(cols)), dtype=A.dtype)
-    has = src >= 0
-    out[has] = A[np.ix_(src[has], cols)]
-    return out
+def _block(T, rows, cols) -> np.ndarray:
+    """``T[rows][:, cols]`` (``rows`` a slice or indices) of a dense map, copying only that
+    block (:meth:`~femrub.reduction.truncation.ColumnMap.__getitem__`)."""
+    return columns_of(T, cols)[rows]
 
 
-def _used(_rows, A, cols, rows) -> np.ndarray:
-    """The columns ``j`` of ``A[:, cols]`` with a nonzero in ``rows``, read
-    :data:`COLUMN_BLOCK` columns at a time."""
-    out = [
-        j + np.flatnonzero(np.any(_rows(A, rows, cols[j : j + COLUMN_BLOCK]) != 0.0, axis=0))
-        for j in range(0, cols.size, COLUMN_BLOCK)
-    ]
-    return np.concatenate(out) if out else np.zeros(0, dtype=np.intp)
+def _used(T, rows) -> np.ndarray:
+    """The columns of ``T`` with a nonzero in ``rows``, read :data:`COLUMN_BLOCK` at a time."""
+    n, out = T.shape[1], [np.zeros(0, dtype=np.intp)]
+    for j in range(0, n, COLUMN_BLOCK):
+        c = np.arange(j, min(j + COLUMN_BLOCK, n))
+        out.append(c[np.any(_block(T, rows, c) != 0.0, axis=0)])
+    return np.concatenate(out)
 
 
 def _scatter(S: sp.csr_matrix, per: np.ndarray) -> np.ndarray:

@@ -35,7 +35,6 @@ from ..model.first_order import LoadTerm
 __all__ = [
     "CONTACT_ROWS",
     "ColumnMap",
-    "column_source",
     "columns_of",
     "prolonged",
     "sliced_contact",
@@ -135,8 +134,10 @@ class ColumnMap:
     def __getitem__(self, key):
         if isinstance(key, tuple):  # rows and columns: from the dense copy
             return np.asarray(self)[key]
-        if self.rows is None:
-            return self.full[key][..., self.cols]
+        if self.rows is None:  # a block of rows: only its columns copied
+            if isinstance(key, slice) or np.ndim(key) == 0:
+                return self.full[key][..., self.cols]
+            return self.full[np.ix_(np.asarray(key), self.cols)]
         src = np.atleast_1d(self.rows[key])
         out = np.zeros((src.size, self.cols.size), dtype=self.full.dtype)
         has = src >= 0
@@ -163,16 +164,6 @@ def prolonged(P, R) -> ColumnMap | None:
 def columns_of(M, cols) -> ColumnMap:
     """The columns ``cols`` of a dense map or of a :class:`ColumnMap` (shared, not copied)."""
     return M.columns(cols) if isinstance(M, ColumnMap) else ColumnMap(M, cols)
-
-
-def column_source(M) -> tuple[np.ndarray, np.ndarray, np.ndarray | None]:
-    """``(A, cols, rows)`` with ``M[i, j] = A[rows[i], cols[j]]`` (zero where ``rows[i] < 0``;
-    ``rows`` ``None``: ``M[:, j] = A[:, cols[j]]``), without a copy: a :class:`ColumnMap`'s
-    shared array, columns and rows, or a dense array with all of its columns."""
-    if isinstance(M, ColumnMap):
-        return M.full, M.cols, M.rows
-    A = np.asarray(M)
-    return A, np.arange(A.shape[1]), None
 
 
 def _block(Q, cols: np.ndarray):
