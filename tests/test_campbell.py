@@ -177,3 +177,23 @@ def test_exact_diagram_is_the_full_solve_at_every_speed(tmp_path):
     f = np.sqrt(lowest_modes(ps.K, mats.M, 3, vectors=False)) / (2 * np.pi)
     np.testing.assert_allclose(np.sort(table[2, 2:]), f, rtol=1e-7)  # CSV: 8 digits
     np.testing.assert_allclose(table[0, 2:], doc["rest_frequencies_hz"], rtol=1e-7)
+
+
+def test_bounds_back_substituted_together_equal_one_speed_at_a_time(tmp_path, monkeypatch):
+    """The speeds' residuals back-substituted together, by groups that share their nearest
+    factorisation, give each speed the bounds it gets from its own solve."""
+    from femrub.app import translate as tr
+    from femrub.fem import speed_modes as sm
+
+    scene = _scene(tmp_path, "nonlinear")
+    disc = discretise(scene_blade(scene), 2)
+    material = tr.material_of(scene)
+    mats = assemble(disc, material).mechanical()
+    speeds = parse_speeds("0:1200:100")
+    args = (disc, material, mats, "nonlinear", speeds)
+    together = sm.speed_modes(*args, modes=3, samples=3, max_samples=3)
+    monkeypatch.setattr(sm, "SPEEDS_PER_SOLVE", 1)
+    alone = sm.speed_modes(*args, modes=3, samples=3, max_samples=3)
+    assert np.all(np.isfinite(together.bounds)) and together.bounds.max() > 0
+    np.testing.assert_allclose(together.bounds, alone.bounds, rtol=1e-7, atol=1e-14)
+    np.testing.assert_allclose(together.frequencies, alone.frequencies, rtol=1e-10)

@@ -97,3 +97,36 @@ def test_frequency_bounds():
     mu, eps = 1 / lam, res / lam**1.5
     delta = eps[0] ** 2 / (mu[0] - mu[1] - eps[1])
     assert small[0] == pytest.approx(1 - np.sqrt(mu[0] / (mu[0] + delta)), rel=1e-12)
+
+
+@pytest.mark.parametrize("newton", [False, True])
+def test_corrections_together_equal_each_alone(box, newton):
+    """Speeds corrected together (residuals on threads, one back-substitution or one
+    conjugate-gradient run per factorisation for all of them) give each speed's correction
+    and ``η`` as that speed corrected alone; the speeds nearest each factorisation use it."""
+    disc, material, mats = box
+    lu = sparse_lu(mats.K, symmetric=True)
+    problem = prestress_problem(disc, material, "nonlinear", mats.K, lu.solve)
+    speeds = np.array([900.0, 2500.0, 3600.0, 4000.0])
+    reduced = initial_reduced(problem)
+    top = reduced.displacement(reduced.path(speeds[-1:] ** 2)[0])
+    op = problem.op
+    K_top = (op.assemble(op.moduli(op.gradients(top))) - speeds[-1] ** 2 * problem.MP)[
+        problem.free
+    ][:, problem.free]
+    problem.add_factor(speeds[-1] ** 2, sparse_lu(K_top.tocsr(), symmetric=True).solve)
+    assert [problem.nearest(s) for s in speeds**2] == [0, 0, 1, 1]
+    u = np.array([reduced.displacement(x) for x in reduced.path(speeds**2)])
+    eta, d = problem.corrections(u, speeds**2, newton=newton)
+    for k in range(speeds.size):
+        eta_k, d_k = problem.corrections(u[k : k + 1], speeds[k : k + 1] ** 2, newton=newton)
+        assert eta[k] == pytest.approx(eta_k[0], rel=1e-9)
+        np.testing.assert_allclose(d[k], d_k[0], rtol=0, atol=1e-9 * np.abs(d_k).max())
+    assert np.all(eta > 0)
+    if not newton:  # each speed's residual back-substituted with its nearest factorisation
+        for k, f in ((0, 0), (3, 1)):
+            alone = problem.factors[f][1](problem.residual(u[k], speeds[k] ** 2))
+            np.testing.assert_allclose(d[k], alone, rtol=0, atol=1e-9 * np.abs(alone).max())
+    if newton:  # the Newton correction is not the back-substitution alone
+        plain = problem.corrections(u, speeds**2, newton=False)[1]
+        assert np.abs(plain - d).max() > 1e-3 * np.abs(d).max()

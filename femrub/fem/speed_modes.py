@@ -31,7 +31,6 @@ Coriolis terms are left out, as in the rest of femrub (docs/theory.md).
 from __future__ import annotations
 
 import math
-import threading
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 
@@ -65,6 +64,9 @@ TRAINING = 4
 #: the exact one, and the shift is taken to first order (on Rotor 37 the error at the
 #: sample speeds, where the Ritz part vanishes, was up to 1.07 times the unscaled shift)
 STATIC_MARGIN = 2.0
+#: most speeds whose residuals are back-substituted together (their memory: a column per
+#: residual of each, ``modes + 1`` per speed, on the free dofs)
+SPEEDS_PER_SOLVE = 32
 #: extra modes per sample in the Ritz basis
 EXTRA_MODES = 4
 #: relative accuracy asked of the samples' eigenvalues (the samples only span ``W``: the
@@ -152,10 +154,6 @@ class _Setting:
             K = self.full_tangent(u, s)
             solve = sparse_lu(K, symmetric=True, what="prestressed tangent").solve
         return lowest_modes(K, self.mats.M, k, solve, tol=SAMPLE_TOLERANCE)[1], solve
-
-    def nearest_solve(self, s: float):
-        """The factorised tangent nearest in ``s = Ω²`` (the ``K⁻¹`` norm of residuals)."""
-        return self.problem.nearest_solve(s)
 
     def prestress(self, speeds, sample_speeds, static_tol):
         """``(u (n, N), η (n,), corrections (n, N), basis size, samples)`` at ``speeds``
@@ -273,42 +271,71 @@ class _Ritz:
         self.W[free] = Wf
         self.BW = op.B @ self.W
         self.MPr = Wf.T @ (setting.MPf @ Wf)
-        self.lock = threading.Lock()
 
     def evaluate(self, speeds, u_all, d_all, modes, check):
         """Ritz values (n, m), coordinates and frequency bounds (n, modes) at every speed
-        (``d_all``: the prestress corrections, whose effect joins the bounds)."""
+        (``d_all``: the prestress corrections, whose effect joins the bounds).
 
-        def one(k):
-            return self._at(float(speeds[k]) ** 2, u_all[k], d_all[k], modes, check)
+        The speeds are taken by groups that share their nearest factorisation, at most
+        :data:`SPEEDS_PER_SOLVE` at a time: their Ritz pairs and residuals on
+        :data:`~femrub.fem.quadrature.THREADS` threads (one BLAS thread each), then the
+        residuals' back-substitution as one solve with all their columns."""
+        n = len(speeds)
+        lam, Y, bounds = [None] * n, [None] * n, np.full((n, modes), np.nan)
+        problem = self.setting.problem
+        near = np.array([problem.nearest(float(w) ** 2) for w in speeds], dtype=int)
+        with ThreadPoolExecutor(THREADS) as pool:
+            for f in np.unique(near):
+                group = np.flatnonzero(near == f)
+                for lo in range(0, group.size, SPEEDS_PER_SOLVE):
+                    idx = group[lo : lo + SPEEDS_PER_SOLVE]
 
-        # one BLAS thread per speed, the speeds shared between the cores
-        with one_blas_thread, ThreadPoolExecutor(THREADS) as pool:
-            out = list(pool.map(one, range(len(speeds))))
-        return np.array([o[0] for o in out]), [o[1] for o in out], np.array([o[2] for o in out])
+                    def one(k):
+                        return self._at(float(speeds[k]) ** 2, u_all[k], d_all[k], modes, check)
+
+                    with one_blas_thread:
+                        out = list(pool.map(one, idx))
+                    for k, (lam_k, Y_k, _, _) in zip(idx, out, strict=True):
+                        lam[k], Y[k] = lam_k, Y_k
+                    if check:
+                        bounds[idx] = self._bounds(out, problem.factors[f][1], modes)
+        return np.array(lam), Y, bounds
 
     def _at(self, s, u, d, modes, check):
+        """At ``s = Ω²``: the Ritz values and coordinates, and (``check``) the residuals
+        ``R`` of the first Ritz pairs on the free dofs and the prestress term of the
+        bounds (:meth:`_static`; 0 without a correction ``d``)."""
         op, setting = self.setting.problem.op, self.setting
         g = op.gradients(u)
         D = op.moduli(g)
         Kr = op.project(D, self.BW)
         lam, Y = sla.eigh(Kr - s * self.MPr)
         if not check:
-            return lam, Y, np.full(modes, np.nan)
+            return lam, Y, None, 0.0
         n_res = min(modes + 1, self.W.shape[1])
         GX = (self.BW @ Y[:, :n_res]).reshape(-1, 9, n_res)
         KX = (op.B.T @ np.matmul(D, GX).reshape(-1, n_res))[setting.free]
         X = self.Wf @ Y[:, :n_res]
         R = KX - s * (setting.MPf @ X) - (setting.mats.M @ X) * lam[:n_res]
-        with self.lock:  # a factorisation's solve is not re-entrant
-            KR = np.asarray(setting.nearest_solve(s)(R)).reshape(R.shape)
-        res_k = np.sqrt(np.maximum(np.sum(R * KR, axis=0), 0.0))
-        bound = frequency_bounds(lam[:n_res], res_k, modes)
         if not np.any(d):
-            return lam, Y, bound
+            return lam, Y, R, 0.0
         y = Y[:, :modes]
         at_u = np.einsum("im,ij,jm->m", y, Kr, y)  # xᵀ K_T(u) x
-        return lam, Y, bound + self._static(at_u, u + d, GX[..., :modes], lam[:modes])
+        return lam, Y, R, self._static(at_u, u + d, GX[..., :modes], lam[:modes])
+
+    @staticmethod
+    def _bounds(out, solve, modes):
+        """The frequency bounds of the speeds whose :meth:`_at` gave ``out``, their
+        residuals' ``K⁻¹`` norms from one back-substitution with ``solve``."""
+        R = np.hstack([R for _, _, R, _ in out])
+        KR = np.asarray(solve(R)).reshape(R.shape)
+        res = np.sqrt(np.maximum(np.einsum("ij,ij->j", R, KR), 0.0))
+        bounds, col = [], 0
+        for lam, _, R_k, static in out:
+            n_res = R_k.shape[1]
+            bounds.append(frequency_bounds(lam[:n_res], res[col : col + n_res], modes) + static)
+            col += n_res
+        return np.array(bounds)
 
     def _static(self, at_u, corrected, GX, lam):
         """Relative frequency shift of the prestress correction ``d``, to first order:
