@@ -104,3 +104,33 @@ def test_pardiso_factor_is_released():
     f.free()
     f.free()
     assert f._s is None
+
+
+@pytest.mark.parametrize("preset", [None, "COMPATIBLE"])
+def test_mkl_is_loaded_in_its_reproducible_mode(preset):
+    """femrub loads MKL with conditional numerical reproducibility (MKL_CBWR=AUTO: a
+    threaded factorisation gives the same bits from run to run); a user's MKL_CBWR stands.
+    In a fresh interpreter, asking MKL itself which branch it runs."""
+    import os
+    import subprocess
+    import sys
+
+    if not linalg.pardiso_available():
+        pytest.skip("pypardiso / MKL not installed")
+    code = (
+        "import ctypes, os\n"
+        "from femrub.fem import linalg\n"
+        "assert linalg.pardiso_available()\n"
+        "import pypardiso\n"
+        "get = pypardiso.PyPardisoSolver().libmkl.MKL_CBWR_Get\n"
+        "get.restype = ctypes.c_int\n"
+        "print(os.environ['MKL_CBWR'], get(ctypes.c_int(1)))\n"  # 1: MKL_CBWR_BRANCH
+    )
+    env = {k: v for k, v in os.environ.items() if k != "MKL_CBWR"}
+    if preset:
+        env["MKL_CBWR"] = preset
+    out = subprocess.run(
+        [sys.executable, "-c", code], env=env, capture_output=True, text=True, check=True
+    ).stdout.split()
+    # MKL's branch codes: 1 off (MKL's default), 2 AUTO, 3 COMPATIBLE
+    assert out == (["COMPATIBLE", "3"] if preset else ["AUTO", "2"])

@@ -47,7 +47,19 @@ def _csv(path):
         return list(csv.DictReader(fh))
 
 
-def test_sweep_runs_and_resumes(tmp_path, capsys):
+def test_sweep_runs_and_resumes(tmp_path, capsys, monkeypatch):
+    """A grid on a local cluster (its first point in this process, which fills the model
+    cache), then rerun after a point failed: only that point runs again."""
+    import femrub.app.sweep as sweep
+
+    here = []
+
+    def spy(scene, chunk, cache, bar):
+        here.append([r["point"] for r in chunk])
+        return run_here(scene, chunk, cache, bar)
+
+    run_here = sweep._run_here
+    monkeypatch.setattr(sweep, "_run_here", spy)
     scene = tmp_path / "tiny.toml"
     scene.write_text(TINY)
     out = tmp_path / "sweep"
@@ -63,6 +75,7 @@ def test_sweep_runs_and_resumes(tmp_path, capsys):
         "-q",
     ]
     assert main(args) == 0
+    assert here == [[0]]
     rows = _csv(out / "interaction.csv")
     assert [r["loads.rotation_speed"] for r in rows] == ["100.0", "200.0", "300.0"]
     assert all(r["status"] == "ok" and r["skipped"] == "False" for r in rows)
@@ -77,6 +90,7 @@ def test_sweep_runs_and_resumes(tmp_path, capsys):
     assert main(args) == 0
     rows = _csv(out / "interaction.csv")
     assert [r["skipped"] for r in rows] == ["True", "False", "True"]
+    assert here == [[0]]  # one point to run: on a worker
     assert all(r["status"] == "ok" for r in rows)
     for r in (runs[0], runs[2]):
         assert (r / "summary.json").stat().st_mtime_ns == stamps[r.name]

@@ -376,13 +376,28 @@ def _compute(scene, todo, scheduler, workers, progress, cache=None) -> None:
 
     try:
         bar = tqdm(total=len(todo), disable=not progress, unit="point", desc="sweep")
-        for chunks in _batches(todo, cache, n_workers):
+        batches = _batches(todo, cache, n_workers)
+        if cluster is not None and len(batches[0]) == 1 and len(todo) > 1:
+            _run_here(scene, batches.pop(0)[0], cache, bar)
+        for chunks in batches:
             _collect(submit(chunks), bar)
         bar.close()
     finally:
         client.close()
         if cluster is not None:
             cluster.close()
+
+
+def _run_here(scene, chunk, cache, bar) -> None:
+    """Run ``chunk`` (the first point, which fills the cache) in this process, on all its
+    cores: the local workers have one thread each and would otherwise build it on one
+    while the others wait (on Rotor 37: 46 s instead of 83 s). MKL's reproducible mode
+    (:data:`femrub.fem.linalg.MKL_REPRODUCIBLE`) keeps its threaded factorisations, and so
+    the bases every point shares, the same from run to run."""
+    rows = run_points(*_here(scene), [(r["params"], r["folder"]) for r in chunk], cache)
+    for r, row in zip(chunk, rows, strict=True):
+        r.update(row)
+    bar.update(len(chunk))
 
 
 def _here(scene) -> tuple:
@@ -397,9 +412,8 @@ def _batches(todo: list, cache, workers: int) -> list[list[list]]:
     With a cache and more than one point, the first point runs alone and fills the cache
     (assembly, damping, reduction bases, map to the mesh); the other chunks then load
     them (a worker's first point would otherwise build them again: on Rotor 37 two
-    workers building at once took longer each than one alone). The first point keeps the
-    worker's one BLAS thread: its bases are then the same from run to run (a threaded
-    sparse factorisation is not), and so are the verdicts of the points that share them."""
+    workers building at once took longer each than one alone). On a ``LocalCluster`` the
+    first point runs in this process, on all its cores (:func:`_run_here`)."""
     first = todo[:1] if cache is not None and len(todo) > 1 else []
     rest = todo[len(first) :]
     n = max(1, min(workers, len(rest)))

@@ -23,6 +23,7 @@ from .spmm import block_columns, csr_dense
 
 __all__ = [
     "DENSE_BELOW",
+    "MKL_REPRODUCIBLE",
     "PARDISO_ABOVE",
     "compact",
     "Factorised",
@@ -50,12 +51,23 @@ def _has_pypardiso() -> bool:
     return importlib.util.find_spec("pypardiso") is not None and pardiso_available()
 
 
+#: MKL's conditional numerical reproducibility (``MKL_CBWR``), set before femrub loads MKL
+#: unless the environment sets it: MKL then keeps one code path for this processor, so a
+#: threaded Pardiso factorisation and its solves give the same bits from run to run on the
+#: same number of threads (without it, two runs of a Rotor 37 stiffness on two threads
+#: differ at round-off about one time in two). It has no effect when another library of
+#: the process loaded MKL first.
+MKL_REPRODUCIBLE = "AUTO"
+
+
 def pardiso_available() -> bool:
     """Whether MKL Pardiso can be loaded (``pypardiso`` and the MKL runtime installed).
 
     The runtime's path is then kept in ``PYPARDISO_MKL_RT``, the variable pypardiso reads
     first: without it every solver object searches the environment's library folders
-    again (about 0.7 s each in a virtual environment)."""
+    again (about 0.7 s each in a virtual environment). MKL is loaded in
+    :data:`MKL_REPRODUCIBLE` mode."""
+    os.environ.setdefault("MKL_CBWR", MKL_REPRODUCIBLE)
     try:
         import pypardiso
 
