@@ -38,6 +38,14 @@ def test_sparse_lu_spd_indefinite_general_and_singular(pardiso):
         np.testing.assert_allclose(M @ x, b, atol=1e-9 * np.abs(b).max())
         x1 = linalg.sparse_lu(M, symmetric=sym).solve(b[:, 0])
         assert x1.shape == (n,)
+    for M, definite in ((_laplacian(n, 2.9), False), (_laplacian(n), False)):
+        lu = linalg.sparse_lu(M, symmetric=True, definite=definite)  # LDLᵀ at once
+        np.testing.assert_allclose(M @ lu.solve(b), b, atol=1e-9 * np.abs(b).max())
+        if pardiso:
+            assert lu.method == "LDLt (MKL Pardiso)"
+    if pardiso:  # Cholesky when definite (the default), LDLᵀ after a failed Cholesky
+        assert linalg.sparse_lu(_laplacian(n), symmetric=True).method.startswith("Cholesky")
+        assert linalg.sparse_lu(_laplacian(n, 2.9), symmetric=True).method.startswith("LDLt")
     free = _laplacian(n).tolil()
     free[0, 0] = free[-1, -1] = 1.0  # a free chain: singular
     with pytest.raises(ValueError, match="singular"):

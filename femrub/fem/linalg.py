@@ -91,7 +91,7 @@ class _Pardiso:
     point hashes the whole matrix on every call to check it is the factorised one.
     """
 
-    def __init__(self, M, symmetric: bool):
+    def __init__(self, M, symmetric: bool, definite: bool = True):
         import pypardiso
 
         self.symmetric = symmetric
@@ -101,9 +101,12 @@ class _Pardiso:
             self._factor(pypardiso, A, _GENERAL)
             return
         full, A = A, sp.triu(A, format="csr")
-        try:
-            self._factor(pypardiso, A, _SPD)
-        except pypardiso.pardiso_wrapper.PyPardisoError:  # not positive definite
+        if definite:
+            try:
+                self._factor(pypardiso, A, _SPD)
+            except pypardiso.pardiso_wrapper.PyPardisoError:  # not positive definite
+                definite = False
+        if not definite:
             self._factor(pypardiso, A, _SYM)
         # a singular matrix may factorise with a round-off pivot: estimate the condition
         # number from one solve, ‖x‖ ‖A‖ / ‖b‖ with b = 1, as SuperLU's exact zero pivot
@@ -171,13 +174,22 @@ class _Pardiso:
         return out.reshape(np.shape(rhs))
 
 
-def sparse_lu(M, *, symmetric: bool = False, what: str = "matrix", pardiso: bool = True):
+def sparse_lu(
+    M,
+    *,
+    symmetric: bool = False,
+    what: str = "matrix",
+    pardiso: bool = True,
+    definite: bool = True,
+):
     """Sparse factorisation of ``M`` with ``solve(rhs, trans="N")``.
 
     MKL Pardiso when ``M`` is large (``n >= PARDISO_ABOVE``) and ``pypardiso`` is installed
     (a default dependency on x86-64): Cholesky for a symmetric positive definite ``M``
     (``symmetric=True``), else symmetric indefinite or general LU. Otherwise SuperLU
-    (minimum-degree ordering on ``A + Aᵀ`` for symmetric patterns).
+    (minimum-degree ordering on ``A + Aᵀ`` for symmetric patterns). ``definite=False``: a
+    symmetric ``M`` likely to be indefinite is factorised as LDLᵀ without trying Cholesky
+    first (a failed Cholesky of a Rotor 37 tangent costs about as much as the LDLᵀ).
 
     Pardiso pays off for one-off factorisations with many right-hand sides (reduction,
     eigen-solvers); a per-step solve is faster with SuperLU (per-call overhead), so
@@ -189,7 +201,7 @@ def sparse_lu(M, *, symmetric: bool = False, what: str = "matrix", pardiso: bool
         if pardiso and n >= PARDISO_ABOVE and _has_pypardiso():
             try:
                 with progress.phase(f"factorising the {name} ({n} unknowns)") as p:
-                    lu = _Pardiso(M, symmetric)
+                    lu = _Pardiso(M, symmetric, definite)
                     p["detail"] = lu.method
             except Exception as exc:  # a Pardiso error: singular, or out of memory
                 if type(exc).__name__ != "PyPardisoError":

@@ -265,18 +265,18 @@ class PrestressProblem:
 
         with ThreadPoolExecutor(THREADS) as pool:
             measured = list(pool.map(measure, range(s_list.size)))
-        r = np.array([m[0] for m in measured]).reshape(s_list.size, -1)
-        energy = np.array([m[1] for m in measured])
-        d = np.empty_like(r)
-        near = np.array([self.nearest(s) for s in s_list], dtype=int)
-        for f in np.unique(near):
-            idx = np.flatnonzero(near == f)
-            solve = self.factors[f][1]
-            if newton:
-                applies = [self.tangent(us[k], s_list[k]) for k in idx]
-                d[idx] = _pcg(applies, r[idx].T, solve).T
-            else:
-                d[idx] = np.asarray(solve(r[idx].T)).reshape(-1, idx.size).T
+            r = np.array([m[0] for m in measured]).reshape(s_list.size, -1)
+            energy = np.array([m[1] for m in measured])
+            d = np.empty_like(r)
+            near = np.array([self.nearest(s) for s in s_list], dtype=int)
+            for f in np.unique(near):
+                idx = np.flatnonzero(near == f)
+                solve = self.factors[f][1]
+                if newton:
+                    applies = list(pool.map(lambda k: self.tangent(us[k], s_list[k]), idx))
+                    d[idx] = _pcg(applies, r[idx].T, solve).T
+                else:
+                    d[idx] = np.asarray(solve(r[idx].T)).reshape(-1, idx.size).T
         work = np.abs(np.einsum("kn,kn->k", d, r))
         eta = np.sqrt(np.divide(work, energy, out=np.zeros_like(work), where=energy > 0))
         return eta, d

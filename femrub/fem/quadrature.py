@@ -138,59 +138,64 @@ class GradientOperator:
 
 def _stress_kernel(g, w, lam, mu, linear, P):  # pragma: no cover (compiled)
     """``P = w F S`` (first Piola–Kirchhoff stress × weight) at every point of ``g``."""
+    F, S = np.empty((3, 3)), np.empty((3, 3))
     for q in range(g.shape[0]):
-        F, S = _point_state(g[q], lam, mu, linear)
+        _point_state(g[q], lam, mu, linear, F, S)
         for i in range(3):
             for j in range(3):
                 P[q, i, j] = w[q] * (F[i, 0] * S[0, j] + F[i, 1] * S[1, j] + F[i, 2] * S[2, j])
 
 
-def _point_state(g, lam, mu, linear):  # pragma: no cover (compiled)
-    """``F``, ``S`` of one point (module docstring)."""
-    F = np.eye(3)
-    E = np.empty((3, 3))
+def _point_state(g, lam, mu, linear, F, S):  # pragma: no cover (compiled)
+    """``F``, ``S`` (3 × 3, filled in place) of one point (module docstring)."""
+    trace = 0.0
     for i in range(3):
         for j in range(3):
-            E[i, j] = 0.5 * (g[i, j] + g[j, i])
+            e = 0.5 * (g[i, j] + g[j, i])
+            F[i, j] = 1.0 if i == j else 0.0
             if not linear:
                 F[i, j] += g[i, j]
-                E[i, j] += 0.5 * (g[0, i] * g[0, j] + g[1, i] * g[1, j] + g[2, i] * g[2, j])
-    S = 2.0 * mu * E
-    trace = E[0, 0] + E[1, 1] + E[2, 2]
+                e += 0.5 * (g[0, i] * g[0, j] + g[1, i] * g[1, j] + g[2, i] * g[2, j])
+            S[i, j] = 2.0 * mu * e
+            if i == j:
+                trace += e
     for i in range(3):
         S[i, i] += lam * trace
-    return F, S
 
 
 def _moduli_kernel(g, w, lam, mu, linear, D):  # pragma: no cover (compiled)
     """``w D`` at every point of ``g``: ``g_xᵀ D g_y = λ tr(Fᵀ g_x) tr(Fᵀ g_y) + 2 μ
     sym(Fᵀ g_x) : sym(Fᵀ g_y) + g_x S : g_y``, rows ``(i, k)`` and columns ``(j, l)`` of the
     flattened gradients."""
+    F, S, C = np.empty((3, 3)), np.empty((3, 3)), np.empty((3, 3))
     for q in range(g.shape[0]):
-        F, S = _point_state(g[q], lam, mu, linear)
+        _point_state(g[q], lam, mu, linear, F, S)
+        for i in range(3):
+            for j in range(3):
+                C[i, j] = mu * (F[i, 0] * F[j, 0] + F[i, 1] * F[j, 1] + F[i, 2] * F[j, 2])
+        wq = w[q]
         for i in range(3):
             for k in range(3):
+                lam_ik = lam * F[i, k]
                 for j in range(3):
                     for l in range(3):
                         # λ tr(Fᵀg) tr(Fᵀh) + 2μ sym(Fᵀg):sym(Fᵀh) + g S : h, with
-                        # (Fᵀg)_kl = Σ_i F_ik g_il: the coefficient of g_ik h_jl
-                        v = lam * F[i, k] * F[j, l]
-                        v += mu * (
-                            F[i, l] * F[j, k]
-                            + (F[i, 0] * F[j, 0] + F[i, 1] * F[j, 1] + F[i, 2] * F[j, 2])
-                            * (1.0 if k == l else 0.0)
-                        )
+                        # (Fᵀg)_kl = Σ_i F_ik g_il: the coefficient of g_ik h_jl is
+                        # λ F_ik F_jl + μ F_il F_jk + μ (F Fᵀ)_ij δ_kl + δ_ij S_kl
+                        v = lam_ik * F[j, l] + mu * F[i, l] * F[j, k]
+                        if k == l:
+                            v += C[i, j]
                         if i == j:
                             v += S[k, l]
-                        D[q, 3 * i + k, 3 * j + l] = w[q] * v
+                        D[q, 3 * i + k, 3 * j + l] = wq * v
 
 
 def _form_kernel(g, w, lam, mu, linear, GX, out):  # pragma: no cover (compiled)
     """``out_c = Σ_q w_q (λ tr(A)² + 2 μ sym(A) : sym(A) + h S : h)`` with ``h`` the
     gradient ``GX[q, :, c]`` and ``A = Fᵀ h`` (the integrand of :func:`_moduli_kernel`)."""
-    A = np.empty((3, 3))
+    A, F, S = np.empty((3, 3)), np.empty((3, 3)), np.empty((3, 3))
     for q in range(g.shape[0]):
-        F, S = _point_state(g[q], lam, mu, linear)
+        _point_state(g[q], lam, mu, linear, F, S)
         for c in range(GX.shape[2]):
             for k in range(3):
                 for l in range(3):

@@ -168,7 +168,9 @@ class _Setting:
         reduced = enrich(reduced, s_train, COARSE_TOLERANCE, newton=False, log=self.log)[0]
         top = s_samples[-1:]
         K = self.full_tangent(reduced.displacement(reduced.path(top)[0]), top[0])
-        self.problem.add_factor(top[0], sparse_lu(K, symmetric=True, what="tangent").solve)
+        # on the coarse state and with spin softening, often indefinite (so on Rotor 37)
+        lu = sparse_lu(K, symmetric=True, what="tangent", definite=False)
+        self.problem.add_factor(top[0], lu.solve)
         reduced = enrich(reduced, s_train, static_tol, log=self.log)[0]
         samples = []
         for s, x in zip(s_samples, reduced.path(s_samples), strict=True):
