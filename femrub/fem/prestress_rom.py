@@ -295,7 +295,7 @@ def _pcg(applies, b, precondition, rtol: float = 1e-2, max_iter: int = 15) -> np
     rz = np.einsum("ij,ij->j", r, z)
     rz0 = rz.copy()
     going = np.ones(b.shape[1], dtype=bool)
-    with one_blas_thread, ThreadPoolExecutor(THREADS) as pool:
+    with ThreadPoolExecutor(THREADS) as pool:  # the preconditioner keeps MKL's threads
         for _ in range(max_iter):
             cols = np.flatnonzero(going)
             for j, Ap in zip(cols, pool.map(lambda j: applies[j](p[:, j]), cols)):
