@@ -194,6 +194,20 @@ def test_bounds_back_substituted_together_equal_one_speed_at_a_time(tmp_path, mo
     together = sm.speed_modes(*args, modes=3, samples=3, max_samples=3)
     monkeypatch.setattr(sm, "SPEEDS_PER_SOLVE", 1)
     alone = sm.speed_modes(*args, modes=3, samples=3, max_samples=3)
+    # residuals over SOLVE_BYTES: one speed per solve too, whatever SPEEDS_PER_SOLVE says
+    monkeypatch.setattr(sm, "SPEEDS_PER_SOLVE", 32)
+    monkeypatch.setattr(sm, "SOLVE_BYTES", 1)
+    solves = []
+    bounds = sm._Ritz._bounds
+
+    def counted(out, *rest):
+        solves.append(len(out))
+        return bounds(out, *rest)
+
+    monkeypatch.setattr(sm._Ritz, "_bounds", staticmethod(counted))
+    capped = sm.speed_modes(*args, modes=3, samples=3, max_samples=3)
+    assert solves == [1] * speeds.size
+    np.testing.assert_allclose(capped.bounds, alone.bounds, rtol=1e-7, atol=1e-14)
     assert np.all(np.isfinite(together.bounds)) and together.bounds.max() > 0
     np.testing.assert_allclose(together.bounds, alone.bounds, rtol=1e-7, atol=1e-14)
     np.testing.assert_allclose(together.frequencies, alone.frequencies, rtol=1e-10)

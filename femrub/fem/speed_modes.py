@@ -64,9 +64,11 @@ TRAINING = 4
 #: the exact one, and the shift is taken to first order (on Rotor 37 the error at the
 #: sample speeds, where the Ritz part vanishes, was up to 1.07 times the unscaled shift)
 STATIC_MARGIN = 2.0
-#: most speeds whose residuals are back-substituted together (their memory: a column per
-#: residual of each, ``modes + 1`` per speed, on the free dofs)
+#: most speeds whose residuals are back-substituted together
 SPEEDS_PER_SOLVE = 32
+#: most bytes of those residuals (a column per Ritz pair checked, ``modes + 1`` per speed,
+#: on the free dofs): fewer speeds per solve on a larger mesh
+SOLVE_BYTES = 256 * 2**20
 #: extra modes per sample in the Ritz basis
 EXTRA_MODES = 4
 #: relative accuracy asked of the samples' eigenvalues (the samples only span ``W``: the
@@ -279,18 +281,21 @@ class _Ritz:
         (``d_all``: the prestress corrections, whose effect joins the bounds).
 
         The speeds are taken by groups that share their nearest factorisation, at most
-        :data:`SPEEDS_PER_SOLVE` at a time: their Ritz pairs and residuals on
+        :data:`SPEEDS_PER_SOLVE` at a time (fewer when their residuals would take more
+        than :data:`SOLVE_BYTES`): their Ritz pairs and residuals on
         :data:`~femrub.fem.quadrature.THREADS` threads (one BLAS thread each), then the
         residuals' back-substitution as one solve with all their columns."""
         n = len(speeds)
         lam, Y, bounds = [None] * n, [None] * n, np.full((n, modes), np.nan)
         problem = self.setting.problem
         near = np.array([problem.nearest(float(w) ** 2) for w in speeds], dtype=int)
+        column = 8 * problem.free.size * min(modes + 1, self.W.shape[1])
+        per_solve = max(1, min(SPEEDS_PER_SOLVE, SOLVE_BYTES // column))
         with ThreadPoolExecutor(THREADS) as pool:
             for f in np.unique(near):
                 group = np.flatnonzero(near == f)
-                for lo in range(0, group.size, SPEEDS_PER_SOLVE):
-                    idx = group[lo : lo + SPEEDS_PER_SOLVE]
+                for lo in range(0, group.size, per_solve):
+                    idx = group[lo : lo + per_solve]
 
                     def one(k):
                         return self._at(float(speeds[k]) ** 2, u_all[k], d_all[k], modes, check)
