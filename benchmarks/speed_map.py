@@ -1,4 +1,4 @@
-"""The 40-speed × 50-revolution interaction map of Rotor 37 (target: ≤ 10 min), one command.
+"""The 40-speed × 50-revolution interaction map of Rotor 37 (target: ≤ 2 min), one command.
 
 Runs ``femrub sweep rotor37 --param loads.rotation_speed=850:1825:25`` (reduced, friction
 on, 50,000 steps per point; no VTK frames, no PNG plots in the points, ``history.csv`` at one
@@ -10,8 +10,8 @@ statuses, the median of each stage of a point (``summary.json["timings"]``) and 
 the model cache at the end. Appends a row to the table between the ``speed_map`` markers of
 ``docs/performance/speed-map-costs.md`` (``--no-write``: print it).
 
-Run: ``flock /tmp/femrub-heavy.lock python benchmarks/speed_map.py`` (both cores for about
-10 minutes); ``--speeds 1300:1400:25`` for a smaller map. Skips without ``../shared/data``.
+Run: ``flock /tmp/femrub-heavy.lock python benchmarks/speed_map.py`` (both cores for a few
+minutes); ``--speeds 1300:1400:25`` for a smaller map. Skips without ``../shared/data``.
 """
 
 from __future__ import annotations
