@@ -227,8 +227,12 @@ class PrestressProblem:
         """Index in :attr:`factors` of the factorisation nearest in ``s = Ω²``."""
         return min(range(len(self.factors)), key=lambda i: abs(self.factors[i][0] - s))
 
-    def nearest_solve(self, s: float):
-        return self.factors[self.nearest(s)][1]
+    def by_factor(self, s_list) -> list:
+        """``[(solve, indices), ...]``: for each factorisation nearest to some ``s`` of
+        ``s_list`` (``Ω²``), its solve and the indices of those ``s`` (in the order of
+        :attr:`factors`)."""
+        near = np.array([self.nearest(s) for s in s_list], dtype=int)
+        return [(self.factors[f][1], np.flatnonzero(near == f)) for f in np.unique(near)]
 
     def residual(self, u: np.ndarray, s: float) -> np.ndarray:
         """``r(u; s)`` on the free dofs (N)."""
@@ -268,10 +272,7 @@ class PrestressProblem:
             r = np.array([m[0] for m in measured]).reshape(s_list.size, -1)
             energy = np.array([m[1] for m in measured])
             d = np.empty_like(r)
-            near = np.array([self.nearest(s) for s in s_list], dtype=int)
-            for f in np.unique(near):
-                idx = np.flatnonzero(near == f)
-                solve = self.factors[f][1]
+            for solve, idx in self.by_factor(s_list):
                 if newton:
                     applies = list(pool.map(lambda k: self.tangent(us[k], s_list[k]), idx))
                     d[idx] = _pcg(applies, r[idx].T, solve).T
@@ -442,7 +443,6 @@ def enrich(reduced: Reduced, s_set, tol: float, *, newton=True, max_basis=MAX_BA
         order = np.argsort(-eta)[: max(max_basis - reduced.V.shape[1], 0)]
         grow = order[eta[order] > tol]
         if newton and grow.size:
-            d = d.copy()
             d[grow] = reduced.problem.corrections(u[grow], s_set[grow], newton=True)[1]
         grown = reduced.enriched(d[grow].T) if grow.size else None
         if grown is None:

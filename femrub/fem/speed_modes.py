@@ -288,24 +288,21 @@ class _Ritz:
         n = len(speeds)
         lam, Y, bounds = [None] * n, [None] * n, np.full((n, modes), np.nan)
         problem = self.setting.problem
-        near = np.array([problem.nearest(float(w) ** 2) for w in speeds], dtype=int)
         column = 8 * problem.free.size * min(modes + 1, self.W.shape[1])
         per_solve = max(1, min(SPEEDS_PER_SOLVE, SOLVE_BYTES // column))
+
+        def one(k):
+            return self._at(float(speeds[k]) ** 2, u_all[k], d_all[k], modes, check)
+
         with ThreadPoolExecutor(THREADS) as pool:
-            for f in np.unique(near):
-                group = np.flatnonzero(near == f)
-                for lo in range(0, group.size, per_solve):
-                    idx = group[lo : lo + per_solve]
-
-                    def one(k):
-                        return self._at(float(speeds[k]) ** 2, u_all[k], d_all[k], modes, check)
-
+            for solve, group in problem.by_factor(np.asarray(speeds, dtype=float) ** 2):
+                for idx in (group[i : i + per_solve] for i in range(0, group.size, per_solve)):
                     with one_blas_thread:
                         out = list(pool.map(one, idx))
                     for k, (lam_k, Y_k, _, _) in zip(idx, out, strict=True):
                         lam[k], Y[k] = lam_k, Y_k
                     if check:
-                        bounds[idx] = self._bounds(out, problem.factors[f][1], modes)
+                        bounds[idx] = self._bounds(out, solve, modes)
         return np.array(lam), Y, bounds
 
     def _at(self, s, u, d, modes, check):
