@@ -133,6 +133,25 @@ def test_damping_stage_is_cached(tmp_path):
     assert abs(second.full.blocks.C - b.C).max() == 0.0
 
 
+@pytest.mark.parametrize("modes", [4, 7])
+def test_the_reported_frequencies_come_from_the_damping_s_eigen_solve(tmp_path, monkeypatch, modes):
+    """A build that reports natural frequencies finds them in the damping's eigen-solve
+    (through the interior factorisation, with as many modes as it needs beyond the damped
+    ones): no second eigen-solve, the frequencies of a factorisation of ``K``."""
+    import femrub.app.cached as cached
+
+    solves = []
+    own = cached.natural_frequencies
+    monkeypatch.setattr(cached, "natural_frequencies", lambda m, k: solves.append(k) or own(m, k))
+    over = {"physics.damping_ratio": 0.005, "physics.damping_modes": [1, 2]}
+    scene = load_scene("twisted-naca", over)
+    sim = build(scene, cache=ModelCache(tmp_path / "cache"), modes=modes, stepper=False)
+    assert solves == []
+    b = sim.full.blocks
+    ref = angular_frequencies(b.K, b.M, modes) / (2 * np.pi)
+    assert np.allclose(sim.report["natural_frequencies_hz"], ref, rtol=1e-9, atol=0.0)
+
+
 def test_each_mode_of_the_run_s_model_reports_its_own_rayleigh_ratio():
     """``physics.damping_ratio`` is Rayleigh damping: the run's model has the ratio asked at
     the two damping modes, its own ``a / 2ω + b ω / 2`` at every other one, and

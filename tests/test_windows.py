@@ -188,6 +188,52 @@ def test_the_window_comparison_reads_the_runs_rows_of_each_window():
     assert late["contact_force"] > 0.03 and late["contact_temperature"] > 0.01
 
 
+def test_the_window_fields_are_the_windows_end_states_through_one_product_each():
+    """The field measures of ``compare_windows`` read each window's states at its ends
+    (the run's snapshots, the reference's last state), every window's through one call of
+    each map to the full states: the same numbers as the states taken one at a time."""
+    from types import SimpleNamespace
+
+    import scipy.sparse as sp
+
+    from femrub.output.results import Snapshot
+    from femrub.reduction.estimate import compare_windows
+
+    rng = np.random.default_rng(2)
+    n, h, plan, r = 60, 1e-3, [(0, 10), (20, 30), (40, 50)], 4
+    t = np.arange(n + 1) * h
+    X = rng.standard_normal((n + 1, r))
+    R = rng.standard_normal((6, r))
+    snaps = [Snapshot(k, t[k], X[k], ()) for w in plan for k in w]
+    run = SimpleNamespace(t=t, impulse=np.zeros((n + 1, 1)), signals={}, snapshots=snaps)
+    refs = [
+        SimpleNamespace(
+            t=t[a : b + 1],
+            impulse=np.zeros((b - a + 1, 1)),
+            signals={},
+            states=np.stack([X[a], X[b] + 0.1 * (j + 1)]),
+        )
+        for j, (a, b) in enumerate(plan)
+    ]
+    calls = []
+
+    def full(Xr):
+        calls.append(len(Xr))
+        return Xr @ R.T
+
+    norms = {"u": (slice(0, 3), sp.identity(3)), "theta": (slice(3, 6), sp.identity(3))}
+    out = compare_windows(run, refs, plan, full, full, norms, 10 * h)
+    assert calls == [2 * len(plan), len(plan)]
+    diff = [np.linalg.norm((R @ X[b] - R @ ref.states[-1])[:3]) for (_, b), ref in zip(plan, refs)]
+    size = [np.linalg.norm((R @ ref.states[-1])[:3]) for ref in refs]
+    rise = [np.linalg.norm((R @ (ref.states[-1] - X[a]))[3:]) for (a, _), ref in zip(plan, refs)]
+    miss = [np.linalg.norm((R @ (X[b] - ref.states[-1]))[3:]) for (_, b), ref in zip(plan, refs)]
+    assert out["displacement"] == pytest.approx(max(diff) / max(size), rel=1e-12)
+    assert out["displacement_end"] == pytest.approx(diff[-1] / size[-1], rel=1e-12)
+    assert out["temperature"] == pytest.approx(max(miss) / max(rise), rel=1e-12)
+    assert out["temperature_end"] == pytest.approx(sum(miss) / sum(rise), rel=1e-12)
+
+
 def test_the_estimates_runs_hold_a_released_reductor(model_cache):
     """With given sizes, the reductor's bases are handed on (to be stored) before any run,
     then the checks and the build keep it released: no left basis through the runs, and the

@@ -22,7 +22,8 @@ cache it only calls them:
   own entry ``map`` (key: the same without what the run depends on), stored once for every
   speed of a sweep, and a reduced model refers to it by its columns; a hit whose ``map`` is
   missing or corrupt is rebuilt like a miss;
-* ``frequencies``: the natural frequencies of the full model (sweeps, ``--modes``);
+* ``frequencies``: the natural frequencies of the full model (sweeps, ``--modes``), taken
+  from the damping's eigen-solve when the build damps (one solve finds both);
 * ``prestress``: the centrifugal prestress (:func:`femrub.fem.prestress.centrifugal_prestress`,
   a Newton solve on the full mesh); key: the mesh, the material, Ω and the method. The
   prestressed tangent then enters the assembly key (a prestressed model is per speed).
@@ -101,13 +102,16 @@ class Stages:
     ``kept``: a :class:`Kept` shared with the builds before and after this one (``None``:
     this build keeps nothing for another)."""
 
-    def __init__(self, cache=None, log=None, kept: Kept | None = None):
+    def __init__(self, cache=None, log=None, kept: Kept | None = None, modes: int = 0):
         self.cache, self.log = cache, log
         self.in_a_row = kept is not None
         self.kept = kept if kept is not None else Kept()
         self.hits: dict[str, bool] = {}
         self._mats_key = self.kept.assembly_key if self.in_a_row else None
         self._stiffness = None  # the interior factorisation of the damping, for ``reduce``
+        #: natural frequencies the build reports: the damping's eigen-solve finds them too
+        self.modes = int(modes)
+        self._omega = None  # (K, ω) of that solve, for :meth:`frequencies`
         if cache is not None and log is not None and cache.log is None:
             cache.log = log
 
@@ -200,7 +204,10 @@ class Stages:
                     damped.info["rayleigh"] = (a, b)
                     return damped
             t0 = time.perf_counter()
-            damped, self._stiffness, omega = modal_rayleigh(mats, zeta, modes, boundary)
+            damped, self._stiffness, omega = modal_rayleigh(
+                mats, zeta, modes, boundary, at_least=self.modes
+            )
+            self._omega = (mats.K, omega)
             a, b = damped.info["rayleigh"]
             self._say(
                 f"modal damping {zeta:g} at modes {modes[0]}, {modes[1]} ("
@@ -346,6 +353,9 @@ class Stages:
             return natural_frequencies(model, k)
         key = content_key(self._mats_key, "frequencies", model.layout.n_u, k)
         f = self._fetch("frequencies", key)
+        if f is None and self._omega is not None and self._omega[0] is model.blocks.K:
+            omega = self._omega[1]  # the damping's eigen-solve, on the same K and M
+            f = omega[:k] / (2.0 * np.pi) if omega.size >= k else None
         if f is None:
             f = natural_frequencies(model, k)
             self._keep("frequencies", key, np.asarray(f), f"{k} frequencies")

@@ -173,7 +173,7 @@ class Simulation:
             the stability limit, ...).
         """
         with progress.reporting(log):  # factorisations, eigen-solves, reduction phases
-            return _build(scene, log, modes, Stages(cache, log, kept), stepper)
+            return _build(scene, log, modes, Stages(cache, log, kept, modes), stepper)
 
 
 def build(scene, *, log=None, modes: int = 0, cache=None, stepper: bool = True) -> Simulation:
@@ -225,7 +225,8 @@ class SceneBuilds:
         sim = None
         if self._last is not None and _differs_only_in_speed(self._last.scene, scene):
             with progress.reporting(log):
-                sim = _at_speed(self._last, scene, Stages(self.cache, log, self.kept), log, modes)
+                stages = Stages(self.cache, log, self.kept, modes)
+                sim = _at_speed(self._last, scene, stages, log, modes)
         if sim is None:
             sim = Simulation.from_scene(
                 scene, log=log, modes=modes, cache=self.cache, kept=self.kept

@@ -30,7 +30,7 @@ from .interior import InteriorStiffness, condensed_solve
 __all__ = ["modal_rayleigh"]
 
 
-def modal_rayleigh(mats, zeta: float, modes: tuple[int, int], boundary: dict):
+def modal_rayleigh(mats, zeta: float, modes: tuple[int, int], boundary: dict, at_least=0):
     """``(mats with C = a M + b K, interior stiffness, ω)`` for ratio ``zeta`` at ``modes``.
 
     Parameters
@@ -38,12 +38,14 @@ def modal_rayleigh(mats, zeta: float, modes: tuple[int, int], boundary: dict):
     mats : :class:`~femrub.fem.assembly.ThermoelasticMatrices` (their ``C`` is replaced).
     zeta : damping ratio ζ in [0, 1); modes : the two modes ``(i, j)``, 1-based.
     boundary : ``{"u": boundary dofs, optional "u_rows": patch rows}`` of the model.
+    at_least : frequencies to find in the same eigen-solve beyond ``max(i, j)`` (the natural
+        frequencies a build reports: one solve instead of two).
 
     Returns
     -------
     mats : the blocks with ``C`` set and ``info["rayleigh"] = (a, b)``.
     stiffness : the :class:`~.interior.InteriorStiffness` of ``K_ii`` (for the reductor).
-    omega : (max(i, j),) lowest angular frequencies (rad/s) of the full model.
+    omega : (max(i, j, at_least),) lowest angular frequencies (rad/s) of the full model.
     """
     i, j = modes
     n_u = mats.n_u
@@ -54,7 +56,7 @@ def modal_rayleigh(mats, zeta: float, modes: tuple[int, int], boundary: dict):
     solve = condensed_solve(K_prime, mb, stiffness)
     if coords is not None:
         solve = coords.solve(solve)
-    omega = angular_frequencies(mats.K, mats.M, max(i, j), solve)
+    omega = angular_frequencies(mats.K, mats.M, max(i, j, at_least), solve)
     a, b = rayleigh_coefficients(float(zeta), omega[i - 1], omega[j - 1])
     damped = replace(mats, C=(a * mats.M + b * mats.K).tocsr(), info=dict(mats.info))
     damped.info["rayleigh"] = (float(a), float(b))
