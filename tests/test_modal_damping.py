@@ -145,11 +145,16 @@ def test_the_reported_frequencies_come_from_the_damping_s_eigen_solve(tmp_path, 
     monkeypatch.setattr(cached, "natural_frequencies", lambda m, k: solves.append(k) or own(m, k))
     over = {"physics.damping_ratio": 0.005, "physics.damping_modes": [1, 2]}
     scene = load_scene("twisted-naca", over)
-    sim = build(scene, cache=ModelCache(tmp_path / "cache"), modes=modes, stepper=False)
+    cache = ModelCache(tmp_path / "cache")
+    sim = build(scene, cache=cache, modes=modes, stepper=False)
     assert solves == []
     b = sim.full.blocks
     ref = angular_frequencies(b.K, b.M, modes) / (2 * np.pi)
     assert np.allclose(sim.report["natural_frequencies_hz"], ref, rtol=1e-9, atol=0.0)
+    lines = []  # and stored for the next build (another sweep worker)
+    again = build(scene, cache=cache, modes=modes, stepper=False, log=lines.append)
+    assert any("cache: frequencies loaded" in t for t in lines) and solves == []
+    assert again.report["natural_frequencies_hz"] == sim.report["natural_frequencies_hz"]
 
 
 def test_each_mode_of_the_run_s_model_reports_its_own_rayleigh_ratio():

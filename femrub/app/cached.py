@@ -348,16 +348,21 @@ class Stages:
         return dict(hit, model=hit["model"].with_(to_full=to_full))
 
     def frequencies(self, model, k: int) -> np.ndarray:
-        """:func:`~femrub.reduction.sizes.natural_frequencies` (Hz), through the cache."""
-        if self.cache is None or self._mats_key is None:
-            return natural_frequencies(model, k)
-        key = content_key(self._mats_key, "frequencies", model.layout.n_u, k)
-        f = self._fetch("frequencies", key)
-        if f is None and self._omega is not None and self._omega[0] is model.blocks.K:
-            omega = self._omega[1]  # the damping's eigen-solve, on the same K and M
+        """:func:`~femrub.reduction.sizes.natural_frequencies` (Hz), through the cache; the
+        damping's eigen-solve when it found them (on the same ``K``)."""
+        key = None
+        if self.cache is not None and self._mats_key is not None:
+            key = content_key(self._mats_key, "frequencies", model.layout.n_u, k)
+            f = self._fetch("frequencies", key)
+            if f is not None:
+                return f
+        f = None
+        if self._omega is not None and self._omega[0] is model.blocks.K:
+            omega = self._omega[1]
             f = omega[:k] / (2.0 * np.pi) if omega.size >= k else None
         if f is None:
             f = natural_frequencies(model, k)
+        if key is not None:
             self._keep("frequencies", key, np.asarray(f), f"{k} frequencies")
         return f
 
