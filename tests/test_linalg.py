@@ -142,3 +142,30 @@ def test_mkl_is_loaded_in_its_reproducible_mode(preset):
     ).stdout.split()
     # MKL's branch codes: 1 off (MKL's default), 2 AUTO, 3 COMPATIBLE
     assert out == (["COMPATIBLE", "3"] if preset else ["AUTO", "2"])
+
+
+def test_the_mkl_runtime_is_found_without_searching_the_environment():
+    """pip's ``mkl`` wheel puts the runtime in ``sys.prefix/lib``: a fresh process loads it
+    from there (kept in ``PYPARDISO_MKL_RT``) without pypardiso's recursive search of the
+    environment's folders (seconds per process on a cold disk)."""
+    import glob
+    import os
+    import subprocess
+    import sys
+
+    if not glob.glob(os.path.join(sys.prefix, "lib", "libmkl_rt.so*")):
+        pytest.skip("no MKL runtime in sys.prefix/lib")
+    code = (
+        "import glob, os\n"
+        "seen = []\n"
+        "plain = glob.glob\n"
+        "glob.glob = lambda p, **k: seen.append(k.get('recursive', False)) or plain(p, **k)\n"
+        "from femrub.fem import linalg\n"
+        "print(linalg.pardiso_available(), any(seen), os.environ['PYPARDISO_MKL_RT'])\n"
+    )
+    env = {k: v for k, v in os.environ.items() if k != "PYPARDISO_MKL_RT"}
+    out = subprocess.run(
+        [sys.executable, "-c", code], env=env, capture_output=True, text=True, check=True
+    ).stdout.split()
+    assert out[:2] == ["True", "False"]
+    assert os.path.dirname(out[2]) == os.path.join(sys.prefix, "lib")
