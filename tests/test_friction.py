@@ -173,10 +173,17 @@ def test_frictionless_single_contact_keeps_the_fast_path():
     assert ThetaMethod(block_model(mu=0.2), 1e-4)._friction
 
 
-def test_history_keys(tmp_path):
+def test_history_keys(tmp_path, monkeypatch):
+    """The friction rows of ``history.npz`` and the summary's friction entries; the Coulomb
+    check of the run's rows is measured once, for the verdict and the summary together."""
+    import femrub.contact.friction as friction
     from femrub.output.run_folder import run_to_folder
 
+    measured = []
+    plain = friction.coulomb_check
+    monkeypatch.setattr(friction, "coulomb_check", lambda *a: measured.append(1) or plain(*a))
     res = run_to_folder(ThetaMethod(block_model(v_belt=0.1), 1e-3), 0.1, tmp_path, plots=False)
+    assert len(measured) == 1 and res.coulomb["slip_steps"] > 0
     with np.load(tmp_path / "history.npz") as d:
         n = res.steps + 1
         assert d["normal_force"].shape == (n, 1)

@@ -23,6 +23,7 @@ into CSV columns by :func:`flatten_columns`; every CSV header carries its unit
 from __future__ import annotations
 
 import csv
+import functools
 import json
 import os
 import zipfile
@@ -239,6 +240,22 @@ class Results:
     def force(self) -> np.ndarray:
         """Mean contact force over each step, ``impulse / h`` (N)."""
         return self.impulse / self.h
+
+    @functools.cached_property
+    def coulomb(self) -> dict | None:
+        """:func:`~femrub.contact.friction.coulomb_check` of every recorded step (``None``
+        without friction rows), measured once for the verdict and the summary; a lean
+        record's is the one measured as its rows passed (``checks["coulomb"]``)."""
+        ff = self.friction_force
+        if ff is None:
+            return self.checks.get("coulomb")
+        if not ff.size or self.friction_limit is None:
+            return None
+        from ..contact.friction import coulomb_check
+
+        return coulomb_check(
+            self.force, ff, self.slip_velocity, self.contact_state, self.friction_limit
+        )
 
     def friction_magnitude(self) -> np.ndarray:
         """``|λ_t| / h`` per row and contact (N), ``(rows, n_c)``: the norms of

@@ -77,11 +77,7 @@ def _friction_summary(res) -> dict:
         "heat_to_casing": float(e["heat_to_casing"][-1]) if "heat_to_casing" in e else 0.0,
     }
     if ff is not None and ff.size and res.friction_limit is not None:
-        from ..contact.friction import coulomb_check
-
-        out["coulomb_check"] = coulomb_check(
-            res.force, ff, res.slip_velocity, res.contact_state, res.friction_limit
-        )
+        out["coulomb_check"] = res.coulomb  # measured once, with the verdict's
     return out
 
 

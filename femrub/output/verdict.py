@@ -139,15 +139,8 @@ def coulomb_message(check: dict | None, bound: float) -> str | None:
 
 
 def _coulomb(res, tol):
-    ff, bound = getattr(res, "friction_force", None), tol.get("coulomb")
-    if ff is None and bound is not None:  # a lean record: checked as its rows passed
-        return coulomb_message(getattr(res, "checks", {}).get("coulomb"), bound)
-    if ff is None or not ff.size or res.friction_limit is None or bound is None:
-        return None
-    from ..contact.friction import coulomb_check
-
-    check = coulomb_check(res.force, ff, res.slip_velocity, res.contact_state, res.friction_limit)
-    return coulomb_message(check, bound)
+    bound = tol.get("coulomb")
+    return None if bound is None else coulomb_message(res.coulomb, bound)
 
 
 #: status rules applied in order to a run the recorder ended as ``ok``
