@@ -191,6 +191,24 @@ def test_every_kind_of_value_round_trips(cache):
     assert (back["l"][1] != sp.csr_matrix(np.eye(3))).nnz == 0
 
 
+def test_an_array_held_in_several_places_is_stored_once_and_comes_back_shared(cache):
+    """A reductor holds its basis as its left basis and its map to the mesh too: one array
+    in the entry (not three copies on disk and in every process that loads it); an equal
+    array that is another object stays its own."""
+    from femrub.app.cache_codec import decode, encode
+
+    basis = np.arange(12.0).reshape(4, 3)
+    value = {"R": basis, "left": basis, "map": [basis], "copy": basis.copy()}
+    tree, arrays = encode(value)
+    assert len(arrays) == 2
+    key = content_key("shared arrays")
+    assert cache.store(key, value, stage="test")
+    back = cache.load(key)
+    assert back["R"] is back["left"] is back["map"][0] and back["copy"] is not back["R"]
+    assert np.array_equal(back["copy"], basis) and np.array_equal(back["R"], basis)
+    assert decode(tree, arrays)["left"] is basis
+
+
 def test_code_is_not_stored(cache):
     assert not cache.store(content_key("f"), {"f": print}, stage="test")
     assert "not stored" in cache.notes[-1]

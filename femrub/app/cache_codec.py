@@ -8,7 +8,9 @@ whose leaves name arrays, plus those arrays (stored in an ``.npz`` read with
 node of an unknown kind, an array of objects, a class outside :data:`CLASS_PACKAGES`, a
 class with its own ``__new__``, an array name that is not in the file. An instance is
 rebuilt as :mod:`pickle` rebuilds a plain object (``object.__new__`` and its attribute
-dictionary) but no function, constructor or method named by the file is ever called.
+dictionary) but no function, constructor or method named by the file is ever called. An
+array the object holds in several places is stored once and decoded as one array, held in
+those places again.
 
 Node kinds (key ``"$"``): ``list``, ``tuple``, ``dict`` (keys and values, any encodable
 keys), ``complex``, ``array`` and ``scalar`` (``ref``: the array's name), ``sparse``
@@ -41,12 +43,19 @@ def _allowed_module(name: str) -> bool:
 class _Encoder:
     def __init__(self):
         self.arrays: dict[str, np.ndarray] = {}
+        self._names: dict[int, str] = {}  # id of each array stored (``arrays`` keeps it alive)
 
     def array(self, a: np.ndarray) -> str:
+        """The name of ``a``, stored once however many times the object holds it (a
+        Galerkin reductor's basis is its left basis and its map to the mesh too)."""
+        name = self._names.get(id(a))
+        if name is not None:
+            return name
         if a.dtype.hasobject or a.dtype.kind not in "biufcSU":
             raise TypeError(f"array of dtype {a.dtype} cannot be stored as data")
         name = f"a{len(self.arrays)}"
         self.arrays[name] = a
+        self._names[id(a)] = name
         return name
 
     def node(self, x, depth: int = 0):
