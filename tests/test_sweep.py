@@ -60,6 +60,15 @@ def test_sweep_runs_and_resumes(tmp_path, capsys, monkeypatch):
 
     run_here = sweep._run_here
     monkeypatch.setattr(sweep, "_run_here", spy)
+    from distributed import Client
+
+    sent, submit = [], Client.submit
+
+    def submit_spy(client, function, *args, **kw):
+        sent.append((function.__name__, args, len(kw.get("workers") or ())))
+        return submit(client, function, *args, **kw)
+
+    monkeypatch.setattr(Client, "submit", submit_spy)
     scene = tmp_path / "tiny.toml"
     scene.write_text(TINY)
     out = tmp_path / "sweep"
@@ -76,6 +85,9 @@ def test_sweep_runs_and_resumes(tmp_path, capsys, monkeypatch):
     ]
     assert main(args) == 0
     assert here == [[0]]
+    # the workers prepared (modules, kernels) while the first point ran here
+    assert sent[:2] == [("prepare_worker", (("one",),), 1)] * 2
+    assert [name for name, *_ in sent[2:]] == ["run_points"] * 2
     rows = _csv(out / "interaction.csv")
     assert [r["loads.rotation_speed"] for r in rows] == ["100.0", "200.0", "300.0"]
     assert all(r["status"] == "ok" and r["skipped"] == "False" for r in rows)
@@ -95,6 +107,16 @@ def test_sweep_runs_and_resumes(tmp_path, capsys, monkeypatch):
     for r in (runs[0], runs[2]):
         assert (r / "summary.json").stat().st_mtime_ns == stamps[r.name]
     assert capsys.readouterr().err == ""
+
+
+def test_a_worker_s_preparation_loads_the_kernels_and_never_raises():
+    from femrub.app.sweep import prepare_worker
+    from femrub.contact.jit import compiled
+    from femrub.contact.theta_block import one_contact_block
+
+    prepare_worker(("one",))
+    assert one_contact_block.signatures or not compiled()
+    prepare_worker(("no such kernels",))  # a preparation that fails is the point's to redo
 
 
 def test_sweep_rejects_an_invalid_point_before_any_work(tmp_path, capsys):
