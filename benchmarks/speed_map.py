@@ -6,9 +6,10 @@ row per 10 steps, ``history.npz`` at every step) on a local dask cluster of ``--
 processes with an empty model cache, in a child process, and records the wall time, the CPU
 and the largest resident memory of the processes (``getrusage`` of the children), the
 1-minute load at the start, at the end and its median (sampled every 15 s), the points'
-statuses, the median of each stage of a point (``summary.json["timings"]``) and the size of
-the model cache at the end. Appends a row to the table between the ``speed_map`` markers of
-``docs/performance/speed-map-costs.md`` (``--no-write``: print it).
+statuses, the median of each stage of a point (``summary.json["timings"]``), the time of
+the first point, of a worker's first point and of the others (the sweep's critical path)
+and the size of the model cache at the end. Appends a row to the table between the
+``speed_map`` markers of ``docs/performance/speed-map-costs.md`` (``--no-write``: print it).
 
 Run: ``flock /tmp/femrub-heavy.lock python benchmarks/speed_map.py`` (both cores for a few
 minutes); ``--speeds 1300:1400:25`` for a smaller map. Skips without ``../shared/data``.
@@ -38,8 +39,9 @@ SETS = ("outputs.vtk_stride=0", "outputs.plots=false", "outputs.csv_stride=10")
 HEADER = (
     "| date (UTC) | code | speeds | wall (s) | CPU user + sys (s) | largest process | "
     "ok / inaccurate / other | per point, median (s): mesh, assembly, reduction, stepping, "
-    "output = total | model cache at the end | load start – end (median) |\n"
-    "|---|---|---|---|---|---|---|---|---|---|"
+    "output = total | first point; a worker's first (median); the others (median) (s) | "
+    "model cache at the end | load start – end (median) |\n"
+    "|---|---|---|---|---|---|---|---|---|---|---|"
 )
 
 
@@ -63,11 +65,23 @@ def _dir_bytes(path: Path) -> int:
 
 
 def _points(out: Path) -> list[dict]:
+    """Each point's status and stage timings, in the grid's order (the first point first)."""
     rows = []
     for s in sorted(out.glob("runs/*/summary.json")):
         d = json.loads(s.read_text())
         rows.append({"status": d.get("status"), "timings": d.get("timings", {})})
     return rows
+
+
+def _critical(points: list[dict]) -> list[float]:
+    """Seconds of the first point (it builds and fills the cache), the median of the points
+    that built their full model from the cache (a worker's first: a ``mesh`` stage) and the
+    median of the others (the previous point's model at their speed)."""
+    total = [sum(p["timings"].get(k, 0.0) for k in STAGES) for p in points]
+    built = [t for t, p in zip(total[1:], points[1:]) if p["timings"].get("mesh")]
+    rest = [t for t, p in zip(total[1:], points[1:]) if not p["timings"].get("mesh")]
+    medians = [statistics.median(x) if x else 0.0 for x in (built, rest)]
+    return [total[0] if total else 0.0, *medians]
 
 
 def measure(speeds: str, workers: int, out: Path, cache: Path) -> dict:
@@ -116,6 +130,7 @@ def measure(speeds: str, workers: int, out: Path, cache: Path) -> dict:
         "inaccurate": statuses.count("inaccurate"),
         "other": len(statuses) - statuses.count("ok") - statuses.count("inaccurate"),
         "median": med,
+        "critical": _critical(points),
         "cache_gb": _dir_bytes(cache) / 1e9,
         "load": [samples[0], load_end, statistics.median(samples + [load_end])],
     }
@@ -128,7 +143,8 @@ def row(r: dict) -> str:
     return (
         f"| {r['date']} | {r['code']} | {r['speeds']} ({r['n_points']}) | {r['wall']:.1f} | "
         f"{r['cpu']:.0f} | {r['peak_gb']:.2f} GB | {r['ok']} / {r['inaccurate']} / "
-        f"{r['other']} | {parts} = {sum(m.values()):.1f} | {r['cache_gb']:.2f} GB | "
+        f"{r['other']} | {parts} = {sum(m.values()):.1f} | "
+        f"{'; '.join(f'{x:.1f}' for x in r['critical'])} | {r['cache_gb']:.2f} GB | "
         f"{lo:.2f} – {hi:.2f} ({med:.2f}) |"
     )
 
