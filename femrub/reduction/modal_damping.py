@@ -38,8 +38,8 @@ def modal_rayleigh(mats, zeta: float, modes: tuple[int, int], boundary: dict, at
     mats : :class:`~femrub.fem.assembly.ThermoelasticMatrices` (their ``C`` is replaced).
     zeta : damping ratio ζ in [0, 1); modes : the two modes ``(i, j)``, 1-based.
     boundary : ``{"u": boundary dofs, optional "u_rows": patch rows}`` of the model.
-    at_least : frequencies to find in the same eigen-solve beyond ``max(i, j)`` (the natural
-        frequencies a build reports: one solve instead of two).
+    at_least : how many of the lowest frequencies the eigen-solve finds at least (the
+        natural frequencies a build reports: one solve instead of two).
 
     Returns
     -------
