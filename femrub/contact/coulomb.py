@@ -167,35 +167,35 @@ def _eliminate(M, x):
 
 @njit
 def _solve(J, b):
-    """``(J⁻¹ b, ok)``: Gaussian elimination with partial pivoting for small systems (a
-    LAPACK call costs more than the arithmetic there), ``numpy.linalg.solve`` above
-    :data:`SMALL_SYSTEM` unknowns; ``ok`` is False for a singular ``J``."""
+    """``(J⁻¹ b, ok)``, ``J`` and ``b`` overwritten (the caller's fresh arrays): Gaussian
+    elimination with partial pivoting for small systems (a LAPACK call costs more than the
+    arithmetic there), ``numpy.linalg.solve`` above :data:`SMALL_SYSTEM` unknowns; ``ok``
+    is False for a singular ``J``."""
     n = b.size
     if n > SMALL_SYSTEM:
         try:
             return np.linalg.solve(J, b), True
         except Exception:  # singular (numba raises a plain exception)
             return b, False
-    M = J.copy()
-    x = b.copy()
-    if not _eliminate(M, x):
-        return x, False
+    if not _eliminate(J, b):
+        return b, False
     for k in range(n - 1, -1, -1):  # back substitution
-        s = x[k]
+        s = b[k]
         for j in range(k + 1, n):
-            s -= M[k, j] * x[j]
-        x[k] = s / M[k, k]
-    return x, True
+            s -= J[k, j] * b[j]
+        b[k] = s / J[k, k]
+    return b, True
 
 
 @njit
-def _newton(P, W, rW, q, mu, rho, U, tol, max_iter):
+def _newton(P, W, rW, q, mu, rho, U, tol, max_iter, at_P):
     """Semi-smooth Newton with Armijo line search on ``‖F‖²/2``; stops when it stalls.
+    ``at_P``: :func:`_residual` at ``P`` (the caller has it).
 
     Returns ``(P, F, u, iterations)``.
     """
     m = q.shape[0]
-    F, u, pos, r, x, nx, slip = _residual(P, W, q, mu, rho, U)
+    F, u, pos, r, x, nx, slip = at_P
     merit = 0.5 * np.sum(F**2)
     it = 0
     for k in range(1, max_iter + 1):
@@ -304,15 +304,16 @@ def alart_curnier(W, q, mu, U, warm, use_warm, tol, max_iter):
     for i in range(3 * m):
         rW[i, :] *= rho[i // 3]
     P = np.zeros((m, 3))
+    at_P = _residual(P, W, q, mu, rho, U)
     if use_warm:  # a cold start when the warm one is worse
-        F0 = _residual(P, W, q, mu, rho, U)[0]
-        Fw = _residual(warm, W, q, mu, rho, U)[0]
-        if np.sum(Fw**2) <= np.sum(F0**2):
-            P = warm.copy()
-    P, F, u, it = _newton(P, W, rW, q, mu, rho, U, tol * scale, max_iter)
+        at_warm = _residual(warm, W, q, mu, rho, U)
+        if np.sum(at_warm[0] ** 2) <= np.sum(at_P[0] ** 2):
+            P, at_P = warm.copy(), at_warm
+    P, F, u, it = _newton(P, W, rW, q, mu, rho, U, tol * scale, max_iter, at_P)
     if np.max(np.abs(F)) > tol * scale:  # Newton stalled: Gauss-Seidel sweeps, then Newton
         P = _gauss_seidel(P, W, q, mu, rho, U, tol * scale, 5000)
-        P, F, u, it2 = _newton(P, W, rW, q, mu, rho, U, tol * scale, max_iter)
+        at_P = _residual(P, W, q, mu, rho, U)
+        P, F, u, it2 = _newton(P, W, rW, q, mu, rho, U, tol * scale, max_iter, at_P)
         it += it2
     res = np.max(np.abs(F)) / scale
     P, slide = _on_cone(P, u, mu, rho, U)
