@@ -109,14 +109,29 @@ def test_sweep_runs_and_resumes(tmp_path, capsys, monkeypatch):
     assert capsys.readouterr().err == ""
 
 
-def test_a_worker_s_preparation_loads_the_kernels_and_never_raises():
+def test_a_worker_s_preparation_never_raises_and_cold_kinds_reads_numba_s_cache():
     from femrub.app.sweep import prepare_worker
-    from femrub.contact.jit import compiled
-    from femrub.contact.theta_block import one_contact_block
+    from femrub.contact.activation import compile_kernels
+    from femrub.contact.jit import cold_kinds
 
-    prepare_worker(("one",))
-    assert one_contact_block.signatures or not compiled()
+    compile_kernels(("one",))
+    assert cold_kinds(("one", "no such kernels")) == ()  # cached now (or not compiled)
     prepare_worker(("no such kernels",))  # a preparation that fails is the point's to redo
+
+
+@pytest.mark.parametrize("cold, loaded", [((), ["one", "friction"]), (("friction",), ["one"])])
+def test_a_worker_loads_only_the_kernels_numba_has_cached(monkeypatch, cold, loaded):
+    import femrub.contact.activation as activation
+    import femrub.contact.jit as jit
+    from femrub.app.sweep import prepare_worker
+
+    seen = []
+    monkeypatch.setattr(jit, "compiled", lambda: True)
+    monkeypatch.setattr(jit, "cold_kinds", lambda kinds: cold)
+    compilers = {k: (lambda k=k: seen.append(k)) for k in activation.KERNEL_KINDS}
+    monkeypatch.setattr(activation, "_COMPILE", compilers)
+    prepare_worker(("one", "friction"))
+    assert seen == loaded  # a cold kind is the first point's build's to compile, once
 
 
 def test_sweep_rejects_an_invalid_point_before_any_work(tmp_path, capsys):

@@ -412,14 +412,20 @@ def prepare_worker(kinds: tuple[str, ...]) -> None:
     point builds (:func:`_run_here`): femrub's modules and the libraries they load (MKL for
     Pardiso), and the contact kernels of ``kinds`` loaded from numba's cache
     (:func:`~femrub.contact.activation.compile_kernels`); 2–3 s per worker on Rotor 37.
+    Kernels numba's cache does not hold yet are left alone: the first point's build
+    compiles them once, in a child (:func:`~femrub.contact.jit.compile_in_background`),
+    and each worker compiling them too took the cores that build needs (Rotor 37's first
+    sweep on a fresh install: its first point 148 s instead of 50 s).
     Never raises: the point would then do it itself."""
     try:
         from ..contact.activation import compile_kernels
+        from ..contact.jit import cold_kinds
         from ..fem.linalg import pardiso_available
         from ..output import run_folder  # noqa: F401 (the modules a point's output loads)
 
         pardiso_available()
-        compile_kernels(kinds)
+        cold = cold_kinds(kinds)
+        compile_kernels(tuple(k for k in kinds if k not in cold))
     except Exception:  # noqa: BLE001 - a preparation, never the point's failure
         pass
 

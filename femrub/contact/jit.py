@@ -31,7 +31,14 @@ import os
 import subprocess
 import sys
 
-__all__ = ["njit", "compiled", "compile_in_background", "wait_background", "KERNEL_FILES"]
+__all__ = [
+    "njit",
+    "compiled",
+    "cold_kinds",
+    "compile_in_background",
+    "wait_background",
+    "KERNEL_FILES",
+]
 
 #: the child process compiling the kernels (:func:`compile_in_background`), once per process
 _CHILD: dict = {}
@@ -115,6 +122,18 @@ def _cold(dispatcher) -> bool:
         return False
 
 
+def cold_kinds(kinds) -> tuple[str, ...]:
+    """The kinds of ``kinds`` (``"one"``, ``"friction"``, ``"rub"``) whose kernels numba's
+    on-disk cache does not hold yet (none without compilation)."""
+    if not compiled():
+        return ()
+    from .rub_block import rub_block
+    from .theta_block import friction_block, one_contact_block
+
+    kernels = {"one": one_contact_block, "friction": friction_block, "rub": rub_block}
+    return tuple(k for k in kinds if k in kernels and _cold(kernels[k]))
+
+
 def compile_in_background(kinds=("one", "friction", "rub")) -> bool:
     """Compile the contact kernels of ``kinds`` in a child process if their on-disk cache is
     cold.
@@ -126,12 +145,8 @@ def compile_in_background(kinds=("one", "friction", "rub")) -> bool:
     """
     if _CHILD or not compiled() or not kinds:
         return False
-    from .rub_block import rub_block
-    from .theta_block import friction_block, one_contact_block
-
     _CHILD["started"] = True
-    kernels = {"one": one_contact_block, "friction": friction_block, "rub": rub_block}
-    kinds = tuple(k for k in kinds if _cold(kernels[k]))
+    kinds = cold_kinds(kinds)
     if not kinds:
         return False
     root = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
