@@ -2,6 +2,7 @@
 
 import csv
 import json
+from pathlib import Path
 
 import pytest
 
@@ -48,18 +49,20 @@ def _csv(path):
 
 
 def test_sweep_runs_and_resumes(tmp_path, capsys, monkeypatch):
-    """A grid on a local cluster (its first point in this process, which fills the model
-    cache), then rerun after a point failed: only that point runs again."""
+    """A grid on this process and a local worker (the first point here, which fills the
+    model cache, then a chunk each), then rerun after a point failed: only that point runs
+    again, here."""
     import femrub.app.sweep as sweep
 
-    here = []
+    here, kept = [], []
 
-    def spy(scene, chunk, cache, bar):
+    def spy(scene, chunk, cache, bar, builds=None):
         here.append([r["point"] for r in chunk])
-        return run_here(scene, chunk, cache, bar)
+        kept.append(builds)
+        return points_here(scene, chunk, cache, bar, builds)
 
-    run_here = sweep._run_here
-    monkeypatch.setattr(sweep, "_run_here", spy)
+    points_here = sweep._points_here
+    monkeypatch.setattr(sweep, "_points_here", spy)
     from distributed import Client
 
     sent, submit = [], Client.submit
@@ -84,10 +87,13 @@ def test_sweep_runs_and_resumes(tmp_path, capsys, monkeypatch):
         "-q",
     ]
     assert main(args) == 0
-    assert here == [[0]]
-    # the workers prepared (modules, kernels) while the first point ran here
-    assert sent[:2] == [("prepare_worker", (("one",),), 1)] * 2
-    assert [name for name, *_ in sent[2:]] == ["run_points"] * 2
+    # the first point here, then this process's chunk from the model it built; the worker
+    # prepared (modules, kernels) while the first point ran, then ran the other chunk
+    assert here == [[0], [1]] and kept[0] is kept[1] is not None
+    assert sent[0] == ("prepare_worker", (("one",),), 1)
+    assert [name for name, *_ in sent[1:]] == ["run_points"]
+    ((changes, folder),) = sent[1][1][3]
+    assert changes == {"loads.rotation_speed": 300.0} and Path(folder).name.startswith("002_")
     rows = _csv(out / "interaction.csv")
     assert [r["loads.rotation_speed"] for r in rows] == ["100.0", "200.0", "300.0"]
     assert all(r["status"] == "ok" and r["skipped"] == "False" for r in rows)
@@ -102,7 +108,7 @@ def test_sweep_runs_and_resumes(tmp_path, capsys, monkeypatch):
     assert main(args) == 0
     rows = _csv(out / "interaction.csv")
     assert [r["skipped"] for r in rows] == ["True", "False", "True"]
-    assert here == [[0]]  # one point to run: on a worker
+    assert here[2:] == [[1]] and len(sent) == 2  # one point to run: here, no cluster
     assert all(r["status"] == "ok" for r in rows)
     for r in (runs[0], runs[2]):
         assert (r / "summary.json").stat().st_mtime_ns == stamps[r.name]

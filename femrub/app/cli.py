@@ -423,7 +423,8 @@ def build_parser() -> argparse.ArgumentParser:
         "--workers",
         type=int,
         default=2,
-        help="local worker processes (default 2; 0: the points one after the other here)",
+        help="processes running points on this machine, this one included (default 2; 0 or 1: "
+        "the points one after the other here)",
     )
     sp.add_argument("--scheduler", help="address of a dask scheduler (default: LocalCluster)")
     sp.set_defaults(func=_sweep)

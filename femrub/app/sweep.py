@@ -3,10 +3,11 @@
 ``femrub sweep SCENE --param rotation_speed=200:2000:50 -o DIR`` runs every point of the
 grid (cartesian product of the ``--param`` values), each writing its own results folder
 ``DIR/runs/NNN_key=value/`` (:func:`femrub.scene.run_scene`), in one chunk of consecutive
-points per worker (:func:`run_points`: a point at another speed reuses the model of the
-point before, the speed being its parameter). Chunks run on a
-``LocalCluster`` of this machine (2 worker processes, 1 thread each, by default) or on the
-cluster behind ``--scheduler ADDRESS`` (the output folder must then be shared). A point
+points per process (:func:`run_points`: a point at another speed reuses the model of the
+point before, the speed being its parameter). Chunks run on this machine, in this process
+and ``--workers`` − 1 worker processes of a ``LocalCluster`` (1 thread each; 2 processes by
+default), or on the cluster behind ``--scheduler ADDRESS`` (the output folder must then be
+shared). A point
 whose folder holds a finished result is skipped, so rerunning the command after a failure
 or an interruption only runs what is missing. A point is keyed by a hash of its resolved
 scene (:func:`femrub.app.run.scene_hash`): its folder name ends with the first characters
@@ -162,21 +163,21 @@ def _rms(path, key):
 
 
 def run_points(
-    scene_data: dict, source: str, base_dir: str, points: list, cache=None, done=None
+    scene_data: dict, source: str, base_dir: str, points: list, cache=None, done=None, builds=None
 ) -> list:
     """Run ``points`` (``[(changes, folder), ...]``) in order in one worker and return their
     rows; never raises: a failed point comes back as its row.
 
-    Their models come from one :class:`~femrub.app.simulation.SceneBuilds`: a point at
-    another rotation speed than the one before takes the previous point's model at its own
-    speed (its parameter) instead of building one; any other point shares the mesh's bases,
-    the assembled blocks and the reductor the points before it built. ``cache``: a
-    :class:`~femrub.app.cache.ModelCache` shared by the workers; ``done``: called after
-    each point (a progress bar).
+    Their models come from one :class:`~femrub.app.simulation.SceneBuilds` (``builds``, or a
+    new one): a point at another rotation speed than the one before takes the previous
+    point's model at its own speed (its parameter) instead of building one; any other point
+    shares the mesh's bases, the assembled blocks and the reductor the points before it
+    built. ``cache``: a :class:`~femrub.app.cache.ModelCache` shared by the workers;
+    ``done``: called after each point (a progress bar).
     """
     heap.map_large_arrays()  # workers of another scheduler (femrub.heap)
     base = Scene(scene_data, source, Path(base_dir))
-    builds = SceneBuilds(cache)
+    builds = builds if builds is not None else SceneBuilds(cache)
     rows = []
     for changes, out in points:
         rows.append(_run_one(base.with_changes(changes), out, builds))
@@ -256,10 +257,11 @@ def run_sweep(
     scene : base :class:`~femrub.scene.scene.Scene`.
     params : list of ``(dotted key, values)`` (:func:`parse_param`).
     out : sweep folder.
-    scheduler : address of a dask scheduler; ``None``: a ``LocalCluster`` of ``workers``.
-    workers : worker processes of the ``LocalCluster``; 0: the points run one after the
-        other in this process, without dask (a small map, a debugger, a script that is
-        not guarded by ``if __name__ == "__main__"``).
+    scheduler : address of a dask scheduler; ``None``: this machine.
+    workers : processes running points on this machine: this one and ``workers - 1``
+        worker processes of a ``LocalCluster`` (:func:`_share_here`); 0 or 1 (or a single
+        point): the points run one after the other in this process, without dask (a small
+        map, a debugger, a script that is not guarded by ``if __name__ == "__main__"``).
     overwrite : rerun points that already have a finished result.
     cache : a :class:`~femrub.app.cache.ModelCache` (its folder must be shared with the
         workers): the first point runs alone and stores its models (assembly, damping,
@@ -272,7 +274,8 @@ def run_sweep(
         isinstance(workers, bool) or not isinstance(workers, int) or workers < 0
     ):
         raise FolderError(
-            f"--workers {workers!r}: give a number of worker processes, or 0 to run here"
+            f"--workers {workers!r}: give a number of worker processes (this one included), "
+            "or 0 to run here"
         )
     keys = [k for k, _ in params]
     twice = sorted({k for k in keys if keys.count(k) > 1})
@@ -351,16 +354,13 @@ def _sweep(
 def _compute(scene, todo, scheduler, workers, progress, cache=None) -> None:
     from tqdm.auto import tqdm
 
-    if scheduler is None and workers == 0:  # in this process, the points in a row
-        bar = tqdm(total=len(todo), disable=not progress, unit="point", desc="sweep")
-        points = [(r["params"], r["folder"]) for r in todo]
-        rows = run_points(*_here(scene), points, cache, done=lambda: bar.update(1))
-        for r, row in zip(todo, rows, strict=True):
-            r.update(row)
+    bar = tqdm(total=len(todo), disable=not progress, unit="point", desc="sweep")
+    if scheduler is None and (workers <= 1 or len(todo) == 1):  # here, the points in a row
+        _points_here(scene, todo, cache, bar)
         bar.close()
         return
-    client, cluster = _client(scheduler, workers)
-    n_workers = len(client.scheduler_info().get("workers", {})) or workers
+    local = scheduler is None  # this process is one of the ``workers`` processes
+    client, cluster = _client(scheduler, workers - 1 if local else workers)
 
     def submit(chunks):
         return {
@@ -376,18 +376,12 @@ def _compute(scene, todo, scheduler, workers, progress, cache=None) -> None:
         }
 
     try:
-        bar = tqdm(total=len(todo), disable=not progress, unit="point", desc="sweep")
-        batches = _batches(todo, cache, n_workers)
-        if cluster is not None and len(batches[0]) == 1 and len(todo) > 1:
-            kinds = kernel_kinds(scene)
-            prepared = [  # kept until the points are submitted after them
-                client.submit(prepare_worker, kinds, workers=[w], pure=False)
-                for w in client.scheduler_info().get("workers", {})
-            ]
-            _run_here(scene, batches.pop(0)[0], cache, bar)
-            del prepared
-        for chunks in batches:
-            _collect(submit(chunks), bar)
+        if local:
+            _share_here(scene, todo, cache, client, submit, workers, bar)
+        else:
+            n_workers = len(client.scheduler_info().get("workers", {})) or workers
+            for chunks in _batches(todo, cache, n_workers):
+                _collect(submit(chunks), bar)
         bar.close()
     finally:
         client.close()
@@ -395,21 +389,49 @@ def _compute(scene, todo, scheduler, workers, progress, cache=None) -> None:
             cluster.close()
 
 
-def _run_here(scene, chunk, cache, bar) -> None:
-    """Run ``chunk`` (the first point, which fills the cache) in this process, on all its
-    cores: the local workers have one thread each and would otherwise build it on one
-    while the others wait (on Rotor 37: 46 s instead of 83 s). MKL's reproducible mode
-    (:data:`femrub.fem.linalg.MKL_REPRODUCIBLE`) keeps its threaded factorisations, and so
-    the bases every point shares, the same from run to run."""
-    rows = run_points(*_here(scene), [(r["params"], r["folder"]) for r in chunk], cache)
+def _points_here(scene, chunk, cache, bar, builds=None) -> None:
+    """Run ``chunk`` in this process (``builds``: what it built before), rows filled in."""
+    points = [(r["params"], r["folder"]) for r in chunk]
+    rows = run_points(*_here(scene), points, cache, done=lambda: bar.update(1), builds=builds)
     for r, row in zip(chunk, rows, strict=True):
         r.update(row)
-    bar.update(len(chunk))
+
+
+def _share_here(scene, todo, cache, client, submit, workers, bar) -> None:
+    """The points on a ``LocalCluster`` of ``workers - 1`` processes and this one.
+
+    With a cache, the first point runs here first, on all this process's cores (the local
+    workers have one thread each and would otherwise build it on one while the others wait:
+    on Rotor 37 46 s instead of 83 s), and fills the cache (assembly, damping, reduction
+    bases, map to the mesh) while the workers prepare (:func:`prepare_worker`); the other
+    chunks then load what they share with it. This process then runs the largest chunk
+    itself, on one BLAS thread, from the model it holds (a worker's first point builds its
+    model from the cache: on Rotor 37 twice a later point). MKL's reproducible mode
+    (:data:`femrub.fem.linalg.MKL_REPRODUCIBLE`) keeps its threaded factorisations, and so
+    the bases every point shares, the same from run to run.
+    """
+    from ..blas import one_blas_thread
+
+    first = todo[:1] if cache is not None else []
+    mine, *theirs = _chunks(todo[len(first) :], workers)
+    builds = SceneBuilds(cache)
+    if first:
+        kinds = kernel_kinds(scene)
+        prepared = [  # kept until the points are submitted after them
+            client.submit(prepare_worker, kinds, workers=[w], pure=False)
+            for w in client.scheduler_info().get("workers", {})
+        ]
+        _points_here(scene, first, cache, bar, builds)
+        del prepared
+    futures = submit(theirs)
+    with one_blas_thread:
+        _points_here(scene, mine, cache, bar, builds)
+    _collect(futures, bar)
 
 
 def prepare_worker(kinds: tuple[str, ...]) -> None:
     """What a worker's first point would otherwise start with, done while the sweep's first
-    point builds (:func:`_run_here`): femrub's modules and the libraries they load (MKL for
+    point builds (:func:`_share_here`): femrub's modules and the libraries they load (MKL for
     Pardiso), and the contact kernels of ``kinds`` loaded from numba's cache
     (:func:`~femrub.contact.activation.compile_kernels`); 2–3 s per worker on Rotor 37.
     Kernels numba's cache does not hold yet are left alone: the first point's build
@@ -436,24 +458,30 @@ def _here(scene) -> tuple:
 
 
 def _batches(todo: list, cache, workers: int) -> list[list[list]]:
-    """The points to submit together, in order, as one chunk of consecutive points per
-    worker (:func:`run_points`: a chunk builds its model once and takes it at each speed).
+    """The points to submit together to a scheduler's cluster, in order, as one chunk of
+    consecutive points per worker (:func:`run_points`: a chunk builds its model once and
+    takes it at each speed); a ``LocalCluster`` shares them with this process instead
+    (:func:`_share_here`).
 
     With a cache and more than one point, the first point runs alone and fills the cache
     (assembly, damping, reduction bases, map to the mesh); the other chunks then load
     them (a worker's first point would otherwise build them again: on Rotor 37 two
-    workers building at once took longer each than one alone). On a ``LocalCluster`` the
-    first point runs in this process, on all its cores (:func:`_run_here`)."""
+    workers building at once took longer each than one alone)."""
     first = todo[:1] if cache is not None and len(todo) > 1 else []
-    rest = todo[len(first) :]
-    n = max(1, min(workers, len(rest)))
-    size, extra = divmod(len(rest), n)
-    cuts = np.cumsum([0] + [size + (i < extra) for i in range(n)])
-    chunks = [rest[a:b] for a, b in zip(cuts[:-1], cuts[1:]) if b > a]
+    chunks = [c for c in _chunks(todo[len(first) :], workers) if c]
     batches = [[first]] if first else []
     if chunks:
         batches.append(chunks)
     return batches
+
+
+def _chunks(points: list, n: int) -> list[list]:
+    """``points`` cut into at most ``n`` chunks of consecutive points, the first ones one
+    point larger when they do not divide evenly (at least one chunk, maybe empty)."""
+    n = max(1, min(n, len(points)))
+    size, extra = divmod(len(points), n)
+    cuts = np.cumsum([0] + [size + (i < extra) for i in range(n)])
+    return [points[a:b] for a, b in zip(cuts[:-1], cuts[1:])]
 
 
 def _collect(futures, bar) -> None:
