@@ -16,7 +16,7 @@ One command, three measurements, each through the CLI a user runs:
 Writes the section between the ``bladed_disk`` markers of
 ``docs/performance/bladed-disk.md`` (``--no-write``: print it). Run alone:
 ``flock /tmp/femrub-heavy.lock python benchmarks/bladed_disk.py`` (about 20 minutes on the
-2-core machine with the default sweep of 21 speeds on two workers).
+2-core machine with the default sweep of 21 speeds on two processes: `--workers 2`).
 """
 
 from __future__ import annotations
