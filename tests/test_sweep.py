@@ -53,12 +53,14 @@ def test_sweep_runs_and_resumes(tmp_path, capsys, monkeypatch):
     model cache, then a chunk each), then rerun after a point failed: only that point runs
     again, here."""
     import femrub.app.sweep as sweep
+    from femrub.blas import one_blas_thread
 
-    here, kept = [], []
+    here, kept, serial = [], [], []
 
     def spy(scene, chunk, cache, bar, builds=None):
         here.append([r["point"] for r in chunk])
         kept.append(builds)
+        serial.append(one_blas_thread._inside > 0)
         return points_here(scene, chunk, cache, bar, builds)
 
     points_here = sweep._points_here
@@ -90,6 +92,7 @@ def test_sweep_runs_and_resumes(tmp_path, capsys, monkeypatch):
     # the first point here, then this process's chunk from the model it built; the worker
     # prepared (modules, kernels) while the first point ran, then ran the other chunk
     assert here == [[0], [1]] and kept[0] is kept[1] is not None
+    assert serial[:2] == [False, True]  # all cores for the build, one BLAS thread after
     assert sent[0] == ("prepare_worker", (("one",),), 1)
     assert [name for name, *_ in sent[1:]] == ["run_points"]
     ((changes, folder),) = sent[1][1][3]
@@ -183,14 +186,17 @@ def test_the_map_draws_temperature_and_wear_only_where_the_scene_models_them():
 
 def test_the_first_point_fills_the_cache_alone():
     """With a cache the first point runs alone and the others load what it stored; the
-    points then run as one chunk of consecutive points per worker (at most one per point)."""
-    from femrub.app.sweep import _batches
+    points then run as one chunk per worker, every N-th point (at most one per point)."""
+    from femrub.app.sweep import _batches, _chunks
 
     todo, cache = [{"point": i} for i in range(4)], object()
-    assert _batches(todo, cache, 2) == [[todo[:1]], [todo[1:3], todo[3:]]]
-    assert _batches(todo, None, 2) == [[todo[:2], todo[2:]]]
+    assert _batches(todo, cache, 2) == [[todo[:1]], [[todo[1], todo[3]], [todo[2]]]]
+    assert _batches(todo, None, 2) == [[todo[0::2], todo[1::2]]]
     assert _batches(todo, None, 8) == [[[r] for r in todo]]
     assert _batches(todo[:1], cache, 2) == [[todo[:1]]]
+    # a map whose cost grows with the speed: each chunk spans it, the first one the largest
+    assert _chunks(list(range(7)), 2) == [[0, 2, 4, 6], [1, 3, 5]]
+    assert _chunks([], 2) == [[]]
 
 
 def test_sweep_with_no_worker_runs_here_and_gives_the_cluster_rows(tmp_path, monkeypatch):
@@ -200,14 +206,16 @@ def test_sweep_with_no_worker_runs_here_and_gives_the_cluster_rows(tmp_path, mon
 
     scene = tmp_path / "tiny.toml"
     scene.write_text(TINY)
-    args = ["sweep", str(scene), "--param", "rotation_speed=100:200:100", "-q"]
-    assert main([*args, "-o", str(tmp_path / "cluster"), "--workers", "1"]) == 0
+    args = ["sweep", str(scene), "--param", "rotation_speed=100:300:100", "-q"]
+    assert main([*args, "-o", str(tmp_path / "cluster"), "--workers", "2"]) == 0
 
     def no_cluster(*_):
-        raise AssertionError("--workers 0 started a dask cluster")
+        raise AssertionError("--workers 0, or one chunk, started a dask cluster")
 
     monkeypatch.setattr(sweep, "_client", no_cluster)
     assert main([*args, "-o", str(tmp_path / "here"), "--workers", "0"]) == 0
+    two = ["sweep", str(scene), "--param", "rotation_speed=100:200:100", "-q"]
+    assert main([*two, "-o", str(tmp_path / "two")]) == 0  # the first, then the other: here
     cluster, here = (
         _csv(tmp_path / "cluster" / "interaction.csv"),
         _csv(tmp_path / "here" / "interaction.csv"),

@@ -2,12 +2,12 @@
 
 ``femrub sweep SCENE --param rotation_speed=200:2000:50 -o DIR`` runs every point of the
 grid (cartesian product of the ``--param`` values), each writing its own results folder
-``DIR/runs/NNN_key=value/`` (:func:`femrub.scene.run_scene`), in one chunk of consecutive
-points per process (:func:`run_points`: a point at another speed reuses the model of the
-point before, the speed being its parameter). Chunks run on this machine, in this process
-and ``--workers`` − 1 worker processes of a ``LocalCluster`` (1 thread each; 2 processes by
-default), or on the cluster behind ``--scheduler ADDRESS`` (the output folder must then be
-shared). A point
+``DIR/runs/NNN_key=value/`` (:func:`femrub.scene.run_scene`), in one chunk of points per
+process, every N-th point of the grid (:func:`run_points`: a point at another speed reuses
+the model of the point before, the speed being its parameter). Chunks run on this machine,
+in this process and up to ``--workers`` − 1 worker processes of a ``LocalCluster`` (1 thread
+each; 2 processes by default), or on the cluster behind ``--scheduler ADDRESS`` (the output
+folder must then be shared). A point
 whose folder holds a finished result is skipped, so rerunning the command after a failure
 or an interruption only runs what is missing. A point is keyed by a hash of its resolved
 scene (:func:`femrub.app.run.scene_hash`): its folder name ends with the first characters
@@ -258,10 +258,11 @@ def run_sweep(
     params : list of ``(dotted key, values)`` (:func:`parse_param`).
     out : sweep folder.
     scheduler : address of a dask scheduler; ``None``: this machine.
-    workers : processes running points on this machine: this one and ``workers - 1``
-        worker processes of a ``LocalCluster`` (:func:`_share_here`); 0 or 1 (or a single
-        point): the points run one after the other in this process, without dask (a small
-        map, a debugger, a script that is not guarded by ``if __name__ == "__main__"``).
+    workers : processes running points on this machine: this one and at most
+        ``workers - 1`` worker processes of a ``LocalCluster`` (:func:`_share_here`); 0 or 1
+        (or points for one chunk): the points run one after the other in this process,
+        without dask (a small map, a debugger, a script that is not guarded by
+        ``if __name__ == "__main__"``).
     overwrite : rerun points that already have a finished result.
     cache : a :class:`~femrub.app.cache.ModelCache` (its folder must be shared with the
         workers): the first point runs alone and stores its models (assembly, damping,
@@ -355,12 +356,14 @@ def _compute(scene, todo, scheduler, workers, progress, cache=None) -> None:
     from tqdm.auto import tqdm
 
     bar = tqdm(total=len(todo), disable=not progress, unit="point", desc="sweep")
-    if scheduler is None and (workers <= 1 or len(todo) == 1):  # here, the points in a row
+    local = scheduler is None  # this process is one of the ``workers`` processes
+    first = todo[:1] if local and cache is not None else []
+    mine, *theirs = _chunks(todo[len(first) :], workers) if local else ([], [])
+    if local and not theirs:  # --workers 0 or 1, or one chunk: here, the points in a row
         _points_here(scene, todo, cache, bar)
         bar.close()
         return
-    local = scheduler is None  # this process is one of the ``workers`` processes
-    client, cluster = _client(scheduler, workers - 1 if local else workers)
+    client, cluster = _client(scheduler, len(theirs) if local else workers)
 
     def submit(chunks):
         return {
@@ -377,7 +380,7 @@ def _compute(scene, todo, scheduler, workers, progress, cache=None) -> None:
 
     try:
         if local:
-            _share_here(scene, todo, cache, client, submit, workers, bar)
+            _share_here(scene, first, mine, theirs, cache, client, submit, bar)
         else:
             n_workers = len(client.scheduler_info().get("workers", {})) or workers
             for chunks in _batches(todo, cache, n_workers):
@@ -397,8 +400,9 @@ def _points_here(scene, chunk, cache, bar, builds=None) -> None:
         r.update(row)
 
 
-def _share_here(scene, todo, cache, client, submit, workers, bar) -> None:
-    """The points on a ``LocalCluster`` of ``workers - 1`` processes and this one.
+def _share_here(scene, first, mine, theirs, cache, client, submit, bar) -> None:
+    """The points on this process (``first``, then the chunk ``mine``) and a
+    ``LocalCluster`` (the chunks ``theirs``, one per worker).
 
     With a cache, the first point runs here first, on all this process's cores (the local
     workers have one thread each and would otherwise build it on one while the others wait:
@@ -412,8 +416,6 @@ def _share_here(scene, todo, cache, client, submit, workers, bar) -> None:
     """
     from ..blas import one_blas_thread
 
-    first = todo[:1] if cache is not None else []
-    mine, *theirs = _chunks(todo[len(first) :], workers)
     builds = SceneBuilds(cache)
     if first:
         kinds = kernel_kinds(scene)
@@ -458,9 +460,9 @@ def _here(scene) -> tuple:
 
 
 def _batches(todo: list, cache, workers: int) -> list[list[list]]:
-    """The points to submit together to a scheduler's cluster, in order, as one chunk of
-    consecutive points per worker (:func:`run_points`: a chunk builds its model once and
-    takes it at each speed); a ``LocalCluster`` shares them with this process instead
+    """The points to submit together to a scheduler's cluster, in order, as one chunk per
+    worker (:func:`_chunks`; :func:`run_points`: a chunk builds its model once and takes it
+    at each speed); a ``LocalCluster`` shares them with this process instead
     (:func:`_share_here`).
 
     With a cache and more than one point, the first point runs alone and fills the cache
@@ -476,12 +478,13 @@ def _batches(todo: list, cache, workers: int) -> list[list[list]]:
 
 
 def _chunks(points: list, n: int) -> list[list]:
-    """``points`` cut into at most ``n`` chunks of consecutive points, the first ones one
-    point larger when they do not divide evenly (at least one chunk, maybe empty)."""
+    """``points`` dealt into at most ``n`` chunks, chunk ``i`` every ``n``-th point from the
+    ``i``-th (the first ones one point larger when they do not divide evenly; at least one
+    chunk, maybe empty). Each chunk spans the whole grid, so points whose cost grows along
+    it (a map's higher speeds: more contact) are shared evenly; in a grid whose last key
+    varies fastest, a chunk's points in a row still differ in that key alone."""
     n = max(1, min(n, len(points)))
-    size, extra = divmod(len(points), n)
-    cuts = np.cumsum([0] + [size + (i < extra) for i in range(n)])
-    return [points[a:b] for a, b in zip(cuts[:-1], cuts[1:])]
+    return [points[i::n] for i in range(n)]
 
 
 def _collect(futures, bar) -> None:
