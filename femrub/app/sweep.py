@@ -7,14 +7,14 @@ process, every N-th point of the grid (:func:`run_points`: a point at another sp
 the model of the point before, the speed being its parameter). Chunks run on this machine,
 in this process and up to ``--workers`` − 1 worker processes of a ``LocalCluster`` (1 thread
 each; 2 processes by default), or on the cluster behind ``--scheduler ADDRESS`` (the output
-folder must then be shared). A point
-whose folder holds a finished result is skipped, so rerunning the command after a failure
-or an interruption only runs what is missing. A point is keyed by a hash of its resolved
-scene (:func:`femrub.app.run.scene_hash`): its folder name ends with the first characters
-of the hash, so changing the scene between two runs of the sweep runs the changed points
-into new folders (the old results stay, never reported as the new ones). The sweep folder
-is claimed like a run folder (kind ``sweep``, locked). At the end ``DIR/interaction.csv``
-and ``DIR/interaction.png`` (:mod:`femrub.output.interaction`) summarise the sweep.
+folder must then be shared). A point whose folder holds a finished result is skipped, so
+rerunning the command after a failure or an interruption only runs what is missing. A
+point is keyed by a hash of its resolved scene (:func:`femrub.app.run.scene_hash`): its
+folder name ends with the first characters of the hash, so changing the scene between two
+runs of the sweep runs the changed points into new folders (the old results stay, never
+reported as the new ones). The sweep folder is claimed like a run folder (kind ``sweep``,
+locked). At the end ``DIR/interaction.csv`` and ``DIR/interaction.png``
+(:mod:`femrub.output.interaction`) summarise the sweep.
 
 Parameter values: ``start:stop:step`` (stop included), ``a,b,c`` or one value; a unit may
 follow the numbers (``1000:3000:500rpm``); plain numbers are SI.
