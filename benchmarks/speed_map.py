@@ -2,15 +2,15 @@
 
 Runs ``femrub sweep rotor37 --param loads.rotation_speed=850:1825:25`` (reduced, friction
 on, 50,000 steps per point; no VTK frames, no PNG plots in the points, ``history.csv`` at one
-row per 10 steps, ``history.npz`` at every step) on a local dask cluster of ``--workers``
-processes with an empty model cache (numba's cache of the scene's contact kernels warmed
-first, in a child: a fresh install's compilation is ``cold_start.py``'s subject), in a child
-process, and records the wall time, the CPU
-and the largest resident memory of the processes (``getrusage`` of the children), the
-1-minute load at the start, at the end and its median (sampled every 15 s), the points'
-statuses, the median of each stage of a point (``summary.json["timings"]``), the time of
-the first point, of a worker's first point and of the others (the sweep's critical path)
-and the size of the model cache at the end. Appends a row to the table between the
+row per 10 steps, ``history.npz`` at every step) on ``--workers`` processes (the sweep's
+own and local dask workers) with an empty model cache (numba's cache of the scene's contact
+kernels warmed first, in a child: a fresh install's compilation is ``cold_start.py``'s
+subject), in a child process, and records the wall time, the CPU and the largest resident
+memory of the processes (``getrusage`` of the children), the 1-minute load at the start, at
+the end and its median (sampled every 15 s), the points' statuses, the median of each
+stage of a point (``summary.json["timings"]``), the time of the first point, of a worker's
+first point and of the others (the sweep's critical path) and the size of the model cache
+at the end. Appends a row to the table between the
 ``speed_map`` markers of ``docs/performance/speed-map-costs.md`` (``--no-write``: print it).
 
 Run: ``flock /tmp/femrub-heavy.lock python benchmarks/speed_map.py`` (both cores for a few

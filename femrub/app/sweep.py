@@ -357,8 +357,7 @@ def _compute(scene, todo, scheduler, workers, progress, cache=None) -> None:
 
     bar = tqdm(total=len(todo), disable=not progress, unit="point", desc="sweep")
     local = scheduler is None  # this process is one of the ``workers`` processes
-    first = todo[:1] if local and cache is not None else []
-    mine, *theirs = _chunks(todo[len(first) :], workers) if local else ([], [])
+    first, (mine, *theirs) = _split(todo, cache, workers) if local else ([], ([], []))
     if local and not theirs:  # --workers 0 or 1, or one chunk: here, the points in a row
         _points_here(scene, todo, cache, bar)
         bar.close()
@@ -469,12 +468,19 @@ def _batches(todo: list, cache, workers: int) -> list[list[list]]:
     (assembly, damping, reduction bases, map to the mesh); the other chunks then load
     them (a worker's first point would otherwise build them again: on Rotor 37 two
     workers building at once took longer each than one alone)."""
-    first = todo[:1] if cache is not None and len(todo) > 1 else []
-    chunks = [c for c in _chunks(todo[len(first) :], workers) if c]
+    first, chunks = _split(todo, cache, workers)
+    chunks = [c for c in chunks if c]
     batches = [[first]] if first else []
     if chunks:
         batches.append(chunks)
     return batches
+
+
+def _split(todo: list, cache, n: int) -> tuple[list, list[list]]:
+    """``(first, chunks)``: with a cache and more than one point, the first point alone (it
+    fills the cache), and the other points dealt into at most ``n`` chunks (:func:`_chunks`)."""
+    first = todo[:1] if cache is not None and len(todo) > 1 else []
+    return first, _chunks(todo[len(first) :], n)
 
 
 def _chunks(points: list, n: int) -> list[list]:
