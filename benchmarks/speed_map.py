@@ -3,14 +3,15 @@
 Runs ``femrub sweep rotor37 --param loads.rotation_speed=850:1825:25`` (reduced, friction
 on, 50,000 steps per point; no VTK frames, no PNG plots in the points, ``history.csv`` at one
 row per 10 steps, ``history.npz`` at every step) on ``--workers`` processes (the sweep's
-own and local dask workers) with an empty model cache (numba's cache of the scene's contact
-kernels warmed first, in a child: a fresh install's compilation is ``cold_start.py``'s
-subject), in a child process, and records the wall time, the CPU and the largest resident
-memory of the processes (``getrusage`` of the children), the 1-minute load at the start, at
-the end and its median (sampled every 15 s), the points' statuses, the median of each
-stage of a point (``summary.json["timings"]``), the time of the first point, of a worker's
-first point and of the others (the sweep's critical path) and the size of the model cache
-at the end. Appends a row to the table between the
+own and local dask workers) with an empty model cache and numba's cache warm (a short run of
+the same scene first, in a child, with its own model cache: every function femrub compiles
+for the map, the contact kernels and the finite-element ones, is then on disk; a fresh
+install's compilation is ``cold_start.py``'s subject), in a child process, and records the
+wall time, the CPU and the largest resident memory of the processes (``getrusage`` of the
+children), the 1-minute load at the start, at the end and its median (sampled every 15 s),
+the points' statuses, the median of each stage of a point (``summary.json["timings"]``), the
+time of the first point, of a worker's first point and of the others (the sweep's critical
+path) and the size of the model cache at the end. Appends a row to the table between the
 ``speed_map`` markers of ``docs/performance/speed-map-costs.md`` (``--no-write``: print it).
 
 Run: ``flock /tmp/femrub-heavy.lock python benchmarks/speed_map.py`` (both cores for a few
@@ -86,16 +87,13 @@ def _critical(points: list[dict]) -> list[float]:
     return [total[0] if total else 0.0, *medians]
 
 
-WARM = (
-    "from femrub.app.translate import kernel_kinds; "
-    "from femrub.contact.activation import compile_kernels; "
-    "from femrub.scene import load_scene; "
-    "compile_kernels(kernel_kinds(load_scene('rotor37')))"
-)
+#: the warm-up run: the map's scene and settings over two revolutions (2,000 steps, its
+#: checks included), in its own folder and model cache
+WARM = ("--set", "scheme.t_end=0.00935")
 
 
 def measure(speeds: str, workers: int, out: Path, cache: Path) -> dict:
-    """Run the sweep in a child process (the kernels' cache warmed first); what it took."""
+    """Run the sweep in a child process (numba's cache warmed first); what it took."""
     cmd = [
         sys.executable,
         "-m",
@@ -114,7 +112,12 @@ def measure(speeds: str, workers: int, out: Path, cache: Path) -> dict:
     for s in SETS:
         cmd += ["--set", s]
     env = dict(os.environ, PYTHONPATH=str(ROOT) + os.pathsep + os.environ.get("PYTHONPATH", ""))
-    subprocess.run([sys.executable, "-c", WARM], env=env, check=True)
+    with tempfile.TemporaryDirectory() as warm:
+        run = [sys.executable, "-m", "femrub", "run", "rotor37", "-q", *WARM]
+        for s in SETS:
+            run += ["--set", s]
+        run += ["-o", str(Path(warm) / "run"), "--cache-dir", str(Path(warm) / "cache")]
+        subprocess.run(run, env=env, check=True, capture_output=True)
     before = resource.getrusage(resource.RUSAGE_CHILDREN)  # the warm-up's CPU left out
     samples, stop = [os.getloadavg()[0]], threading.Event()
     sampler = threading.Thread(target=_sample_load, args=(samples, stop), daemon=True)

@@ -227,6 +227,13 @@ def test_sliced_models_take_the_gap_functions_of_the_reductors_model(paper):
     rom = red.for_model(other).reduce(4, 3)
     assert np.allclose(rom.contact.gap0, 2 * paper.contact.gap0)
     assert _rel(rom.contact.G, red.reduce(4, 3).contact.G) == 0.0
+    # the energy forms rest on the matrices only: made once, the same for every speed
+    assert rom.energy is red.reduce(4, 3).energy
+    fresh = ThermoelasticCraigBampton(paper, 8, 6, projection="second-order")
+    fresh.reduce()
+    alone = fresh.for_model(other).reduce(4, 3)  # made on ``other``: no size made before
+    assert _rel(alone.energy.Pd.toarray(), rom.energy.Pd.toarray()) == 0.0
+    assert alone.info["energy_growth_rate"] == rom.info["energy_growth_rate"]
 
 
 def test_smaller_sizes_share_the_largest_map_to_the_mesh(paper):

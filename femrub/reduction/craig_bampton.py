@@ -183,6 +183,9 @@ class ThermoelasticCraigBampton:
         self.timings = {}
         self._largest = None  # the largest reduced operators, projected on first use
         self._models = {}  # the reduced models made, by sizes: each made once
+        #: the energy forms of each size, shared with :meth:`for_model`'s reductors (same
+        #: matrices: the forms do not depend on what a speed changes)
+        self._energy_forms = {}
         t0 = time.perf_counter()
         self.solver = solver = InteriorSolver(blocks, mi, ti, stiffness)
         self._bnd = np.r_[mb, nu + mb, 2 * nu + tb].astype(int)
@@ -383,7 +386,10 @@ class ThermoelasticCraigBampton:
     def _slice(self, cols, layout) -> dict:
         """The operators of the sizes of ``cols`` as blocks of the largest projected ones,
         with the full model's gap, heat and load functions (:meth:`for_model`)."""
-        return sliced(self._largest, self.fom, cols, layout)
+        key = cols.tobytes()
+        parts = sliced(self._largest, self.fom, cols, layout, self._energy_forms.get(key))
+        self._energy_forms[key] = (parts["energy"], parts["growth"])
+        return parts
 
     def reconstruct(self, Xr: np.ndarray, n_uv=None, n_theta=None) -> np.ndarray:
         """Full state ``R X̄`` of a reduced state (r,) or of the rows of an (m, r) array.

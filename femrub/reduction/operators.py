@@ -83,9 +83,13 @@ def left_sliced(largest: dict, fom, cols) -> dict:
     }
 
 
-def sliced(largest: dict, fom, cols, layout) -> dict:
+def sliced(largest: dict, fom, cols, layout, energy=None) -> dict:
     """The operators of the columns ``cols`` as blocks of the ``largest`` model's
-    (projected on every column), with ``fom``'s gap, heat and load functions."""
+    (projected on every column), with ``fom``'s gap, heat and load functions.
+
+    ``energy``: the ``(forms, growth rate)`` of these columns already made on a model with
+    the same matrices (they rest on ``Ā``, ``B̄`` and the projected forms only), or ``None``
+    to make them (:func:`~femrub.reduction.energy_forms.energy_rates`)."""
     left = left_sliced(largest, fom, cols)
     A, B = left["A"], left["B"]
     every = cols.size == A.shape[0] == largest["A"].shape[0] and np.array_equal(
@@ -94,8 +98,8 @@ def sliced(largest: dict, fom, cols, layout) -> dict:
     to_full = largest["to_full"]
     if to_full is not None and not every:  # the map to the mesh of the largest model is
         to_full = columns_of(to_full, cols)  # shared, not copied (n × r: 0.6 GB on Rotor 37)
-    energy, growth = None, 0.0
-    if largest["energy"] is not None:
+    energy, growth = (None, 0.0) if energy is None else energy
+    if largest["energy"] is not None and energy is None:
         energy, growth = energy_rates(fom, sliced_energy(largest["energy"], cols), A, B, layout)
     return {
         **left,
