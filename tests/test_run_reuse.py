@@ -181,11 +181,16 @@ def test_builds_in_a_row_keep_the_discretisation(tmp_path):
     builds, notes = SceneBuilds(cache), []
     builds.build(scene, log=notes.append)
     assert not any("discretisation kept" in n for n in notes)
+    (disc,) = builds.kept.discretisation.values()
+    # the assembly came from the cache: the quadrature bases were never built, only the
+    # spaces on one point per cell (dof numbers, contact points, strain at the centroids)
+    assert "basis_u" not in vars(disc.spaces) and "basis_t" not in vars(disc.spaces)
+    assert "dofs_u" in vars(disc.spaces)
     notes.clear()
     kept = builds.build(other, log=notes.append)
     assert any("discretisation kept by this process" in n for n in notes)
     (disc,) = builds.kept.discretisation.values()
-    assert kept.fields.vertex_dofs_u is disc.basis_u.nodal_dofs  # the bases shared, not rebuilt
+    assert kept.fields.vertex_dofs_u is disc.dofs_u.nodal_dofs  # the spaces shared, not rebuilt
     for name in ("A", "B"):
         a, b = getattr(kept.full, name), getattr(fresh.full, name)
         np.testing.assert_array_equal(a.toarray(), b.toarray())

@@ -165,7 +165,7 @@ def locate_contacts(disc, points=None, spread: str = "patch") -> ContactPoints:
     """
     if spread not in SPREADS:
         raise ValueError(f"contact spread must be one of {SPREADS}, got {spread!r}")
-    blade, basis_u = disc.blade, disc.basis_u
+    blade, basis_u = disc.blade, disc.dofs_u
     dim = blade.dim
     pts = np.asarray(blade.contact_points if points is None else points, dtype=float)
     pts = pts.reshape(dim, -1)
@@ -188,10 +188,10 @@ def locate_contacts(disc, points=None, spread: str = "patch") -> ContactPoints:
     u_dofs[comp.T, np.arange(pts.shape[1])] = idx.T
     vertices = cKDTree(blade.mesh.p.T).query(pts.T)[1]
     weights, on_face = tributary_heat_weights(blade, pts, tol, vertices)
-    tdofs = disc.basis_t.nodal_dofs[0]
+    tdofs = disc.dofs_t.nodal_dofs[0]
     heat = sp.csr_matrix(
         (weights.data, tdofs[weights.indices], weights.indptr),
-        shape=(pts.shape[1], disc.basis_t.N),
+        shape=(pts.shape[1], disc.dofs_t.N),
     )
     radii = blade.radius(pts)
     if np.any(radii <= 0):

@@ -1,9 +1,11 @@
 """The strain at each element's centroid as a sparse operator on the displacement dofs.
 
-For the von Mises stress of the VTK frames (:mod:`femrub.output.frame_fields`): the mean over
-an element's quadrature points of ``ε_ab = (∂_b u_a + ∂_a u_b) / 2``, for the pairs
-``a ≤ b``, taken once from a vector basis so that the output holds this operator, not the
-basis.
+For the von Mises stress of the VTK frames (:mod:`femrub.output.frame_fields`):
+``ε_ab = (∂_b u_a + ∂_a u_b) / 2`` at each element's centroid, for the pairs ``a ≤ b``, taken
+once from a vector basis on one point per cell (the centroid:
+:attr:`~femrub.fem.discretisation.Discretisation.dofs_u`) so that the output holds this
+operator, not the basis; a basis on more points gives the mean over them (the same on
+straight cells, whose strain is linear over the cell for quadratic displacement).
 """
 
 from __future__ import annotations

@@ -67,7 +67,7 @@ class MeshNodes:
 
 def mesh_nodes(disc) -> MeshNodes:
     """The :class:`MeshNodes` of ``disc`` (P2: the edges' curved midpoints)."""
-    mesh, basis = disc.mesh, disc.basis_u
+    mesh, basis = disc.mesh, disc.dofs_u
     p = mesh.p
     if disc.dim == 1:
         return MeshNodes(p, np.zeros((2, 0), dtype=int), p.shape[1])
@@ -125,14 +125,14 @@ def node_rows(basis, nodes: MeshNodes, node: int, directions) -> sp.csr_matrix:
 
 def _displacement_row(disc, mats, nodes: MeshNodes, node: int, d: np.ndarray) -> sp.csr_matrix:
     """(1, n_u) row ``dᵀ u(x_node)`` on the free displacement dofs."""
-    full = node_rows(disc.basis_u, nodes, node, d)
+    full = node_rows(disc.dofs_u, nodes, node, d)
     return sp.csr_matrix(full @ mats.prolongation_u())
 
 
 def _temperature_row(disc, mats, nodes: MeshNodes, node: int) -> sp.csr_matrix:
     """(1, n_θ) row ``θ(x_node)`` on the free temperature dofs (P1)."""
     verts, weights = nodes.weights(node)
-    dofs = disc.basis_t.nodal_dofs[0][verts]
+    dofs = disc.dofs_t.nodal_dofs[0][verts]
     full = sp.csr_matrix((weights, (np.zeros(dofs.size, dtype=int), dofs)), shape=(1, mats.n_t_all))
     return sp.csr_matrix(full @ mats.prolongation_t())
 

@@ -64,15 +64,15 @@ class FieldMap:
     @classmethod
     def of(cls, disc: Discretisation, contacts: ContactPoints, lam: float, mu: float):
         """The map of ``disc``'s mesh (:func:`~femrub.fem.strain.centroid_strain`)."""
-        G, pairs = centroid_strain(disc.basis_u)
+        G, pairs = centroid_strain(disc.dofs_u)
         return cls(
             disc.mesh,
             contacts,
             lam,
             mu,
-            disc.basis_u.nodal_dofs,
-            disc.basis_t.nodal_dofs[0],
-            int(disc.basis_u.N),
+            disc.dofs_u.nodal_dofs,
+            disc.dofs_t.nodal_dofs[0],
+            int(disc.dofs_u.N),
             G,
             tuple(pairs),
         )
@@ -84,7 +84,7 @@ def tip_load(disc: Discretisation, mats, force, signal) -> Load:
     facets = disc.facets_of("tip")
     if facets.size == 0:
         raise ValueError(f"the 'tip' node set of {disc.blade.source} covers no boundary face")
-    fb = fem.FacetBasis(disc.mesh, disc.basis_u.elem, mapping=disc.basis_u.mapping, facets=facets)
+    fb = fem.FacetBasis(disc.mesh, disc.dofs_u.elem, mapping=disc.dofs_u.mapping, facets=facets)
     area = float(fem.Functional(lambda w: 1.0 + 0.0 * w.x[0]).assemble(fb))
     traction = np.asarray(force, dtype=float).reshape(disc.dim) / area
 
