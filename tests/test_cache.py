@@ -166,43 +166,60 @@ def _stored(cache, stage):
 
 
 def test_one_map_to_the_mesh_for_every_speed(tmp_path, monkeypatch):
-    """The reduced model's map to the mesh (columns of the reductor's largest map) is stored
-    once, as its own entry, and each speed's reduction refers to it by its columns."""
+    """The reduced model's map to the mesh (columns of the reductor's largest map, which is
+    its basis with the constrained rows put back) is not stored a second time: each speed's
+    reduction refers to the basis of the ``bases`` entry by its columns."""
     from femrub.reduction.truncation import ColumnMap
 
     local = ModelCache(tmp_path / "c")
-    a = _build(local)
+    notes = []
+    a = _build(local, notes)
     b = _build(local, None, **{"loads.rotation_speed": 1700.0})
     assert isinstance(a.model.to_full, ColumnMap)
-    maps, reductions = _stored(local, "map"), _stored(local, "reduction")
-    assert len(maps) == 1 and len(reductions) == 2
-    assert all(e["size"] < maps[0]["size"] for e in reductions)
+    reductions, (bases,) = _stored(local, "reduction"), _stored(local, "bases")
+    assert len(reductions) == 2 and not _stored(local, "map")
+    assert not any("map stored" in n for n in notes), notes
+    assert all(e["size"] < bases["size"] for e in reductions)
     for e in reductions:
         entry = local.load(e["key"])
-        assert entry["model"].to_full is None
+        assert entry["model"].to_full is None and entry["map"]["basis"] is True
         np.testing.assert_array_equal(entry["map"]["columns"], a.model.to_full.cols)
     notes = []
     hit = _build(local, notes, **{"loads.rotation_speed": 1700.0})
     assert hit.report["reduction"]["cache"] == "hit"
-    assert any("map loaded" in n for n in notes)
+    assert any("bases loaded" in n for n in notes), notes
+    assert hit.model.to_full.full is not None
     _same_model(hit.model, b.model)
+    np.testing.assert_array_equal(np.asarray(hit.model.to_full), np.asarray(b.model.to_full))
 
 
-def test_a_map_the_cache_holds_is_not_written_again(tmp_path):
-    """A build at another speed with nothing kept in memory (another run or process) finds
-    the map to the mesh in the cache: the entry is not written a second time."""
+def test_a_map_that_is_not_the_basis_has_its_own_entry(tmp_path):
+    """Without a ``bases`` entry (``reduction.method = "auto"`` stores none) the map to the
+    mesh is its own entry, stored once: a build at another speed with nothing kept in memory
+    (another run or process) finds it and does not write it again."""
     local = ModelCache(tmp_path / "c")
     notes = []
-    _build(local, notes)
-    assert any("map stored" in n for n in notes)
+    auto = {k: v for k, v in SMALL.items() if not k.startswith("reduction.n_")}
+    auto["reduction.method"] = "auto"
+
+    def built(**changes):
+        return build(load_scene("twisted-naca", {**auto, **changes}), log=notes.append, cache=local)
+
+    built()
+    assert any("map stored" in n for n in notes) and not _stored(local, "bases")
     (entry,) = _stored(local, "map")
     data = local.root / f"{entry['key']}.npz"
     written = data.stat().st_mtime_ns
     notes.clear()
-    faster = _build(local, notes, **{"loads.rotation_speed": 1700.0})
+    faster = built(**{"loads.rotation_speed": 1700.0})
     assert "cache" not in faster.report["reduction"]  # reduced anew, its map not stored
     assert not any("map stored" in n for n in notes), notes
     assert data.stat().st_mtime_ns == written and len(_stored(local, "map")) == 1
+    notes.clear()
+    hit = built(**{"loads.rotation_speed": 1700.0})
+    assert hit.report["reduction"]["cache"] == "hit"
+    assert any("map loaded" in n for n in notes), notes
+    _same_model(hit.model, faster.model)
 
 
 def test_a_model_at_another_speed_is_not_hashed_again(monkeypatch):
@@ -230,12 +247,12 @@ def test_a_model_at_another_speed_is_not_hashed_again(monkeypatch):
 
 
 @pytest.mark.parametrize("damage", ["corrupt", "missing"])
-def test_corrupt_or_missing_map_rebuilds_the_reduction(first, tmp_path, monkeypatch, damage):
+def test_corrupt_or_missing_basis_rebuilds_the_reduction(first, tmp_path, monkeypatch, damage):
 
     cache, sim, _ = first
     local = ModelCache(tmp_path / "c")
     _build(local)
-    (entry,) = _stored(local, "map")
+    (entry,) = _stored(local, "bases")  # the basis the reduction's map is
     path = local.root / f"{entry['key']}.npz"
     if damage == "corrupt":
         data = bytearray(path.read_bytes())
@@ -250,7 +267,7 @@ def test_corrupt_or_missing_map_rebuilds_the_reduction(first, tmp_path, monkeypa
     assert any("is corrupt" in n for n in notes) == (damage == "corrupt"), notes
     assert "cache" not in rebuilt.report["reduction"]  # rebuilt, not loaded
     _same_model(rebuilt.model, sim.model)
-    assert len(_stored(local, "map")) == 1  # stored again
+    assert len(_stored(local, "bases")) == 1  # stored again
     again = _build(local)
     assert again.report["reduction"]["cache"] == "hit"
     _same_model(again.model, sim.model)

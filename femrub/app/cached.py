@@ -18,10 +18,12 @@ cache it only calls them:
   projects (``A``, ``B``, contact rows, load vectors, observations, energy forms, map to the
   mesh, boundary dofs, initial state), the ``reduction`` options and, for ``"auto"``, the
   end time that sets its thermal frequencies; the map to the mesh of the reductor's largest
-  model (dense, a few hundred MB on a blade; a smaller size uses its leading columns) is its
-  own entry ``map`` (key: the same without what the run depends on), stored once for every
-  speed of a sweep, and a reduced model refers to it by its columns; a hit whose ``map`` is
-  missing or corrupt is rebuilt like a miss;
+  model (dense, a few hundred MB on a blade; a smaller size uses its leading columns) is not
+  stored with it: a reduced model refers by its columns to the basis of the ``bases`` entry
+  when the map is that basis (its constrained rows put back as it is read), else to its own
+  entry ``map`` (key: the same without what the run depends on), stored once for every
+  speed of a sweep; a hit whose basis or ``map`` is missing or corrupt is rebuilt like a
+  miss;
 * ``frequencies``: the natural frequencies of the full model (sweeps, ``--modes``), taken
   from the damping's eigen-solve when the build damps (one solve finds both);
 * ``prestress``: the centrifugal prestress (:func:`femrub.fem.prestress.centrifugal_prestress`,
@@ -291,14 +293,14 @@ class Stages:
         model_key = self._model_key(model)  # hashed once: the keys below derive from it
         map_key = content_key(model_key, "map", opts)  # the largest model's map: speed-free
         key = content_key(model_key, "reduction", opts, _run_key(scene, make_stepper, limits))
+        bases = content_key(model_key, "bases", opts) if opts["method"] != "auto" else None
         if stored:
             hit = self._fetch("reduction", key)
-            hit = None if hit is None else self._with_map(hit, map_key)
+            hit = None if hit is None else self._with_map(hit, map_key, bases)
             if hit is not None:
                 if stiffness is not None:
                     stiffness.free()
                 return _attach(hit, model), None, dict(hit["report"], cache="hit")
-        bases = content_key(model_key, "bases", opts) if opts["method"] != "auto" else None
         kept = self.kept.reductor.get(bases)
         if kept is None and bases is not None and stored:  # built by another process
             kept = self._fetch("bases", bases)
@@ -318,34 +320,58 @@ class Stages:
         )
         _say_phases(self._say, reduced.info.get("timings", {}))
         if stored:
-            self._store_reduction(key, map_key, reduced, reductor, report)
+            self._store_reduction(key, map_key, bases, reduced, reductor, report)
         return reduced, reductor, report
 
-    def _store_reduction(self, key, map_key, reduced, reductor, report) -> None:
-        """Store ``reduced`` (entry ``reduction``) and its largest model's map (``map``)."""
+    def _store_reduction(self, key, map_key, bases, reduced, reductor, report) -> None:
+        """Store ``reduced`` (entry ``reduction``) and its largest model's map: the basis of
+        the ``bases`` entry when the map is that basis with the constrained rows put back (it
+        is not stored twice), else its own entry ``map``."""
         entry, shared = _detach(reduced, report, reductor.R.shape[1])
-        if shared is not None and self.kept.map.get(map_key) is not shared:
+        if shared is not None and bases is not None and shared is reductor.R:
+            entry["map"]["basis"] = True  # the bases entry's basis (``_with_map``)
+        elif shared is not None and self.kept.map.get(map_key) is not shared:
             if not self.cache.holds(map_key):  # stored by another point, process or run
                 self._keep("map", map_key, shared, f"map to the mesh {shared.shape}")
             Kept.last(self.kept.map, map_key, shared)
         self._keep("reduction", key, entry, f"{reduced.n_dofs} dofs")
 
-    def _with_map(self, hit: dict, map_key: str):
-        """A stored reduction with its map to the mesh (kept by this process, or the cache's
-        ``map`` entry); ``None`` when that entry is missing or corrupt: the caller rebuilds."""
+    def _with_map(self, hit: dict, map_key: str, bases: str | None):
+        """A stored reduction with its map to the mesh (the basis of the ``bases`` entry, or
+        the ``map`` entry; kept by this process or loaded); ``None`` when that entry is
+        missing or corrupt: the caller rebuilds."""
         if hit.get("map") is None:  # stored with its own map
             return hit
-        full = self.kept.map.get(map_key)
+        full = self._basis(bases) if hit["map"].get("basis") else self._map(map_key)
         if full is None:
-            full = self._fetch("map", map_key)
-            if full is None:
-                self.hits["reduction"] = False
-                self._say("cache: the reduction's map to the mesh is not in the cache; rebuilding")
-                return None
-            Kept.last(self.kept.map, map_key, full)
+            self.hits["reduction"] = False
+            self._say("cache: the reduction's map to the mesh is not in the cache; rebuilding")
+            return None
         cols, rows = hit["map"]["columns"], hit["map"].get("rows")
         to_full = full if cols is None else ColumnMap(full, cols, rows)
         return dict(hit, model=hit["model"].with_(to_full=to_full))
+
+    def _map(self, map_key: str):
+        """The ``map`` entry (kept by this process, or loaded), or ``None``."""
+        full = self.kept.map.get(map_key)
+        if full is None:
+            full = self._fetch("map", map_key)
+            if full is not None:
+                Kept.last(self.kept.map, map_key, full)
+        return full
+
+    def _basis(self, bases: str | None):
+        """The basis ``R`` of the ``bases`` entry (its reductor kept by this process, or
+        loaded and then kept), or ``None``."""
+        if bases is None:
+            return None
+        reductor = self.kept.reductor.get(bases)
+        if reductor is None:
+            reductor = self._fetch("bases", bases)
+            if reductor is None:
+                return None
+            Kept.last(self.kept.reductor, bases, reductor)
+        return reductor.R
 
     def frequencies(self, model, k: int) -> np.ndarray:
         """:func:`~femrub.reduction.sizes.natural_frequencies` (Hz), through the cache; the
@@ -437,8 +463,9 @@ def _state_arrays(obj, n: int) -> dict:
 def _detach(reduced, report, largest: int) -> tuple[dict, np.ndarray | None]:
     """What to store of a reduced model: its arrays, without the run-specific functions, and
     the largest model's map to the mesh it uses (``largest``: that model's number of
-    coordinates), stored once for every speed (entry ``map``), or ``None`` (then the map is
-    stored with the model)."""
+    coordinates), stored once for every speed (the ``bases`` entry's basis, or the entry
+    ``map``: :meth:`Stages._store_reduction`), or ``None`` (then the map is stored with the
+    model)."""
     n, to_full, shared, ref = reduced.n_dofs, reduced.to_full, None, None
     if isinstance(to_full, ColumnMap):
         shared, ref = to_full.full, {"columns": to_full.cols, "rows": to_full.rows}
