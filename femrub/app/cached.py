@@ -301,9 +301,8 @@ class Stages:
                 if stiffness is not None:
                     stiffness.free()
                 return _attach(hit, model), None, dict(hit["report"], cache="hit")
-        kept = self.kept.reductor.get(bases)
-        if kept is None and bases is not None and stored:  # built by another process
-            kept = self._fetch("bases", bases)
+        # the bases kept by this process, or built by another one (the cache)
+        kept = self._loaded("bases", bases) if stored else self.kept.reductor.get(bases)
 
         def keep_bases(reductor) -> None:  # before the estimate's runs (they may release it)
             if bases is None:
@@ -342,7 +341,11 @@ class Stages:
         missing or corrupt: the caller rebuilds."""
         if hit.get("map") is None:  # stored with its own map
             return hit
-        full = self._basis(bases) if hit["map"].get("basis") else self._map(map_key)
+        if hit["map"].get("basis"):
+            reductor = self._loaded("bases", bases)
+            full = None if reductor is None else reductor.R
+        else:
+            full = self._loaded("map", map_key)
         if full is None:
             self.hits["reduction"] = False
             self._say("cache: the reduction's map to the mesh is not in the cache; rebuilding")
@@ -351,27 +354,16 @@ class Stages:
         to_full = full if cols is None else ColumnMap(full, cols, rows)
         return dict(hit, model=hit["model"].with_(to_full=to_full))
 
-    def _map(self, map_key: str):
-        """The ``map`` entry (kept by this process, or loaded), or ``None``."""
-        full = self.kept.map.get(map_key)
-        if full is None:
-            full = self._fetch("map", map_key)
-            if full is not None:
-                Kept.last(self.kept.map, map_key, full)
-        return full
-
-    def _basis(self, bases: str | None):
-        """The basis ``R`` of the ``bases`` entry (its reductor kept by this process, or
-        loaded and then kept), or ``None``."""
-        if bases is None:
-            return None
-        reductor = self.kept.reductor.get(bases)
-        if reductor is None:
-            reductor = self._fetch("bases", bases)
-            if reductor is None:
-                return None
-            Kept.last(self.kept.reductor, bases, reductor)
-        return reductor.R
+    def _loaded(self, stage: str, key: str | None):
+        """What this process keeps of ``stage`` (``"bases"``: the reductor, ``"map"``) under
+        ``key``, else the cache's entry loaded and then kept; ``None`` without either."""
+        memo = self.kept.reductor if stage == "bases" else self.kept.map
+        value = memo.get(key)
+        if value is None and key is not None:
+            value = self._fetch(stage, key)
+            if value is not None:
+                Kept.last(memo, key, value)
+        return value
 
     def frequencies(self, model, k: int) -> np.ndarray:
         """:func:`~femrub.reduction.sizes.natural_frequencies` (Hz), through the cache; the

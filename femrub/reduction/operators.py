@@ -98,9 +98,11 @@ def sliced(largest: dict, fom, cols, layout, energy=None) -> dict:
     to_full = largest["to_full"]
     if to_full is not None and not every:  # the map to the mesh of the largest model is
         to_full = columns_of(to_full, cols)  # shared, not copied (n × r: 0.6 GB on Rotor 37)
-    energy, growth = (None, 0.0) if energy is None else energy
-    if largest["energy"] is not None and energy is None:
-        energy, growth = energy_rates(fom, sliced_energy(largest["energy"], cols), A, B, layout)
+    if energy is None:
+        energy = (None, 0.0)
+        if largest["energy"] is not None:
+            energy = energy_rates(fom, sliced_energy(largest["energy"], cols), A, B, layout)
+    energy, growth = energy
     return {
         **left,
         "observations": {k: O[:, cols] for k, O in largest["observations"].items()},
