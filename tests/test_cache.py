@@ -369,3 +369,74 @@ def test_cli_cache_info_and_clear(tmp_path, capsys):
     assert main(["cache", "clear", "--cache-dir", str(tmp_path)]) == 0
     assert "removed 1 entries" in capsys.readouterr().out
     assert cache.entries() == []
+
+
+def test_an_entry_another_process_is_building_is_waited_for_and_loaded(tmp_path):
+    """Two builders of one entry at once (the workers of a sweep): the second waits while
+    the first builds it, then loads what it stored instead of building it too."""
+    import threading
+
+    from femrub.app.cached import Stages
+
+    cache = ModelCache(tmp_path)
+    key = content_key("entry built once")
+    inside, release, order = threading.Event(), threading.Event(), []
+
+    def first():
+        with Stages(cache)._building("test", key) as hit:
+            order.append(("first", hit))
+            inside.set()
+            release.wait(10)
+            cache.store(key, {"a": np.arange(3.0)}, stage="test")
+
+    notes = []
+
+    def second():
+        with Stages(cache, notes.append)._building("test", key) as hit:
+            order.append(("second", None if hit is None else hit["a"].tolist()))
+
+    builder = threading.Thread(target=first)
+    builder.start()
+    assert inside.wait(10)
+    waiter = threading.Thread(target=second)
+    waiter.start()
+    waiter.join(0.5)
+    assert waiter.is_alive() and order == [("first", None)]  # waiting, not building
+    release.set()
+    builder.join(10)
+    waiter.join(10)
+    assert order == [("first", None), ("second", [0.0, 1.0, 2.0])]
+    assert any("being built by another process" in n for n in notes)
+    assert (tmp_path / f"{key}.lock").is_file()
+    assert cache.clear()[0] == 1 and not (tmp_path / f"{key}.lock").exists()  # an entry
+
+
+def test_a_builder_that_died_leaves_no_lock(tmp_path):
+    """The operating system releases the lock of a process that dies while building: the
+    next builder goes on at once (and builds the entry itself)."""
+    import subprocess
+    import sys
+
+    cache = ModelCache(tmp_path)
+    key = content_key("builder killed")
+    with cache.building(key):
+        pass  # the folder marked, the lock file made
+    holder = subprocess.Popen(
+        [
+            sys.executable,
+            "-c",
+            "import fcntl, os, sys, time\n"
+            f"fd = os.open({str(tmp_path / (key + '.lock'))!r}, os.O_RDWR)\n"
+            "fcntl.flock(fd, fcntl.LOCK_EX); print('held', flush=True); time.sleep(60)",
+        ],
+        stdout=subprocess.PIPE,
+        text=True,
+    )
+    try:
+        assert holder.stdout.readline().strip() == "held"
+    finally:
+        holder.kill()
+        holder.wait(10)
+    t0 = time.perf_counter()
+    with cache.building(key):
+        assert time.perf_counter() - t0 < 5.0

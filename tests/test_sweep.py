@@ -2,7 +2,6 @@
 
 import csv
 import json
-from pathlib import Path
 
 import pytest
 
@@ -48,20 +47,25 @@ def _csv(path):
         return list(csv.DictReader(fh))
 
 
-def test_sweep_runs_and_resumes(tmp_path, capsys, monkeypatch):
+@pytest.mark.parametrize("cold", [False, True])
+def test_sweep_runs_and_resumes(tmp_path, capsys, monkeypatch, cold):
     """A grid on this process and a local worker (the first point here, which fills the
-    model cache, then a chunk each), then rerun after a point failed: only that point runs
-    again, here."""
+    model cache, then each process the next point left), then rerun after a point failed:
+    only that point runs again, here. The worker starts at once when numba's cache holds
+    the kernels (its first point waits for the cache's entries), else after the first
+    point, having loaded its modules meanwhile."""
     import femrub.app.sweep as sweep
+    import femrub.contact.jit as jit
     from femrub.blas import one_blas_thread
 
     here, kept, serial = [], [], []
+    monkeypatch.setattr(jit, "cold_kinds", lambda kinds: kinds if cold else ())
 
-    def spy(scene, chunk, cache, bar, builds=None):
+    def spy(scene, chunk, cache, bar, builds=None, claims=None):
         here.append([r["point"] for r in chunk])
         kept.append(builds)
         serial.append(one_blas_thread._inside > 0)
-        return points_here(scene, chunk, cache, bar, builds)
+        return points_here(scene, chunk, cache, bar, builds, claims)
 
     points_here = sweep._points_here
     monkeypatch.setattr(sweep, "_points_here", spy)
@@ -89,14 +93,14 @@ def test_sweep_runs_and_resumes(tmp_path, capsys, monkeypatch):
         "-q",
     ]
     assert main(args) == 0
-    # the first point here, then this process's chunk from the model it built; the worker
-    # prepared (modules, kernels) while the first point ran, then ran the other chunk
-    assert here == [[0], [1]] and kept[0] is kept[1] is not None
+    # the first point here, then the others from the model it built, each point in the
+    # process that claims it first; the worker walks the same points
+    assert here == [[0], [1, 2]] and kept[0] is kept[1] is not None
     assert serial[:2] == [False, True]  # all cores for the build, one BLAS thread after
-    assert sent[0] == ("prepare_worker", (("one",),), 1)
-    assert [name for name, *_ in sent[1:]] == ["run_points"]
-    ((changes, folder),) = sent[1][1][3]
-    assert changes == {"loads.rotation_speed": 300.0} and Path(folder).name.startswith("002_")
+    names = [name for name, *_ in sent]
+    assert names == (["prepare_worker", "run_points"] if cold else ["run_points"])
+    assert [c["loads.rotation_speed"] for c, _ in sent[-1][1][3]] == [200.0, 300.0]
+    assert not list((out / "runs").glob(".claims-*"))  # the claims go with the sweep
     rows = _csv(out / "interaction.csv")
     assert [r["loads.rotation_speed"] for r in rows] == ["100.0", "200.0", "300.0"]
     assert all(r["status"] == "ok" and r["skipped"] == "False" for r in rows)
@@ -111,11 +115,39 @@ def test_sweep_runs_and_resumes(tmp_path, capsys, monkeypatch):
     assert main(args) == 0
     rows = _csv(out / "interaction.csv")
     assert [r["skipped"] for r in rows] == ["True", "False", "True"]
-    assert here[2:] == [[1]] and len(sent) == 2  # one point to run: here, no cluster
+    assert here[2:] == [[1]] and len(sent) == len(names)  # one point to run: here, no cluster
     assert all(r["status"] == "ok" for r in rows)
     for r in (runs[0], runs[2]):
         assert (r / "summary.json").stat().st_mtime_ns == stamps[r.name]
     assert capsys.readouterr().err == ""
+
+
+def test_a_point_runs_in_the_process_that_claims_it_first(tmp_path):
+    """Processes given the same points run each once: a point another process claimed is
+    skipped (its row ``None``), the others run in order."""
+    from femrub.app.sweep import claim_point, run_points
+    from femrub.scene import load_scene
+
+    scene = load_scene(str(_tiny(tmp_path)))
+    claims = tmp_path / "claims"
+    claims.mkdir()
+    runs = tmp_path / "runs"
+    points = [
+        ({"loads.rotation_speed": w}, str(runs / f"{i:03d}")) for i, w in enumerate((1e2, 2e2))
+    ]
+    assert claim_point(claims, points[0][1])  # taken by another process
+    assert not claim_point(claims, runs / "elsewhere" / "000")  # the point, not the path
+    rows = run_points(scene.data, scene.source, str(scene.base_dir), points, claims=claims)
+    assert rows[0] is None and rows[1]["status"] == "ok"
+    assert not (runs / "000").exists() and (runs / "001" / "summary.json").is_file()
+    again = run_points(scene.data, scene.source, str(scene.base_dir), points, claims=claims)
+    assert again == [None, None]  # both claimed: nothing runs twice
+
+
+def _tiny(tmp_path):
+    path = tmp_path / "tiny.toml"
+    path.write_text(TINY)
+    return path
 
 
 def test_a_worker_s_preparation_never_raises_and_cold_kinds_reads_numba_s_cache():

@@ -13,12 +13,19 @@ per entry in the cache folder:
 * ``KEY.json``: its metadata (stage, size, SHA-256 of ``KEY.npz``, creation time, code
   version, a description), checked against :data:`ENTRY_SCHEMA` on every read.
 
+and, once a process has built it, an empty ``KEY.lock``: :meth:`ModelCache.building` holds an
+exclusive ``flock`` on it while the entry is built, so that processes that need the same
+entry at once (the workers of a sweep) build it once: the others wait and load it. The
+operating system releases the lock of a process that dies; the waiting one then finds no
+entry and builds it itself.
+
 The folder is femrub's when it holds the marker ``CACHEDIR.TAG`` (the cache directory tag
 standard, naming femrub), written when femrub creates the folder or finds it empty: femrub
-stores in, reads from, evicts from and clears only a marked folder, and only the files named
-after a key (``KEY.npz``, ``KEY.json``, an older femrub's ``KEY.pkl``, never read) and its
-own temporaries ``.KEY.*.tmp``; the metadata files are its manifest. A folder holding other
-files and no marker is left alone (the run goes on without the cache, with a notice).
+stores in, reads from, evicts from and clears only a marked folder, and only the files
+named after a key (``KEY.npz``, ``KEY.json``, ``KEY.lock``, an older femrub's ``KEY.pkl``,
+never read) and its own temporaries ``.KEY.*.tmp``; the metadata files are its manifest. A
+folder holding other files and no marker is left alone (the run goes on without the cache,
+with a notice).
 
 Writes go to a temporary file beside the target renamed into place, the data before the
 metadata, so concurrent runs (sweep workers) never see half an entry; files are opened
@@ -34,7 +41,9 @@ metadata) are removed until the total fits ``limit`` bytes. ``clear()`` empties 
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
+import fcntl
 import hashlib
 import json
 import os
@@ -78,7 +87,7 @@ _MARKER_TEXT = (
 _FORMAT = "femrub-cache-entry"
 _VERSION = 2
 _HEX = re.compile(r"[0-9a-f]{64}")
-_ENTRY_FILE = re.compile(r"([0-9a-f]{64})\.(npz|json|pkl)")
+_ENTRY_FILE = re.compile(r"([0-9a-f]{64})\.(npz|json|pkl|lock)")
 _TEMP_FILE = re.compile(r"\.([0-9a-f]{64})\..*\.tmp")
 _LEGACY_TEMP = re.compile(r"tmp[0-9a-z_]{8}\.tmp")
 #: The metadata of an entry: field -> (types, check).
@@ -353,6 +362,36 @@ class ModelCache:
         _mark_used(meta)
         return obj
 
+    @contextlib.contextmanager
+    def building(self, key: str, stage: str = "entry"):
+        """Hold the right to build the entry ``key`` for the block (single flight).
+
+        An exclusive ``flock`` on ``KEY.lock``: while another process holds it (it builds
+        the same entry) this one waits, says so (``log``) and then goes on, the entry
+        stored by then (the caller loads it again before building). Nothing is locked when
+        the folder is not femrub's or the lock file cannot be opened: the entry may then be
+        built twice, never half-read (stores are atomic)."""
+        fd = None
+        try:
+            if self._claim():
+                path = self.root / f"{check_key(key)}.lock"
+                fd = os.open(path, os.O_RDWR | os.O_CREAT | _NOFOLLOW, 0o600)
+        except OSError:
+            fd = None
+        try:
+            if fd is not None:
+                try:
+                    fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+                except BlockingIOError:
+                    t0 = time.perf_counter()
+                    self._notice(f"cache: {stage} ({key[:12]}) is being built by another process")
+                    fcntl.flock(fd, fcntl.LOCK_EX)
+                    self._notice(f"cache: waited {time.perf_counter() - t0:.1f} s for {stage}")
+            yield
+        finally:
+            if fd is not None:
+                os.close(fd)  # releases the lock
+
     def holds(self, key: str) -> bool:
         """Whether the folder holds an entry ``key`` (valid metadata and a data file of the
         size it records), marked as just used; its checksum is checked when it is loaded. An
@@ -411,7 +450,7 @@ class ModelCache:
 
     def _remove(self, key: str) -> int:
         freed = 0
-        for p in (*self._paths(key), self.root / f"{check_key(key)}.pkl"):
+        for p in (*self._paths(key), self.root / f"{check_key(key)}.pkl"):  # not its lock
             try:
                 freed += p.lstat().st_size
                 p.unlink()
@@ -467,7 +506,7 @@ class ModelCache:
             except OSError:
                 continue
             freed += size
-            if not p.name.endswith(".tmp"):
+            if not p.name.endswith((".tmp", ".lock")):
                 keys.add(m.group(1))
         return len(keys), freed
 

@@ -58,6 +58,7 @@ run at another speed) loads it instead of building it.
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import time
 
@@ -129,6 +130,18 @@ class Stages:
             self._say(f"cache: {stage} loaded in {time.perf_counter() - t0:.2f} s ({key[:12]})")
         return obj
 
+    @contextlib.contextmanager
+    def _building(self, stage: str, key: str):
+        """The cache's entry ``key`` of ``stage``, or ``None`` with the right to build it
+        held for the block (:meth:`ModelCache.building <femrub.app.cache.ModelCache.building>`:
+        a process that needs it while another builds it waits and loads it)."""
+        hit = self._fetch(stage, key)
+        if hit is not None:
+            yield hit
+            return
+        with self.cache.building(key, stage):
+            yield self._fetch(stage, key)  # stored meanwhile by the process waited for
+
     def _keep(self, stage: str, key: str, obj, describe: str) -> None:
         t0 = time.perf_counter()
         if self.cache.store(key, obj, stage=stage, describe=describe):
@@ -180,10 +193,10 @@ class Stages:
             self.hits["assembly"] = True
             self._say(f"cache: assembly kept by this process ({key[:12]})")
         else:
-            mats = self._fetch("assembly", key)
-        if mats is None:
-            mats = assemble(disc, material, **kw)
-            self._keep("assembly", key, mats, f"{mats.n_u} + {mats.n_t} FE dofs")
+            with self._building("assembly", key) as mats:
+                if mats is None:
+                    mats = assemble(disc, material, **kw)
+                    self._keep("assembly", key, mats, f"{mats.n_u} + {mats.n_t} FE dofs")
         if self.in_a_row:  # the next build on this blade: the same blocks
             Kept.last(self.kept.assembly, key, mats)
             self.kept.assembly_key = key
@@ -195,16 +208,21 @@ class Stages:
         factorisation it makes for :meth:`reduce`."""
 
         def damp(mats, boundary):
-            key = None
-            if self.cache is not None and self._mats_key is not None:
-                key = content_key(self._mats_key, "damping", boundary, float(zeta), modes)
-                hit = self._fetch("damping", key)
-                if hit is not None:
-                    a, b = hit["rayleigh"]
-                    C = (a * mats.M + b * mats.K).tocsr()
-                    damped = dataclasses.replace(mats, C=C, info=dict(mats.info))
-                    damped.info["rayleigh"] = (a, b)
-                    return damped
+            if self.cache is None or self._mats_key is None:
+                return made(mats, boundary, None)
+            key = content_key(self._mats_key, "damping", boundary, float(zeta), modes)
+            with self._building("damping", key) as hit:
+                if hit is None:
+                    return made(mats, boundary, key)
+            a, b = hit["rayleigh"]
+            C = (a * mats.M + b * mats.K).tocsr()
+            damped = dataclasses.replace(mats, C=C, info=dict(mats.info))
+            damped.info["rayleigh"] = (a, b)
+            if "omega" in hit:  # the frequencies a build reports, from the same solve
+                self._omega = (mats.K, np.asarray(hit["omega"]))
+            return damped
+
+        def made(mats, boundary, key):
             t0 = time.perf_counter()
             damped, self._stiffness, omega = modal_rayleigh(
                 mats, zeta, modes, boundary, at_least=self.modes
@@ -237,11 +255,10 @@ class Stages:
             float(omega),
             method,
         )
-        hit = self._fetch("prestress", key)
-        if hit is not None:
-            return hit
-        ps = centrifugal_prestress(disc, material, omega, method, log=self.log)
-        self._keep("prestress", key, ps, f"{method} at {omega:g} rad/s")
+        with self._building("prestress", key) as ps:
+            if ps is None:
+                ps = centrifugal_prestress(disc, material, omega, method, log=self.log)
+                self._keep("prestress", key, ps, f"{method} at {omega:g} rad/s")
         return ps
 
     def _model_key(self, model) -> str:
@@ -301,22 +318,28 @@ class Stages:
                 if stiffness is not None:
                     stiffness.free()
                 return _attach(hit, model), None, dict(hit["report"], cache="hit")
-        # the bases kept by this process, or built by another one (the cache)
-        kept = self._loaded("bases", bases) if stored else self.kept.reductor.get(bases)
+        with contextlib.ExitStack() as building:
+            # the bases kept by this process, or built by another one (the cache), waited
+            # for while another process builds them
+            kept = self._loaded("bases", bases) if stored else self.kept.reductor.get(bases)
+            if kept is None and stored and bases is not None:
+                building.enter_context(self.cache.building(bases, "bases"))
+                kept = self._loaded("bases", bases)
 
-        def keep_bases(reductor) -> None:  # before the estimate's runs (they may release it)
-            if bases is None:
-                return
-            detached = reductor.detached()  # not the model of this point
-            if self.in_a_row:
-                Kept.last(self.kept.reductor, bases, detached)
-            if kept is None and stored:
-                shapes = f"{reductor.n_uv} + {reductor.n_theta} shapes on {model.n_dofs} dofs"
-                self._keep("bases", bases, detached, shapes)
+            def keep_bases(reductor) -> None:  # before the estimate's runs (they may free it)
+                if bases is None:
+                    return
+                detached = reductor.detached()  # not the model of this point
+                if self.in_a_row:
+                    Kept.last(self.kept.reductor, bases, detached)
+                if kept is None and stored:
+                    shapes = f"{reductor.n_uv} + {reductor.n_theta} shapes on {model.n_dofs} dofs"
+                    self._keep("bases", bases, detached, shapes)
+                building.close()  # stored: a process waiting for them loads them now
 
-        reduced, reductor, report = reduce_checked(
-            model, scene, log, make_stepper, reductor=kept, on_bases=keep_bases, **kw
-        )
+            reduced, reductor, report = reduce_checked(
+                model, scene, log, make_stepper, reductor=kept, on_bases=keep_bases, **kw
+            )
         _say_phases(self._say, reduced.info.get("timings", {}))
         if stored:
             self._store_reduction(key, map_key, bases, reduced, reductor, report)

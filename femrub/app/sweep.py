@@ -22,10 +22,13 @@ follow the numbers (``1000:3000:500rpm``); plain numbers are SI.
 
 from __future__ import annotations
 
+import contextlib
 import csv
 import itertools
 import json
+import os
 import re
+import tempfile
 from pathlib import Path
 
 import numpy as np
@@ -163,7 +166,14 @@ def _rms(path, key):
 
 
 def run_points(
-    scene_data: dict, source: str, base_dir: str, points: list, cache=None, done=None, builds=None
+    scene_data: dict,
+    source: str,
+    base_dir: str,
+    points: list,
+    cache=None,
+    done=None,
+    builds=None,
+    claims=None,
 ) -> list:
     """Run ``points`` (``[(changes, folder), ...]``) in order in one worker and return their
     rows; never raises: a failed point comes back as its row.
@@ -173,17 +183,33 @@ def run_points(
     point's model at its own speed (its parameter) instead of building one; any other point
     shares the mesh's bases, the assembled blocks and the reductor the points before it
     built. ``cache``: a :class:`~femrub.app.cache.ModelCache` shared by the workers;
-    ``done``: called after each point (a progress bar).
+    ``done``: called after each point (a progress bar). ``claims``: a folder shared by the
+    processes given the same points (:func:`claim_point`): each point runs in the process
+    that claims it first, the others skip it (its row ``None``), so that a process free
+    before the others takes the next point left.
     """
     heap.map_large_arrays()  # workers of another scheduler (femrub.heap)
     base = Scene(scene_data, source, Path(base_dir))
     builds = builds if builds is not None else SceneBuilds(cache)
     rows = []
     for changes, out in points:
+        if claims is not None and not claim_point(claims, out):
+            rows.append(None)  # run by another process
+            continue
         rows.append(_run_one(base.with_changes(changes), out, builds))
         if done is not None:
             done()
     return rows
+
+
+def claim_point(claims, folder) -> bool:
+    """Whether this process is the first to claim the point whose folder is ``folder``
+    (an empty file named after it created in ``claims``, exclusively)."""
+    try:
+        os.close(os.open(Path(claims) / Path(folder).name, os.O_CREAT | os.O_EXCL | os.O_WRONLY))
+    except FileExistsError:
+        return False
+    return True
 
 
 def run_point(
@@ -357,29 +383,33 @@ def _compute(scene, todo, scheduler, workers, progress, cache=None) -> None:
 
     bar = tqdm(total=len(todo), disable=not progress, unit="point", desc="sweep")
     local = scheduler is None  # this process is one of the ``workers`` processes
-    first, (mine, *theirs) = _split(todo, cache, workers) if local else ([], ([], []))
+    first, (_, *theirs) = _split(todo, cache, workers) if local else ([], ([], []))
     if local and not theirs:  # --workers 0 or 1, or one chunk: here, the points in a row
         _points_here(scene, todo, cache, bar)
         bar.close()
         return
     client, cluster = _client(scheduler, len(theirs) if local else workers)
 
-    def submit(chunks):
+    def submit(chunks, claims=None, on=()):
+        """A task per chunk (on the worker ``on[i]`` when given)."""
         return {
             client.submit(
                 run_points,
                 *_here(scene),
                 [(r["params"], r["folder"]) for r in chunk],
                 cache,
+                claims=claims,
                 pure=False,
-                key=f"femrub-points-{chunk[0]['point']}-{id(chunk)}",
+                key=f"femrub-points-{chunk[0]['point']}-{id(chunk)}-{i}",
+                workers=[on[i]] if on else None,
             ): chunk
-            for chunk in chunks
+            for i, chunk in enumerate(chunks)
         }
 
     try:
         if local:
-            _share_here(scene, first, mine, theirs, cache, client, submit, bar)
+            with _claims_folder(todo[0]["folder"]) as claims:
+                _share_here(scene, first, todo[len(first) :], cache, client, submit, bar, claims)
         else:
             n_workers = len(client.scheduler_info().get("workers", {})) or workers
             for chunks in _batches(todo, cache, n_workers):
@@ -391,42 +421,73 @@ def _compute(scene, todo, scheduler, workers, progress, cache=None) -> None:
             cluster.close()
 
 
-def _points_here(scene, chunk, cache, bar, builds=None) -> None:
-    """Run ``chunk`` in this process (``builds``: what it built before), rows filled in."""
+@contextlib.contextmanager
+def _claims_folder(point_folder):
+    """A new folder beside the points' folders for their claims (:func:`claim_point`),
+    removed with the claims this sweep made in it."""
+    runs = Path(point_folder).parent
+    runs.mkdir(parents=True, exist_ok=True)
+    claims = Path(tempfile.mkdtemp(prefix=".claims-", dir=runs))
+    try:
+        yield claims
+    finally:
+        for f in claims.iterdir():
+            f.unlink(missing_ok=True)
+        claims.rmdir()
+
+
+def _points_here(scene, chunk, cache, bar, builds=None, claims=None) -> None:
+    """Run ``chunk`` in this process (``builds``: what it built before), rows filled in
+    (``claims``: :func:`run_points`; the points another process claimed are left as they
+    are)."""
     points = [(r["params"], r["folder"]) for r in chunk]
-    rows = run_points(*_here(scene), points, cache, done=lambda: bar.update(1), builds=builds)
+    rows = run_points(
+        *_here(scene), points, cache, done=lambda: bar.update(1), builds=builds, claims=claims
+    )
     for r, row in zip(chunk, rows, strict=True):
-        r.update(row)
+        if row is not None:
+            r.update(row)
 
 
-def _share_here(scene, first, mine, theirs, cache, client, submit, bar) -> None:
-    """The points on this process (``first``, then the chunk ``mine``) and a
-    ``LocalCluster`` (the chunks ``theirs``, one per worker).
+def _share_here(scene, first, rest, cache, client, submit, bar, claims) -> None:
+    """The points on this process (``first``, then its share of ``rest``) and on the
+    workers of a ``LocalCluster`` (their share of ``rest``): every process walks ``rest`` in
+    order and runs the points it claims first (:func:`run_points`, ``claims``), so each
+    takes the next point left when it is free.
 
     With a cache, the first point runs here first, on all this process's cores (the local
     workers have one thread each and would otherwise build it on one while the others wait:
     on Rotor 37 46 s instead of 83 s), and fills the cache (assembly, damping, reduction
-    bases, map to the mesh) while the workers prepare (:func:`prepare_worker`); the other
-    chunks then load what they share with it. This process then runs the largest chunk
-    itself, on one BLAS thread, from the model it holds (a worker's first point builds its
-    model from the cache: on Rotor 37 twice a later point). MKL's reproducible mode
+    bases, map to the mesh). The workers start at once when numba's cache holds the
+    kernels the points need: their first point waits for each entry the first point is
+    building (:meth:`ModelCache.building <femrub.app.cache.ModelCache.building>`), loads it,
+    and runs as soon as the bases are stored, before the first point's own run; otherwise
+    they prepare (:func:`prepare_worker`) and start after it. This process then runs its
+    points on one BLAS thread from the model it holds (a worker's first point builds its
+    model from the cache). MKL's reproducible mode
     (:data:`femrub.fem.linalg.MKL_REPRODUCIBLE`) keeps its threaded factorisations, and so
     the bases every point shares, the same from run to run.
     """
     from ..blas import one_blas_thread
+    from ..contact.jit import cold_kinds
 
     builds = SceneBuilds(cache)
+    workers = list(client.scheduler_info().get("workers", {}))
+    kinds = kernel_kinds(scene)
+    early = not first or not cold_kinds(kinds)
+    futures = submit([rest] * len(workers), claims, workers) if early else None
     if first:
-        kinds = kernel_kinds(scene)
         prepared = [  # kept until the points are submitted after them
             client.submit(prepare_worker, kinds, workers=[w], pure=False)
-            for w in client.scheduler_info().get("workers", {})
+            for w in workers
+            if not early
         ]
         _points_here(scene, first, cache, bar, builds)
         del prepared
-    futures = submit(theirs)
+    if futures is None:
+        futures = submit([rest] * len(workers), claims, workers)
     with one_blas_thread:
-        _points_here(scene, mine, cache, bar, builds)
+        _points_here(scene, rest, cache, bar, builds, claims)
     _collect(futures, bar)
 
 
@@ -494,17 +555,25 @@ def _chunks(points: list, n: int) -> list[list]:
 
 
 def _collect(futures, bar) -> None:
+    """Fill in the rows of the points each task ran (``None``: run elsewhere); a point
+    left without a row (its worker lost, ...) is ``failed``."""
     from dask.distributed import as_completed
 
+    lost = None
     for fut in as_completed(futures):
-        chunk = futures[fut]
         try:
-            for r, row in zip(chunk, fut.result(), strict=True):
-                r.update(row)
+            rows = fut.result()
         except Exception as exc:  # worker lost, etc.
-            for r in chunk:
-                r.update(status="failed", message=f"{type(exc).__name__}: {exc}")
-        bar.update(len(chunk))
+            lost = f"{type(exc).__name__}: {exc}"
+            continue
+        ran = [(r, row) for r, row in zip(futures[fut], rows, strict=True) if row is not None]
+        for r, row in ran:
+            r.update(row)
+        bar.update(len(ran))
+    for r in (r for chunk in futures.values() for r in chunk):
+        if "status" not in r:
+            r.update(status="failed", message=lost or "not run")
+            bar.update(1)
 
 
 def _x(scene, key) -> float:
