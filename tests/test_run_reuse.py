@@ -305,3 +305,21 @@ def test_a_run_that_writes_frames_is_stepped_again_and_its_checks_only_compared(
         b = framed.report[key].get("error", framed.report[key])
         assert a["status_reference"] == b["status_reference"] == "ok"
         assert b["estimate"] == pytest.approx(a["estimate"], rel=1e-6)
+
+
+def test_no_history_csv_at_stride_zero(sim, tmp_path):
+    """``outputs.csv_stride = 0``: no ``history.csv``, stepped or reused, and the same
+    ``history.npz`` as with one."""
+    a = _write(sim, tmp_path / "reused", sim.ran, csv_stride=0)
+    b = _write(sim, tmp_path / "stepped", None, csv_stride=0)
+    c = _write(sim, tmp_path / "with", None, csv_stride=1)
+    assert not (tmp_path / "reused/history.csv").exists()
+    assert not (tmp_path / "stepped/history.csv").exists()
+    assert (tmp_path / "with/history.csv").is_file()
+    assert a.status == b.status == c.status == "ok"
+    with (
+        np.load(tmp_path / "stepped/history.npz") as hb,
+        np.load(tmp_path / "with/history.npz") as hc,
+    ):
+        assert sorted(hb.files) == sorted(hc.files)
+        np.testing.assert_array_equal(hb["impulse"], hc["impulse"])

@@ -26,7 +26,7 @@ from .csv_rows import write_csv_rows
 from .results import UNITS, csv_header, flatten_columns
 from .safe_write import naming, open_nofollow
 
-__all__ = ["HistoryCSV"]
+__all__ = ["HistoryCSV", "NoHistoryCSV"]
 
 _IMPULSE, _FORCE = "contact_impulse", "contact_force"
 
@@ -166,3 +166,14 @@ class HistoryCSV:
         except OSError as exc:
             self.error = self.error or exc
         self._fh = None
+
+
+class NoHistoryCSV:
+    """What a run keeps instead of :class:`HistoryCSV` with ``outputs.csv_stride = 0``: no
+    file (the run streams it no rows)."""
+
+    rows = received = 0
+    error = None
+
+    def close(self) -> None:
+        """Nothing to close."""

@@ -29,7 +29,7 @@ import numpy as np
 from .. import __version__
 from ..steppers.record import State
 from .folder import OUTPUTS, ResultExists, claim
-from .history_file import HistoryCSV
+from .history_file import HistoryCSV, NoHistoryCSV
 from .interrupts import deferred, interruptible
 from .jsonfile import write_json as _write_json
 from .plots import savefig, tip_panels
@@ -124,7 +124,7 @@ def run_to_folder(  # noqa: PLR0913 (keyword-only output options)
     ``vtk_stride`` steps). ``csv_stride``:
     ``history.csv`` at one row every that many steps
     (:meth:`~femrub.output.results.Results.save_csv`'s ``every``; ``history.npz`` keeps every
-    step). Returns the :class:`~femrub.output.results.Results`.
+    step), 0: no ``history.csv``. Returns the :class:`~femrub.output.results.Results`.
     """
     out = Path(out)
     with nullcontext() if claimed else claim(out, "run", overwrite=overwrite):
@@ -231,7 +231,11 @@ def _run(  # noqa: PLR0913 (run_to_folder's options passed on)
             series = VTKSeries(out / "vtk", model, fields, h=stepper.h, stride=vtk_stride)
     for stale in ("history.csv", "history.npz", "signals.png", "snapshot.png"):
         (out / stale).unlink(missing_ok=True)  # results of an earlier, unfinished run
-    history = HistoryCSV(out / "history.csv", every=csv_stride, units=signal_units(model))
+    history = (
+        HistoryCSV(out / "history.csv", every=csv_stride, units=signal_units(model))
+        if csv_stride
+        else NoHistoryCSV()
+    )
     t0 = time.perf_counter()
     tolerances = {"reduction": reduction_error, "time_step": step_error}
     try:
@@ -246,7 +250,7 @@ def _run(  # noqa: PLR0913 (run_to_folder's options passed on)
                     progress=progress,
                     limits=limits,
                     on_state=series,
-                    on_rows=history,
+                    on_rows=history if csv_stride else None,
                     merge_time=merge_time,
                     tolerances=tolerances,
                 )
@@ -338,7 +342,7 @@ def _finish(  # noqa: PLR0913 (run_to_folder's options passed on)
 ):
     vtk_wall, vtk_cpu = (series.seconds, series.cpu_seconds) if series is not None else (0.0, 0.0)
     t_out = time.perf_counter()
-    if history.received != len(res.t) and history.error is None:  # not streamed
+    if csv_stride and history.received != len(res.t) and history.error is None:  # not streamed
         with naming(out / "history.csv"):
             res.save_csv(out / "history.csv", every=csv_stride)
     with naming(out / "history.npz"):

@@ -195,9 +195,10 @@ OUTPUTS = {
     "csv_stride": Spec(
         I,
         1,
-        lo=1,
+        lo=0,
         doc="history.csv: one row every that many steps (contact impulses summed, forces "
-        "averaged over the steps between rows); history.npz keeps every step",
+        "averaged over the steps between rows; 0: no history.csv, as for the points of a "
+        "map); history.npz keeps every step",
     ),
     "plots": Spec(
         B,
