@@ -4,6 +4,7 @@ import csv
 import io
 import json
 import zipfile
+import zlib
 
 import numpy as np
 
@@ -77,6 +78,12 @@ def test_npz_stores_what_does_not_deflate_as_it_is(tmp_path):
     assert kinds["gap.npy"] == kinds["signal_tip_displacement.npy"] == zipfile.ZIP_STORED
     assert kinds["impulse.npy"] == kinds["normal_force.npy"] == zipfile.ZIP_DEFLATED
     assert kinds["contact_state.npy"] == kinds["meta.npy"] == zipfile.ZIP_DEFLATED
+    with zipfile.ZipFile(path) as zf:  # deflated by run-length matches (R.NPZ_STRATEGY)
+        size = zf.getinfo("impulse.npy").compress_size
+    npy = io.BytesIO()
+    np.lib.format.write_array(npy, impulse, allow_pickle=False)
+    rle = zlib.compressobj(R.NPZ_LEVEL, zlib.DEFLATED, -15, 9, zlib.Z_RLE)
+    assert size == len(rle.compress(npy.getvalue()) + rle.flush())
     with np.load(path) as d:
         for key, want in [("gap", res.gap), ("impulse", impulse), ("t", t)]:
             assert d[key].dtype == want.dtype
