@@ -2,12 +2,13 @@
 
 ``femrub sweep SCENE --param rotation_speed=200:2000:50 -o DIR`` runs every point of the
 grid (cartesian product of the ``--param`` values), each writing its own results folder
-``DIR/runs/NNN_key=value/`` (:func:`femrub.scene.run_scene`), in one chunk of points per
-process, every N-th point of the grid (:func:`run_points`: a point at another speed reuses
-the model of the point before, the speed being its parameter). Chunks run on this machine,
-in this process and up to ``--workers`` − 1 worker processes of a ``LocalCluster`` (1 thread
-each; 2 processes by default), or on the cluster behind ``--scheduler ADDRESS`` (the output
-folder must then be shared). A point whose folder holds a finished result is skipped, so
+``DIR/runs/NNN_key=value/`` (:func:`femrub.scene.run_scene`). On this machine, this process
+and up to ``--workers`` − 1 worker processes of a ``LocalCluster`` (1 thread each; 2
+processes by default) walk the grid in order and each runs the next point no other has
+claimed (:func:`claim_point`); on the cluster behind ``--scheduler ADDRESS`` (the output
+folder must then be shared) each worker runs one chunk of points, every N-th of the grid
+(:func:`run_points`: in both, a point at another speed reuses the model of the point
+before, the speed being its parameter). A point whose folder holds a finished result is skipped, so
 rerunning the command after a failure or an interruption only runs what is missing. A
 point is keyed by a hash of its resolved scene (:func:`femrub.app.run.scene_hash`): its
 folder name ends with the first characters of the hash, so changing the scene between two
