@@ -78,7 +78,7 @@ def test_npz_stores_what_does_not_deflate_as_it_is(tmp_path):
     assert kinds["gap.npy"] == kinds["signal_tip_displacement.npy"] == zipfile.ZIP_STORED
     assert kinds["impulse.npy"] == kinds["normal_force.npy"] == zipfile.ZIP_DEFLATED
     assert kinds["contact_state.npy"] == kinds["meta.npy"] == zipfile.ZIP_DEFLATED
-    with zipfile.ZipFile(path) as zf:  # deflated by run-length matches (R.NPZ_STRATEGY)
+    with zipfile.ZipFile(path) as zf:  # deflated by run-length matches (R.NPZ_STRATEGIES)
         size = zf.getinfo("impulse.npy").compress_size
     npy = io.BytesIO()
     np.lib.format.write_array(npy, impulse, allow_pickle=False)
@@ -112,3 +112,17 @@ def test_friction_magnitude_in_blocks_is_the_norm_of_the_whole(monkeypatch):
     )
     res.friction_force = None
     assert res.friction_magnitude().shape == (m, 0)
+
+
+def test_npz_deflates_repeats_that_are_not_runs_by_the_default_strategy(tmp_path):
+    """An array whose bytes repeat without runs (a periodic history) does not deflate by run
+    lengths: the default strategy deflates it, instead of storing it as it is."""
+    periodic = np.tile(np.random.default_rng(5).standard_normal(64), 4000)
+    path = tmp_path / "h.npz"
+    R._savez(path, {"periodic": periodic})
+    with zipfile.ZipFile(path) as zf:
+        info = zf.getinfo("periodic.npy")
+    assert info.compress_type == zipfile.ZIP_DEFLATED
+    assert info.compress_size < 0.1 * periodic.nbytes
+    with np.load(path) as d:
+        np.testing.assert_array_equal(d["periodic"], periodic)

@@ -151,11 +151,13 @@ def csv_header(columns, units: dict[str, str]) -> list[str]:
 
 #: zlib level of ``history.npz`` (1: float histories barely compress more at 6, 1.5× slower)
 NPZ_LEVEL = 1
-#: zlib strategy of ``history.npz``: run-length matches only. A run's impulses and friction
-#: forces are mostly zero: deflated to the same size as by the default strategy (Rotor 37,
-#: 50,000 steps: 0.287 against 0.292 of their bytes) in a third to a half of the time; the
-#: file is ordinary deflate, read by ``numpy.load`` and any unzip
-NPZ_STRATEGY = zlib.Z_RLE
+#: zlib strategies of ``history.npz``, the first that deflates an array's samples enough
+#: (:data:`NPZ_DEFLATE_BELOW`): run-length matches only, then the default. A run's impulses
+#: and friction forces are mostly zero: run lengths deflate them to the same size as the
+#: default (Rotor 37, 50,000 steps: 0.287 against 0.292 of their bytes) in a third to a half
+#: of the time; arrays with other repeats (a bar's states) need the default. The file is
+#: ordinary deflate, read by ``numpy.load`` and any unzip
+NPZ_STRATEGIES = (zlib.Z_RLE, zlib.Z_DEFAULT_STRATEGY)
 #: an array of ``history.npz`` is written deflated only when samples of its bytes deflate
 #: below this share of their size: the gaps, displacements and slip velocities of a long
 #: run deflate to 90-95 % and are stored as they are (Rotor 37, 50,000 steps: the file 5 %
@@ -169,43 +171,49 @@ NPZ_SAMPLES, NPZ_SAMPLE_BYTES = 16, 1 << 12
 ROW_BLOCK = 65536
 
 
-def _deflater():
-    """A raw deflate stream (as a ZIP member holds it) at :data:`NPZ_LEVEL` and
-    :data:`NPZ_STRATEGY`."""
-    return zlib.compressobj(NPZ_LEVEL, zlib.DEFLATED, -15, 9, NPZ_STRATEGY)
+def _deflater(strategy: int):
+    """A raw deflate stream (as a ZIP member holds it) at :data:`NPZ_LEVEL` and ``strategy``."""
+    return zlib.compressobj(NPZ_LEVEL, zlib.DEFLATED, -15, 9, strategy)
 
 
-def _deflates(a: np.ndarray) -> bool:
-    """Whether ``a`` is worth deflating (:data:`NPZ_DEFLATE_BELOW`; small arrays always are)."""
+def _strategy(a: np.ndarray) -> int | None:
+    """The first of :data:`NPZ_STRATEGIES` that deflates samples of ``a`` below
+    :data:`NPZ_DEFLATE_BELOW` of their size, or ``None``: ``a`` is stored as it is (small
+    arrays are deflated by the default strategy)."""
     if a.dtype.hasobject or a.nbytes <= NPZ_SAMPLES * NPZ_SAMPLE_BYTES:
-        return True
+        return zlib.Z_DEFAULT_STRATEGY
     raw = np.ascontiguousarray(a).reshape(-1).view(np.uint8)
     starts = np.linspace(0, raw.size - NPZ_SAMPLE_BYTES, NPZ_SAMPLES).astype(int)
     sample = b"".join(raw[i : i + NPZ_SAMPLE_BYTES].tobytes() for i in starts)
-    z = _deflater()
-    return len(z.compress(sample) + z.flush()) < NPZ_DEFLATE_BELOW * len(sample)
+    for strategy in NPZ_STRATEGIES:
+        z = _deflater(strategy)
+        if len(z.compress(sample) + z.flush()) < NPZ_DEFLATE_BELOW * len(sample):
+            return strategy
+    return None
 
 
 def _savez(path: Path, arrays: dict) -> None:
-    """``numpy.savez_compressed``'s format at zlib level :data:`NPZ_LEVEL` and strategy
-    :data:`NPZ_STRATEGY` (read by ``numpy.load``), each array that does not deflate
-    (:func:`_deflates`) stored as is."""
+    """``numpy.savez_compressed``'s format at zlib level :data:`NPZ_LEVEL` (read by
+    ``numpy.load``), each array deflated by its strategy (:func:`_strategy`) or stored as
+    it is."""
     with zipfile.ZipFile(path, "w", zipfile.ZIP_DEFLATED, compresslevel=NPZ_LEVEL) as zf:
         for key, value in arrays.items():
             a = np.asanyarray(value)
-            zf.compression = zipfile.ZIP_DEFLATED if _deflates(a) else zipfile.ZIP_STORED
+            strategy = _strategy(a)
+            zf.compression = zipfile.ZIP_STORED if strategy is None else zipfile.ZIP_DEFLATED
             with zf.open(key + ".npy", "w", force_zip64=True) as f:
-                _use_strategy(f)
+                _use_strategy(f, strategy)
                 np.lib.format.write_array(f, a, allow_pickle=False)
 
 
-def _use_strategy(member) -> None:
-    """Deflate the ZIP member being written with :func:`_deflater` (``zipfile`` offers the
+def _use_strategy(member, strategy: int | None) -> None:
+    """Deflate the ZIP member being written with ``strategy`` (``zipfile`` offers the
     level, not the strategy: its writer's compressor, made by ``ZipFile.open`` and fed by
-    its ``write``, is replaced before any byte; left as it is on a ``zipfile`` without that
-    attribute or for a stored member)."""
-    if getattr(member, "_compressor", None) is not None:
-        member._compressor = _deflater()
+    its ``write``, is replaced before any byte; left as it is for the default strategy, a
+    stored member or a ``zipfile`` without that attribute)."""
+    if strategy not in (None, zlib.Z_DEFAULT_STRATEGY):
+        if getattr(member, "_compressor", None) is not None:
+            member._compressor = _deflater(strategy)
 
 
 class Snapshot(NamedTuple):
