@@ -80,20 +80,23 @@ def newton_law(W, q, e, ub, idx):
 def _residual(P, W, q, mu, rho, U):
     """Alart–Curnier function ``F(P)`` (m, 3) and what its Jacobian needs."""
     m = q.shape[0]
-    p = P.reshape(-1)
-    u = q.copy()  # W P + q, by hand: a BLAS call costs more than the product at this size
-    for i in range(m):
+    F, u, x = np.empty((m, 3)), np.empty((m, 3)), np.empty((m, 2))
+    pos, slip = np.empty(m, dtype=np.bool_), np.empty(m, dtype=np.bool_)
+    r, nx = np.empty(m), np.empty(m)
+    _residual_into(P, W, q, mu, rho, U, F, u, pos, r, x, nx, slip)
+    return F, u, pos, r, x, nx, slip
+
+
+@njit
+def _residual_into(P, W, q, mu, rho, U, F, u, pos, r, x, nx, slip):
+    """:func:`_residual` written into ``F, u, pos, r, x, nx, slip`` (every entry)."""
+    m = q.shape[0]
+    for i in range(m):  # u = W P + q, by hand: a BLAS call costs more at this size
         for c in range(3):
             s = 0.0
             for j in range(3 * m):
-                s += W[3 * i + c, j] * p[j]
-            u[i, c] += s
-    F = np.empty((m, 3))
-    pos = np.empty(m, dtype=np.bool_)
-    slip = np.empty(m, dtype=np.bool_)
-    r = np.empty(m)
-    x = np.empty((m, 2))
-    nx = np.empty(m)
+                s += W[3 * i + c, j] * P[j // 3, j % 3]
+            u[i, c] = q[i, c] + s
     for i in range(m):
         a = P[i, 0] - rho[i] * u[i, 0]
         pn = min(max(a, 0.0), U[i])
@@ -108,15 +111,14 @@ def _residual(P, W, q, mu, rho, U):
         F[i, 0] = P[i, 0] - pn
         F[i, 1] = P[i, 1] - s * x0
         F[i, 2] = P[i, 2] - s * x1
-    return F, u, pos, r, x, nx, slip
 
 
 @njit
-def _jacobian(rW, mu, pos, r, x, nx, slip):
-    """An element of the generalised Jacobian of :func:`_residual` (3m, 3m); ``ρ W`` given,
-    ``dA = I − ρ W``."""
+def _jacobian_into(J, rW, mu, pos, r, x, nx, slip):
+    """An element of the generalised Jacobian of :func:`_residual` (3m, 3m) written into
+    ``J``; ``ρ W`` given, ``dA = I − ρ W``."""
     m = pos.size
-    J = rW.copy()
+    J[:, :] = rW
     for i in range(m):
         if not pos[i]:  # F_n = P_n
             J[3 * i, :] = 0.0
@@ -133,7 +135,6 @@ def _jacobian(rW, mu, pos, r, x, nx, slip):
                 J[3 * i + 2, j] = -xh1 * dr - c * (p01 * a1 + p11 * a2)
             J[3 * i + 1, 3 * i + 1] += 1.0
             J[3 * i + 2, 3 * i + 2] += 1.0
-    return J
 
 
 #: largest Newton system solved by the in-kernel elimination (above it: LAPACK)
@@ -188,37 +189,82 @@ def _solve(J, b):
 
 
 @njit
+def _max_abs(F) -> float:
+    """``max |F|`` as ``numpy.max(numpy.abs(F))`` gives it, NaN included (no temporary)."""
+    big = 0.0
+    for i in range(F.shape[0]):
+        for c in range(F.shape[1]):
+            a = abs(F[i, c])
+            if a > big:
+                big = a
+            elif a != a:  # NaN: the maximum is NaN
+                return a
+    return big
+
+
+@njit
+def _half_square(F) -> float:
+    """``‖F‖² / 2`` summed in the order of the entries."""
+    s = 0.0
+    for i in range(F.shape[0]):
+        for c in range(F.shape[1]):
+            s += F[i, c] ** 2
+    return 0.5 * s
+
+
+@njit
 def _newton(P, W, rW, q, mu, rho, U, tol, max_iter, at_P):
     """Semi-smooth Newton with Armijo line search on ``‖F‖²/2``; stops when it stalls.
-    ``at_P``: :func:`_residual` at ``P`` (the caller has it).
+    ``at_P``: :func:`_residual` at ``P`` (the caller has it). The iterate and a trial point
+    live in two sets of arrays made once, swapped when a step is taken (no allocation per
+    iteration); ``P`` and ``at_P``'s arrays are among them.
 
     Returns ``(P, F, u, iterations)``.
     """
     m = q.shape[0]
     F, u, pos, r, x, nx, slip = at_P
-    merit = 0.5 * np.sum(F**2)
+    Pn, Fn, un, xn = np.empty((m, 3)), np.empty((m, 3)), np.empty((m, 3)), np.empty((m, 2))
+    posn, slipn = np.empty(m, dtype=np.bool_), np.empty(m, dtype=np.bool_)
+    rn, nxn = np.empty(m), np.empty(m)
+    J, b = np.empty((3 * m, 3 * m)), np.empty(3 * m)
+    merit = _half_square(F)
     it = 0
     for k in range(1, max_iter + 1):
         it = k
-        if np.max(np.abs(F)) <= tol:
+        if _max_abs(F) <= tol:
             break
-        J = _jacobian(rW, mu, pos, r, x, nx, slip)
-        d, ok = _solve(J, -F.reshape(-1))
+        _jacobian_into(J, rW, mu, pos, r, x, nx, slip)
+        for i in range(m):
+            for c in range(3):
+                b[3 * i + c] = -F[i, c]
+        d, ok = _solve(J, b)
         if not ok:  # singular Jacobian
             break
-        d = d.reshape(m, 3)
         t = 1.0
         while True:
-            Pn = P + t * d
-            Fn, un, posn, rn, xn, nxn, slipn = _residual(Pn, W, q, mu, rho, U)
-            mn = 0.5 * np.sum(Fn**2)
+            for i in range(m):
+                for c in range(3):
+                    Pn[i, c] = P[i, c] + t * d[3 * i + c]
+            _residual_into(Pn, W, q, mu, rho, U, Fn, un, posn, rn, xn, nxn, slipn)
+            mn = _half_square(Fn)
             if mn <= (1.0 - 1e-4 * t) * merit:
                 break
             t *= 0.5
             if t < 1e-8:
                 return P, F, u, it
-        P, F, u, merit = Pn, Fn, un, mn
-        pos, r, x, nx, slip = posn, rn, xn, nxn, slipn
+        P, Pn, F, Fn, u, un, merit = Pn, P, Fn, F, un, u, mn
+        pos, posn, r, rn, x, xn, nx, nxn, slip, slipn = (
+            posn,
+            pos,
+            rn,
+            r,
+            xn,
+            x,
+            nxn,
+            nx,
+            slipn,
+            slip,
+        )
     return P, F, u, it
 
 
@@ -310,12 +356,12 @@ def alart_curnier(W, q, mu, U, warm, use_warm, tol, max_iter):
         if np.sum(at_warm[0] ** 2) <= np.sum(at_P[0] ** 2):
             P, at_P = warm.copy(), at_warm
     P, F, u, it = _newton(P, W, rW, q, mu, rho, U, tol * scale, max_iter, at_P)
-    if np.max(np.abs(F)) > tol * scale:  # Newton stalled: Gauss-Seidel sweeps, then Newton
+    if _max_abs(F) > tol * scale:  # Newton stalled: Gauss-Seidel sweeps, then Newton
         P = _gauss_seidel(P, W, q, mu, rho, U, tol * scale, 5000)
         at_P = _residual(P, W, q, mu, rho, U)
         P, F, u, it2 = _newton(P, W, rW, q, mu, rho, U, tol * scale, max_iter, at_P)
         it += it2
-    res = np.max(np.abs(F)) / scale
+    res = _max_abs(F) / scale
     P, slide = _on_cone(P, u, mu, rho, U)
     status = SOLVED if res <= math.sqrt(tol) else NOT_SOLVED
     return P, slide, res, it, status

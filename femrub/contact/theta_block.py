@@ -131,17 +131,17 @@ def friction_step(
         e[i] = 1.0 if gdk[i] > 0.0 else e3[i]
     q = yp[n:].copy().reshape((n, 3))
     entry_bounds(U, yk[:n], yp[:n])  # a coating's bound: the part of the step on it
-    active, P, u, st, res, it, status = frictional_fixed_point(
+    active, P, u, st, res, it, status = frictional_fixed_point(  # reads these, never writes
         code,
-        yk[:n].copy(),
-        gdk.copy(),
-        yp[:n].copy(),
+        yk[:n],
+        gdk,
+        yp[:n],
         GZ,
         W,
         q,
         mu,
-        e.copy(),
-        gdk.copy(),
+        e,
+        gdk,
         U,
         warm,
         use_warm,
