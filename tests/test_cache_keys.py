@@ -89,6 +89,31 @@ def test_scene_hash_follows_the_mesh_file_and_its_includes(tmp_path):
     assert scene_hash(scene) != before
 
 
+def test_the_files_are_read_again_only_when_their_status_changes(tmp_path, monkeypatch):
+    """The 40 points of a map on one deck read it once for their keys; a file written again
+    (here: the same bytes, its times moved) is read again, and a changed one gives a new
+    key even at the same size."""
+    import os
+
+    import femrub.app.inputs as inputs
+
+    _deck(tmp_path, name="part.inp")
+    (tmp_path / "blade.inp").write_text("*HEADING\nmain\n*INCLUDE, INPUT=part.inp\n")
+    scene = _mesh_scene(tmp_path)
+    before = scene_hash(scene)
+    read = []
+    feed = inputs._feed_file
+    monkeypatch.setattr(inputs, "_feed_file", lambda h, path: (read.append(path), feed(h, path)))
+    assert [scene_hash(scene) for _ in range(3)] == [before] * 3 and read == []
+    part = tmp_path / "part.inp"
+    st = part.stat()
+    os.utime(part, ns=(st.st_atime_ns, st.st_mtime_ns + 10**9))
+    assert scene_hash(scene) == before and part.resolve() in read
+    text = part.read_text()
+    part.write_text(text.replace("2, 10, 0, 0", "2, 10, 0, 1", 1))  # the same size, new bytes
+    assert len(part.read_text()) == len(text) and scene_hash(scene) != before
+
+
 def test_an_edited_mesh_file_makes_a_resumed_sweep_rerun_its_points(tmp_path, monkeypatch):
     import csv
 
