@@ -253,18 +253,8 @@ def _newton(P, W, rW, q, mu, rho, U, tol, max_iter, at_P):
             if t < 1e-8:
                 return P, F, u, it
         P, Pn, F, Fn, u, un, merit = Pn, P, Fn, F, un, u, mn
-        pos, posn, r, rn, x, xn, nx, nxn, slip, slipn = (
-            posn,
-            pos,
-            rn,
-            r,
-            xn,
-            x,
-            nxn,
-            nx,
-            slipn,
-            slip,
-        )
+        pos, posn, r, rn, x, xn = posn, pos, rn, r, xn, x
+        nx, nxn, slip, slipn = nxn, nx, slipn, slip
     return P, F, u, it
 
 
