@@ -62,6 +62,17 @@ def test_run_writes_the_results_folder(tiny, tmp_path, capsys):
     assert main(["check", str(out / "scene.toml"), "-q"]) == 0
 
 
+def test_the_run_names_the_files_it_wrote(tiny, tmp_path, capsys):
+    """Without ``history.csv`` (``outputs.csv_stride = 0``) and plots, the closing line names
+    what the folder holds."""
+    out = tmp_path / "out"
+    sets = ["--set", "outputs.csv_stride=0", "--set", "outputs.plots=false"]
+    assert main(["run", str(tiny), "-o", str(out), *sets]) == 0
+    said = [line for line in capsys.readouterr().out.splitlines() if "results in" in line]
+    assert said == [f"  results in {out}/: summary.json, history.npz"]
+    assert not (out / "history.csv").exists() and (out / "history.npz").is_file()
+
+
 def test_rerun_refuses_to_overwrite_a_finished_result(tiny, tmp_path, capsys):
     out = tmp_path / "out"
     assert main(["run", str(tiny), "-o", str(out), "-q", *NO_PLOTS]) == 0

@@ -147,7 +147,9 @@ def _run(args) -> int:
         cache=_cache(args, _log(args)),
         keep_build=False,
     )
-    where = f"{out}/ (summary.json, history.csv, history.npz)"
+    written = ["summary.json", "history.npz"]
+    written += ["history.csv"] if scene["outputs.csv_stride"] else []
+    where = f"{out}/ ({', '.join(written)})"
     if res.status == "interrupted":
         print(
             f"femrub: interrupted at t = {res.t[-1]:.6g} s after {res.steps} steps; partial "
@@ -180,7 +182,8 @@ def _run(args) -> int:
         if built.fields is not None and scene["outputs.vtk_stride"]:
             series = built.fields.parts() if hasattr(built.fields, "parts") else ("rub",)
             vtk = " and " + ", ".join(f"vtk/{name}.pvd" for name in series) + " (ParaView)"
-        print(f"  results in {out}/: summary.json, history.csv, signals.png{vtk}")
+        plots = ", signals.png" if scene["outputs.plots"] else ""
+        print(f"  results in {out}/: {', '.join(written)}{plots}{vtk}")
     if args.explain:
         from .explain import format_timings
 
