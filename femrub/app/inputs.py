@@ -96,10 +96,7 @@ def _deck_files(path: Path, depth: int = 0, seen=None) -> list[Path]:
 
 
 def _is_regular(path: Path) -> bool:
-    try:
-        return stat.S_ISREG(path.stat().st_mode)
-    except OSError:
-        return False
+    return _status(path) is not None
 
 
 def input_files(scene) -> list[Path]:
