@@ -71,6 +71,16 @@ def test_the_run_names_the_files_it_wrote(tiny, tmp_path, capsys):
     said = [line for line in capsys.readouterr().out.splitlines() if "results in" in line]
     assert said == [f"  results in {out}/: summary.json, history.npz"]
     assert not (out / "history.csv").exists() and (out / "history.npz").is_file()
+    sets += ["--set", "outputs.history_npz=false"]
+    assert main(["run", str(tiny), "-o", str(tmp_path / "lean"), *sets]) == 0
+    said = [line for line in capsys.readouterr().out.splitlines() if "results in" in line]
+    assert said == [f"  results in {tmp_path / 'lean'}/: summary.json"]
+    assert sorted(p.name for p in (tmp_path / "lean").iterdir() if p.suffix != ".lock") == [
+        ".femrub",
+        "explain.txt",
+        "scene.toml",
+        "summary.json",
+    ]
 
 
 def test_rerun_refuses_to_overwrite_a_finished_result(tiny, tmp_path, capsys):

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import csv
 import json
+import shutil
 import sys
 from pathlib import Path
 
@@ -204,6 +205,15 @@ def test_interaction_csv_has_probe_columns(runs, tmp_path):
     assert probes["rms_probe_tip_y_m"] == pytest.approx(np.sqrt(np.mean(x**2)), rel=1e-12)
     assert probes["max_probe_tip_y_m"] == pytest.approx(np.abs(x).max(), rel=1e-12)
     assert "max_probe_tip_c_m_s" in probes
+    # a folder written before the summary held the measures: read from its history.npz
+    older = tmp_path / "older"
+    older.mkdir()
+    summary = json.loads((folder / "summary.json").read_text())
+    del summary["signals_rms"]
+    (older / "summary.json").write_text(json.dumps(summary))
+    shutil.copy(folder / "history.npz", older / "history.npz")
+    assert point_metrics(older)["probes"] == probes
+    assert point_metrics(older)["rms_tip_displacement"] == metrics["rms_tip_displacement"]
     row = {"point": 0, "params": {}, "x": 1.0, "skipped": False, "folder": str(folder), **metrics}
     _write_csv([row], ["loads.rotation_speed"], tmp_path / "interaction.csv")
     with open(tmp_path / "interaction.csv") as fh:

@@ -24,7 +24,7 @@ def sim():
     return build(load_scene("twisted-naca", SMALL))
 
 
-def _write(sim, out, ran, csv_stride=1):
+def _write(sim, out, ran, csv_stride=1, history_npz=True):
     s = sim.scene
     return run_to_folder(
         bare_stepper(s, sim.model),
@@ -36,6 +36,7 @@ def _write(sim, out, ran, csv_stride=1):
         ran=ran,
         rotation_speed=s["loads"]["rotation_speed"],
         csv_stride=csv_stride,
+        history_npz=history_npz,
     )
 
 
@@ -323,3 +324,22 @@ def test_no_history_csv_at_stride_zero(sim, tmp_path):
     ):
         assert sorted(hb.files) == sorted(hc.files)
         np.testing.assert_array_equal(hb["impulse"], hc["impulse"])
+
+
+def test_no_history_npz_keeps_the_measures(sim, tmp_path):
+    """``outputs.history_npz = false``: no ``history.npz``, stepped or reused, and the
+    summary's largest magnitudes and root mean squares of every signal are those of the
+    ``history.npz`` the same run writes with it."""
+    a = _write(sim, tmp_path / "reused", sim.ran, history_npz=False)
+    b = _write(sim, tmp_path / "stepped", None, history_npz=False)
+    _write(sim, tmp_path / "with", None)
+    assert not (tmp_path / "reused/history.npz").exists()
+    assert not (tmp_path / "stepped/history.npz").exists()
+    assert a.status == b.status == "ok"
+    summary = json.loads((tmp_path / "stepped/summary.json").read_text())
+    assert set(summary["signals_rms"]) == set(b.signals) and b.signals
+    with np.load(tmp_path / "with/history.npz") as h:
+        for name, rms in summary["signals_rms"].items():
+            x = h[name if name.startswith("probe_") else f"signal_{name}"]
+            assert rms == np.sqrt(np.mean(x**2))
+            assert summary["signals_max_abs"][name] == np.abs(x).max()

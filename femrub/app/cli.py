@@ -147,7 +147,8 @@ def _run(args) -> int:
         cache=_cache(args, _log(args)),
         keep_build=False,
     )
-    written = ["summary.json", "history.npz"]
+    written = ["summary.json"]
+    written += ["history.npz"] if scene["outputs.history_npz"] else []
     written += ["history.csv"] if scene["outputs.csv_stride"] else []
     where = f"{out}/ ({', '.join(written)})"
     if res.status == "interrupted":

@@ -197,6 +197,7 @@ def _run_claimed(scene, out, progress, log, on_built, modes, make, keep_build=Tr
         step_error=built.report.get("time_step"),
         ran=built.ran,  # stepped by the error estimate: not twice
         csv_stride=o["csv_stride"],
+        history_npz=o["history_npz"],
     )
     if log:
         t = res.info.get("timings", {})

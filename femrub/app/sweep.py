@@ -126,7 +126,7 @@ def point_metrics(folder) -> dict:
         "status": s.get("status"),
         "message": s.get("message", ""),
         "max_tip_displacement": max(disp) if disp else None,
-        "rms_tip_displacement": _rms(folder / "history.npz", "signal_tip_displacement"),
+        "rms_tip_displacement": _rms(s, folder / "history.npz", "tip_displacement"),
         "max_wear_depth": s.get("max_wear_depth", 0.0),
         "max_contact_force": s.get("max_contact_force"),
         "max_temperature": max(temps) if temps else 0.0,
@@ -134,36 +134,52 @@ def point_metrics(folder) -> dict:
         "t_reached": s.get("t_reached"),
         "wall_seconds": s.get("wall_seconds"),
         "natural_frequencies_hz": build.get("natural_frequencies_hz", []),
-        "probes": _probe_metrics(folder / "history.npz", s.get("units", {})),
+        "probes": _probe_metrics(s, folder / "history.npz"),
     }
 
 
-def _probe_metrics(path, units: dict) -> dict:
+def _probe_metrics(summary: dict, path) -> dict:
     """``rms_probe_<name>_<unit>`` and ``max_probe_<name>_<unit>`` (largest magnitude) of
-    each probe in a ``history.npz`` (``outputs.probes``; SI units, ``m_s`` for m/s)."""
+    each probe (``outputs.probes``; SI units, ``m_s`` for m/s): from the summary's
+    ``signals_rms`` and ``signals_max_abs``, or from ``history.npz`` for a folder written
+    before the summary held them."""
+    units, rms = summary.get("units", {}), summary.get("signals_rms")
+    if rms is not None:
+        peak = summary.get("signals_max_abs", {})
+        measures = {k: (v, peak.get(k)) for k, v in rms.items() if k.startswith(PROBE_PREFIX)}
+    else:
+        try:
+            with np.load(path) as h:
+                keys = [k for k in h.files if k.startswith(PROBE_PREFIX)]
+                measures = {k: _measures(np.asarray(h[k], dtype=float)) for k in keys}
+        except (OSError, ValueError):
+            return {}
     out = {}
-    try:
-        with np.load(path) as h:
-            probes = {
-                k: np.asarray(h[k], dtype=float) for k in h.files if k.startswith(PROBE_PREFIX)
-            }
-    except (OSError, ValueError):
-        return out
-    for key, x in probes.items():
+    for key, (r, peak) in measures.items():
         unit = units.get(key, "-").replace("/", "_")
-        out[f"rms_{key}_{unit}"] = float(np.sqrt(np.mean(x**2))) if x.size else None
-        out[f"max_{key}_{unit}"] = float(np.abs(x).max()) if x.size else None
+        out[f"rms_{key}_{unit}"], out[f"max_{key}_{unit}"] = r, peak
     return out
 
 
-def _rms(path, key):
-    """Root mean square of ``key`` in a ``history.npz`` (``None`` when absent)."""
+def _measures(x: np.ndarray) -> tuple:
+    """Root mean square and largest magnitude of ``x`` (``None`` when empty)."""
+    if not x.size:
+        return None, None
+    return float(np.sqrt(np.mean(x**2))), float(np.abs(x).max())
+
+
+def _rms(summary: dict, path, name: str):
+    """Root mean square of the signal ``name``: the summary's ``signals_rms``, or from
+    ``history.npz`` (``signal_<name>``) for a folder written before the summary held it
+    (``None`` when absent)."""
+    if "signals_rms" in summary:
+        return summary["signals_rms"].get(name)
     try:
         with np.load(path) as h:
-            x = np.asarray(h[key], dtype=float)
+            x = np.asarray(h[f"signal_{name}"], dtype=float)
     except (OSError, KeyError, ValueError):
         return None
-    return float(np.sqrt(np.mean(x**2))) if x.size else None
+    return _measures(x)[0]
 
 
 def run_points(

@@ -37,6 +37,7 @@ def load_results(path) -> Results:
     if not file.is_file():
         where = f"folder {path} has no {HISTORY}" if path.is_dir() else f"{path} does not exist"
         raise FileNotFoundError(
-            f"load_results: {where}; give a results folder of `femrub run` or a saved .npz file"
+            f"load_results: {where}; give a results folder of `femrub run` or a saved .npz "
+            "file (a run with outputs.history_npz = false writes none: run it again with it)"
         )
     return Results.load_npz(file)

@@ -81,6 +81,19 @@ def _friction_summary(res) -> dict:
     return out
 
 
+def signal_measures(signals: dict) -> dict:
+    """``{"signals_max_abs": ..., "signals_rms": ...}``: the largest magnitude and the root
+    mean square of each recorded signal and probe over the run's rows (in its unit,
+    ``summary.json["units"]``; ``None`` for an empty one): what a map reads of a run, with or
+    without its ``history.npz``."""
+    peak, rms = {}, {}
+    for name, arr in signals.items():
+        a = np.asarray(arr, dtype=float)
+        peak[name] = float(np.abs(a).max()) if a.size else 0.0
+        rms[name] = float(np.sqrt(np.mean(a**2))) if a.size else None
+    return {"signals_max_abs": peak, "signals_rms": rms}
+
+
 def run_to_folder(  # noqa: PLR0913 (keyword-only output options)
     stepper,
     t_end: float,
@@ -103,6 +116,7 @@ def run_to_folder(  # noqa: PLR0913 (keyword-only output options)
     ran=None,
     step_error: dict | None = None,
     csv_stride: int = 1,
+    history_npz: bool = True,
 ):
     """Run ``stepper`` to ``t_end`` and write the results folder ``out`` (module docstring).
 
@@ -124,7 +138,9 @@ def run_to_folder(  # noqa: PLR0913 (keyword-only output options)
     ``vtk_stride`` steps). ``csv_stride``:
     ``history.csv`` at one row every that many steps
     (:meth:`~femrub.output.results.Results.save_csv`'s ``every``; ``history.npz`` keeps every
-    step), 0: no ``history.csv``. Returns the :class:`~femrub.output.results.Results`.
+    step), 0: no ``history.csv``; ``history_npz``: False writes no ``history.npz`` (the
+    summary's ``signals_max_abs`` and ``signals_rms`` keep each signal's measures). Returns
+    the :class:`~femrub.output.results.Results`.
     """
     out = Path(out)
     with nullcontext() if claimed else claim(out, "run", overwrite=overwrite):
@@ -146,7 +162,7 @@ def run_to_folder(  # noqa: PLR0913 (keyword-only output options)
             reduction_error,
             ran,
             step_error,
-            csv_stride,
+            (csv_stride, history_npz),
         )
 
 
@@ -199,8 +215,9 @@ def _run(  # noqa: PLR0913 (run_to_folder's options passed on)
     reduction_error,
     ran,
     step_error=None,
-    csv_stride=1,
+    histories=(1, True),
 ):
+    csv_stride = histories[0]
     summary_path = out / "summary.json"
     model = stepper.model
     doc = {
@@ -277,7 +294,7 @@ def _run(  # noqa: PLR0913 (run_to_folder's options passed on)
         timings,
         rotation_speed,
         summary_path,
-        csv_stride,
+        histories,
     )
     return _close(finish, res, out, doc, history, summary_path)
 
@@ -338,15 +355,17 @@ def _finish(  # noqa: PLR0913 (run_to_folder's options passed on)
     timings,
     rotation_speed,
     summary_path,
-    csv_stride=1,
+    histories=(1, True),
 ):
+    csv_stride, history_npz = histories
     vtk_wall, vtk_cpu = (series.seconds, series.cpu_seconds) if series is not None else (0.0, 0.0)
     t_out = time.perf_counter()
     if csv_stride and history.received != len(res.t) and history.error is None:  # not streamed
         with naming(out / "history.csv"):
             res.save_csv(out / "history.csv", every=csv_stride)
-    with naming(out / "history.npz"):
-        res.save_npz(out / "history.npz")
+    if history_npz:
+        with naming(out / "history.npz"):
+            res.save_npz(out / "history.npz")
     panels = [k for k in ("tip_displacement", "tip_temperature") if k in res.signals]
     panels += [k for k in res.signals if k.startswith(PROBE_PREFIX)][:MAX_PROBE_PANELS]
     if plots:
@@ -411,8 +430,7 @@ def _finish(  # noqa: PLR0913 (run_to_folder's options passed on)
         vtk_frames=len(series.frames) if series is not None else 0,
     )
     doc.update(_friction_summary(res))
-    for name, arr in res.signals.items():
-        doc.setdefault("signals_max_abs", {})[name] = float(np.abs(arr).max()) if arr.size else 0.0
+    doc.update(signal_measures(res.signals))
     with naming(summary_path):
         _write_json(summary_path, doc)
     return res

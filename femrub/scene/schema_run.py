@@ -200,6 +200,13 @@ OUTPUTS = {
         "averaged over the steps between rows; 0: no history.csv, as for the points of a "
         "map); history.npz keeps every step",
     ),
+    "history_npz": Spec(
+        B,
+        True,
+        doc="history.npz: every step's signals, gaps, contact forces, energies (false: none, "
+        "as for the points of a map; summary.json keeps each signal's and probe's largest "
+        "magnitude and root mean square)",
+    ),
     "plots": Spec(
         B,
         True,
