@@ -36,6 +36,7 @@ def site(tmp_path_factory):
         **os.environ,
         "FEMRUB_DOCS_QUICK": "1",
         "MPLBACKEND": "Agg",
+        "TMPDIR": str(tmp),  # the examples' working folders, removed with the test's own
         "PYTHONPATH": os.pathsep.join([str(ROOT), os.environ.get("PYTHONPATH", "")]),
     }
     out = tmp / "html"
