@@ -343,7 +343,7 @@ def alart_curnier(W, q, mu, U, warm, use_warm, tol, max_iter):
     at_P = _residual(P, W, q, mu, rho, U)
     if use_warm:  # a cold start when the warm one is worse
         at_warm = _residual(warm, W, q, mu, rho, U)
-        if np.sum(at_warm[0] ** 2) <= np.sum(at_P[0] ** 2):
+        if _half_square(at_warm[0]) <= _half_square(at_P[0]):
             P, at_P = warm.copy(), at_warm
     P, F, u, it = _newton(P, W, rW, q, mu, rho, U, tol * scale, max_iter, at_P)
     if _max_abs(F) > tol * scale:  # Newton stalled: Gauss-Seidel sweeps, then Newton
