@@ -12,6 +12,7 @@ import glob
 import importlib.util
 import os
 import sys
+import threading
 import time
 
 import numpy as np
@@ -110,7 +111,9 @@ class _Pardiso:
     triangle) and, when a pivot is not positive, as symmetric indefinite (``L D Lᵀ`` with
     Bunch-Kaufman pivoting); other matrices by LU with pivot perturbation and iterative
     refinement. Solves call Pardiso's solve phase directly: the ``pypardiso.solve`` entry
-    point hashes the whole matrix on every call to check it is the factorised one.
+    point hashes the whole matrix on every call to check it is the factorised one. Threads
+    may share a factorisation: its solves take turns (Pardiso's solve phase writes in the
+    factorisation's memory).
     """
 
     def __init__(self, M, symmetric: bool, definite: bool = True):
@@ -118,6 +121,7 @@ class _Pardiso:
 
         self.symmetric = symmetric
         self._AT = None
+        self._solving = threading.Lock()
         A = sp.csr_matrix(M, dtype=float)
         if not symmetric:
             self._factor(pypardiso, A, _GENERAL)
@@ -183,11 +187,12 @@ class _Pardiso:
         s = self._s
         many = b.ndim == 2 and b.shape[1] > 1
         t0 = time.perf_counter() if many else 0.0
-        if hasattr(s, "_call_pardiso"):  # solve phase only (pypardiso 0.4)
-            s.set_phase(33)
-            out = s._call_pardiso(self.A, b)
-        else:  # pragma: no cover - other pypardiso versions
-            out = s.solve(self.A, b)
+        with self._solving:  # one solve at a time in a factorisation's memory
+            if hasattr(s, "_call_pardiso"):  # solve phase only (pypardiso 0.4)
+                s.set_phase(33)
+                out = s._call_pardiso(self.A, b)
+            else:  # pragma: no cover - other pypardiso versions
+                out = s.solve(self.A, b)
         if many:
             progress.note(
                 f"solved {b.shape[1]} right-hand sides of {b.shape[0]} unknowns in "

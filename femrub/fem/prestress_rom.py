@@ -206,13 +206,14 @@ def energy_polynomial(op, BV: np.ndarray, previous: EnergyPolynomial | None = No
 class PrestressProblem:
     """The full problem's pieces: ``B`` (:mod:`femrub.fem.quadrature`), ``f_0``, ``M_P``
     and the stiffness at rest ``K0`` on the free dofs ``free``, with the factorisations
-    that precondition the corrections: ``(s, solve)`` pairs, the first at rest."""
+    that precondition the corrections: ``(s, solve)`` pairs, the first at rest (``solve``;
+    ``None``: added later with :meth:`add_factor`, before any correction)."""
 
     def __init__(self, op, f0, MP, free, K0, solve):
         self.op, self.f0, self.MP, self.free = op, f0, MP, free
         self.MP_free = MP[free][:, free].tocsr()
         self.K0 = K0
-        self.factors = [(0.0, solve)]
+        self.factors = [] if solve is None else [(0.0, solve)]
 
     def add_factor(self, s: float, solve) -> None:
         """A factorisation of the tangent at ``s = Ω²`` (preconditions nearby speeds)."""
@@ -324,7 +325,7 @@ def _pcg(applies, b, precondition, rtol: float = 1e-2, max_iter: int = 15) -> np
 def prestress_problem(disc, material, method: str, K0, solve) -> PrestressProblem:
     """The :class:`PrestressProblem` of ``disc`` (3D, clamped) for ``method`` = ``"linear"``
     or ``"nonlinear"``; ``K0`` the stiffness at rest on its free dofs, ``solve`` its
-    factorisation's solve."""
+    factorisation's solve (``None``: :class:`PrestressProblem`)."""
     basis = disc.basis_u
     lam, mu = lame_parameters(material.young, material.poisson, 3)
     op = gradient_operator(basis, lam, mu, linear=method == "linear")

@@ -34,8 +34,9 @@ except ImportError:  # pragma: no cover
 
 __all__ = ["GradientOperator", "gradient_operator"]
 
-#: quadrature points per chunk of the products with many vectors
-CHUNK = 16384
+#: quadrature points per chunk of the products with many vectors (a chunk's ``9 × m``
+#: gradients of 30 vectors take 8.4 MiB)
+CHUNK = 4096
 #: threads sharing the quadrature points or the speeds (the cores this process may use,
 #: at most 4)
 THREADS = max(1, min(4, len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else 1))
@@ -70,11 +71,12 @@ class GradientOperator:
         _stress_kernel(g, self.w, self.lam, self.mu, self.linear, P)
         return self.B.T @ P.reshape(-1)
 
-    def moduli(self, g: np.ndarray, w=None) -> np.ndarray:
+    def moduli(self, g: np.ndarray, w=None, out=None) -> np.ndarray:
         """``w D`` (``n_q × 9 × 9``): the tangent's integrand ``g_xᵀ D g_y`` at the state of
-        the gradients ``g`` (module docstring; ``w``: the weights of those points)."""
+        the gradients ``g`` (module docstring; ``w``: the weights of those points; ``out``:
+        an array to write ``D`` into)."""
         g = np.ascontiguousarray(g)
-        D = np.empty((g.shape[0], 9, 9))
+        D = np.empty((g.shape[0], 9, 9)) if out is None else out
         _moduli_kernel(g, self.w if w is None else w, self.lam, self.mu, self.linear, D)
         return D
 
@@ -92,18 +94,33 @@ class GradientOperator:
 
     def projected_tangent(self, u: np.ndarray, BW: np.ndarray) -> np.ndarray:
         """``Wᵀ K_T(u) W`` (no spin softening) from ``BW = B @ W`` (``9 n_q × m``)."""
-        return self.project(self.moduli(self.gradients(u)), BW)
+        return self.project(self.gradients(u), BW)
 
-    def project(self, D: np.ndarray, BW: np.ndarray) -> np.ndarray:
-        """``Wᵀ K W = Σ_q (B W)_qᵀ D_q (B W)_q`` for the moduli ``D`` (:meth:`moduli`),
-        summed by chunks of :data:`CHUNK` points (no ``9 n_q × m`` temporary)."""
+    def chunks(self) -> list[tuple[int, int]]:
+        """Bounds ``(lo, hi)`` of the quadrature points taken :data:`CHUNK` at a time."""
+        return [(lo, min(lo + CHUNK, self.n_points)) for lo in range(0, self.n_points, CHUNK)]
+
+    def project(self, g: np.ndarray, BW: np.ndarray) -> np.ndarray:
+        """``Wᵀ K W = Σ_q (B W)_qᵀ D_q (B W)_q`` at the state of the gradients ``g``
+        (``n_q × 3 × 3``), summed by chunks of :data:`CHUNK` points: each chunk's moduli
+        ``D`` (:meth:`moduli`) and ``D (B W)`` in two buffers written again by every chunk,
+        so that no ``n_q``-long temporary is made and the chunk stays in cache."""
         m = BW.shape[1]
         out = np.zeros((m, m))
-        for lo in range(0, self.n_points, CHUNK):
-            hi = min(lo + CHUNK, self.n_points)
+        D = np.empty((min(CHUNK, self.n_points), 9, 9))
+        DG = np.empty((D.shape[0], 9, m))
+        for lo, hi in self.chunks():
             gx = BW[9 * lo : 9 * hi]
-            out += gx.T @ np.matmul(D[lo:hi], gx.reshape(-1, 9, m)).reshape(-1, m)
+            Dc = self.moduli(g[lo:hi], self.w[lo:hi], out=D[: hi - lo])
+            np.matmul(Dc, gx.reshape(-1, 9, m), out=DG[: hi - lo])
+            out += gx.T @ DG[: hi - lo].reshape(-1, m)
         return 0.5 * (out + out.T)
+
+    def add_transposed(self, lo: int, V: np.ndarray, out: np.ndarray) -> None:
+        """``out += B_cᵀ V`` for the rows ``B_c`` of the points from ``lo`` (``V``: ``(9 c,
+        m)``, ``out``: ``(N, m)``), compiled on ``B``'s own arrays (no slice of it made)."""
+        B = self.B
+        _transposed_kernel(B.indptr, B.indices, B.data, 9 * lo, V, out)
 
     def assemble(self, D: np.ndarray) -> sp.csr_matrix:
         """The sparse matrix ``Bᵀ D B`` (``N × N``) for the moduli ``D`` (:meth:`moduli`):
@@ -118,15 +135,15 @@ class GradientOperator:
         N = self.B.shape[1]
         return sp.csr_matrix((Ke.ravel(), (rows, cols)), shape=(N, N))
 
-    def quadratic_forms(self, g: np.ndarray, GX: np.ndarray) -> np.ndarray:
+    def quadratic_forms(self, g: np.ndarray, GX: np.ndarray, w=None) -> np.ndarray:
         """``xᵀ K_T x`` (no spin softening) for each column ``x`` whose gradients are
         ``GX`` (``n_q × 9 × m``), at the state of the gradients ``g``: the integrand of
         :meth:`moduli` evaluated on the columns without forming ``D`` (J per unit
-        amplitude²)."""
+        amplitude²; ``w``: the weights of those points, when not all of them)."""
         out = np.zeros(GX.shape[2])
         _form_kernel(
             np.ascontiguousarray(g),
-            self.w,
+            self.w if w is None else w,
             self.lam,
             self.mu,
             self.linear,
@@ -216,6 +233,16 @@ def _form_kernel(g, w, lam, mu, linear, GX, out):  # pragma: no cover (compiled)
             out[c] += w[q] * (lam * trace * trace + 2.0 * mu * sym2 + geometric)
 
 
+def _transposed_kernel(indptr, indices, data, row0, V, out):  # pragma: no cover (compiled)
+    """``out += B_cᵀ V`` for the rows ``row0 … row0 + len(V)`` of the CSR matrix
+    ``(indptr, indices, data)``."""
+    for r in range(V.shape[0]):
+        for p in range(indptr[row0 + r], indptr[row0 + r + 1]):
+            c, b = indices[p], data[p]
+            for j in range(V.shape[1]):
+                out[c, j] += b * V[r, j]
+
+
 def _assembly_kernel(dphi, D, Ke):  # pragma: no cover (compiled)
     """Element matrices ``Ke`` (``n_el × 3 n_loc × 3 n_loc``, rows ``(i, a)``) from the
     shape-function gradients ``dphi`` (``n_el × n_qp × 3 × n_loc``) and the moduli ``D``
@@ -253,6 +280,7 @@ if numba is not None:
     _stress_kernel = numba.njit(cache=True, nogil=True)(_stress_kernel)
     _moduli_kernel = numba.njit(cache=True, nogil=True)(_moduli_kernel)
     _form_kernel = numba.njit(cache=True, nogil=True)(_form_kernel)
+    _transposed_kernel = numba.njit(cache=True, nogil=True)(_transposed_kernel)
 
 
 def gradient_operator(basis, lam: float, mu: float, *, linear: bool = False) -> GradientOperator:

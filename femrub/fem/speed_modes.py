@@ -30,6 +30,7 @@ Coriolis terms are left out, as in the rest of femrub (docs/theory.md).
 
 from __future__ import annotations
 
+import contextvars
 import math
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
@@ -41,7 +42,7 @@ from ..blas import one_blas_thread
 from .eigen import lowest_modes
 from .linalg import sparse_lu
 from .prestress_rom import enrich, initial_reduced, prestress_problem
-from .quadrature import THREADS
+from .quadrature import CHUNK, THREADS
 from .speed_family import sample_speeds
 
 __all__ = ["SpeedModes", "frequency_bounds", "speed_modes"]
@@ -136,9 +137,13 @@ class _Setting:
             method,
             log,
         )
-        lu0 = sparse_lu(mats.K, symmetric=True, what="stiffness")
-        self.solve0 = lu0.solve
-        self.problem = prestress_problem(disc, material, method, mats.K, lu0.solve)
+        with ThreadPoolExecutor(1) as beside:  # the stiffness factorised beside the forms
+            lu0 = beside.submit(
+                contextvars.copy_context().run, sparse_lu, mats.K, symmetric=True, what="stiffness"
+            )
+            self.problem = prestress_problem(disc, material, method, mats.K, None)
+            self.solve0 = lu0.result().solve
+        self.problem.add_factor(0.0, self.solve0)
         self.free = self.problem.free
         self.MPf = self.problem.MP_free
 
@@ -174,10 +179,18 @@ class _Setting:
         lu = sparse_lu(K, symmetric=True, what="tangent", definite=False)
         self.problem.add_factor(top[0], lu.solve)
         reduced = enrich(reduced, s_train, static_tol, log=self.log)[0]
+        self.problem.drop_factor(top[0])  # the coarse state's, released before the samples
+        states = [reduced.displacement(x) for x in reduced.path(s_samples)]
+        # the samples side by side, each its tangent's assembly, factorisation and
+        # eigen-solve (their messages in this thread's log)
+        with ThreadPoolExecutor(min(THREADS, len(states))) as pool:
+            taken = [
+                pool.submit(contextvars.copy_context().run, self.sample, u, s, self.k)
+                for u, s in zip(states, s_samples, strict=True)
+            ]
+            taken = [job.result() for job in taken]
         samples = []
-        for s, x in zip(s_samples, reduced.path(s_samples), strict=True):
-            self.problem.drop_factor(s)  # the coarse state's, released before the new one
-            shapes, solve = self.sample(reduced.displacement(x), s, self.k)
+        for s, (shapes, solve) in zip(s_samples, taken, strict=True):
             self.problem.add_factor(s, solve)
             samples.append((float(np.sqrt(s)), shapes))
         # every listed speed, with the final factorisations: measured, and enriched only
@@ -218,17 +231,23 @@ def speed_modes(
     moving = np.unique(speeds[speeds > 0])
     u_all, eta_all = np.zeros((speeds.size, disc.basis_u.N)), np.zeros(speeds.size)
     d_all = np.zeros_like(u_all)
-    lam0, shapes0 = lowest_modes(mats.K, mats.M, setting.k, setting.solve0, tol=SAMPLE_TOLERANCE)
-    first = [(0.0, shapes0)]
-    static_basis = 0
-    if moving.size:
-        u_m, eta_m, d_m, static_basis, taken = setting.prestress(moving, sampled, static_tol)
-        where = np.searchsorted(moving, speeds)
-        moving_mask = speeds > 0
-        u_all[moving_mask] = u_m[where[moving_mask]]
-        eta_all[moving_mask] = eta_m[where[moving_mask]]
-        d_all[moving_mask] = d_m[where[moving_mask]]
-        first += taken
+    static_basis, taken = 0, []
+    with ThreadPoolExecutor(1) as beside:  # the modes at rest, beside the prestress
+        at_rest = beside.submit(
+            contextvars.copy_context().run,
+            lowest_modes,
+            *(mats.K, mats.M, setting.k, setting.solve0),
+            tol=SAMPLE_TOLERANCE,
+        )
+        if moving.size:
+            u_m, eta_m, d_m, static_basis, taken = setting.prestress(moving, sampled, static_tol)
+            where = np.searchsorted(moving, speeds)
+            moving_mask = speeds > 0
+            u_all[moving_mask] = u_m[where[moving_mask]]
+            eta_all[moving_mask] = eta_m[where[moving_mask]]
+            d_all[moving_mask] = d_m[where[moving_mask]]
+        lam0, shapes0 = at_rest.result()
+    first = [(0.0, shapes0), *taken]
     ritz = _Ritz(setting, first)
     while True:
         lam, Y, bounds = ritz.evaluate(speeds, u_all, d_all, modes, check)
@@ -283,26 +302,32 @@ class _Ritz:
         The speeds are taken by groups that share their nearest factorisation, at most
         :data:`SPEEDS_PER_SOLVE` at a time (fewer when their residuals would take more
         than :data:`SOLVE_BYTES`): their Ritz pairs and residuals on
-        :data:`~femrub.fem.quadrature.THREADS` threads (one BLAS thread each), then the
-        residuals' back-substitution as one solve with all their columns."""
+        :data:`~femrub.fem.quadrature.THREADS` threads (one BLAS thread each), and the
+        residuals' back-substitution as one solve with all their columns, in this thread
+        while the others go on with the next group."""
         n = len(speeds)
         lam, Y, bounds = [None] * n, [None] * n, np.full((n, modes), np.nan)
         problem = self.setting.problem
         column = 8 * problem.free.size * min(modes + 1, self.W.shape[1])
         per_solve = max(1, min(SPEEDS_PER_SOLVE, SOLVE_BYTES // column))
+        groups = [
+            (solve, group[i : i + per_solve])
+            for solve, group in problem.by_factor(np.asarray(speeds, dtype=float) ** 2)
+            for i in range(0, group.size, per_solve)
+        ]
 
         def one(k):
-            return self._at(float(speeds[k]) ** 2, u_all[k], d_all[k], modes, check)
+            with one_blas_thread:
+                return self._at(float(speeds[k]) ** 2, u_all[k], d_all[k], modes, check)
 
         with ThreadPoolExecutor(THREADS) as pool:
-            for solve, group in problem.by_factor(np.asarray(speeds, dtype=float) ** 2):
-                for idx in (group[i : i + per_solve] for i in range(0, group.size, per_solve)):
-                    with one_blas_thread:
-                        out = list(pool.map(one, idx))
-                    for k, (lam_k, Y_k, _, _) in zip(idx, out, strict=True):
-                        lam[k], Y[k] = lam_k, Y_k
-                    if check:
-                        bounds[idx] = self._bounds(out, solve, modes)
+            jobs = {k: pool.submit(one, k) for _, idx in groups for k in idx}
+            for solve, idx in groups:
+                out = [jobs.pop(k).result() for k in idx]
+                for k, (lam_k, Y_k, _, _) in zip(idx, out, strict=True):
+                    lam[k], Y[k] = lam_k, Y_k
+                if check:
+                    bounds[idx] = self._bounds(out, solve, modes)
         return np.array(lam), Y, bounds
 
     def _at(self, s, u, d, modes, check):
@@ -311,21 +336,40 @@ class _Ritz:
         bounds (:meth:`_static`; 0 without a correction ``d``)."""
         op, setting = self.setting.problem.op, self.setting
         g = op.gradients(u)
-        D = op.moduli(g)
-        Kr = op.project(D, self.BW)
+        Kr = op.project(g, self.BW)
         lam, Y = sla.eigh(Kr - s * self.MPr)
         if not check:
             return lam, Y, None, 0.0
         n_res = min(modes + 1, self.W.shape[1])
-        GX = (self.BW @ Y[:, :n_res]).reshape(-1, 9, n_res)
-        KX = (op.B.T @ np.matmul(D, GX).reshape(-1, n_res))[setting.free]
+        corrected = op.gradients(u + d) if np.any(d) else None
+        KX, at_corrected = self._tangent_applied(g, Y[:, :n_res], corrected, modes)
         X = self.Wf @ Y[:, :n_res]
-        R = KX - s * (setting.MPf @ X) - (setting.mats.M @ X) * lam[:n_res]
-        if not np.any(d):
+        R = KX[setting.free] - s * (setting.MPf @ X) - (setting.mats.M @ X) * lam[:n_res]
+        if corrected is None:
             return lam, Y, R, 0.0
         y = Y[:, :modes]
         at_u = np.einsum("im,ij,jm->m", y, Kr, y)  # xᵀ K_T(u) x
-        return lam, Y, R, self._static(at_u, u + d, GX[..., :modes], lam[:modes])
+        return lam, Y, R, self._static(at_u, at_corrected, lam[:modes])
+
+    def _tangent_applied(self, g, Y, corrected, modes):
+        """``K_T(u) W Y`` on all dofs at the state of the gradients ``g`` and, when the
+        gradients ``corrected`` of ``u + d`` are given, ``xᵀ K_T(u + d) x`` for the first
+        ``modes`` columns ``x`` of ``W Y``: chunk by chunk of quadrature points (the chunk's
+        ``B W Y``, moduli and their product in buffers written again by every chunk)."""
+        op = self.setting.problem.op
+        m = Y.shape[1]
+        KX = np.zeros((op.B.shape[1], m))
+        forms = np.zeros(modes)
+        size = min(CHUNK, op.n_points)
+        D, DG = np.empty((size, 9, 9)), np.empty((size, 9, m))
+        for lo, hi in op.chunks():
+            GX = (self.BW[9 * lo : 9 * hi] @ Y).reshape(-1, 9, m)
+            Dc = op.moduli(g[lo:hi], op.w[lo:hi], out=D[: hi - lo])
+            np.matmul(Dc, GX, out=DG[: hi - lo])
+            op.add_transposed(lo, DG[: hi - lo].reshape(-1, m), KX)
+            if corrected is not None:
+                forms += op.quadratic_forms(corrected[lo:hi], GX[..., :modes], w=op.w[lo:hi])
+        return KX, forms
 
     @staticmethod
     def _bounds(out, solve, modes):
@@ -341,10 +385,9 @@ class _Ritz:
             col += n_res
         return np.array(bounds)
 
-    def _static(self, at_u, corrected, GX, lam):
+    @staticmethod
+    def _static(at_u, at_corrected, lam):
         """Relative frequency shift of the prestress correction ``d``, to first order:
-        ``|xᵀ (K_T(u + d) − K_T(u)) x| / 2λ`` per Ritz vector ``x`` (``GX``: its gradients,
-        ``at_u``: ``xᵀ K_T(u) x``, ``corrected = u + d``), times :data:`STATIC_MARGIN`."""
-        op = self.setting.problem.op
-        shift = op.quadratic_forms(op.gradients(corrected), GX) - at_u
-        return STATIC_MARGIN * np.abs(shift) / (2.0 * lam)
+        ``|xᵀ (K_T(u + d) − K_T(u)) x| / 2λ`` per Ritz vector ``x`` (``at_u``: ``xᵀ K_T(u)
+        x``, ``at_corrected``: ``xᵀ K_T(u + d) x``), times :data:`STATIC_MARGIN`."""
+        return STATIC_MARGIN * np.abs(at_corrected - at_u) / (2.0 * lam)
