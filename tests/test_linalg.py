@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from concurrent.futures import ThreadPoolExecutor
+
 import numpy as np
 import pytest
 import scipy.sparse as sp
@@ -169,3 +171,18 @@ def test_the_mkl_runtime_is_found_without_searching_the_environment():
     ).stdout.split()
     assert out[:2] == ["True", "False"]
     assert os.path.dirname(out[2]) == os.path.join(sys.prefix, "lib")
+
+
+def test_threads_may_share_a_factorisation(pardiso):
+    """Solves of one factorisation from several threads at once give the serial solves
+    (Pardiso's solve phase writes in the factorisation's memory: they take turns)."""
+    side = 120  # a 2D Laplacian: its factor fills in, so that the solves overlap
+    one = _laplacian(side)
+    A = sp.kron(one, sp.identity(side)) + sp.kron(sp.identity(side), one)
+    lu = linalg.sparse_lu(A.tocsr(), symmetric=True)
+    B = np.random.default_rng(3).standard_normal((side**2, 32))
+    serial = np.column_stack([lu.solve(B[:, j]) for j in range(B.shape[1])])
+    with ThreadPoolExecutor(4) as pool:
+        for _ in range(6):  # a race shows in one round of two or so
+            shared = pool.map(lambda j: lu.solve(B[:, j]), range(B.shape[1]))
+            np.testing.assert_array_equal(np.column_stack(list(shared)), serial)

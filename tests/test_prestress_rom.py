@@ -1,5 +1,7 @@
 """The quadrature-point forms and the reduced prestress against the assembled ones."""
 
+from types import SimpleNamespace
+
 import numpy as np
 import pytest
 from test_campbell import BOX
@@ -7,13 +9,14 @@ from test_campbell import BOX
 from femrub.app import translate as tr
 from femrub.app.blade import load_blade
 from femrub.fem import centrifugal as cf
+from femrub.fem import quadrature
 from femrub.fem.discretisation import assemble, discretise
 from femrub.fem.forms import lame_parameters
 from femrub.fem.linalg import sparse_lu
 from femrub.fem.prestress import centrifugal_prestress
 from femrub.fem.prestress_rom import enrich, initial_reduced, prestress_problem
 from femrub.fem.quadrature import gradient_operator
-from femrub.fem.speed_modes import frequency_bounds
+from femrub.fem.speed_modes import _Ritz, frequency_bounds
 from femrub.scene import load_scene
 
 
@@ -48,6 +51,35 @@ def test_quadrature_forms_equal_the_assembled_ones(box, linear):
     np.testing.assert_allclose(assembled.toarray(), K.toarray(), atol=1e-12 * abs(K).max())
     forms = op.quadratic_forms(op.gradients(u), (op.B @ W).reshape(-1, 9, 4))
     np.testing.assert_allclose(forms, np.diag(W.T @ (K @ W)), rtol=1e-10)
+
+
+def test_chunked_forms_equal_the_whole_products(box, monkeypatch):
+    """By chunks of quadrature points (7 here, the last one shorter): ``Wᵀ K_T W``, the
+    sum of the chunks' ``B_cᵀ V`` and the Ritz residuals' ``K_T W Y`` with their quadratic
+    forms at another state equal the products over all points at once."""
+    disc, material, _ = box
+    lam, mu = lame_parameters(material.young, material.poisson, 3)
+    op = gradient_operator(disc.basis_u, lam, mu)
+    monkeypatch.setattr(quadrature, "CHUNK", 7)
+    assert op.n_points % 7 and len(op.chunks()) > 2
+    rng = np.random.default_rng(2)
+    u, other = 1e-3 * rng.standard_normal((2, disc.basis_u.N))
+    W = rng.standard_normal((disc.basis_u.N, 5))
+    BW = op.B @ W
+    K = cf.tangent_stiffness(disc.basis_u, u, lam, mu, False)
+    np.testing.assert_allclose(op.project(op.gradients(u), BW), W.T @ (K @ W), rtol=1e-10)
+    V = rng.standard_normal((op.B.shape[0], 3))
+    summed = np.zeros((op.B.shape[1], 3))
+    for lo, hi in op.chunks():
+        op.add_transposed(lo, V[9 * lo : 9 * hi], summed)
+    np.testing.assert_allclose(summed, op.B.T @ V, atol=1e-12 * np.abs(op.B.T @ V).max())
+    ritz = SimpleNamespace(setting=SimpleNamespace(problem=SimpleNamespace(op=op)), BW=BW)
+    Y = rng.standard_normal((5, 3))
+    KX, forms = _Ritz._tangent_applied(ritz, op.gradients(u), Y, op.gradients(other), 2)
+    np.testing.assert_allclose(KX, K @ (W @ Y), atol=1e-12 * np.abs(K @ (W @ Y)).max())
+    K_other = cf.tangent_stiffness(disc.basis_u, other, lam, mu, False)
+    X = W @ Y[:, :2]
+    np.testing.assert_allclose(forms, np.einsum("ij,ij->j", X, K_other @ X), rtol=1e-10)
 
 
 def test_energy_polynomial_is_the_projected_energy(box):

@@ -107,9 +107,10 @@ class GradientOperator:
         so that no ``n_q``-long temporary is made and the chunk stays in cache."""
         m = BW.shape[1]
         out = np.zeros((m, m))
-        D = np.empty((min(CHUNK, self.n_points), 9, 9))
+        chunks = self.chunks()
+        D = np.empty((max(hi - lo for lo, hi in chunks), 9, 9))
         DG = np.empty((D.shape[0], 9, m))
-        for lo, hi in self.chunks():
+        for lo, hi in chunks:
             gx = BW[9 * lo : 9 * hi]
             Dc = self.moduli(g[lo:hi], self.w[lo:hi], out=D[: hi - lo])
             np.matmul(Dc, gx.reshape(-1, 9, m), out=DG[: hi - lo])

@@ -42,7 +42,7 @@ from ..blas import one_blas_thread
 from .eigen import lowest_modes
 from .linalg import sparse_lu
 from .prestress_rom import enrich, initial_reduced, prestress_problem
-from .quadrature import CHUNK, THREADS
+from .quadrature import THREADS
 from .speed_family import sample_speeds
 
 __all__ = ["SpeedModes", "frequency_bounds", "speed_modes"]
@@ -360,9 +360,10 @@ class _Ritz:
         m = Y.shape[1]
         KX = np.zeros((op.B.shape[1], m))
         forms = np.zeros(modes)
-        size = min(CHUNK, op.n_points)
+        chunks = op.chunks()
+        size = max(hi - lo for lo, hi in chunks)
         D, DG = np.empty((size, 9, 9)), np.empty((size, 9, m))
-        for lo, hi in op.chunks():
+        for lo, hi in chunks:
             GX = (self.BW[9 * lo : 9 * hi] @ Y).reshape(-1, 9, m)
             Dc = op.moduli(g[lo:hi], op.w[lo:hi], out=D[: hi - lo])
             np.matmul(Dc, GX, out=DG[: hi - lo])
