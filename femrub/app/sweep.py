@@ -38,6 +38,7 @@ from .. import heap
 from ..output.folder import FINISHED, FolderError, claim, folder_status
 from ..output.jsonfile import write_json
 from ..output.results import PROBE_PREFIX
+from ..output.run_folder import signal_measures
 from ..output.safe_write import atomic_file, write_atomic
 from ..scene import SceneError, parse_value, resolve_key
 from ..scene.run_checks import check_run
@@ -122,11 +123,12 @@ def point_metrics(folder) -> dict:
     temps = [peaks[k] for k in ("tip_temperature", "contact_temperature") if k in peaks]
     disp = [peaks[k] for k in ("tip_displacement", "contact_displacement") if k in peaks]
     build = s.get("inputs", {}).get("build", {})
+    measures = _measures(s, folder / "history.npz")
     return {
         "status": s.get("status"),
         "message": s.get("message", ""),
         "max_tip_displacement": max(disp) if disp else None,
-        "rms_tip_displacement": _rms(s, folder / "history.npz", "tip_displacement"),
+        "rms_tip_displacement": measures["signals_rms"].get("tip_displacement"),
         "max_wear_depth": s.get("max_wear_depth", 0.0),
         "max_contact_force": s.get("max_contact_force"),
         "max_temperature": max(temps) if temps else 0.0,
@@ -134,52 +136,39 @@ def point_metrics(folder) -> dict:
         "t_reached": s.get("t_reached"),
         "wall_seconds": s.get("wall_seconds"),
         "natural_frequencies_hz": build.get("natural_frequencies_hz", []),
-        "probes": _probe_metrics(s, folder / "history.npz"),
+        "probes": _probe_metrics(measures, s.get("units", {})),
     }
 
 
-def _probe_metrics(summary: dict, path) -> dict:
-    """``rms_probe_<name>_<unit>`` and ``max_probe_<name>_<unit>`` (largest magnitude) of
-    each probe (``outputs.probes``; SI units, ``m_s`` for m/s): from the summary's
-    ``signals_rms`` and ``signals_max_abs``, or from ``history.npz`` for a folder written
-    before the summary held them."""
-    units, rms = summary.get("units", {}), summary.get("signals_rms")
-    if rms is not None:
-        peak = summary.get("signals_max_abs", {})
-        measures = {k: (v, peak.get(k)) for k, v in rms.items() if k.startswith(PROBE_PREFIX)}
-    else:
-        try:
-            with np.load(path) as h:
-                keys = [k for k in h.files if k.startswith(PROBE_PREFIX)]
-                measures = {k: _measures(np.asarray(h[k], dtype=float)) for k in keys}
-        except (OSError, ValueError):
-            return {}
-    out = {}
-    for key, (r, peak) in measures.items():
-        unit = units.get(key, "-").replace("/", "_")
-        out[f"rms_{key}_{unit}"], out[f"max_{key}_{unit}"] = r, peak
-    return out
-
-
-def _measures(x: np.ndarray) -> tuple:
-    """Root mean square and largest magnitude of ``x`` (``None`` when empty)."""
-    if not x.size:
-        return None, None
-    return float(np.sqrt(np.mean(x**2))), float(np.abs(x).max())
-
-
-def _rms(summary: dict, path, name: str):
-    """Root mean square of the signal ``name``: the summary's ``signals_rms``, or from
-    ``history.npz`` (``signal_<name>``) for a folder written before the summary held it
-    (``None`` when absent)."""
+def _measures(summary: dict, path) -> dict:
+    """Each signal's and probe's ``signals_rms`` and ``signals_max_abs`` (summary names):
+    the summary's, or measured in ``history.npz`` for a folder written before the summary
+    held ``signals_rms`` (the same :func:`~femrub.output.run_folder.signal_measures`; empty
+    when neither is there)."""
     if "signals_rms" in summary:
-        return summary["signals_rms"].get(name)
+        return {k: summary.get(k, {}) for k in ("signals_rms", "signals_max_abs")}
     try:
         with np.load(path) as h:
-            x = np.asarray(h[f"signal_{name}"], dtype=float)
-    except (OSError, KeyError, ValueError):
-        return None
-    return _measures(x)[0]
+            stored = {
+                k.removeprefix("signal_"): h[k]
+                for k in h.files
+                if k.startswith(("signal_", PROBE_PREFIX))
+            }
+    except (OSError, ValueError):
+        return {"signals_rms": {}, "signals_max_abs": {}}
+    return signal_measures(stored)
+
+
+def _probe_metrics(measures: dict, units: dict) -> dict:
+    """``rms_probe_<name>_<unit>`` and ``max_probe_<name>_<unit>`` (largest magnitude) of
+    each probe (``outputs.probes``; SI units, ``m_s`` for m/s) from :func:`_measures`."""
+    out = {}
+    peak = measures["signals_max_abs"]
+    for key, rms in measures["signals_rms"].items():
+        if key.startswith(PROBE_PREFIX):
+            unit = units.get(key, "-").replace("/", "_")
+            out[f"rms_{key}_{unit}"], out[f"max_{key}_{unit}"] = rms, peak.get(key)
+    return out
 
 
 def run_points(

@@ -184,11 +184,11 @@ class _Setting:
         # the samples side by side, each its tangent's assembly, factorisation and
         # eigen-solve (their messages in this thread's log)
         with ThreadPoolExecutor(min(THREADS, len(states))) as pool:
-            taken = [
+            jobs = [
                 pool.submit(contextvars.copy_context().run, self.sample, u, s, self.k)
                 for u, s in zip(states, s_samples, strict=True)
             ]
-            taken = [job.result() for job in taken]
+            taken = [job.result() for job in jobs]
         samples = []
         for s, (shapes, solve) in zip(s_samples, taken, strict=True):
             self.problem.add_factor(s, solve)
